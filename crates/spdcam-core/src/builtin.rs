@@ -1,0 +1,188 @@
+//! The data spdcam ships inside the binary, and name resolution against a data directory.
+//!
+//! Built-in tables come from `data/` of the repository (see `data/PROVENANCE.md`); larger or
+//! licence-restricted sets are read from a data directory given by `--data-dir` or
+//! `SPDCAM_DATA`, where a name such as `canon_eos_5d_mark_ii_mod_bw486` resolves to a CSV.
+
+use crate::error::{Error, Result};
+use crate::spectral::SpectralSet;
+use std::path::{Path, PathBuf};
+
+/// Environment variable naming the data directory.
+pub const DATA_DIR_ENV: &str = "SPDCAM_DATA";
+
+/// A built-in spectral table: its name, what it is, and its CSV text.
+#[derive(Debug, Clone, Copy)]
+pub struct BuiltinTable {
+    pub name: &'static str,
+    pub description: &'static str,
+    pub csv: &'static str,
+}
+
+impl BuiltinTable {
+    /// Parses the table (the shipped files are known to be valid).
+    pub fn load(&self) -> Result<SpectralSet> {
+        SpectralSet::from_csv_str(self.csv, &format!("built-in {}", self.name))
+    }
+}
+
+/// Camera sensitivities shipped with the program.
+pub const CAMERAS: &[BuiltinTable] = &[
+    BuiltinTable {
+        name: "nikon_d5100_npl",
+        description: "Nikon D5100, NPL measurement (Darrodi et al. 2015)",
+        csv: include_str!("../../../data/camera_nikon_d5100_npl.csv"),
+    },
+    BuiltinTable {
+        name: "sigma_sd_merrill_npl",
+        description: "Sigma SD Merrill, NPL measurement (Darrodi et al. 2015)",
+        csv: include_str!("../../../data/camera_sigma_sd_merrill_npl.csv"),
+    },
+];
+
+/// The ColorChecker 24 reflectances (Ohta), p01 dark skin … p24 black.
+pub const COLORCHECKER24: BuiltinTable = BuiltinTable {
+    name: "colorchecker24",
+    description: "X-Rite ColorChecker Classic 24 (N. Ohta), 4×6",
+    csv: include_str!("../../../data/colorchecker24.csv"),
+};
+
+/// The 99 colour evaluation samples of ANSI/IES TM-30 (CIE 2017).
+pub const TM30_CES99: BuiltinTable = BuiltinTable {
+    name: "tm30_ces99",
+    description: "ANSI/IES TM-30 / CIE 2017 colour evaluation samples (99)",
+    csv: include_str!("../../../data/tm30_ces99.csv"),
+};
+
+/// Looks up a built-in table by name in `tables`.
+pub fn find<'a>(tables: &'a [BuiltinTable], name: &str) -> Option<&'a BuiltinTable> {
+    tables.iter().find(|t| t.name.eq_ignore_ascii_case(name))
+}
+
+/// Where named data files are looked for, besides built-in tables.
+#[derive(Debug, Clone, Default)]
+pub struct DataDir {
+    root: Option<PathBuf>,
+}
+
+impl DataDir {
+    /// A data directory given explicitly, else from `SPDCAM_DATA`, else none.
+    pub fn new(explicit: Option<PathBuf>) -> DataDir {
+        let root = explicit.or_else(|| std::env::var_os(DATA_DIR_ENV).map(PathBuf::from));
+        DataDir { root }
+    }
+
+    /// The directory, if one is set.
+    pub fn root(&self) -> Option<&Path> {
+        self.root.as_deref()
+    }
+
+    /// Finds `<root>/<sub>/<name>.csv` for each of `subdirs` (and the root itself), first hit.
+    pub fn find_csv(&self, name: &str, subdirs: &[&str]) -> Option<PathBuf> {
+        let root = self.root.as_ref()?;
+        let file = if name.ends_with(".csv") {
+            name.to_string()
+        } else {
+            format!("{name}.csv")
+        };
+        std::iter::once("")
+            .chain(subdirs.iter().copied())
+            .map(|sub| root.join(sub).join(&file))
+            .find(|p| p.is_file())
+    }
+
+    /// The names (file stems) of CSVs in the given subdirectories, sorted.
+    pub fn list_csv(&self, subdirs: &[&str]) -> Vec<String> {
+        let Some(root) = &self.root else {
+            return Vec::new();
+        };
+        let mut names: Vec<String> = subdirs
+            .iter()
+            .filter_map(|sub| std::fs::read_dir(root.join(sub)).ok())
+            .flat_map(|rd| rd.filter_map(|e| e.ok()))
+            .filter_map(|e| {
+                let p = e.path();
+                if p.extension()? != "csv" {
+                    return None;
+                }
+                Some(p.file_stem()?.to_string_lossy().into_owned())
+            })
+            .collect();
+        names.sort();
+        names.dedup();
+        names
+    }
+}
+
+/// Whether `spec` names a file path rather than a built-in or data-directory name.
+pub fn looks_like_path(spec: &str) -> bool {
+    spec.contains('/') || spec.contains('\\') || spec.ends_with(".csv")
+}
+
+/// Resolves `spec` as: an existing file path; a built-in table; a CSV under the data directory.
+/// Unknown names list the valid ones.
+pub fn resolve_table(
+    spec: &str,
+    kind: &'static str,
+    builtins: &[BuiltinTable],
+    data_dir: &DataDir,
+    subdirs: &[&str],
+) -> Result<(String, SpectralSet)> {
+    if looks_like_path(spec) {
+        let path = Path::new(spec);
+        if !path.is_file() {
+            return Err(Error::invalid(format!("{kind} file {spec} does not exist")));
+        }
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| spec.to_string());
+        return Ok((name, SpectralSet::read_csv(path)?));
+    }
+    if let Some(t) = find(builtins, spec) {
+        return Ok((t.name.to_string(), t.load()?));
+    }
+    if let Some(path) = data_dir.find_csv(spec, subdirs) {
+        return Ok((spec.to_string(), SpectralSet::read_csv(&path)?));
+    }
+    let mut valid: Vec<String> = builtins.iter().map(|t| t.name.to_string()).collect();
+    valid.extend(data_dir.list_csv(subdirs));
+    let hint = if data_dir.root().is_none() {
+        format!(" (set --data-dir or {DATA_DIR_ENV} for more)")
+    } else {
+        String::new()
+    };
+    Err(Error::UnknownName {
+        kind,
+        name: spec.to_string(),
+        valid: format!("{}{hint}", valid.join(", ")),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_table_parses() {
+        for t in CAMERAS.iter().chain([&COLORCHECKER24, &TM30_CES99]) {
+            let set = t.load().unwrap();
+            assert!(!set.is_empty(), "{}", t.name);
+        }
+        assert_eq!(COLORCHECKER24.load().unwrap().len(), 24);
+        assert_eq!(TM30_CES99.load().unwrap().len(), 99);
+        for c in CAMERAS {
+            assert_eq!(c.load().unwrap().names(), ["r", "g", "b"]);
+        }
+    }
+
+    #[test]
+    fn unknown_name_lists_valid_ones() {
+        let e = resolve_table("nope", "camera", CAMERAS, &DataDir::default(), &[]).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("nikon_d5100_npl") && msg.contains("'nope'"),
+            "{msg}"
+        );
+    }
+}

@@ -1,0 +1,370 @@
+//! The virtual camera (thesis chapter 3): sensor ─► noise ─► demosaic ─► white balance ─►
+//! aberration ─► colour, each stage switchable, then the patch features.
+//!
+//! [`Camera::render`] runs the whole image pipeline; [`Camera::features_fast`] gives the
+//! noise-free features straight from patch-level values, without an image, for very large
+//! datasets.
+
+pub mod aberration;
+pub mod colour;
+pub mod demosaic;
+pub mod noise;
+pub mod sensor;
+pub mod white_balance;
+
+use crate::chart::Chart;
+use crate::colorimetry::Observer;
+use crate::error::{Error, Result};
+use crate::illuminant::StandardIlluminant;
+use crate::raster::{Mosaic, RgbImage};
+use crate::seed;
+use crate::spectral::Grid;
+use aberration::LateralAberration;
+use colour::{ColourConfig, ColourTransform};
+use demosaic::DemosaicMethod;
+use noise::NoiseParams;
+use sensor::{Sensitivities, SensorConfig, SensorMode, SpectralResponse};
+use serde::{Deserialize, Serialize};
+use white_balance::{RegionGeometry, WhiteBalance};
+
+/// Every setting of the camera, one field per stage; `None` switches a stage off.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CameraConfig {
+    pub sensor: SensorConfig,
+    pub noise: Option<NoiseParams>,
+    /// Used with a single sensor only.
+    pub demosaic: DemosaicMethod,
+    pub white_balance: WhiteBalance,
+    pub aberration: Option<LateralAberration>,
+    pub colour: ColourConfig,
+}
+
+impl Default for CameraConfig {
+    /// The thesis's camera: RGGB, thesis noise, Menon 2007, shades of grey (p = 6),
+    /// aberration 20/4000, D65-fitted colour matrix, 8-bit sRGB.
+    fn default() -> Self {
+        CameraConfig {
+            sensor: SensorConfig::default(),
+            noise: Some(NoiseParams::THESIS),
+            demosaic: DemosaicMethod::Menon2007,
+            white_balance: WhiteBalance::default(),
+            aberration: Some(LateralAberration::THESIS),
+            colour: ColourConfig::default(),
+        }
+    }
+}
+
+/// A camera looking at one chart: everything that does not depend on the light is
+/// precomputed here (spectral response, region map, D65 colour matrix).
+#[derive(Debug, Clone)]
+pub struct Camera {
+    config: CameraConfig,
+    grid: Grid,
+    camera_name: String,
+    chart: Chart,
+    response: SpectralResponse,
+    region_map: Vec<u16>,
+    geometry: RegionGeometry,
+    camera_to_xyz: Option<nalgebra::Matrix3<f64>>,
+    colour: ColourTransform,
+}
+
+/// Reusable buffers for rendering, so a loop over many lights allocates nothing per sample.
+#[derive(Debug, Clone)]
+pub struct RenderBuffers {
+    raw: Vec<[f32; 3]>,
+    mosaic: Mosaic,
+    /// The final image after [`Camera::render_into`]: encoded sRGB, quantised, on 0…1.
+    pub image: RgbImage,
+    scratch: Vec<f32>,
+}
+
+/// The intermediate images of one render, for inspection (`--stages`).
+#[derive(Debug, Clone, Default)]
+pub struct Stages {
+    /// The mosaic after noise (single sensor only), normalised raw.
+    pub cfa: Option<Mosaic>,
+    pub demosaiced: Option<RgbImage>,
+    pub white_balanced: Option<RgbImage>,
+    pub aberrated: Option<RgbImage>,
+}
+
+/// One rendered chart: the final sRGB image (0…1, quantised), its features, its stages.
+#[derive(Debug, Clone)]
+pub struct Rendering {
+    pub image: RgbImage,
+    pub features: Vec<f32>,
+    pub stages: Stages,
+    pub white_balance_gains: [f32; 3],
+}
+
+impl Camera {
+    /// Builds a camera for `chart` (reflectances on `grid`) from `sensitivities` (on `grid`).
+    /// Fits the colour matrix under CIE D65 on the chart's patches (noise-free, patch level).
+    pub fn new(
+        sensitivities: &Sensitivities,
+        chart: Chart,
+        config: CameraConfig,
+        grid: &Grid,
+    ) -> Result<Camera> {
+        if let Some(noise) = &config.noise {
+            noise.validate()?;
+        }
+        if !(config.sensor.exposure > 0.0 && config.sensor.exposure <= 1.0) {
+            return Err(Error::invalid(format!(
+                "exposure {} is outside (0, 1]",
+                config.sensor.exposure
+            )));
+        }
+        if chart.reflectances.len() >= u16::MAX as usize {
+            return Err(Error::invalid("a chart may have at most 65534 patches"));
+        }
+        let response = SpectralResponse::new(sensitivities, &chart, grid)?;
+        let region_map = chart.layout.region_map();
+        let geometry =
+            RegionGeometry::from_region_map(&region_map, chart.layout.width, response.regions());
+        let mut camera = Camera {
+            config,
+            grid: *grid,
+            camera_name: sensitivities.name.clone(),
+            chart,
+            response,
+            region_map,
+            geometry,
+            camera_to_xyz: None,
+            colour: ColourTransform::new(None, config.colour.bit_depth)?,
+        };
+        if config.colour.correction {
+            let t = camera.fit_d65_matrix()?;
+            camera.camera_to_xyz = Some(t);
+            camera.colour = ColourTransform::new(Some(t), config.colour.bit_depth)?;
+        }
+        Ok(camera)
+    }
+
+    /// Thesis 3.1.6: white-balanced camera RGB of every patch under D65 against the
+    /// patches' XYZ under D65 (perfect white Y = 1).
+    fn fit_d65_matrix(&self) -> Result<nalgebra::Matrix3<f64>> {
+        let d65 = StandardIlluminant::D65.spd(&self.grid)?;
+        let light = self.light(&d65)?;
+        let mut balanced = Vec::new();
+        self.balanced_regions(&light, &mut balanced);
+        let observer = Observer::cie1931(&self.grid)?;
+        let patches = self.chart.reflectances.len();
+        let rgb: Vec<[f64; 3]> = balanced[..patches]
+            .iter()
+            .map(|v| v.map(|x| x as f64))
+            .collect();
+        let xyz: Vec<[f64; 3]> = (0..patches)
+            .map(|p| observer.reflectance_to_xyz(self.chart.reflectances.item(p), &d65))
+            .collect();
+        colour::fit_correction_matrix(&rgb, &xyz)
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &CameraConfig {
+        &self.config
+    }
+
+    /// The chart.
+    pub fn chart(&self) -> &Chart {
+        &self.chart
+    }
+
+    /// The simulation grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The camera's name.
+    pub fn camera_name(&self) -> &str {
+        &self.camera_name
+    }
+
+    /// The D65-fitted camera RGB → XYZ matrix, if colour correction is on.
+    pub fn correction_matrix(&self) -> Option<nalgebra::Matrix3<f64>> {
+        self.camera_to_xyz
+    }
+
+    /// Checks an SPD on the simulation grid and converts it for rendering: it must be
+    /// finite, non-negative and give the camera a signal.
+    pub fn light(&self, spd: &[f64]) -> Result<Vec<f32>> {
+        if spd.len() != self.grid.count {
+            return Err(Error::invalid(format!(
+                "the SPD has {} values; the simulation grid {} needs {}",
+                spd.len(),
+                self.grid,
+                self.grid.count
+            )));
+        }
+        if let Some((i, v)) = spd
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite() || **v < 0.0)
+        {
+            return Err(Error::invalid(format!(
+                "the SPD is {v} at {} nm; it must be finite and non-negative",
+                self.grid.wavelength(i)
+            )));
+        }
+        if spd.iter().all(|&v| v == 0.0) {
+            return Err(Error::invalid(
+                "the SPD is zero everywhere: there is no light",
+            ));
+        }
+        let light: Vec<f32> = spd.iter().map(|&v| v as f32).collect();
+        let mut raw = Vec::new();
+        self.response.raw_into(&light, &mut raw);
+        if raw.iter().flatten().all(|&v| v <= 0.0) {
+            return Err(Error::invalid(
+                "the light gives this camera no signal (no power where the camera is sensitive)",
+            ));
+        }
+        Ok(light)
+    }
+
+    /// Fresh buffers sized for this camera's images.
+    pub fn buffers(&self) -> RenderBuffers {
+        let l = &self.chart.layout;
+        let pattern = match self.config.sensor.mode {
+            SensorMode::SingleSensor(p) => p,
+            SensorMode::ThreeSensor => crate::raster::CfaPattern::Rggb,
+        };
+        RenderBuffers {
+            raw: Vec::new(),
+            mosaic: Mosaic::new(l.width, l.height, pattern),
+            image: RgbImage::new(l.width, l.height),
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Exposed raw values of every region under `light` (into `raw`).
+    fn exposed_regions(&self, light: &[f32], raw: &mut Vec<[f32; 3]>) {
+        self.response.raw_into(light, raw);
+        let scale = sensor::exposure_scale(
+            raw,
+            self.chart.layout.shows_background(),
+            self.config.sensor.exposure,
+        );
+        raw.iter_mut().for_each(|v| *v = v.map(|x| x * scale));
+    }
+
+    /// Patch-level white-balanced values (noise-free) into `raw`, used by the D65 fit and
+    /// the fast path.
+    fn balanced_regions(&self, light: &[f32], raw: &mut Vec<[f32; 3]>) {
+        self.exposed_regions(light, raw);
+        let gains = self
+            .config
+            .white_balance
+            .gains_for_regions(raw, &self.geometry);
+        raw.iter_mut()
+            .for_each(|v| *v = std::array::from_fn(|c| v[c] * gains[c]));
+    }
+
+    /// Runs the full pipeline for one light and returns the image, features and stages.
+    pub fn render(&self, spd: &[f64], seed: u64, keep_stages: bool) -> Result<Rendering> {
+        let light = self.light(spd)?;
+        let mut buffers = self.buffers();
+        let mut stages = Stages::default();
+        let gains = self.render_into(
+            &light,
+            seed,
+            &mut buffers,
+            keep_stages.then_some(&mut stages),
+        );
+        let features = self.features(&buffers.image);
+        Ok(Rendering {
+            image: buffers.image,
+            features,
+            stages,
+            white_balance_gains: gains,
+        })
+    }
+
+    /// The full pipeline into reusable buffers (the final image lands in `buffers.image`);
+    /// `light` must come from [`Camera::light`]. Returns the white-balance gains.
+    pub fn render_into(
+        &self,
+        light: &[f32],
+        seed: u64,
+        buffers: &mut RenderBuffers,
+        mut stages: Option<&mut Stages>,
+    ) -> [f32; 3] {
+        let RenderBuffers {
+            raw,
+            mosaic,
+            image,
+            scratch,
+        } = buffers;
+        self.exposed_regions(light, raw);
+        match self.config.sensor.mode {
+            SensorMode::SingleSensor(_) => {
+                sensor::form_mosaic(&self.region_map, raw, mosaic);
+                if let Some(noise) = &self.config.noise {
+                    noise::add_noise(&mut mosaic.data, mosaic.width, noise, seed);
+                }
+                if let Some(s) = stages.as_deref_mut() {
+                    s.cfa = Some(mosaic.clone());
+                }
+                demosaic::demosaic_into(mosaic, self.config.demosaic, image);
+            }
+            SensorMode::ThreeSensor => {
+                sensor::form_three_sensor(&self.region_map, raw, image);
+                if let Some(noise) = &self.config.noise {
+                    for (c, plane) in image.planes.iter_mut().enumerate() {
+                        noise::add_noise(plane, mosaic.width, noise, seed::derive(seed, c as u64));
+                    }
+                }
+            }
+        }
+        if let Some(s) = stages.as_deref_mut() {
+            s.demosaiced = Some(image.clone());
+        }
+        let gains = self.config.white_balance.gains(image);
+        white_balance::apply_gains(image, gains);
+        if let Some(s) = stages.as_deref_mut() {
+            s.white_balanced = Some(image.clone());
+        }
+        if let Some(ab) = &self.config.aberration {
+            ab.apply(image, scratch);
+        }
+        if let Some(s) = stages.as_deref_mut() {
+            s.aberrated = Some(image.clone());
+        }
+        self.colour.apply(image);
+        gains
+    }
+
+    /// Features of a final image: the mean encoded sRGB (0–255) of each feature patch's
+    /// central sampling region, `p01_r, p01_g, p01_b, p02_r, …`.
+    pub fn features(&self, image: &RgbImage) -> Vec<f32> {
+        let layout = &self.chart.layout;
+        let mut out = Vec::with_capacity(self.chart.feature_patches.len() * 3);
+        for &p in &self.chart.feature_patches {
+            let (x0, y0, side) = layout.sampling_region(p);
+            for plane in &image.planes {
+                let sum: f64 = (y0..y0 + side)
+                    .map(|y| {
+                        plane[y * image.width + x0..y * image.width + x0 + side]
+                            .iter()
+                            .map(|&v| v as f64)
+                            .sum::<f64>()
+                    })
+                    .sum();
+                out.push((255.0 * sum / (side * side) as f64) as f32);
+            }
+        }
+        out
+    }
+
+    /// Noise-free features straight from patch-level values (no image, no demosaicing, no
+    /// aberration, no quantisation): what [`Camera::render`] gives with noise off, up to
+    /// quantisation, at a fraction of the cost. Appends to `out`.
+    pub fn features_fast(&self, light: &[f32], raw: &mut Vec<[f32; 3]>, out: &mut Vec<f32>) {
+        self.balanced_regions(light, raw);
+        for &p in &self.chart.feature_patches {
+            let encoded = self.colour.encode_pixel(raw[p]);
+            out.extend(encoded.map(|v| 255.0 * v));
+        }
+    }
+}

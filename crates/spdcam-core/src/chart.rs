@@ -1,0 +1,362 @@
+//! Colour charts: patch reflectances, their layout on the image, and which patches feed the
+//! features a model reads.
+
+use crate::builtin::{self, DataDir};
+use crate::error::{Error, Result};
+use crate::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use serde::{Deserialize, Serialize};
+
+/// Where the patches lie on the rendered image: a `rows × cols` grid of square patches of
+/// `patch_px`, `gap_px` apart, its top-left corner at (`margin_x`, `margin_y`) of a
+/// `width × height` canvas. Gaps, margins and the canvas show the chart's background.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Layout {
+    pub rows: usize,
+    pub cols: usize,
+    pub patch_px: usize,
+    pub gap_px: usize,
+    pub margin_x: usize,
+    pub margin_y: usize,
+    pub width: usize,
+    pub height: usize,
+}
+
+impl Layout {
+    /// A grid of patches with an even border around it.
+    pub fn grid(
+        rows: usize,
+        cols: usize,
+        patch_px: usize,
+        gap_px: usize,
+        border_px: usize,
+    ) -> Layout {
+        Layout {
+            rows,
+            cols,
+            patch_px,
+            gap_px,
+            margin_x: border_px,
+            margin_y: border_px,
+            width: cols * patch_px + cols.saturating_sub(1) * gap_px + 2 * border_px,
+            height: rows * patch_px + rows.saturating_sub(1) * gap_px + 2 * border_px,
+        }
+    }
+
+    /// The largest grid with gaps of `gap_fraction` of a patch that fits a `width × height`
+    /// canvas with at least `border_fraction` of a patch around it, centred.
+    pub fn fit(
+        rows: usize,
+        cols: usize,
+        width: usize,
+        height: usize,
+        gap_fraction: f64,
+        border_fraction: f64,
+    ) -> Result<Layout> {
+        let units_x = cols as f64 + (cols as f64 - 1.0) * gap_fraction + 2.0 * border_fraction;
+        let units_y = rows as f64 + (rows as f64 - 1.0) * gap_fraction + 2.0 * border_fraction;
+        let patch = (width as f64 / units_x)
+            .min(height as f64 / units_y)
+            .floor() as usize;
+        if patch < 4 {
+            return Err(Error::invalid(format!(
+                "a {rows}×{cols} chart does not fit a {width}×{height} image with patches of 4 px or more"
+            )));
+        }
+        let gap = (patch as f64 * gap_fraction).round() as usize;
+        let grid_w = cols * patch + (cols - 1) * gap;
+        let grid_h = rows * patch + (rows - 1) * gap;
+        Ok(Layout {
+            rows,
+            cols,
+            patch_px: patch,
+            gap_px: gap,
+            margin_x: (width - grid_w) / 2,
+            margin_y: (height - grid_h) / 2,
+            width,
+            height,
+        })
+    }
+
+    /// Number of patches.
+    pub fn patch_count(&self) -> usize {
+        self.rows * self.cols
+    }
+
+    /// Top-left pixel of patch `i` (row-major).
+    pub fn patch_origin(&self, i: usize) -> (usize, usize) {
+        let (r, c) = (i / self.cols, i % self.cols);
+        (
+            self.margin_x + c * (self.patch_px + self.gap_px),
+            self.margin_y + r * (self.patch_px + self.gap_px),
+        )
+    }
+
+    /// Whether any background (gap, border or canvas) shows.
+    pub fn shows_background(&self) -> bool {
+        self.gap_px > 0
+            || self.margin_x > 0
+            || self.margin_y > 0
+            || self.width > self.cols * self.patch_px
+            || self.height > self.rows * self.patch_px
+    }
+
+    /// For every pixel, the index of the patch it shows, or `patch_count()` for background.
+    pub fn region_map(&self) -> Vec<u16> {
+        let background = self.patch_count() as u16;
+        let mut map = vec![background; self.width * self.height];
+        for i in 0..self.patch_count() {
+            let (x0, y0) = self.patch_origin(i);
+            for y in y0..y0 + self.patch_px {
+                map[y * self.width + x0..y * self.width + x0 + self.patch_px].fill(i as u16);
+            }
+        }
+        map
+    }
+
+    /// The central sampling region of a patch: the thesis samples 14×14 px starting 5 px
+    /// inside a 24×24 patch; other sizes keep the same proportion. Returns (x0, y0, side).
+    pub fn sampling_region(&self, i: usize) -> (usize, usize, usize) {
+        let side = ((self.patch_px as f64 * 14.0 / 24.0).round() as usize).max(1);
+        let inset = (self.patch_px - side) / 2;
+        let (x0, y0) = self.patch_origin(i);
+        (x0 + inset, y0 + inset, side)
+    }
+}
+
+/// A colour chart: reflectances on the simulation grid (one per patch, row-major in the
+/// layout), a flat background reflectance, and the patches whose colours are the features.
+#[derive(Debug, Clone)]
+pub struct Chart {
+    pub name: String,
+    pub reflectances: SpectralSet,
+    pub background_reflectance: f64,
+    pub layout: Layout,
+    /// Indices (row-major) of the feature patches, in feature order.
+    pub feature_patches: Vec<usize>,
+}
+
+/// The thesis's patch size in pixels (m = 576 pixels per patch).
+pub const THESIS_PATCH_PX: usize = 24;
+/// Reflectance of a chart's matte black body, shown in gaps and borders.
+pub const DEFAULT_BACKGROUND: f64 = 0.04;
+
+/// The chart names `Chart::resolve` knows, with what they are.
+pub const CHART_NAMES: &[(&str, &str)] = &[
+    ("colorchecker24", "ColorChecker Classic 24, 4×6, built in"),
+    (
+        "colorchecker_sg96",
+        "ColorChecker Digital SG, the thesis's 96 centre patches (i1Pro2), 8×12; data directory",
+    ),
+    (
+        "colorchecker_sg140",
+        "ColorChecker Digital SG, all 140 patches, 10×14, the 96 centre patches are features; data directory",
+    ),
+];
+
+impl Chart {
+    /// A chart whose every patch is a feature, laid out `rows × cols` with the thesis's
+    /// 24 px patches and no gap, reflectances resampled onto `grid`.
+    pub fn from_reflectances(
+        name: &str,
+        reflectances: &SpectralSet,
+        rows: usize,
+        cols: usize,
+        grid: &Grid,
+    ) -> Result<Chart> {
+        if rows == 0 || cols == 0 || rows * cols != reflectances.len() {
+            return Err(Error::invalid(format!(
+                "chart '{name}' has {} reflectances, which do not fill a {rows}×{cols} layout",
+                reflectances.len()
+            )));
+        }
+        let (resampled, _) = reflectances
+            .clone()
+            .require_non_negative("reflectance", 0.01)?
+            .resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
+        Ok(Chart {
+            name: name.to_string(),
+            reflectances: resampled,
+            background_reflectance: DEFAULT_BACKGROUND,
+            layout: Layout::grid(rows, cols, THESIS_PATCH_PX, 0, 0),
+            feature_patches: (0..rows * cols).collect(),
+        })
+    }
+
+    /// The built-in ColorChecker 24 on `grid`.
+    pub fn colorchecker24(grid: &Grid) -> Result<Chart> {
+        Chart::from_reflectances(
+            "colorchecker24",
+            &builtin::COLORCHECKER24.load()?,
+            4,
+            6,
+            grid,
+        )
+    }
+
+    /// The full 140-patch ColorChecker Digital SG from a set named in X-Rite style
+    /// (`A1`…`N10`: letter = column A–N, number = row 1–10); the 96 patches inside the outer
+    /// ring are the features, row-major.
+    pub fn colorchecker_sg140(reflectances: &SpectralSet, grid: &Grid) -> Result<Chart> {
+        let mut order = Vec::with_capacity(140);
+        for row in 1..=10 {
+            for col in b'A'..=b'N' {
+                let name = format!("{}{row}", col as char);
+                order.push(reflectances.position(&name).ok_or_else(|| {
+                    Error::invalid(format!(
+                        "ColorChecker SG reflectances lack patch '{name}' (expected A1…N10)"
+                    ))
+                })?);
+            }
+        }
+        let mut chart = Chart::from_reflectances(
+            "colorchecker_sg140",
+            &reflectances.select(&order),
+            10,
+            14,
+            grid,
+        )?;
+        chart.feature_patches = (1..9)
+            .flat_map(|r| (1..13).map(move |c| r * 14 + c))
+            .collect();
+        Ok(chart)
+    }
+
+    /// Resolves a chart by name or file: the names of [`CHART_NAMES`], or a reflectance CSV
+    /// (path or data-directory name) with `layout` rows × cols (needed unless the file has
+    /// 24, 96 or 140 patches, whose layouts are known).
+    pub fn resolve(
+        spec: &str,
+        layout: Option<(usize, usize)>,
+        data_dir: &DataDir,
+        grid: &Grid,
+    ) -> Result<Chart> {
+        let (name, set) = match spec {
+            "colorchecker24" => return Chart::colorchecker24(grid),
+            "colorchecker_sg96" => (
+                spec.to_string(),
+                builtin::resolve_table(
+                    "colorchecker_digital_sg_96_i1pro2",
+                    "chart",
+                    &[],
+                    data_dir,
+                    &["thesis"],
+                )?
+                .1,
+            ),
+            "colorchecker_sg140" => (
+                spec.to_string(),
+                builtin::resolve_table("colorchecker_sg", "chart", &[], data_dir, &["charts"])?.1,
+            ),
+            _ => builtin::resolve_table(
+                spec,
+                "chart",
+                &[builtin::COLORCHECKER24],
+                data_dir,
+                &["charts", "reflectances", "thesis"],
+            )
+            .map_err(|e| match e {
+                Error::UnknownName { name, .. } => Error::UnknownName {
+                    kind: "chart",
+                    name,
+                    valid: CHART_NAMES
+                        .iter()
+                        .map(|(n, _)| *n)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                        + ", or a reflectance CSV with --layout ROWSxCOLS",
+                },
+                other => other,
+            })?,
+        };
+        let sg_named = set.position("A1").is_some() && set.position("N10").is_some();
+        if set.len() == 140 && sg_named && layout.is_none() {
+            return Chart::colorchecker_sg140(&set, grid);
+        }
+        let (rows, cols) = match (layout, set.len()) {
+            (Some(l), _) => l,
+            (None, 24) => (4, 6),
+            (None, 96) => (8, 12),
+            (None, n) => {
+                return Err(Error::invalid(format!(
+                    "chart '{name}' has {n} patches; give its layout as ROWSxCOLS"
+                )))
+            }
+        };
+        Chart::from_reflectances(&name, &set, rows, cols, grid)
+    }
+
+    /// The same chart with another layout geometry (patch size, gap, border) kept at
+    /// the same rows × cols.
+    pub fn with_layout(mut self, layout: Layout) -> Result<Chart> {
+        if (layout.rows, layout.cols) != (self.layout.rows, self.layout.cols) {
+            return Err(Error::invalid(format!(
+                "layout {}×{} does not match chart '{}' ({}×{})",
+                layout.rows, layout.cols, self.name, self.layout.rows, self.layout.cols
+            )));
+        }
+        if layout.patch_px < 4 {
+            return Err(Error::invalid("patches must be at least 4 px wide"));
+        }
+        self.layout = layout;
+        Ok(self)
+    }
+
+    /// Feature column names: `p01_r,p01_g,p01_b,p02_r,…` in feature order.
+    pub fn feature_names(&self) -> Vec<String> {
+        let width = if self.feature_patches.len() >= 100 {
+            3
+        } else {
+            2
+        };
+        (1..=self.feature_patches.len())
+            .flat_map(|k| ["r", "g", "b"].map(|c| format!("p{k:0width$}_{c}")))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colorchecker24_thesis_layout() {
+        let chart = Chart::colorchecker24(&Grid::SIMULATION).unwrap();
+        assert_eq!((chart.layout.width, chart.layout.height), (144, 96));
+        assert!(!chart.layout.shows_background());
+        assert_eq!(chart.layout.sampling_region(0), (5, 5, 14));
+        assert_eq!(chart.layout.sampling_region(7), (24 + 5, 24 + 5, 14));
+        let names = chart.feature_names();
+        assert_eq!(&names[..4], ["p01_r", "p01_g", "p01_b", "p02_r"]);
+        assert_eq!(names.len(), 72);
+    }
+
+    #[test]
+    fn region_map_marks_patches_and_gaps() {
+        let l = Layout::grid(2, 3, 4, 2, 1);
+        assert_eq!((l.width, l.height), (17, 11));
+        let map = l.region_map();
+        assert_eq!(map[0], 6);
+        assert_eq!(map[l.width + 1], 0);
+        assert_eq!(map[l.width + 5], 6);
+        assert_eq!(map[l.width + 7], 1);
+        assert_eq!(map[7 * l.width + 13], 5);
+    }
+
+    #[test]
+    fn fit_centres_the_grid() {
+        let l = Layout::fit(4, 6, 1709, 1212, 0.1, 0.3).unwrap();
+        assert_eq!((l.width, l.height), (1709, 1212));
+        let (x_end, _) = l.patch_origin(5);
+        assert!(x_end + l.patch_px <= 1709);
+        let (_, y_end) = l.patch_origin(23);
+        assert!(y_end + l.patch_px <= 1212);
+        assert!(Layout::fit(4, 6, 10, 10, 0.0, 0.0).is_err());
+    }
+
+    #[test]
+    fn wrong_patch_count_is_an_error() {
+        let set = builtin::COLORCHECKER24.load().unwrap();
+        let e = Chart::from_reflectances("x", &set, 5, 5, &Grid::SIMULATION).unwrap_err();
+        assert!(e.to_string().contains("5×5"), "{e}");
+    }
+}

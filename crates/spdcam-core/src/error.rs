@@ -1,0 +1,60 @@
+//! The error type of the simulation library: every variant names what is wrong and where.
+
+use std::path::PathBuf;
+
+/// Errors of spdcam-core. Messages name the file, line, column or value that is wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A spectral CSV (or other table) is malformed; `source_name` is the file or built-in name.
+    #[error("{source_name}: {message}")]
+    Parse {
+        source_name: String,
+        message: String,
+    },
+    /// A value is out of its valid range or inconsistent with another one.
+    #[error("{0}")]
+    Invalid(String),
+    /// A name was not found among the known ones.
+    #[error("unknown {kind} '{name}'; valid: {valid}")]
+    UnknownName {
+        kind: &'static str,
+        name: String,
+        valid: String,
+    },
+    /// An image could not be decoded or encoded.
+    #[error("{context}: {message}")]
+    Image { context: String, message: String },
+}
+
+impl Error {
+    /// Shorthand for [`Error::Invalid`].
+    pub fn invalid(message: impl Into<String>) -> Self {
+        Error::Invalid(message.into())
+    }
+
+    /// Shorthand for [`Error::Parse`].
+    pub fn parse(source_name: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Parse {
+            source_name: source_name.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Wraps an I/O error with the path it concerns.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// Result with the library's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,18 @@
+//! spdcam-core: the spectral core, the virtual camera and everything around it that needs no
+//! deep learning — spectra and colorimetry, shipped data, charts, the camera stages and the
+//! features a model reads.
+
+pub mod builtin;
+pub mod camera;
+pub mod chart;
+pub mod colorimetry;
+pub mod error;
+pub mod fsio;
+pub mod illuminant;
+pub mod imageio;
+pub mod light;
+pub mod raster;
+pub mod seed;
+pub mod spectral;
+
+pub use error::{Error, Result};

@@ -1,0 +1,134 @@
+//! Lights named on the command line: a standard illuminant, a colour temperature, or a
+//! spectral CSV, resolved to an SPD on the simulation grid.
+
+use crate::builtin::{self, DataDir};
+use crate::error::{Error, Result};
+use crate::illuminant::{self, StandardIlluminant};
+use crate::spectral::{Extrapolation, Grid, Interpolation, ResampleReport};
+
+/// The forms an SPD may be named in, for help and error messages.
+pub const SPD_FORMS: &str = "D65, A, D50, daylight:CCT (4000–25000 K), planck:CCT, \
+cct:CCT (CIE reference: Planckian below 5000 K, daylight from 5000 K), or a spectral CSV \
+(FILE.csv or FILE.csv:COLUMN)";
+
+/// A light resolved to the simulation grid.
+#[derive(Debug, Clone)]
+pub struct ResolvedSpd {
+    pub name: String,
+    pub values: Vec<f64>,
+    /// Present when the light came from a file: how it was resampled.
+    pub resampling: Option<ResampleReport>,
+}
+
+/// Resolves `spec` (see [`SPD_FORMS`]) to an SPD on `grid`.
+pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<ResolvedSpd> {
+    if let Ok(ill) = StandardIlluminant::parse(spec) {
+        return Ok(ResolvedSpd {
+            name: ill.name().to_string(),
+            values: ill.spd(grid)?,
+            resampling: None,
+        });
+    }
+    if let Some((kind, value)) = spec.split_once(':') {
+        let kind_lc = kind.to_ascii_lowercase();
+        if matches!(kind_lc.as_str(), "daylight" | "planck" | "cct") {
+            let t: f64 = value.trim_end_matches(['K', 'k']).parse().map_err(|_| {
+                Error::invalid(format!(
+                    "'{spec}': '{value}' is not a temperature in kelvin"
+                ))
+            })?;
+            let values = match kind_lc.as_str() {
+                "daylight" => illuminant::daylight(t, grid)?,
+                "planck" => illuminant::planck(t, grid)?,
+                _ if t < 5000.0 => illuminant::planck(t, grid)?,
+                _ => illuminant::daylight(t, grid)?,
+            };
+            return Ok(ResolvedSpd {
+                name: spec.to_string(),
+                values,
+                resampling: None,
+            });
+        }
+    }
+    let (file, column) = match spec.rsplit_once(".csv:") {
+        Some((f, c)) => (format!("{f}.csv"), Some(c)),
+        None => (spec.to_string(), None),
+    };
+    if !builtin::looks_like_path(&file) && data_dir.find_csv(&file, &["spds"]).is_none() {
+        return Err(Error::UnknownName {
+            kind: "light",
+            name: spec.to_string(),
+            valid: SPD_FORMS.to_string(),
+        });
+    }
+    let (name, set) = builtin::resolve_table(&file, "light", &[], data_dir, &["spds"])?;
+    let index = match column {
+        Some(c) => set.position(c).ok_or_else(|| {
+            Error::invalid(format!(
+                "{file} has no column '{c}'; it has {}",
+                set.names().join(", ")
+            ))
+        })?,
+        None if set.len() == 1 => 0,
+        None => {
+            return Err(Error::invalid(format!(
+                "{file} holds {} SPDs ({}); pick one as {file}:COLUMN",
+                set.len(),
+                set.names().join(", ")
+            )))
+        }
+    };
+    let one = set.select(&[index]).require_non_negative("SPD", 0.01)?;
+    let (resampled, report) = one.resample(grid, Interpolation::Auto, Extrapolation::Zero)?;
+    let values = resampled.item(0).to_vec();
+    if values.iter().all(|&v| v == 0.0) {
+        return Err(Error::invalid(format!(
+            "SPD '{}' in {file} is zero everywhere on {grid}",
+            one.names()[0]
+        )));
+    }
+    Ok(ResolvedSpd {
+        name: format!("{name}:{}", one.names()[0]),
+        values,
+        resampling: Some(report),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn named_lights_resolve() {
+        let g = Grid::SIMULATION;
+        let d = DataDir::default();
+        for spec in [
+            "D65",
+            "a",
+            "cct:3000",
+            "cct:6500",
+            "daylight:5000",
+            "planck:2856K",
+        ] {
+            let spd = resolve_spd(spec, &d, &g).unwrap();
+            assert_eq!(spd.values.len(), g.count, "{spec}");
+            assert!(spd.values.iter().all(|v| *v >= 0.0));
+        }
+        let e = resolve_spd("moonlight", &d, &g).unwrap_err().to_string();
+        assert!(e.contains("D65") && e.contains("moonlight"), "{e}");
+        assert!(resolve_spd("planck:hot", &d, &g).is_err());
+    }
+
+    #[test]
+    fn zero_spd_file_is_rejected() {
+        let dir = std::env::temp_dir().join(format!("spdcam-light-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("zero.csv");
+        std::fs::write(&f, "wavelength_nm,z\n380,0\n780,0\n").unwrap();
+        let e = resolve_spd(f.to_str().unwrap(), &DataDir::default(), &Grid::SIMULATION)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("zero everywhere"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,139 @@
+//! Image buffers that pass between the camera stages: a Bayer mosaic and a planar RGB image.
+
+use serde::{Deserialize, Serialize};
+
+/// Bayer colour-filter layouts, named by the top-left 2×2 block read row by row.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CfaPattern {
+    Rggb,
+    Bggr,
+    Grbg,
+    Gbrg,
+}
+
+impl CfaPattern {
+    /// All four layouts.
+    pub const ALL: [CfaPattern; 4] = [
+        CfaPattern::Rggb,
+        CfaPattern::Bggr,
+        CfaPattern::Grbg,
+        CfaPattern::Gbrg,
+    ];
+
+    /// The channel (0 = R, 1 = G, 2 = B) the filter at pixel (`x`, `y`) passes.
+    #[inline]
+    pub fn channel_at(self, x: usize, y: usize) -> usize {
+        let block = match self {
+            CfaPattern::Rggb => [0, 1, 1, 2],
+            CfaPattern::Bggr => [2, 1, 1, 0],
+            CfaPattern::Grbg => [1, 0, 2, 1],
+            CfaPattern::Gbrg => [1, 2, 0, 1],
+        };
+        block[(y & 1) * 2 + (x & 1)]
+    }
+
+    /// Parses `RGGB`, `BGGR`, `GRBG` or `GBRG` (any case).
+    pub fn parse(text: &str) -> Option<CfaPattern> {
+        match text.to_ascii_uppercase().as_str() {
+            "RGGB" => Some(CfaPattern::Rggb),
+            "BGGR" => Some(CfaPattern::Bggr),
+            "GRBG" => Some(CfaPattern::Grbg),
+            "GBRG" => Some(CfaPattern::Gbrg),
+            _ => None,
+        }
+    }
+}
+
+/// A single-channel raw image behind a Bayer filter, row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mosaic {
+    pub width: usize,
+    pub height: usize,
+    pub pattern: CfaPattern,
+    pub data: Vec<f32>,
+}
+
+impl Mosaic {
+    /// A mosaic of zeros.
+    pub fn new(width: usize, height: usize, pattern: CfaPattern) -> Mosaic {
+        Mosaic {
+            width,
+            height,
+            pattern,
+            data: vec![0.0; width * height],
+        }
+    }
+
+    /// The value at (`x`, `y`).
+    #[inline]
+    pub fn get(&self, x: usize, y: usize) -> f32 {
+        self.data[y * self.width + x]
+    }
+
+    /// The mosaic a three-channel image gives behind this filter (each pixel keeps one channel).
+    pub fn from_rgb(image: &RgbImage, pattern: CfaPattern) -> Mosaic {
+        let mut m = Mosaic::new(image.width, image.height, pattern);
+        for y in 0..image.height {
+            for x in 0..image.width {
+                let i = y * image.width + x;
+                m.data[i] = image.planes[pattern.channel_at(x, y)][i];
+            }
+        }
+        m
+    }
+}
+
+/// A three-channel image stored as three row-major planes (R, G, B).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RgbImage {
+    pub width: usize,
+    pub height: usize,
+    pub planes: [Vec<f32>; 3],
+}
+
+impl RgbImage {
+    /// An image of zeros.
+    pub fn new(width: usize, height: usize) -> RgbImage {
+        let n = width * height;
+        RgbImage {
+            width,
+            height,
+            planes: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
+        }
+    }
+
+    /// The (R, G, B) value at (`x`, `y`).
+    #[inline]
+    pub fn pixel(&self, x: usize, y: usize) -> [f32; 3] {
+        let i = y * self.width + x;
+        [self.planes[0][i], self.planes[1][i], self.planes[2][i]]
+    }
+
+    /// Number of pixels.
+    pub fn len(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// Whether the image has no pixels.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_pattern_has_two_greens_per_block() {
+        for p in CfaPattern::ALL {
+            let block: Vec<usize> = (0..4).map(|k| p.channel_at(k % 2, k / 2)).collect();
+            assert_eq!(block.iter().filter(|&&c| c == 1).count(), 2, "{p:?}");
+            assert_eq!(block.iter().filter(|&&c| c == 0).count(), 1);
+            assert_eq!(CfaPattern::parse(&format!("{p:?}")), Some(p));
+        }
+        assert_eq!(CfaPattern::Rggb.channel_at(0, 0), 0);
+        assert_eq!(CfaPattern::Rggb.channel_at(1, 1), 2);
+        assert_eq!(CfaPattern::Gbrg.channel_at(1, 0), 2);
+    }
+}

@@ -1,0 +1,412 @@
+//! Named spectra sharing one list of wavelengths, and the spectral CSV layout.
+
+use crate::error::{Error, Result};
+use crate::fsio;
+use crate::spectral::Grid;
+use std::path::Path;
+
+/// A set of named spectra (SPDs, reflectances or sensitivities) sampled at common wavelengths.
+///
+/// The CSV layout is the one colour-science's `read_sds_from_csv_file` reads: a header row,
+/// the first column `wavelength_nm`, then one column per item.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpectralSet {
+    wavelengths: Vec<f64>,
+    names: Vec<String>,
+    /// `values[item][sample]`.
+    values: Vec<Vec<f64>>,
+}
+
+impl SpectralSet {
+    /// Builds a set, checking that wavelengths are finite and strictly increasing, that every
+    /// item has one finite value per wavelength, and that names are unique.
+    pub fn new(wavelengths: Vec<f64>, names: Vec<String>, values: Vec<Vec<f64>>) -> Result<Self> {
+        if wavelengths.is_empty() {
+            return Err(Error::invalid(
+                "a spectral set needs at least one wavelength",
+            ));
+        }
+        if let Some(w) = wavelengths.iter().find(|w| !w.is_finite()) {
+            return Err(Error::invalid(format!(
+                "wavelength {w} is not a finite number"
+            )));
+        }
+        for pair in wavelengths.windows(2) {
+            if pair[1] <= pair[0] {
+                return Err(Error::invalid(format!(
+                    "wavelength {} nm follows {} nm: wavelengths must be strictly increasing",
+                    pair[1], pair[0]
+                )));
+            }
+        }
+        if names.len() != values.len() {
+            return Err(Error::invalid(format!(
+                "{} names for {} spectra",
+                names.len(),
+                values.len()
+            )));
+        }
+        for (name, v) in names.iter().zip(&values) {
+            if v.len() != wavelengths.len() {
+                return Err(Error::invalid(format!(
+                    "spectrum '{name}' has {} values for {} wavelengths",
+                    v.len(),
+                    wavelengths.len()
+                )));
+            }
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(Error::invalid(format!(
+                    "spectrum '{name}' has a non-finite value"
+                )));
+            }
+        }
+        for (i, n) in names.iter().enumerate() {
+            if names[..i].contains(n) {
+                return Err(Error::invalid(format!("spectrum name '{n}' appears twice")));
+            }
+        }
+        Ok(SpectralSet {
+            wavelengths,
+            names,
+            values,
+        })
+    }
+
+    /// A set on a regular grid.
+    pub fn on_grid(grid: &Grid, names: Vec<String>, values: Vec<Vec<f64>>) -> Result<Self> {
+        SpectralSet::new(grid.wavelengths(), names, values)
+    }
+
+    /// Parses spectral CSV text; `source_name` (a path or built-in name) is used in errors.
+    pub fn from_csv_str(text: &str, source_name: &str) -> Result<Self> {
+        let err = |msg: String| Error::parse(source_name, msg);
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .trim(csv::Trim::All)
+            .comment(Some(b'#'))
+            .flexible(true)
+            .from_reader(text.as_bytes());
+        let mut records = reader.records();
+        let header = match records.next() {
+            None => return Err(err("the file is empty".into())),
+            Some(r) => r.map_err(|e| err(format!("line 1: {e}")))?,
+        };
+        let first = header.get(0).unwrap_or("");
+        if first.parse::<f64>().is_ok() {
+            return Err(err(
+                "line 1: no header row; the first line must be 'wavelength_nm,<name>,…'".into(),
+            ));
+        }
+        if !first.eq_ignore_ascii_case("wavelength_nm") && !first.eq_ignore_ascii_case("wavelength")
+        {
+            return Err(err(format!(
+                "line 1: first column is '{first}', expected 'wavelength_nm'"
+            )));
+        }
+        let names: Vec<String> = header.iter().skip(1).map(str::to_string).collect();
+        if names.is_empty() {
+            return Err(err(
+                "line 1: no spectrum columns after 'wavelength_nm'".into()
+            ));
+        }
+        if let Some(i) = names.iter().position(|n| n.is_empty()) {
+            return Err(err(format!("line 1: column {} has an empty name", i + 2)));
+        }
+        let mut wavelengths = Vec::new();
+        let mut values = vec![Vec::new(); names.len()];
+        for record in records {
+            let record = record.map_err(|e| err(e.to_string()))?;
+            let line = record.position().map(|p| p.line()).unwrap_or(0);
+            if record.iter().all(str::is_empty) {
+                continue;
+            }
+            if record.len() != names.len() + 1 {
+                return Err(err(format!(
+                    "line {line}: {} cells, expected {} (wavelength_nm + {} columns)",
+                    record.len(),
+                    names.len() + 1,
+                    names.len()
+                )));
+            }
+            let number = |cell: &str, column: &str| -> Result<f64> {
+                cell.parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| {
+                        err(format!(
+                            "line {line}, column '{column}': '{cell}' is not a number"
+                        ))
+                    })
+            };
+            let w = number(&record[0], "wavelength_nm")?;
+            if let Some(&prev) = wavelengths.last() {
+                if w <= prev {
+                    let what = if w == prev { "duplicate" } else { "unsorted" };
+                    return Err(err(format!(
+                        "line {line}: {what} wavelength {w} nm after {prev} nm; wavelengths must be strictly increasing"
+                    )));
+                }
+            }
+            wavelengths.push(w);
+            for (k, name) in names.iter().enumerate() {
+                values[k].push(number(&record[k + 1], name)?);
+            }
+        }
+        if wavelengths.len() < 2 {
+            return Err(err("fewer than two wavelength rows".into()));
+        }
+        SpectralSet::new(wavelengths, names, values).map_err(|e| err(e.to_string()))
+    }
+
+    /// Reads a spectral CSV file.
+    pub fn read_csv(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        SpectralSet::from_csv_str(&text, &path.display().to_string())
+    }
+
+    /// The set as spectral CSV text.
+    pub fn to_csv_string(&self) -> String {
+        let mut out = String::from("wavelength_nm");
+        for n in &self.names {
+            out.push(',');
+            out.push_str(&csv_escape(n));
+        }
+        out.push('\n');
+        for (i, w) in self.wavelengths.iter().enumerate() {
+            out.push_str(&format_number(*w));
+            for v in &self.values {
+                out.push(',');
+                out.push_str(&format_number(v[i]));
+            }
+            out.push('\n');
+        }
+        out
+    }
+
+    /// Writes the set as spectral CSV, atomically.
+    pub fn write_csv(&self, path: &Path) -> Result<()> {
+        fsio::write_atomic(path, self.to_csv_string().as_bytes())
+    }
+
+    /// The wavelengths, in nm.
+    pub fn wavelengths(&self) -> &[f64] {
+        &self.wavelengths
+    }
+
+    /// The item names, in column order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// The number of items.
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Whether the set holds no items.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// The values of item `i`, one per wavelength.
+    pub fn item(&self, i: usize) -> &[f64] {
+        &self.values[i]
+    }
+
+    /// All items, `[item][sample]`.
+    pub fn items(&self) -> &[Vec<f64>] {
+        &self.values
+    }
+
+    /// The index of the item called `name`.
+    pub fn position(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| n == name)
+    }
+
+    /// The regular grid the wavelengths form, if they form one.
+    pub fn grid(&self) -> Option<Grid> {
+        let w = &self.wavelengths;
+        if w.len() < 2 {
+            return None;
+        }
+        let step = w[1] - w[0];
+        let regular = w
+            .windows(2)
+            .all(|p| ((p[1] - p[0]) - step).abs() <= 1e-6 * step.max(1.0));
+        regular.then_some(Grid {
+            start_nm: w[0],
+            step_nm: step,
+            count: w.len(),
+        })
+    }
+
+    /// Checks that the set is sampled exactly on `grid`.
+    pub fn require_grid(&self, grid: &Grid, what: &str) -> Result<()> {
+        match self.grid() {
+            Some(g)
+                if g.count == grid.count
+                    && (g.start_nm - grid.start_nm).abs() < 1e-6
+                    && (g.step_nm - grid.step_nm).abs() < 1e-6 =>
+            {
+                Ok(())
+            }
+            _ => Err(Error::invalid(format!(
+                "{what} is not sampled on the working grid {grid}; resample it first"
+            ))),
+        }
+    }
+
+    /// A new set with only the items at `indices`, in that order.
+    pub fn select(&self, indices: &[usize]) -> SpectralSet {
+        SpectralSet {
+            wavelengths: self.wavelengths.clone(),
+            names: indices.iter().map(|&i| self.names[i].clone()).collect(),
+            values: indices.iter().map(|&i| self.values[i].clone()).collect(),
+        }
+    }
+
+    /// Renames the items; the count must match.
+    pub fn with_names(mut self, names: Vec<String>) -> Result<Self> {
+        if names.len() != self.values.len() {
+            return Err(Error::invalid(format!(
+                "{} names for {} spectra",
+                names.len(),
+                self.values.len()
+            )));
+        }
+        self.names = names;
+        SpectralSet::new(self.wavelengths, self.names, self.values)
+    }
+
+    /// Each item divided by its own maximum. An item whose maximum is not positive is an error.
+    pub fn normalised_by_max(&self) -> Result<SpectralSet> {
+        let mut out = self.clone();
+        for (name, v) in out.names.iter().zip(out.values.iter_mut()) {
+            let max = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            if max <= 0.0 {
+                return Err(Error::invalid(format!(
+                    "spectrum '{name}' has no positive value (all zero or negative)"
+                )));
+            }
+            v.iter_mut().for_each(|x| *x /= max);
+        }
+        Ok(out)
+    }
+
+    /// Rejects values below `-tolerance × max` of their item (physically meaningless for
+    /// `kind`, e.g. a reflectance) and clamps the remaining small negatives (measurement
+    /// noise) to zero.
+    pub fn require_non_negative(mut self, kind: &str, tolerance: f64) -> Result<Self> {
+        for (name, v) in self.names.iter().zip(self.values.iter_mut()) {
+            let max = v.iter().cloned().fold(0.0f64, f64::max);
+            if let Some((i, x)) = v
+                .iter()
+                .enumerate()
+                .find(|(_, x)| **x < -tolerance * max.max(f64::MIN_POSITIVE))
+            {
+                return Err(Error::invalid(format!(
+                    "{kind} '{name}' is negative ({x}) at {} nm; a {kind} cannot be negative",
+                    self.wavelengths[i]
+                )));
+            }
+            v.iter_mut().for_each(|x| *x = x.max(0.0));
+        }
+        Ok(self)
+    }
+}
+
+/// Shortest text that reads back to the same `f64`.
+fn format_number(v: f64) -> String {
+    let s = format!("{v}");
+    if s == "-0" {
+        "0".into()
+    } else {
+        s
+    }
+}
+
+fn csv_escape(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SAMPLE: &str = "wavelength_nm,a,b\n400,0.1,1\n410,0.25,2\n420,0.5,3\n";
+
+    #[test]
+    fn csv_round_trip_keeps_every_number() {
+        let set = SpectralSet::from_csv_str(SAMPLE, "sample").unwrap();
+        assert_eq!(set.names(), ["a", "b"]);
+        assert_eq!(set.item(0), [0.1, 0.25, 0.5]);
+        let again = SpectralSet::from_csv_str(&set.to_csv_string(), "again").unwrap();
+        assert_eq!(set, again);
+        let odd = SpectralSet::new(
+            vec![380.0, 380.8],
+            vec!["x,y".into()],
+            vec![vec![1.0 / 3.0, 2e-17]],
+        )
+        .unwrap();
+        assert_eq!(
+            SpectralSet::from_csv_str(&odd.to_csv_string(), "odd").unwrap(),
+            odd
+        );
+    }
+
+    fn parse_err(text: &str) -> String {
+        SpectralSet::from_csv_str(text, "f.csv")
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn malformed_csv_gives_located_errors() {
+        assert!(parse_err("400,1\n410,2\n").contains("no header"));
+        let e = parse_err("wavelength_nm,a\n400,1\n410,x\n");
+        assert!(
+            e.contains("line 3") && e.contains("'a'") && e.contains("'x'"),
+            "{e}"
+        );
+        assert!(parse_err("wavelength_nm,a\n410,1\n400,2\n").contains("unsorted"));
+        assert!(parse_err("wavelength_nm,a\n400,1\n400,2\n").contains("duplicate"));
+        assert!(parse_err("wavelength_nm,a\n400,1\n410\n").contains("cells"));
+        assert!(parse_err("").contains("empty"));
+        assert!(parse_err("nm,a\n400,1\n410,2\n").contains("expected 'wavelength_nm'"));
+    }
+
+    #[test]
+    fn negative_values_rejected_small_noise_clamped() {
+        let set = SpectralSet::from_csv_str("wavelength_nm,a\n400,-0.5\n410,1\n", "f").unwrap();
+        let e = set.require_non_negative("reflectance", 0.01).unwrap_err();
+        assert!(e.to_string().contains("400 nm"), "{e}");
+        let set = SpectralSet::from_csv_str("wavelength_nm,a\n400,-0.001\n410,1\n", "f").unwrap();
+        let ok = set.require_non_negative("reflectance", 0.01).unwrap();
+        assert_eq!(ok.item(0), [0.0, 1.0]);
+    }
+
+    #[test]
+    fn normalisation_by_max_and_zero_spd() {
+        let set = SpectralSet::from_csv_str(SAMPLE, "s").unwrap();
+        let n = set.normalised_by_max().unwrap();
+        assert_eq!(n.item(1), [1.0 / 3.0, 2.0 / 3.0, 1.0]);
+        let zero = SpectralSet::from_csv_str("wavelength_nm,z\n400,0\n410,0\n", "s").unwrap();
+        assert!(zero
+            .normalised_by_max()
+            .unwrap_err()
+            .to_string()
+            .contains("'z'"));
+    }
+
+    #[test]
+    fn grid_detection() {
+        let set = SpectralSet::from_csv_str(SAMPLE, "s").unwrap();
+        assert_eq!(set.grid(), Some(Grid::new(400.0, 420.0, 10.0).unwrap()));
+        let irregular = SpectralSet::new(vec![1.0, 2.0, 4.0], vec!["a".into()], vec![vec![0.0; 3]]);
+        assert_eq!(irregular.unwrap().grid(), None);
+    }
+}

@@ -1,0 +1,190 @@
+//! The whole virtual camera against independent expectations.
+
+mod shared_data;
+
+use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::camera::demosaic::{demosaic, DemosaicMethod};
+use spdcam_core::camera::sensor::{Sensitivities, SensorMode};
+use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::chart::Chart;
+use spdcam_core::colorimetry::{self, Observer};
+use spdcam_core::illuminant::StandardIlluminant;
+use spdcam_core::raster::{CfaPattern, Mosaic, RgbImage};
+use spdcam_core::spectral::Grid;
+
+const GRID: Grid = Grid::SIMULATION;
+
+fn nikon() -> Sensitivities {
+    let set = builtin::CAMERAS[0].load().unwrap();
+    Sensitivities::new("nikon_d5100_npl", &set, &GRID).unwrap()
+}
+
+fn noise_free() -> CameraConfig {
+    CameraConfig {
+        noise: None,
+        ..CameraConfig::default()
+    }
+}
+
+/// The chart's true sRGB (0–1, encoded) under D65 from its reflectances.
+fn true_srgb(chart: &Chart) -> Vec<[f64; 3]> {
+    let obs = Observer::cie1931(&GRID).unwrap();
+    let d65 = StandardIlluminant::D65.spd(&GRID).unwrap();
+    chart
+        .feature_patches
+        .iter()
+        .map(|&p| {
+            let xyz = obs.reflectance_to_xyz(chart.reflectances.item(p), &d65);
+            colorimetry::xyz_to_linear_srgb(xyz)
+                .map(|v| colorimetry::srgb_encode(v.clamp(0.0, 1.0)))
+        })
+        .collect()
+}
+
+fn lab_of_srgb(rgb: [f64; 3], white: [f64; 3]) -> [f64; 3] {
+    let lin = rgb.map(colorimetry::srgb_decode);
+    colorimetry::xyz_to_lab(colorimetry::linear_srgb_to_xyz(lin), white)
+}
+
+fn mean_delta_e(features: &[f32], truth: &[[f64; 3]]) -> (f64, f64) {
+    let white = colorimetry::linear_srgb_to_xyz([1.0, 1.0, 1.0]);
+    let des: Vec<f64> = truth
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let r = [0, 1, 2].map(|c| features[3 * i + c] as f64 / 255.0);
+            colorimetry::delta_e_2000(lab_of_srgb(r, white), lab_of_srgb(*t, white))
+        })
+        .collect();
+    let max = des.iter().cloned().fold(0.0, f64::max);
+    (des.iter().sum::<f64>() / des.len() as f64, max)
+}
+
+#[test]
+fn d65_render_reproduces_the_chart_colours() {
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let truth = true_srgb(&chart);
+    let camera = Camera::new(&nikon(), chart, noise_free(), &GRID).unwrap();
+    let d65 = StandardIlluminant::D65.spd(&GRID).unwrap();
+    let rendering = camera.render(&d65, 0, false).unwrap();
+    let (mean, max) = mean_delta_e(&rendering.features, &truth);
+    println!(
+        "ColorChecker 24 under D65, Nikon D5100, noise off: mean ΔE2000 {mean:.3}, max {max:.3}"
+    );
+    assert!(mean <= 2.0, "mean ΔE2000 {mean}");
+}
+
+#[test]
+fn d65_render_with_the_thesis_camera_and_sg() {
+    let data = DataDir::new(Some(shared_data::data_dir()));
+    let (name, set) = builtin::resolve_table(
+        "canon_eos_5d_mark_ii_mod_bw486",
+        "camera",
+        &[],
+        &data,
+        &["thesis"],
+    )
+    .unwrap();
+    let canon = Sensitivities::new(&name, &set, &GRID).unwrap();
+    for chart_name in ["colorchecker24", "colorchecker_sg96", "colorchecker_sg140"] {
+        let chart = Chart::resolve(chart_name, None, &data, &GRID).unwrap();
+        let truth = true_srgb(&chart);
+        let camera = Camera::new(&canon, chart, noise_free(), &GRID).unwrap();
+        let d65 = StandardIlluminant::D65.spd(&GRID).unwrap();
+        let rendering = camera.render(&d65, 0, false).unwrap();
+        let (mean, max) = mean_delta_e(&rendering.features, &truth);
+        println!("{chart_name} under D65, Canon 5D Mark II BW486, noise off: mean ΔE2000 {mean:.3}, max {max:.3}");
+        assert!(mean <= 2.0, "{chart_name}: mean ΔE2000 {mean}");
+    }
+}
+
+#[test]
+fn fast_features_match_the_noise_free_image_pipeline() {
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let camera = Camera::new(&nikon(), chart, noise_free(), &GRID).unwrap();
+    for spd in ["A", "cct:9000", "D50"] {
+        let spd = spdcam_core::light::resolve_spd(spd, &DataDir::default(), &GRID).unwrap();
+        let full = camera.render(&spd.values, 0, false).unwrap().features;
+        let light = camera.light(&spd.values).unwrap();
+        let mut fast = Vec::new();
+        camera.features_fast(&light, &mut Vec::new(), &mut fast);
+        for (a, b) in full.iter().zip(&fast) {
+            // full-pipeline features are 8-bit quantised; aberration shifts by < 1 px.
+            assert!((a - b).abs() <= 0.75, "{}: {a} vs {b}", spd.name);
+        }
+    }
+}
+
+#[test]
+fn noisy_renders_are_reproducible_and_seed_dependent() {
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let camera = Camera::new(&nikon(), chart, CameraConfig::default(), &GRID).unwrap();
+    let a_spd = StandardIlluminant::A.spd(&GRID).unwrap();
+    let one = camera.render(&a_spd, 5, false).unwrap();
+    let two = camera.render(&a_spd, 5, false).unwrap();
+    let other = camera.render(&a_spd, 6, false).unwrap();
+    assert_eq!(one.image, two.image);
+    assert_ne!(one.image, other.image);
+}
+
+#[test]
+fn white_balance_neutralises_the_light() {
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let camera = Camera::new(&nikon(), chart, noise_free(), &GRID).unwrap();
+    let a_spd = StandardIlluminant::A.spd(&GRID).unwrap();
+    let features = camera.render(&a_spd, 0, false).unwrap().features;
+    // Patch 22 (neutral 5): R, G, B within a few levels after shades-of-grey balance.
+    let n5 = &features[21 * 3..21 * 3 + 3];
+    let spread =
+        n5.iter().cloned().fold(f32::MIN, f32::max) - n5.iter().cloned().fold(f32::MAX, f32::min);
+    assert!(spread < 12.0, "neutral 5 under A: {n5:?}");
+}
+
+fn psnr(a: &RgbImage, b: &RgbImage, border: usize) -> f64 {
+    let mut se = 0.0;
+    let mut n = 0usize;
+    for c in 0..3 {
+        for y in border..a.height - border {
+            for x in border..a.width - border {
+                let i = y * a.width + x;
+                se += ((a.planes[c][i] - b.planes[c][i]) as f64).powi(2);
+                n += 1;
+            }
+        }
+    }
+    10.0 * (1.0 / (se / n as f64)).log10()
+}
+
+#[test]
+fn demosaicing_quality_on_a_rendered_chart() {
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let config = CameraConfig {
+        noise: None,
+        aberration: None,
+        white_balance: spdcam_core::camera::white_balance::WhiteBalance::None,
+        colour: spdcam_core::camera::colour::ColourConfig {
+            correction: false,
+            bit_depth: 16,
+        },
+        ..CameraConfig::default()
+    };
+    let mut three = config;
+    three.sensor.mode = SensorMode::ThreeSensor;
+    let camera = Camera::new(&nikon(), chart, three, &GRID).unwrap();
+    let d65 = StandardIlluminant::D65.spd(&GRID).unwrap();
+    let truth = camera
+        .render(&d65, 0, true)
+        .unwrap()
+        .stages
+        .demosaiced
+        .unwrap();
+    let mosaic = Mosaic::from_rgb(&truth, CfaPattern::Rggb);
+    let scores: Vec<(DemosaicMethod, f64)> = DemosaicMethod::ALL
+        .iter()
+        .map(|&m| (m, psnr(&demosaic(&mosaic, m), &truth, 4)))
+        .collect();
+    println!("demosaicing PSNR on a ColorChecker 24 render: {scores:?}");
+    let get = |m| scores.iter().find(|(k, _)| *k == m).unwrap().1;
+    assert!(get(DemosaicMethod::Menon2007) >= get(DemosaicMethod::Malvar2004));
+    assert!(get(DemosaicMethod::Malvar2004) > get(DemosaicMethod::Bilinear));
+}

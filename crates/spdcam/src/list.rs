@@ -1,0 +1,74 @@
+//! `spdcam list`: what is built in, and what the data directory offers.
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::camera::noise::NoiseParams;
+use spdcam_core::chart::CHART_NAMES;
+use spdcam_core::illuminant::StandardIlluminant;
+use spdcam_core::light::SPD_FORMS;
+
+/// What to list.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum Topic {
+    Cameras,
+    Charts,
+    Illuminants,
+    Presets,
+}
+
+/// Options of `spdcam list`.
+#[derive(Debug, Args)]
+pub struct ListArgs {
+    /// One topic; all when omitted.
+    topic: Option<Topic>,
+}
+
+/// Runs `spdcam list`.
+pub fn run(args: ListArgs, data_dir: &DataDir) -> Result<()> {
+    let all = args.topic.is_none();
+    let want = |t: Topic| all || matches!((args.topic, t), (Some(a), b) if a as u8 == b as u8);
+    if want(Topic::Cameras) {
+        println!("cameras (built in):");
+        for c in builtin::CAMERAS {
+            println!("  {:<28} {}", c.name, c.description);
+        }
+        let more = data_dir.list_csv(&["cameras", "thesis"]);
+        if !more.is_empty() {
+            println!("in the data directory (cameras and thesis tables; any r,g,b CSV works):");
+            for name in more {
+                println!("  {name}");
+            }
+        }
+    }
+    if want(Topic::Charts) {
+        println!("charts:");
+        for (name, what) in CHART_NAMES {
+            println!("  {name:<28} {what}");
+        }
+        println!(
+            "  {:<28} a reflectance CSV with --layout ROWSxCOLS",
+            "FILE.csv"
+        );
+    }
+    if want(Topic::Illuminants) {
+        println!("illuminants:");
+        for ill in StandardIlluminant::ALL {
+            println!("  {}", ill.name());
+        }
+        println!("  forms: {SPD_FORMS}");
+    }
+    if want(Topic::Presets) {
+        println!("noise presets:");
+        for (name, p) in NoiseParams::PRESETS {
+            println!(
+                "  {name:<10} {} ADU/e-, read noise {} e-, black level {} ADU, {} bits",
+                p.gain_adu_per_e, p.read_noise_e, p.black_level_adu, p.bit_depth
+            );
+        }
+        println!("  off");
+        println!("demosaicing: menon2007 (default), malvar2004, bilinear");
+        println!("white balance: shades-of-grey:6 (default), grey-world, white-patch, grey-edge:p:sigma, none");
+    }
+    Ok(())
+}

@@ -1,0 +1,257 @@
+//! `spdcam render`: one chart under one light through the virtual camera.
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::camera::aberration::LateralAberration;
+use spdcam_core::camera::demosaic::DemosaicMethod;
+use spdcam_core::camera::noise::NoiseParams;
+use spdcam_core::camera::sensor::{Sensitivities, SensorMode};
+use spdcam_core::camera::white_balance::WhiteBalance;
+use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::chart::{Chart, Layout};
+use spdcam_core::raster::CfaPattern;
+use spdcam_core::spectral::Grid;
+use spdcam_core::{fsio, imageio, light};
+use std::path::{Path, PathBuf};
+
+/// Camera and chart options shared by every command that renders.
+#[derive(Debug, Args, Clone)]
+pub struct CameraArgs {
+    /// Camera sensitivities: a built-in name, a data-directory name or FILE.csv (r,g,b).
+    #[arg(long, default_value = "nikon_d5100_npl")]
+    pub camera: String,
+    /// Chart: colorchecker24, colorchecker_sg96, colorchecker_sg140, or a reflectance CSV.
+    #[arg(long, default_value = "colorchecker24")]
+    pub chart: String,
+    /// Layout ROWSxCOLS of a chart given as a reflectance CSV.
+    #[arg(long, value_name = "ROWSxCOLS")]
+    pub layout: Option<String>,
+    /// Patch size in pixels (the thesis: 24).
+    #[arg(long, default_value_t = 24)]
+    pub patch_px: usize,
+    /// Gap between patches in pixels.
+    #[arg(long, default_value_t = 0)]
+    pub gap_px: usize,
+    /// Border around the patches in pixels.
+    #[arg(long, default_value_t = 0)]
+    pub border_px: usize,
+    /// Image size WxH: fit the chart into it (overrides --patch-px, --gap-px, --border-px).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<String>,
+    /// Sensor: a Bayer pattern (rggb, bggr, grbg, gbrg) or `three` for three sensors.
+    #[arg(long, default_value = "rggb")]
+    pub sensor: String,
+    /// Brightest raw value as a fraction of full scale.
+    #[arg(long, default_value_t = 1.0)]
+    pub exposure: f64,
+    /// Noise preset: thesis, phone, or off.
+    #[arg(long, default_value = "thesis")]
+    pub noise: String,
+    /// Demosaicing: menon2007, malvar2004, bilinear.
+    #[arg(long, default_value = "menon2007")]
+    pub demosaic: String,
+    /// White balance: none, grey-world, white-patch, shades-of-grey[:p], grey-edge[:p[:sigma]].
+    #[arg(long, default_value = "shades-of-grey:6")]
+    pub white_balance: String,
+    /// Lateral chromatic aberration strength, or `off` (the thesis: 0.005 = 20/4000).
+    #[arg(long, default_value = "0.005")]
+    pub aberration: String,
+    /// Skip the D65-fitted colour-correction matrix.
+    #[arg(long)]
+    pub no_colour_correction: bool,
+    /// Output bits per channel: 8 or 16.
+    #[arg(long, default_value_t = 8)]
+    pub bit_depth: u32,
+}
+
+fn parse_pair(text: &str, what: &str) -> Result<(usize, usize)> {
+    let (a, b) = text
+        .split_once(['x', 'X', '×'])
+        .with_context(|| format!("{what} '{text}' is not of the form AxB"))?;
+    let a: usize = a
+        .trim()
+        .parse()
+        .with_context(|| format!("{what} '{text}'"))?;
+    let b: usize = b
+        .trim()
+        .parse()
+        .with_context(|| format!("{what} '{text}'"))?;
+    if a == 0 || b == 0 {
+        bail!("{what} '{text}' must be positive");
+    }
+    Ok((a, b))
+}
+
+impl CameraArgs {
+    /// The camera settings these options describe.
+    pub fn config(&self) -> Result<CameraConfig> {
+        let mode = if self.sensor.eq_ignore_ascii_case("three") {
+            SensorMode::ThreeSensor
+        } else {
+            SensorMode::SingleSensor(CfaPattern::parse(&self.sensor).with_context(|| {
+                format!(
+                    "unknown sensor '{}'; valid: rggb, bggr, grbg, gbrg, three",
+                    self.sensor
+                )
+            })?)
+        };
+        let noise = match self.noise.as_str() {
+            "off" | "none" => None,
+            name => Some(NoiseParams::preset(name)?),
+        };
+        let demosaic = DemosaicMethod::parse(&self.demosaic).with_context(|| {
+            format!(
+                "unknown demosaicing method '{}'; valid: menon2007, malvar2004, bilinear",
+                self.demosaic
+            )
+        })?;
+        let aberration = match self.aberration.as_str() {
+            "off" | "none" => None,
+            s => {
+                let strength: f64 = s
+                    .parse()
+                    .ok()
+                    .filter(|v: &f64| v.is_finite() && v.abs() < 0.5)
+                    .with_context(|| {
+                        format!("aberration '{s}' is not a strength in (-0.5, 0.5) or 'off'")
+                    })?;
+                Some(LateralAberration { strength })
+            }
+        };
+        let mut config = CameraConfig {
+            noise,
+            demosaic,
+            white_balance: WhiteBalance::parse(&self.white_balance)?,
+            aberration,
+            ..CameraConfig::default()
+        };
+        config.sensor.mode = mode;
+        config.sensor.exposure = self.exposure;
+        config.colour.correction = !self.no_colour_correction;
+        config.colour.bit_depth = self.bit_depth;
+        Ok(config)
+    }
+
+    /// The chart with the requested geometry.
+    pub fn chart(&self, data_dir: &DataDir, grid: &Grid) -> Result<Chart> {
+        let layout = self
+            .layout
+            .as_deref()
+            .map(|l| parse_pair(l, "layout"))
+            .transpose()?;
+        let chart = Chart::resolve(&self.chart, layout, data_dir, grid)?;
+        let (rows, cols) = (chart.layout.rows, chart.layout.cols);
+        let geometry = match &self.size {
+            Some(size) => {
+                let (w, h) = parse_pair(size, "size")?;
+                Layout::fit(rows, cols, w, h, 0.1, 0.3)?
+            }
+            None => Layout::grid(rows, cols, self.patch_px, self.gap_px, self.border_px),
+        };
+        Ok(chart.with_layout(geometry)?)
+    }
+
+    /// The camera: sensitivities, chart and settings.
+    pub fn camera(&self, data_dir: &DataDir, grid: &Grid) -> Result<Camera> {
+        let (name, measured) = builtin::resolve_table(
+            &self.camera,
+            "camera",
+            builtin::CAMERAS,
+            data_dir,
+            &["cameras", "thesis"],
+        )?;
+        let sensitivities = Sensitivities::new(&name, &measured, grid)?;
+        Ok(Camera::new(
+            &sensitivities,
+            self.chart(data_dir, grid)?,
+            self.config()?,
+            grid,
+        )?)
+    }
+}
+
+/// Options of `spdcam render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// The light: D65, A, D50, cct:T, daylight:T, planck:T, or a spectral CSV (FILE.csv[:COLUMN]).
+    #[arg(long)]
+    spd: String,
+    /// Output PNG.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also write the feature row (mean sRGB 0–255 of each patch) as CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    features: Option<PathBuf>,
+    /// Also write every intermediate stage as an image into this directory.
+    #[arg(long, value_name = "DIR")]
+    stages: Option<PathBuf>,
+    /// Seed of the noise.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    #[command(flatten)]
+    camera: CameraArgs,
+}
+
+/// Runs `spdcam render`.
+pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
+    let grid = Grid::SIMULATION;
+    for path in std::iter::once(&args.output).chain(&args.features) {
+        fsio::check_parent_dir(path)?;
+    }
+    if let Some(dir) = &args.stages {
+        if !dir.is_dir() {
+            bail!("stages directory {} does not exist", dir.display());
+        }
+    }
+    let spd = light::resolve_spd(&args.spd, data_dir, &grid)?;
+    if let Some(report) = spd.resampling.as_ref().filter(|r| r.extrapolated()) {
+        eprintln!(
+            "warning: {}",
+            report.describe(&format!("light {}", spd.name), &grid)
+        );
+    }
+    let camera = args.camera.camera(data_dir, &grid)?;
+    let rendering = camera.render(&spd.values, args.seed, args.stages.is_some())?;
+    let depth = camera.config().colour.bit_depth;
+    if let Some(dir) = &args.stages {
+        write_stages(dir, &rendering.stages)?;
+    }
+    if let Some(path) = &args.features {
+        let names = camera.chart().feature_names();
+        let values: Vec<String> = rendering.features.iter().map(|v| format!("{v}")).collect();
+        let text = format!("{}\n{}\n", names.join(","), values.join(","));
+        fsio::write_atomic(path, text.as_bytes())?;
+        println!("features: {}", path.display());
+    }
+    imageio::write_png(&args.output, &rendering.image, depth)?;
+    let l = &camera.chart().layout;
+    println!(
+        "rendered {} under {} with {} ({}×{} px, {}-bit sRGB): {}",
+        camera.chart().name,
+        spd.name,
+        camera.camera_name(),
+        l.width,
+        l.height,
+        depth,
+        args.output.display()
+    );
+    Ok(())
+}
+
+fn write_stages(dir: &Path, stages: &spdcam_core::camera::Stages) -> Result<()> {
+    if let Some(cfa) = &stages.cfa {
+        imageio::write_mosaic_png(&dir.join("1_cfa.png"), cfa)?;
+    }
+    for (name, image) in [
+        ("2_demosaiced.png", &stages.demosaiced),
+        ("3_white_balanced.png", &stages.white_balanced),
+        ("4_aberrated.png", &stages.aberrated),
+    ] {
+        if let Some(image) = image {
+            imageio::write_png(&dir.join(name), image, 16)?;
+        }
+    }
+    println!("stages (linear raw, 16-bit): {}", dir.display());
+    Ok(())
+}
