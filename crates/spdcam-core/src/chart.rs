@@ -333,7 +333,7 @@ mod tests {
     #[test]
     fn region_map_marks_patches_and_gaps() {
         let l = Layout::grid(2, 3, 4, 2, 1);
-        assert_eq!((l.width, l.height), (17, 11));
+        assert_eq!((l.width, l.height), (18, 12));
         let map = l.region_map();
         assert_eq!(map[0], 6);
         assert_eq!(map[l.width + 1], 0);

@@ -242,14 +242,14 @@ mod tests {
 
     #[test]
     fn daylight_at_6504k_reproduces_the_d65_table() {
-        // D65 is the D-series at 6500·1.4388/1.4380 K; the CIE table was computed with the
-        // same formulas from rounded intermediate values, so it agrees to a few 0.01.
+        // D65 is the D-series at 6500·1.4388/1.4380 K; at the 10 nm points the model
+        // reproduces the CIE table to its 4-decimal rounding.
         let grid = Grid::new(300.0, 780.0, 10.0).unwrap();
         let model = daylight(6500.0 * 1.4388 / 1.4380, &grid).unwrap();
         let table = StandardIlluminant::D65.spd(&grid).unwrap();
         for (i, (m, t)) in model.iter().zip(&table).enumerate() {
             assert!(
-                (m - t).abs() < 0.05,
+                (m - t).abs() <= 5.0001e-4,
                 "{} nm: {m} vs {t}",
                 grid.wavelength(i)
             );

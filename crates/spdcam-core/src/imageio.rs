@@ -26,7 +26,7 @@ pub fn encode_png(image: &RgbImage, bit_depth: u32) -> Result<Vec<u8>> {
                     .pixel(x as usize, y as usize)
                     .map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16))
             });
-            let raw: Vec<u8> = buf.as_raw().iter().flat_map(|v| v.to_be_bytes()).collect();
+            let raw: Vec<u8> = buf.as_raw().iter().flat_map(|v| v.to_ne_bytes()).collect();
             encoder.write_image(&raw, w, h, image::ExtendedColorType::Rgb16)
         }
         other => {
@@ -53,7 +53,7 @@ pub fn write_mosaic_png(path: &Path, mosaic: &Mosaic) -> Result<()> {
     let buf = ImageBuffer::<Luma<u16>, _>::from_fn(w, h, |x, y| {
         Luma([(mosaic.get(x as usize, y as usize).clamp(0.0, 1.0) * 65535.0).round() as u16])
     });
-    let raw: Vec<u8> = buf.as_raw().iter().flat_map(|v| v.to_be_bytes()).collect();
+    let raw: Vec<u8> = buf.as_raw().iter().flat_map(|v| v.to_ne_bytes()).collect();
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(&raw, w, h, image::ExtendedColorType::L16)

@@ -17,47 +17,97 @@ impl LateralAberration {
         strength: 20.0 / 4000.0,
     };
 
+    /// The (channel, scale) pairs the aberration changes: red magnified, blue shrunk.
+    fn scaled_channels(&self) -> [(usize, f64); 2] {
+        [(0, 1.0 + self.strength), (2, 1.0 - self.strength)]
+    }
+
     /// Applies the aberration in place; `scratch` is reused between calls.
     pub fn apply(&self, image: &mut RgbImage, scratch: &mut Vec<f32>) {
         let (w, h) = (image.width, image.height);
-        for (channel, scale) in [(0usize, 1.0 + self.strength), (2, 1.0 - self.strength)] {
+        for (channel, scale) in self.scaled_channels() {
             scratch.clear();
             scratch.extend_from_slice(&image.planes[channel]);
-            scale_about_centre(scratch, &mut image.planes[channel], w, h, scale);
+            let axis = AxisMap::new(w, h, scale);
+            let plane = &mut image.planes[channel];
+            let row = |(y, out): (usize, &mut [f32])| axis.row(scratch, y, out);
+            if w * h > 200_000 {
+                plane.par_chunks_mut(w).enumerate().for_each(row);
+            } else {
+                plane.chunks_mut(w).enumerate().for_each(row);
+            }
         }
+    }
+
+    /// The aberrated image's pixel (`x`, `y`) without aberrating the whole image: exactly
+    /// what [`LateralAberration::apply`] puts there.
+    pub fn pixel(&self, image: &RgbImage, x: usize, y: usize) -> [f32; 3] {
+        let mut out = image.pixel(x, y);
+        for (channel, scale) in self.scaled_channels() {
+            let axis = AxisMap::new(image.width, image.height, scale);
+            out[channel] = axis.sample(&image.planes[channel], x, y);
+        }
+        out
     }
 }
 
-/// `dst(x) = src(c + (x − c)/scale)` with bilinear interpolation, edges clamped.
-fn scale_about_centre(src: &[f32], dst: &mut [f32], w: usize, h: usize, scale: f64) {
-    let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
-    let inv = 1.0 / scale;
-    let max_x = (w - 1) as f64;
-    let max_y = (h - 1) as f64;
-    // Source column positions are the same for every row: compute them once.
-    let columns: Vec<(usize, usize, f32)> = (0..w)
-        .map(|x| {
-            let sx = (cx + (x as f64 - cx) * inv).clamp(0.0, max_x);
-            let x0 = sx.floor() as usize;
-            (x0, (x0 + 1).min(w - 1), (sx - x0 as f64) as f32)
-        })
-        .collect();
-    let row = |(y, out): (usize, &mut [f32])| {
-        let sy = (cy + (y as f64 - cy) * inv).clamp(0.0, max_y);
-        let y0 = sy.floor() as usize;
-        let y1 = (y0 + 1).min(h - 1);
-        let fy = (sy - y0 as f64) as f32;
-        let (r0, r1) = (&src[y0 * w..y0 * w + w], &src[y1 * w..y1 * w + w]);
-        for (o, &(x0, x1, fx)) in out.iter_mut().zip(&columns) {
-            let top = r0[x0] + fx * (r0[x1] - r0[x0]);
-            let bottom = r1[x0] + fx * (r1[x1] - r1[x0]);
-            *o = top + fy * (bottom - top);
+/// Where a channel scaled by `scale` about the image centre takes each output pixel from:
+/// `dst(x) = src(c + (x − c)/scale)`, bilinear, edges clamped.
+struct AxisMap {
+    width: usize,
+    height: usize,
+    centre: (f64, f64),
+    inverse_scale: f64,
+}
+
+impl AxisMap {
+    fn new(width: usize, height: usize, scale: f64) -> AxisMap {
+        AxisMap {
+            width,
+            height,
+            centre: ((width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0),
+            inverse_scale: 1.0 / scale,
         }
-    };
-    if w * h > 200_000 {
-        dst.par_chunks_mut(w).enumerate().for_each(row);
-    } else {
-        dst.chunks_mut(w).enumerate().for_each(row);
+    }
+
+    /// Source sample of output coordinate `v` along an axis of `n` pixels centred at `c`:
+    /// the lower index, the upper index and the weight of the upper one.
+    #[inline]
+    fn taps(&self, v: usize, c: f64, n: usize) -> (usize, usize, f32) {
+        let s = (c + (v as f64 - c) * self.inverse_scale).clamp(0.0, (n - 1) as f64);
+        let i0 = s as usize; // s >= 0: truncation is floor
+        (i0, (i0 + 1).min(n - 1), (s - i0 as f64) as f32)
+    }
+
+    #[inline]
+    fn blend(
+        src: &[f32],
+        w: usize,
+        (x0, x1, fx): (usize, usize, f32),
+        (y0, y1, fy): (usize, usize, f32),
+    ) -> f32 {
+        let (r0, r1) = (&src[y0 * w..y0 * w + w], &src[y1 * w..y1 * w + w]);
+        let top = r0[x0] + fx * (r0[x1] - r0[x0]);
+        let bottom = r1[x0] + fx * (r1[x1] - r1[x0]);
+        top + fy * (bottom - top)
+    }
+
+    /// One output row.
+    fn row(&self, src: &[f32], y: usize, out: &mut [f32]) {
+        let ty = self.taps(y, self.centre.1, self.height);
+        for (x, o) in out.iter_mut().enumerate() {
+            *o = Self::blend(src, self.width, self.taps(x, self.centre.0, self.width), ty);
+        }
+    }
+
+    /// One output pixel.
+    fn sample(&self, src: &[f32], x: usize, y: usize) -> f32 {
+        Self::blend(
+            src,
+            self.width,
+            self.taps(x, self.centre.0, self.width),
+            self.taps(y, self.centre.1, self.height),
+        )
     }
 }
 

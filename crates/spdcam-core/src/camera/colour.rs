@@ -124,7 +124,8 @@ impl ColourTransform {
     /// Quantises an encoded value to the output bit depth (result still on 0…1).
     #[inline]
     pub fn quantise(&self, encoded: f32) -> f32 {
-        (encoded * self.levels).round() / self.levels
+        // `encoded` is on 0…1: adding ½ and truncating rounds without a libm call.
+        ((encoded * self.levels + 0.5) as u32) as f32 / self.levels
     }
 
     /// Camera RGB → encoded sRGB, unquantised (the patch-level path).
@@ -136,20 +137,26 @@ impl ColourTransform {
     /// Transforms a white-balanced camera image in place into quantised encoded sRGB (0…1).
     pub fn apply(&self, image: &mut RgbImage) {
         let [r, g, b] = &mut image.planes;
-        let work = |((r, g), b): ((&mut [f32], &mut [f32]), &mut [f32])| {
-            for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
-                let out = self.encode_pixel([*r, *g, *b]).map(|v| self.quantise(v));
-                (*r, *g, *b) = (out[0], out[1], out[2]);
-            }
-        };
         const CHUNK: usize = 16384;
         if r.len() > 200_000 {
             r.par_chunks_mut(CHUNK)
                 .zip(g.par_chunks_mut(CHUNK))
                 .zip(b.par_chunks_mut(CHUNK))
-                .for_each(work);
+                .for_each(|((r, g), b)| self.apply_planes(r, g, b));
         } else {
-            work(((r.as_mut_slice(), g.as_mut_slice()), b.as_mut_slice()));
+            self.apply_planes(r, g, b);
+        }
+    }
+
+    /// The per-pixel work of [`ColourTransform::apply`] on three equally long plane slices.
+    fn apply_planes(&self, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+        let n = r.len().min(g.len()).min(b.len());
+        let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
+        for i in 0..n {
+            let lin = self.to_linear_srgb([r[i], g[i], b[i]]);
+            r[i] = self.quantise(self.encode(lin[0]));
+            g[i] = self.quantise(self.encode(lin[1]));
+            b[i] = self.quantise(self.encode(lin[2]));
         }
     }
 }

@@ -302,6 +302,7 @@ fn fill_rows(plane: &mut [f32], w: usize, h: usize, border: Border) {
 fn bilinear(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 3]) {
     let w = grid.w;
     grid.pass(Border::None, out, |y, [r, g, b]| {
+        let [r, g, b] = [r, g, b].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let (own, other) = own_other(own, r, b);
         let [up, mid, down] = grid.window::<3>(mosaic, y);
@@ -326,6 +327,7 @@ fn bilinear(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 3
 fn malvar2004(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 3]) {
     let w = grid.w;
     grid.pass(Border::None, out, |y, [r, g, b]| {
+        let [r, g, b] = [r, g, b].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let (own, other) = own_other(own, r, b);
         let [up2, up, mid, down, down2] = grid.window::<5>(mosaic, y);
@@ -369,6 +371,7 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
     // 1. Colour differences (R or B) − G at the red and blue samples, with green interpolated
     //    along the row and along the column by [0, ½, 0, ½, 0] + [−¼, 0, ½, 0, −¼]; zero at green.
     grid.pass(Border::Mirror, [&mut diff_h, &mut diff_v], |y, [ch, cv]| {
+        let [ch, cv] = [ch, cv].map(|p| &mut p[..w]);
         let (gpar, _) = row_layout(pattern, y);
         let [up2, up, mid, down, down2] = grid.window::<5>(mosaic, y);
         let (u2, u, d, d2) = (
@@ -391,6 +394,7 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
     // 2. Gradients of those differences two pixels along their direction; zero border, as
     //    the reference classifies with a zero-padded ('constant') convolution.
     grid.pass(Border::Zero, [&mut grad_h, &mut grad_v], |y, [dh, dv]| {
+        let [dh, dv] = [dh, dv].map(|p| &mut p[..w]);
         let [row] = grid.window::<1>(&diff_h, y);
         let (c, c2) = (span(row, 2, w), span(row, 4, w));
         let [_, _, here, _, below2] = grid.window::<5>(&diff_v, y);
@@ -407,6 +411,7 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
         Border::Mirror,
         [&mut green, &mut horizontal],
         |y, [g, hz]| {
+            let [g, hz] = [g, hz].map(|p| &mut p[..w]);
             let [h_u2, h_u, h_c, h_d, h_d2] = grid.window::<5>(&grad_h, y);
             let [v_u2, v_u, v_c, _, _] = grid.window::<5>(&grad_v, y);
             let ([m], [ch], [cv]) = (
@@ -431,10 +436,10 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
                     + 3.0 * (v_cc[x] + v_u2c[x])
                     + (v_u2l[x] + v_u2r[x])
                     + (v_ul[x] + v_ur[x]);
-                let along_row = sum_v >= sum_h;
+                let along_row = f32::from(u8::from(sum_v >= sum_h));
                 // The differences are zero at green samples, which so keep their value.
-                g[x] = m[x] - if along_row { ch[x] } else { cv[x] };
-                hz[x] = if along_row { 1.0 } else { 0.0 };
+                g[x] = m[x] - (along_row * ch[x] + (1.0 - along_row) * cv[x]);
+                hz[x] = along_row;
             }
         },
     );
@@ -443,6 +448,7 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
     //    neighbours that carry the colour (along the row for the row's colour, else the column).
     let (mut red, mut blue) = (grad_h, grad_v);
     grid.pass(Border::Mirror, [&mut red, &mut blue], |y, [r, b]| {
+        let [r, b] = [r, b].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let (own, other) = own_other(own, r, b);
         let [m_u, m_c, m_d] = grid.window::<3>(mosaic, y);
@@ -469,6 +475,7 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
     //    difference to green averaged over three pixels in that direction.
     let (mut cross, mut refined) = (diff_h, diff_v);
     grid.pass(Border::Mirror, [&mut cross, &mut refined], |y, [cr, gf]| {
+        let [cr, gf] = [cr, gf].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let (own, other) = if own == 0 {
             (&red, &blue)
@@ -516,6 +523,7 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
     //    sample − green of the two neighbours carrying the colour. Kept as R − B everywhere.
     let mut red_blue = red;
     grid.pass(Border::Mirror, [&mut red_blue], |y, [rb]| {
+        let [rb] = [rb].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let sign = if own == 0 { 1.0 } else { -1.0 };
         let [m_u, m_c, m_d] = grid.window::<3>(mosaic, y);
@@ -542,6 +550,7 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
     // 7. Refining step, red at blue samples and blue at red ones: the R − B difference averaged
     //    over three pixels in the chosen direction. Writes the image.
     grid.pass(Border::None, out, |y, [r, g, b]| {
+        let [r, g, b] = [r, g, b].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let sign = if own == 0 { 1.0 } else { -1.0 };
         let (own, other) = own_other(own, r, b);
@@ -575,4 +584,319 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
             };
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An image from a function of (x, y) giving (R, G, B).
+    fn image(w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 3]) -> RgbImage {
+        let mut img = RgbImage::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let rgb = f(x, y);
+                for c in 0..3 {
+                    img.planes[c][y * w + x] = rgb[c];
+                }
+            }
+        }
+        img
+    }
+
+    /// A deterministic value in [0, 1) from a counter (an LCG step).
+    fn hash(i: u64) -> f32 {
+        let v = i
+            .wrapping_add(1)
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((v >> 40) as f32) / (1u64 << 24) as f32
+    }
+
+    /// The 24 ColorChecker colours, sRGB-encoded, 8 bits.
+    const COLORCHECKER: [[u8; 3]; 24] = [
+        [115, 82, 68],
+        [194, 150, 130],
+        [98, 122, 157],
+        [87, 108, 67],
+        [133, 128, 177],
+        [103, 189, 170],
+        [214, 126, 44],
+        [80, 91, 166],
+        [193, 90, 99],
+        [94, 60, 108],
+        [157, 188, 64],
+        [224, 163, 46],
+        [56, 61, 150],
+        [70, 148, 73],
+        [175, 54, 60],
+        [231, 199, 31],
+        [187, 86, 149],
+        [8, 133, 161],
+        [243, 243, 242],
+        [200, 200, 200],
+        [160, 160, 160],
+        [122, 122, 121],
+        [85, 85, 85],
+        [52, 52, 52],
+    ];
+
+    /// ColorChecker colour `k` (mod 24) in 0..1.
+    fn checker(k: usize) -> [f32; 3] {
+        COLORCHECKER[k % 24].map(|v| f32::from(v) / 255.0)
+    }
+
+    /// 256×256: a tinted zone plate, crossed sinusoidal gratings, bars and discs in ColorChecker
+    /// colours with sharp edges.
+    fn edge_rich() -> RgbImage {
+        use std::f32::consts::TAU;
+        image(256, 256, |x, y| {
+            let (xf, yf) = (x as f32, y as f32);
+            match (x < 128, y < 128) {
+                (true, true) => {
+                    // Reaches 0.25 cycles/pixel in the corners.
+                    let s = (0.0087 * ((xf - 64.0).powi(2) + (yf - 64.0).powi(2))).cos();
+                    [0.5 + 0.4 * s, 0.45 + 0.35 * s, 0.4 + 0.3 * s]
+                }
+                (false, true) => {
+                    let a = (TAU * (0.11 * xf + 0.05 * yf)).cos();
+                    let b = (TAU * (-0.07 * xf + 0.13 * yf)).cos();
+                    let lum = 0.5 + 0.2 * a + 0.2 * b;
+                    [1.1 * lum + 0.03 * a, lum, 0.85 * lum + 0.03 * b]
+                }
+                (true, false) => checker(x / 9 + 3 * (y / 21)),
+                (false, false) => {
+                    let d2 = ((x % 32) as f32 - 15.5).powi(2) + ((y % 32) as f32 - 15.5).powi(2);
+                    if d2 < 120.0 {
+                        checker(5 * (x / 32) + 3 * (y / 32))
+                    } else {
+                        [0.45 + 0.1 * (0.05 * xf).sin(); 3]
+                    }
+                }
+            }
+        })
+    }
+
+    /// A ColorChecker rendering, 288 × 192: 8 × 12 cells of 24 × 24 pixels, each a patch of one
+    /// of the 24 colours (at four exposures, with a gentle shading across the patch) inside the
+    /// chart's 4-pixel dark frame.
+    fn chart() -> RgbImage {
+        image(288, 192, |x, y| {
+            let (u, v) = (x % 24, y % 24);
+            if u < 4 || v < 4 {
+                return [0.04; 3];
+            }
+            let patch = y / 24 * 12 + x / 24;
+            let exposure = [1.0, 0.85, 0.7, 0.55][patch / 24];
+            let shade = 1.0 + 0.08 * (u as f32 / 23.0 - 0.5) + 0.05 * (v as f32 / 23.0 - 0.5);
+            checker(7 * patch).map(|c| (c * exposure * shade).min(1.0))
+        })
+    }
+
+    /// PSNR (peak 1) of `got` against `want` over the pixels at least 4 from the border.
+    fn psnr(got: &RgbImage, want: &RgbImage) -> f64 {
+        let (w, h) = (want.width, want.height);
+        let (mut sum, mut n) = (0.0f64, 0usize);
+        for y in 4..h - 4 {
+            for x in 4..w - 4 {
+                for c in 0..3 {
+                    let e = f64::from(got.planes[c][y * w + x] - want.planes[c][y * w + x]);
+                    sum += e * e;
+                    n += 1;
+                }
+            }
+        }
+        10.0 * (n as f64 / sum).log10()
+    }
+
+    fn assert_close(got: &RgbImage, want: &RgbImage, tol: f32, what: &str) {
+        for c in 0..3 {
+            for (i, (g, w)) in got.planes[c].iter().zip(&want.planes[c]).enumerate() {
+                assert!(
+                    (g - w).abs() <= tol,
+                    "{what}: channel {c} pixel ({}, {}): {g} vs {w}",
+                    i % want.width,
+                    i / want.width
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn names_round_trip() {
+        for method in DemosaicMethod::ALL {
+            assert_eq!(DemosaicMethod::parse(method.name()), Some(method));
+            let upper = method.name().to_ascii_uppercase();
+            assert_eq!(DemosaicMethod::parse(&upper), Some(method));
+        }
+        assert_eq!(DemosaicMethod::parse("menon"), None);
+    }
+
+    #[test]
+    fn flat_colour_comes_back_everywhere() {
+        let sizes = [
+            (2, 2),
+            (3, 2),
+            (2, 3),
+            (3, 3),
+            (4, 5),
+            (5, 5),
+            (7, 4),
+            (31, 17),
+        ];
+        for (w, h) in sizes.into_iter().chain([(520, 400)]) {
+            let flat = image(w, h, |_, _| [0.2, 0.55, 0.85]);
+            for pattern in CfaPattern::ALL {
+                let mosaic = Mosaic::from_rgb(&flat, pattern);
+                for method in DemosaicMethod::ALL {
+                    let got = demosaic(&mosaic, method);
+                    assert_eq!((got.width, got.height), (w, h));
+                    assert_close(
+                        &got,
+                        &flat,
+                        1e-5,
+                        &format!("{method:?} {pattern:?} {w}×{h}"),
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn samples_are_kept_at_their_own_channel() {
+        let img = image(37, 22, |x, y| {
+            [0, 1, 2].map(|c| hash((y * 37 + x) as u64 * 3 + c))
+        });
+        for pattern in CfaPattern::ALL {
+            let mosaic = Mosaic::from_rgb(&img, pattern);
+            for method in DemosaicMethod::ALL {
+                let got = demosaic(&mosaic, method);
+                for y in 0..22 {
+                    for x in 0..37 {
+                        let c = pattern.channel_at(x, y);
+                        assert_eq!(
+                            got.pixel(x, y)[c],
+                            mosaic.get(x, y),
+                            "{method:?} {pattern:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn linear_kernels_reproduce_a_ramp() {
+        for channel in 0..3 {
+            let ramp = image(40, 30, |x, _| {
+                let mut rgb = [0.3, 0.5, 0.7];
+                rgb[channel] = 0.1 + 0.02 * x as f32;
+                rgb
+            });
+            for pattern in CfaPattern::ALL {
+                let mosaic = Mosaic::from_rgb(&ramp, pattern);
+                for method in [DemosaicMethod::Bilinear, DemosaicMethod::Malvar2004] {
+                    let got = demosaic(&mosaic, method);
+                    for y in 2..28 {
+                        for x in 2..38 {
+                            let (g, w) = (got.pixel(x, y), ramp.pixel(x, y));
+                            for c in 0..3 {
+                                assert!(
+                                    (g[c] - w[c]).abs() < 1e-5,
+                                    "{method:?} {pattern:?} ({x}, {y}) {c}: {g:?} vs {w:?}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn menon_matches_the_reference_example() {
+        // demosaicing_CFA_Bayer_Menon2007's documented example (colour-demosaicing).
+        let data = vec![
+            0.309_803_93,
+            0.360_784_32,
+            0.305_882_36,
+            0.376_470_6,
+            0.356_862_75,
+            0.396_078_44,
+            0.360_784_32,
+            0.400_000_01,
+        ];
+        let mosaic = Mosaic {
+            width: 4,
+            height: 2,
+            pattern: CfaPattern::Rggb,
+            data,
+        };
+        let row = [
+            [0.309_803_93, 0.356_862_75, 0.392_156_87],
+            [0.309_803_93, 0.360_784_32, 0.396_078_44],
+            [0.305_882_36, 0.360_784_32, 0.390_196_08],
+            [0.321_568_64, 0.376_470_6, 0.400_000_01],
+        ];
+        let want = image(4, 2, |x, _| row[x]);
+        let got = demosaic(&mosaic, DemosaicMethod::Menon2007);
+        assert_close(&got, &want, 1e-6, "Menon2007 example");
+    }
+
+    #[test]
+    fn parallel_bands_match_one_thread() {
+        let img = image(301, 203, |x, y| {
+            let (xf, yf) = (x as f32, y as f32);
+            [
+                0.5 + 0.4 * (0.3 * xf + 0.1 * yf).sin(),
+                0.5 + 0.4 * (0.2 * yf).cos(),
+                hash((y * 301 + x) as u64),
+            ]
+        });
+        for pattern in CfaPattern::ALL {
+            let mosaic = Mosaic::from_rgb(&img, pattern);
+            for method in DemosaicMethod::ALL {
+                let (mut one, mut many) = (RgbImage::new(1, 1), RgbImage::new(1, 1));
+                demosaic_with(&mosaic, method, &mut one, false);
+                demosaic_with(&mosaic, method, &mut many, true);
+                assert_eq!(one, many, "{method:?} {pattern:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn into_reuses_and_resizes_the_output() {
+        let big = Mosaic::from_rgb(&chart(), CfaPattern::Grbg);
+        let small = Mosaic::from_rgb(&edge_rich(), CfaPattern::Gbrg);
+        let mut out = demosaic(&big, DemosaicMethod::Menon2007);
+        for method in DemosaicMethod::ALL {
+            demosaic_into(&small, method, &mut out);
+            assert_eq!(out, demosaic(&small, method));
+            demosaic_into(&big, method, &mut out);
+            assert_eq!(out, demosaic(&big, method));
+        }
+    }
+
+    #[test]
+    fn quality_ranks_menon_over_malvar_over_bilinear() {
+        for (name, truth) in [("edge-rich", edge_rich()), ("chart", chart())] {
+            for pattern in CfaPattern::ALL {
+                let mosaic = Mosaic::from_rgb(&truth, pattern);
+                let [bilinear, malvar, menon] =
+                    DemosaicMethod::ALL.map(|m| psnr(&demosaic(&mosaic, m), &truth));
+                println!(
+                    "PSNR {name} {pattern:?}: bilinear {bilinear:.2} dB, malvar2004 {malvar:.2} dB, \
+                     menon2007 {menon:.2} dB"
+                );
+                assert!(
+                    menon >= malvar,
+                    "{name} {pattern:?}: Menon {menon} < Malvar {malvar}"
+                );
+                assert!(
+                    malvar > bilinear,
+                    "{name} {pattern:?}: Malvar {malvar} ≤ bilinear {bilinear}"
+                );
+            }
+        }
+    }
 }

@@ -290,11 +290,59 @@ impl Camera {
         buffers: &mut RenderBuffers,
         mut stages: Option<&mut Stages>,
     ) -> [f32; 3] {
+        let gains = self.capture_balanced(light, seed, buffers, stages.as_deref_mut());
+        if let Some(ab) = &self.config.aberration {
+            ab.apply(&mut buffers.image, &mut buffers.scratch);
+        }
+        if let Some(s) = stages.as_deref_mut() {
+            s.aberrated = Some(buffers.image.clone());
+        }
+        self.colour.apply(&mut buffers.image);
+        gains
+    }
+
+    /// The features [`Camera::render_into`] followed by [`Camera::features`] give, computed
+    /// without aberrating and colour-transforming the pixels no feature samples (the stages
+    /// after white balance act pixel by pixel). Appends to `out`.
+    pub fn render_features_into(
+        &self,
+        light: &[f32],
+        seed: u64,
+        buffers: &mut RenderBuffers,
+        out: &mut Vec<f32>,
+    ) {
+        self.capture_balanced(light, seed, buffers, None);
+        let image = &buffers.image;
+        let layout = &self.chart.layout;
+        for &p in &self.chart.feature_patches {
+            let (x0, y0, side) = layout.sampling_region(p);
+            let mut sum = [0.0f64; 3];
+            for y in y0..y0 + side {
+                for x in x0..x0 + side {
+                    let rgb = match &self.config.aberration {
+                        Some(ab) => ab.pixel(image, x, y),
+                        None => image.pixel(x, y),
+                    };
+                    let lin = self.colour.to_linear_srgb(rgb);
+                    for c in 0..3 {
+                        sum[c] += self.colour.quantise(self.colour.encode(lin[c])) as f64;
+                    }
+                }
+            }
+            out.extend(sum.map(|s| (255.0 * s / (side * side) as f64) as f32));
+        }
+    }
+
+    /// Sensor, noise, demosaicing and white balance into `buffers.image`; returns the gains.
+    fn capture_balanced(
+        &self,
+        light: &[f32],
+        seed: u64,
+        buffers: &mut RenderBuffers,
+        mut stages: Option<&mut Stages>,
+    ) -> [f32; 3] {
         let RenderBuffers {
-            raw,
-            mosaic,
-            image,
-            scratch,
+            raw, mosaic, image, ..
         } = buffers;
         self.exposed_regions(light, raw);
         match self.config.sensor.mode {
@@ -322,16 +370,9 @@ impl Camera {
         }
         let gains = self.config.white_balance.gains(image);
         white_balance::apply_gains(image, gains);
-        if let Some(s) = stages.as_deref_mut() {
+        if let Some(s) = stages {
             s.white_balanced = Some(image.clone());
         }
-        if let Some(ab) = &self.config.aberration {
-            ab.apply(image, scratch);
-        }
-        if let Some(s) = stages.as_deref_mut() {
-            s.aberrated = Some(image.clone());
-        }
-        self.colour.apply(image);
         gains
     }
 

@@ -130,7 +130,8 @@ pub fn add_noise(data: &mut [f32], width: usize, params: &NoiseParams, seed: u64
                 let z: f32 = rng.sample(StandardNormal);
                 shot + z * read
             };
-            let adu = (black + electrons * gain).round().clamp(0.0, full);
+            // Round half up by truncation (no libm call), then clip to the ADC's range.
+            let adu = ((black + electrons * gain + 0.5).max(0.0) as u32 as f32).min(full);
             *v = (adu - black) / range;
         }
     };

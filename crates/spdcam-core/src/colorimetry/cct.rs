@@ -6,9 +6,10 @@
 //! CIE 1931 2° CMFs (plain sum over their native 360–830 nm at 1 nm); the table point nearest
 //! the test chromaticity and its two neighbours give the CCT by Ohno's triangular solution
 //! when |Duv| < 0.002 and by his parabolic solution otherwise. This is the method of
-//! colour-science's `uv_to_CCT_Ohno2013`; the table here is geometric with ratio 1.001 per
-//! step (4,609 temperatures), fine enough that Ohno's 1 %-table correction factor is not
-//! needed (the interpolation error is below 0.02 K at 1,000–100,000 K).
+//! colour-science's `uv_to_CCT_Ohno2013`. The table here is geometric with ratio 1.001 per
+//! step (4,609 temperatures, the spacing colour-science uses by default), fine enough that
+//! Ohno's correction factor for a 1 % table is not needed: on the reference cases the CCT is
+//! within 0.04 K of the exact minimum-distance solution and Duv within 1e-8.
 
 use super::observer::cie1931_native;
 use crate::error::{Error, Result};
