@@ -3,7 +3,7 @@
 //! patch-level features (≥ 100,000 per second). Each line prints the median time and its
 //! ratio against the target; when python3 with numpy and colour-demosaicing is present, the
 //! same 1709×1212 pipeline in numpy (`tools/baseline_render.py`) runs as the baseline of the
-//! same run and the speed-up over it is printed.
+//! same run and the speed-up over it is printed (`SPDCAM_PYTHON` picks the interpreter).
 
 use spdcam_core::builtin;
 use spdcam_core::camera::sensor::Sensitivities;
@@ -136,13 +136,15 @@ fn report(what: &str, time: Duration, target: Duration) {
     );
 }
 
-/// Times `tools/baseline_render.py` (numpy + colour-demosaicing) if python3 can run it.
+/// Times `tools/baseline_render.py` (numpy + colour-demosaicing) if python3 (or
+/// `$SPDCAM_PYTHON`) can run it.
 fn numpy_baseline() -> Option<Duration> {
     let script = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../tools/baseline_render.py"
     );
-    let out = std::process::Command::new("python3")
+    let python = std::env::var("SPDCAM_PYTHON").unwrap_or_else(|_| "python3".into());
+    let out = std::process::Command::new(python)
         .arg(script)
         .output()
         .ok()?;

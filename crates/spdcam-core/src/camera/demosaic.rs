@@ -12,6 +12,8 @@
 //! smaller ones stay on the calling thread, which is what a caller that already works on many
 //! images at once wants.
 
+use std::cell::RefCell;
+
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -96,6 +98,17 @@ const PARALLEL_PIXELS: usize = 200_000;
 /// Width of the border around intermediate planes: the widest tap of any pass.
 const PAD: usize = 2;
 
+/// Padded scratch planes [`menon2007`] needs besides the padded mosaic.
+const MENON_PLANES: usize = 6;
+
+thread_local! {
+    /// Scratch planes kept between calls on a thread: the padded mosaic first, then the
+    /// intermediate planes. Fresh allocations of this size would be page-faulted in anew on
+    /// every call, which costs as much as the demosaicing itself. A thread keeps what its
+    /// largest image needed (7 planes of (w + 4) × (h + 4) floats for Menon2007).
+    static SCRATCH: RefCell<Vec<Vec<f32>>> = const { RefCell::new(Vec::new()) };
+}
+
 /// [`demosaic_into`] with the choice of threading made by the caller.
 fn demosaic_with(mosaic: &Mosaic, method: DemosaicMethod, out: &mut RgbImage, parallel: bool) {
     let (w, h) = (mosaic.width, mosaic.height);
@@ -114,14 +127,35 @@ fn demosaic_with(mosaic: &Mosaic, method: DemosaicMethod, out: &mut RgbImage, pa
         return;
     }
     let grid = Grid { w, h, parallel };
-    let padded = grid.pad_mosaic(&mosaic.data);
+    let planes = match method {
+        DemosaicMethod::Menon2007 => 1 + MENON_PLANES,
+        _ => 1,
+    };
+    // Taken rather than borrowed: a nested call on this thread (rayon may run one while this
+    // call waits for its bands) then simply works with fresh planes.
+    let mut scratch = SCRATCH.with(|cell| std::mem::take(&mut *cell.borrow_mut()));
+    if scratch.len() < planes {
+        scratch.resize_with(planes, Vec::new);
+    }
+    for plane in &mut scratch[..planes] {
+        plane.resize(grid.plane_len(), 0.0);
+    }
+    let (padded, work) = scratch.split_at_mut(1);
+    let padded = &mut padded[0];
+    grid.pad_mosaic(&mosaic.data, padded);
     let [r, g, b] = &mut out.planes;
     let out = [r.as_mut_slice(), g.as_mut_slice(), b.as_mut_slice()];
     match method {
-        DemosaicMethod::Bilinear => bilinear(grid, mosaic.pattern, &padded, out),
-        DemosaicMethod::Malvar2004 => malvar2004(grid, mosaic.pattern, &padded, out),
-        DemosaicMethod::Menon2007 => menon2007(grid, mosaic.pattern, &padded, out),
+        DemosaicMethod::Bilinear => bilinear(grid, mosaic.pattern, padded, out),
+        DemosaicMethod::Malvar2004 => malvar2004(grid, mosaic.pattern, padded, out),
+        DemosaicMethod::Menon2007 => {
+            let work = (&mut work[..MENON_PLANES])
+                .try_into()
+                .expect("scratch planes");
+            menon2007(grid, mosaic.pattern, padded, work, out);
+        }
     }
+    SCRATCH.with(|cell| *cell.borrow_mut() = scratch);
 }
 
 /// The layout of row `y`: the x parity of its green samples and the channel (0 = R, 2 = B) of
@@ -188,9 +222,9 @@ impl Grid {
         self.w + 2 * PAD
     }
 
-    /// A padded plane of zeros.
-    fn plane(self) -> Vec<f32> {
-        vec![0.0; self.pw() * (self.h + 2 * PAD)]
+    /// Length of a padded plane.
+    fn plane_len(self) -> usize {
+        self.pw() * (self.h + 2 * PAD)
     }
 
     /// The `N` padded rows centred on interior row `y` of `plane` (rows y − N/2 ..= y + N/2).
@@ -201,14 +235,12 @@ impl Grid {
         std::array::from_fn(|k| &plane[(first + k) * pw..(first + k + 1) * pw])
     }
 
-    /// The mosaic in a padded plane with a mirror border.
-    fn pad_mosaic(self, data: &[f32]) -> Vec<f32> {
-        let mut plane = self.plane();
+    /// Copies the row-major `data` into the padded `plane` with a mirror border.
+    fn pad_mosaic(self, data: &[f32], plane: &mut [f32]) {
         let w = self.w;
-        self.pass(Border::Mirror, [&mut plane], |y, [row]| {
+        self.pass(Border::Mirror, [plane], |y, [row]| {
             row.copy_from_slice(&data[y * w..(y + 1) * w]);
         });
-        plane
     }
 
     /// Runs `row(y, rows)` for every interior row `y`, where `rows` are the `w` interior values
@@ -360,17 +392,21 @@ fn malvar2004(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32];
 
 /// [`DemosaicMethod::Menon2007`], with its refining step; stage by stage the same computation
 /// as colour-demosaicing's `demosaicing_CFA_Bayer_Menon2007(CFA, pattern, refining_step=True)`.
-fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 3]) {
+fn menon2007(
+    grid: Grid,
+    pattern: CfaPattern,
+    mosaic: &[f32],
+    work: &mut [Vec<f32>; MENON_PLANES],
+    out: [&mut [f32]; 3],
+) {
     const THIRD: f32 = 1.0 / 3.0;
     let w = grid.w;
-    // Six padded planes, reused as the stages retire them.
-    let (mut diff_h, mut diff_v) = (grid.plane(), grid.plane());
-    let (mut grad_h, mut grad_v) = (grid.plane(), grid.plane());
-    let (mut green, mut horizontal) = (grid.plane(), grid.plane());
+    // Padded planes, renamed as later stages reuse those that earlier ones retire.
+    let [diff_h, diff_v, grad_h, grad_v, green, horizontal] = work;
 
     // 1. Colour differences (R or B) − G at the red and blue samples, with green interpolated
     //    along the row and along the column by [0, ½, 0, ½, 0] + [−¼, 0, ½, 0, −¼]; zero at green.
-    grid.pass(Border::Mirror, [&mut diff_h, &mut diff_v], |y, [ch, cv]| {
+    grid.pass(Border::Mirror, [diff_h, diff_v], |y, [ch, cv]| {
         let [ch, cv] = [ch, cv].map(|p| &mut p[..w]);
         let (gpar, _) = row_layout(pattern, y);
         let [up2, up, mid, down, down2] = grid.window::<5>(mosaic, y);
@@ -393,7 +429,7 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
 
     // 2. Gradients of those differences two pixels along their direction; zero border, as
     //    the reference classifies with a zero-padded ('constant') convolution.
-    grid.pass(Border::Zero, [&mut grad_h, &mut grad_v], |y, [dh, dv]| {
+    grid.pass(Border::Zero, [grad_h, grad_v], |y, [dh, dv]| {
         let [dh, dv] = [dh, dv].map(|p| &mut p[..w]);
         let [row] = grid.window::<1>(&diff_h, y);
         let (c, c2) = (span(row, 2, w), span(row, 4, w));
@@ -407,47 +443,43 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
 
     // 3. The a posteriori decision: sum the gradients over a 5×5 window (the paper's k_b
     //    classifier) and keep the direction with the smaller sum; green follows that direction.
-    grid.pass(
-        Border::Mirror,
-        [&mut green, &mut horizontal],
-        |y, [g, hz]| {
-            let [g, hz] = [g, hz].map(|p| &mut p[..w]);
-            let [h_u2, h_u, h_c, h_d, h_d2] = grid.window::<5>(&grad_h, y);
-            let [v_u2, v_u, v_c, _, _] = grid.window::<5>(&grad_v, y);
-            let ([m], [ch], [cv]) = (
-                grid.window::<1>(mosaic, y),
-                grid.window::<1>(&diff_h, y),
-                grid.window::<1>(&diff_v, y),
-            );
-            let (m, ch, cv) = (span(m, 2, w), span(ch, 2, w), span(cv, 2, w));
-            let (h_u2l, h_u2c) = (span(h_u2, 0, w), span(h_u2, 2, w));
-            let (h_cl, h_cc) = (span(h_c, 0, w), span(h_c, 2, w));
-            let (h_d2l, h_d2c) = (span(h_d2, 0, w), span(h_d2, 2, w));
-            let (h_ul, h_dl) = (span(h_u, 1, w), span(h_d, 1, w));
-            let (v_cl, v_cc, v_cr) = (span(v_c, 0, w), span(v_c, 2, w), span(v_c, 4, w));
-            let (v_u2l, v_u2c, v_u2r) = (span(v_u2, 0, w), span(v_u2, 2, w), span(v_u2, 4, w));
-            let (v_ul, v_ur) = (span(v_u, 1, w), span(v_u, 3, w));
-            for x in 0..w {
-                let sum_h = (h_u2c[x] + h_u2l[x])
-                    + 3.0 * (h_cc[x] + h_cl[x])
-                    + (h_d2c[x] + h_d2l[x])
-                    + (h_ul[x] + h_dl[x]);
-                let sum_v = (v_cl[x] + v_cr[x])
-                    + 3.0 * (v_cc[x] + v_u2c[x])
-                    + (v_u2l[x] + v_u2r[x])
-                    + (v_ul[x] + v_ur[x]);
-                let along_row = f32::from(u8::from(sum_v >= sum_h));
-                // The differences are zero at green samples, which so keep their value.
-                g[x] = m[x] - (along_row * ch[x] + (1.0 - along_row) * cv[x]);
-                hz[x] = along_row;
-            }
-        },
-    );
+    grid.pass(Border::Mirror, [green, horizontal], |y, [g, hz]| {
+        let [g, hz] = [g, hz].map(|p| &mut p[..w]);
+        let [h_u2, h_u, h_c, h_d, h_d2] = grid.window::<5>(&grad_h, y);
+        let [v_u2, v_u, v_c, _, _] = grid.window::<5>(&grad_v, y);
+        let ([m], [ch], [cv]) = (
+            grid.window::<1>(mosaic, y),
+            grid.window::<1>(&diff_h, y),
+            grid.window::<1>(&diff_v, y),
+        );
+        let (m, ch, cv) = (span(m, 2, w), span(ch, 2, w), span(cv, 2, w));
+        let (h_u2l, h_u2c) = (span(h_u2, 0, w), span(h_u2, 2, w));
+        let (h_cl, h_cc) = (span(h_c, 0, w), span(h_c, 2, w));
+        let (h_d2l, h_d2c) = (span(h_d2, 0, w), span(h_d2, 2, w));
+        let (h_ul, h_dl) = (span(h_u, 1, w), span(h_d, 1, w));
+        let (v_cl, v_cc, v_cr) = (span(v_c, 0, w), span(v_c, 2, w), span(v_c, 4, w));
+        let (v_u2l, v_u2c, v_u2r) = (span(v_u2, 0, w), span(v_u2, 2, w), span(v_u2, 4, w));
+        let (v_ul, v_ur) = (span(v_u, 1, w), span(v_u, 3, w));
+        for x in 0..w {
+            let sum_h = (h_u2c[x] + h_u2l[x])
+                + 3.0 * (h_cc[x] + h_cl[x])
+                + (h_d2c[x] + h_d2l[x])
+                + (h_ul[x] + h_dl[x]);
+            let sum_v = (v_cl[x] + v_cr[x])
+                + 3.0 * (v_cc[x] + v_u2c[x])
+                + (v_u2l[x] + v_u2r[x])
+                + (v_ul[x] + v_ur[x]);
+            let along_row = f32::from(u8::from(sum_v >= sum_h));
+            // The differences are zero at green samples, which so keep their value.
+            g[x] = m[x] - (along_row * ch[x] + (1.0 - along_row) * cv[x]);
+            hz[x] = along_row;
+        }
+    });
 
     // 4. Red and blue at the green samples: green plus the mean colour difference of the two
     //    neighbours that carry the colour (along the row for the row's colour, else the column).
-    let (mut red, mut blue) = (grad_h, grad_v);
-    grid.pass(Border::Mirror, [&mut red, &mut blue], |y, [r, b]| {
+    let (red, blue) = (grad_h, grad_v);
+    grid.pass(Border::Mirror, [red, blue], |y, [r, b]| {
         let [r, b] = [r, b].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let (own, other) = own_other(own, r, b);
@@ -473,8 +505,8 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
     // 5. Blue at red samples and red at blue ones from the R − B difference of the neighbours
     //    in the chosen direction; and the refining step's green: the sample minus its colour
     //    difference to green averaged over three pixels in that direction.
-    let (mut cross, mut refined) = (diff_h, diff_v);
-    grid.pass(Border::Mirror, [&mut cross, &mut refined], |y, [cr, gf]| {
+    let (cross, refined) = (diff_h, diff_v);
+    grid.pass(Border::Mirror, [cross, refined], |y, [cr, gf]| {
         let [cr, gf] = [cr, gf].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let (own, other) = if own == 0 {
@@ -521,8 +553,8 @@ fn menon2007(grid: Grid, pattern: CfaPattern, mosaic: &[f32], out: [&mut [f32]; 
 
     // 6. Refining step, red and blue at green samples: refined green plus the mean difference
     //    sample − green of the two neighbours carrying the colour. Kept as R − B everywhere.
-    let mut red_blue = red;
-    grid.pass(Border::Mirror, [&mut red_blue], |y, [rb]| {
+    let red_blue = red;
+    grid.pass(Border::Mirror, [red_blue], |y, [rb]| {
         let [rb] = [rb].map(|p| &mut p[..w]);
         let (gpar, own) = row_layout(pattern, y);
         let sign = if own == 0 { 1.0 } else { -1.0 };

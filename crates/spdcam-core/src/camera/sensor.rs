@@ -154,17 +154,19 @@ impl SpectralResponse {
 #[inline]
 fn dot(a: &[f32], b: &[f32]) -> f32 {
     let mut acc = [0.0f32; 8];
-    let chunks = a.len() / 8;
-    for k in 0..chunks {
+    let (a8, b8) = (a.chunks_exact(8), b.chunks_exact(8));
+    let tail: f32 = a8
+        .remainder()
+        .iter()
+        .zip(b8.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in a8.zip(b8) {
         for j in 0..8 {
-            acc[j] += a[k * 8 + j] * b[k * 8 + j];
+            acc[j] += x[j] * y[j];
         }
     }
-    let mut sum: f32 = acc.iter().sum();
-    for k in chunks * 8..a.len() {
-        sum += a[k] * b[k];
-    }
-    sum
+    acc.iter().sum::<f32>() + tail
 }
 
 /// The exposure scale: maps the brightest visible raw value to `exposure` of full scale.

@@ -179,13 +179,18 @@ impl WhiteBalance {
     }
 }
 
-/// `x^p`, by repeated multiplication when p is a small whole number (the usual case).
+/// `x^p`, spelled out as multiplications for the usual whole powers (no libm call).
 #[inline]
 fn power(x: f64, p: f64) -> f64 {
-    if p.fract() == 0.0 && p <= 16.0 {
-        x.powi(p as i32)
-    } else {
-        x.powf(p)
+    match p {
+        1.0 => x,
+        2.0 => x * x,
+        4.0 => (x * x) * (x * x),
+        6.0 => {
+            let x2 = x * x;
+            x2 * x2 * x2
+        }
+        _ => x.powf(p),
     }
 }
 
