@@ -9,7 +9,7 @@ use spdcam_core::illuminant::StandardIlluminant;
 use spdcam_core::light::SPD_FORMS;
 
 /// What to list.
-#[derive(Debug, Clone, Copy, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Topic {
     Cameras,
     Charts,
@@ -27,7 +27,7 @@ pub struct ListArgs {
 /// Runs `spdcam list`.
 pub fn run(args: ListArgs, data_dir: &DataDir) -> Result<()> {
     let all = args.topic.is_none();
-    let want = |t: Topic| all || matches!((args.topic, t), (Some(a), b) if a as u8 == b as u8);
+    let want = |t: Topic| all || args.topic == Some(t);
     if want(Topic::Cameras) {
         println!("cameras (built in):");
         for c in builtin::CAMERAS {

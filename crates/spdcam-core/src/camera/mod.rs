@@ -294,7 +294,7 @@ impl Camera {
         if let Some(ab) = &self.config.aberration {
             ab.apply(&mut buffers.image, &mut buffers.scratch);
         }
-        if let Some(s) = stages.as_deref_mut() {
+        if let Some(s) = stages {
             s.aberrated = Some(buffers.image.clone());
         }
         self.colour.apply(&mut buffers.image);

@@ -79,10 +79,14 @@ impl NoiseParams {
                 self.bit_depth
             )));
         }
-        if !(self.gain_adu_per_e > 0.0) || !(self.read_noise_e >= 0.0) {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(self.gain_adu_per_e) || self.read_noise_e.is_nan() || self.read_noise_e < 0.0 {
             return Err(Error::invalid("noise gain must be > 0 and read noise >= 0"));
         }
-        if !(self.black_level_adu >= 0.0) || self.black_level_adu >= self.full_scale_adu() / 2.0 {
+        if self.black_level_adu.is_nan()
+            || self.black_level_adu < 0.0
+            || self.black_level_adu >= self.full_scale_adu() / 2.0
+        {
             return Err(Error::invalid(format!(
                 "black level {} ADU does not fit {} bits",
                 self.black_level_adu, self.bit_depth

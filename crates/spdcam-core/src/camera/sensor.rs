@@ -203,8 +203,8 @@ pub fn form_mosaic(region_map: &[u16], region_rgb: &[[f32; 3]], mosaic: &mut Mos
 
 /// Fills a three-sensor image: every pixel takes its region's full (R, G, B).
 pub fn form_three_sensor(region_map: &[u16], region_rgb: &[[f32; 3]], image: &mut RgbImage) {
-    for c in 0..3 {
-        for (v, &r) in image.planes[c].iter_mut().zip(region_map) {
+    for (c, plane) in image.planes.iter_mut().enumerate() {
+        for (v, &r) in plane.iter_mut().zip(region_map) {
             *v = region_rgb[r as usize][c];
         }
     }
