@@ -101,15 +101,17 @@ fn d65_render_with_the_thesis_camera_and_sg() {
 #[test]
 fn fast_features_match_the_noise_free_image_pipeline() {
     use spdcam_core::camera::white_balance::WhiteBalance;
-    // Without white balance and aberration the two paths differ by quantisation only; with
-    // them, the image's white balance also sees demosaicing overshoot at patch edges and the
-    // aberration's sub-pixel shift, which move features by about a level.
+    // The paths differ by 8-bit quantisation only (and the aberration's sub-pixel shift,
+    // which stays far inside the sampled region), white balance included: its statistics
+    // come from the binned raw mosaic, which the patch-level path reproduces exactly.
     let plain = CameraConfig {
         white_balance: WhiteBalance::None,
         aberration: None,
         ..noise_free()
     };
-    for (config, tolerance) in [(plain, 0.51f32), (noise_free(), 1.5)] {
+    for (config, max_tolerance, mean_tolerance) in
+        [(plain, 0.51f32, 0.3f32), (noise_free(), 0.75, 0.35)]
+    {
         let chart = Chart::colorchecker24(&GRID).unwrap();
         let camera = Camera::new(&nikon(), chart, config, &GRID).unwrap();
         for spd in ["A", "cct:9000", "D50"] {
@@ -119,13 +121,18 @@ fn fast_features_match_the_noise_free_image_pipeline() {
             let mut fast = Vec::new();
             camera.features_fast(&light, &mut Vec::new(), &mut fast);
             assert_eq!(full.len(), fast.len());
-            for (a, b) in full.iter().zip(&fast) {
-                assert!(
-                    (a - b).abs() <= tolerance,
-                    "{}: {a} vs {b}\n{full:?}\n{fast:?}",
-                    spd.name
-                );
-            }
+            let diffs: Vec<f32> = full.iter().zip(&fast).map(|(a, b)| (a - b).abs()).collect();
+            let max = diffs.iter().cloned().fold(0.0, f32::max);
+            let mean = diffs.iter().sum::<f32>() / diffs.len() as f32;
+            println!(
+                "fast vs full, {}, {:?}: mean {mean:.2}, max {max:.2} levels",
+                spd.name, config.white_balance
+            );
+            assert!(
+                max <= max_tolerance && mean <= mean_tolerance,
+                "{}: mean {mean}, max {max}",
+                spd.name
+            );
         }
     }
 }
@@ -178,7 +185,11 @@ fn psnr(a: &RgbImage, b: &RgbImage, border: usize) -> f64 {
 
 #[test]
 fn demosaicing_quality_on_a_rendered_chart() {
-    let chart = Chart::colorchecker24(&GRID).unwrap();
+    // A ColorChecker as it is built: patches on a black body with gaps between them.
+    let chart = Chart::colorchecker24(&GRID)
+        .unwrap()
+        .with_layout(spdcam_core::chart::Layout::grid(4, 6, 24, 4, 8))
+        .unwrap();
     let config = CameraConfig {
         noise: None,
         aberration: None,
@@ -208,4 +219,28 @@ fn demosaicing_quality_on_a_rendered_chart() {
     let get = |m| scores.iter().find(|(k, _)| *k == m).unwrap().1;
     assert!(get(DemosaicMethod::Menon2007) >= get(DemosaicMethod::Malvar2004));
     assert!(get(DemosaicMethod::Malvar2004) > get(DemosaicMethod::Bilinear));
+}
+
+#[test]
+fn thesis_white_balance_statistics_see_demosaicing_overshoot() {
+    use spdcam_core::camera::WhiteBalanceStatistics;
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let thesis = CameraConfig {
+        white_balance_statistics: WhiteBalanceStatistics::Demosaiced,
+        aberration: None,
+        ..noise_free()
+    };
+    let a_spd = StandardIlluminant::A.spd(&GRID).unwrap();
+    let gains = |config: CameraConfig| {
+        let camera = Camera::new(&nikon(), chart.clone(), config, &GRID).unwrap();
+        camera.render(&a_spd, 0, false).unwrap().white_balance_gains
+    };
+    let raw = gains(CameraConfig {
+        aberration: None,
+        ..noise_free()
+    });
+    let demosaiced = gains(thesis);
+    // Menon's blue overshoot at edges under A raises the blue estimate: a smaller blue gain.
+    assert!(demosaiced[2] < raw[2] * 0.97, "{demosaiced:?} vs {raw:?}");
+    assert_eq!(raw[1], 1.0);
 }

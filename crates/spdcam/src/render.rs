@@ -8,7 +8,7 @@ use spdcam_core::camera::demosaic::DemosaicMethod;
 use spdcam_core::camera::noise::NoiseParams;
 use spdcam_core::camera::sensor::{Sensitivities, SensorMode};
 use spdcam_core::camera::white_balance::WhiteBalance;
-use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::camera::{Camera, CameraConfig, WhiteBalanceStatistics};
 use spdcam_core::chart::{Chart, Layout};
 use spdcam_core::raster::CfaPattern;
 use spdcam_core::spectral::Grid;
@@ -54,6 +54,10 @@ pub struct CameraArgs {
     /// White balance: none, grey-world, white-patch, shades-of-grey[:p], grey-edge[:p[:sigma]].
     #[arg(long, default_value = "shades-of-grey:6")]
     pub white_balance: String,
+    /// White-balance statistics from the 2×2-binned raw mosaic (`raw`, as camera ISPs) or
+    /// the demosaiced image (`demosaiced`, as the thesis).
+    #[arg(long, default_value = "raw")]
+    pub white_balance_statistics: String,
     /// Lateral chromatic aberration strength, or `off` (the thesis: 0.005 = 20/4000).
     #[arg(long, default_value = "0.005")]
     pub aberration: String,
@@ -119,10 +123,16 @@ impl CameraArgs {
                 Some(LateralAberration { strength })
             }
         };
+        let white_balance_statistics = match self.white_balance_statistics.as_str() {
+            "raw" => WhiteBalanceStatistics::BinnedRaw,
+            "demosaiced" => WhiteBalanceStatistics::Demosaiced,
+            other => bail!("unknown white-balance statistics '{other}'; valid: raw, demosaiced"),
+        };
         let mut config = CameraConfig {
             noise,
             demosaic,
             white_balance: WhiteBalance::parse(&self.white_balance)?,
+            white_balance_statistics,
             aberration,
             ..CameraConfig::default()
         };

@@ -35,8 +35,24 @@ pub struct CameraConfig {
     /// Used with a single sensor only.
     pub demosaic: DemosaicMethod,
     pub white_balance: WhiteBalance,
+    /// Which image the white-balance statistics are taken from.
+    pub white_balance_statistics: WhiteBalanceStatistics,
     pub aberration: Option<LateralAberration>,
     pub colour: ColourConfig,
+}
+
+/// The image white balance estimates the light from; the gains are always applied to the
+/// demosaiced image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum WhiteBalanceStatistics {
+    /// The raw mosaic binned into 2×2 cells (R, mean of the two G, B), as camera ISPs
+    /// gather AWB statistics: free of demosaicing overshoot, so the patch-level path gives
+    /// the same gains.
+    #[default]
+    BinnedRaw,
+    /// The demosaiced image, as the thesis did: Menon's overshoot at sharp patch edges
+    /// enters the estimate.
+    Demosaiced,
 }
 
 impl Default for CameraConfig {
@@ -48,6 +64,7 @@ impl Default for CameraConfig {
             noise: Some(NoiseParams::THESIS),
             demosaic: DemosaicMethod::Menon2007,
             white_balance: WhiteBalance::default(),
+            white_balance_statistics: WhiteBalanceStatistics::default(),
             aberration: Some(LateralAberration::THESIS),
             colour: ColourConfig::default(),
         }
@@ -77,6 +94,7 @@ pub struct RenderBuffers {
     /// The final image after [`Camera::render_into`]: encoded sRGB, quantised, on 0…1.
     pub image: RgbImage,
     scratch: Vec<f32>,
+    binned: RgbImage,
 }
 
 /// The intermediate images of one render, for inspection (`--stages`).
@@ -235,6 +253,7 @@ impl Camera {
             mosaic: Mosaic::new(l.width, l.height, pattern),
             image: RgbImage::new(l.width, l.height),
             scratch: Vec::new(),
+            binned: RgbImage::new(l.width / 2, l.height / 2),
         }
     }
 
@@ -342,8 +361,13 @@ impl Camera {
         mut stages: Option<&mut Stages>,
     ) -> [f32; 3] {
         let RenderBuffers {
-            raw, mosaic, image, ..
+            raw,
+            mosaic,
+            image,
+            binned,
+            ..
         } = buffers;
+        let mut from_raw = false;
         self.exposed_regions(light, raw);
         match self.config.sensor.mode {
             SensorMode::SingleSensor(_) => {
@@ -353,6 +377,10 @@ impl Camera {
                 }
                 if let Some(s) = stages.as_deref_mut() {
                     s.cfa = Some(mosaic.clone());
+                }
+                if self.config.white_balance_statistics == WhiteBalanceStatistics::BinnedRaw {
+                    bin_mosaic(mosaic, binned);
+                    from_raw = true;
                 }
                 demosaic::demosaic_into(mosaic, self.config.demosaic, image);
             }
@@ -368,7 +396,10 @@ impl Camera {
         if let Some(s) = stages.as_deref_mut() {
             s.demosaiced = Some(image.clone());
         }
-        let gains = self.config.white_balance.gains(image);
+        let gains = self
+            .config
+            .white_balance
+            .gains(if from_raw { binned } else { image });
         white_balance::apply_gains(image, gains);
         if let Some(s) = stages {
             s.white_balanced = Some(image.clone());
@@ -406,6 +437,28 @@ impl Camera {
         for &p in &self.chart.feature_patches {
             let encoded = self.colour.encode_pixel(raw[p]);
             out.extend(encoded.map(|v| 255.0 * v));
+        }
+    }
+}
+
+/// Bins a mosaic into 2×2 cells, each giving (R, mean of the two G, B); odd edges dropped.
+fn bin_mosaic(mosaic: &Mosaic, out: &mut RgbImage) {
+    let (w, h) = (mosaic.width / 2, mosaic.height / 2);
+    if (out.width, out.height) != (w, h) {
+        *out = RgbImage::new(w, h);
+    }
+    let p = mosaic.pattern;
+    for y in 0..h {
+        for x in 0..w {
+            let mut rgb = [0.0f32; 3];
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let (mx, my) = (2 * x + dx, 2 * y + dy);
+                rgb[p.channel_at(mx, my)] += mosaic.get(mx, my);
+            }
+            let i = y * w + x;
+            out.planes[0][i] = rgb[0];
+            out.planes[1][i] = rgb[1] / 2.0;
+            out.planes[2][i] = rgb[2];
         }
     }
 }
