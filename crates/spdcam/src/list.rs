@@ -7,6 +7,7 @@ use spdcam_core::camera::noise::NoiseParams;
 use spdcam_core::chart::CHART_NAMES;
 use spdcam_core::illuminant::StandardIlluminant;
 use spdcam_core::light::SPD_FORMS;
+use spdcam_core::lighting;
 
 /// What to list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -14,6 +15,7 @@ pub enum Topic {
     Cameras,
     Charts,
     Illuminants,
+    Lighting,
     Presets,
 }
 
@@ -57,6 +59,12 @@ pub fn run(args: ListArgs, data_dir: &DataDir) -> Result<()> {
             println!("  {}", ill.name());
         }
         println!("  forms: {SPD_FORMS}");
+    }
+    if want(Topic::Lighting) {
+        println!("lighting recipes (spdcam generate --lighting):");
+        for (form, what) in lighting::catalogue() {
+            println!("  {form:<28} {what}");
+        }
     }
     if want(Topic::Presets) {
         println!("noise presets:");

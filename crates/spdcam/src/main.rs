@@ -1,5 +1,7 @@
 //! spdcam: what light is in the room, from a photo of a colour chart.
 
+mod dataset;
+mod generate;
 mod list;
 mod render;
 
@@ -22,8 +24,12 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Render a chart under a light through the virtual camera.
-    Render(render::RenderArgs),
-    /// List built-in cameras, charts, illuminants and presets.
+    Render(Box<render::RenderArgs>),
+    /// Generate a dataset of (features, SPD) samples with the virtual camera.
+    Generate(Box<generate::GenerateArgs>),
+    /// Import, export, merge, split and inspect datasets.
+    Dataset(dataset::DatasetArgs),
+    /// List built-in cameras, charts, illuminants, lighting recipes and presets.
     List(list::ListArgs),
 }
 
@@ -31,7 +37,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let data_dir = spdcam_core::builtin::DataDir::new(cli.data_dir);
     let result = match cli.command {
-        Command::Render(args) => render::run(args, &data_dir),
+        Command::Render(args) => render::run(*args, &data_dir),
+        Command::Generate(args) => generate::run(*args, &data_dir),
+        Command::Dataset(args) => dataset::run(args),
         Command::List(args) => list::run(args, &data_dir),
     };
     match result {

@@ -336,8 +336,8 @@ mod tests {
         for y in 0..32 {
             for x in 0..32 {
                 let grey = if (x / 8 + y / 8) % 2 == 0 { 0.3 } else { 0.9 };
-                for c in 0..3 {
-                    img.planes[c][y * 32 + x] = grey * light[c];
+                for (plane, tint) in img.planes.iter_mut().zip(light) {
+                    plane[y * 32 + x] = grey * tint;
                 }
             }
         }
@@ -369,8 +369,8 @@ mod tests {
         let geometry = RegionGeometry::from_region_map(&map, layout.width, 5);
         let mut img = RgbImage::new(layout.width, layout.height);
         for (i, &r) in map.iter().enumerate() {
-            for c in 0..3 {
-                img.planes[c][i] = values[r as usize][c];
+            for (plane, value) in img.planes.iter_mut().zip(values[r as usize]) {
+                plane[i] = value;
             }
         }
         for wb in [

@@ -1,0 +1,215 @@
+//! The columns of a dataset and a block of samples held in memory.
+
+use crate::error::{Error, Result};
+use crate::spectral::Grid;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// How feature values are stored in the sample files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// Parquet FLOAT: what the camera computes; used for generated sets.
+    Float32,
+    /// Parquet DOUBLE: keeps every digit of imported data.
+    Float64,
+}
+
+/// The columns of every sample file of a dataset, in file order: `sample` (INT64), `family`
+/// (UTF-8), the features (`p01_r`, …; FLOAT or DOUBLE, mean encoded sRGB on 0–255), the SPD
+/// (`spd_380`, … in nm; DOUBLE), the weights (`w_<name>`; DOUBLE) and `attempts` (INT32).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Columns {
+    pub feature_names: Vec<String>,
+    pub feature_precision: Precision,
+    pub spd_grid: Grid,
+    /// Names of the lighting's weights (channel drive levels); empty when it has none.
+    pub weight_names: Vec<String>,
+}
+
+impl Columns {
+    /// Number of feature values per sample.
+    pub fn feature_count(&self) -> usize {
+        self.feature_names.len()
+    }
+
+    /// Number of SPD values per sample.
+    pub fn spd_len(&self) -> usize {
+        self.spd_grid.count
+    }
+
+    /// Number of weights per sample.
+    pub fn weight_count(&self) -> usize {
+        self.weight_names.len()
+    }
+
+    /// Every column name in file order.
+    pub fn column_names(&self) -> Vec<String> {
+        let mut names = vec!["sample".to_string(), "family".to_string()];
+        names.extend(self.feature_names.iter().cloned());
+        names.extend(self.spd_grid.wavelengths().into_iter().map(spd_column_name));
+        names.extend(self.weight_names.iter().map(|w| format!("w_{w}")));
+        names.push("attempts".to_string());
+        names
+    }
+
+    /// Checks that there are features and that no two columns share a name.
+    pub fn validate(&self) -> Result<()> {
+        if self.feature_names.is_empty() {
+            return Err(Error::invalid(
+                "a dataset needs at least one feature column",
+            ));
+        }
+        let names = self.column_names();
+        let mut seen = std::collections::HashSet::new();
+        if let Some(dup) = names.iter().find(|n| !seen.insert(n.as_str())) {
+            return Err(Error::invalid(format!(
+                "column name '{dup}' appears twice in the dataset's columns"
+            )));
+        }
+        Ok(())
+    }
+
+    /// An empty batch with this layout.
+    pub fn batch(&self) -> SampleBatch {
+        SampleBatch {
+            feature_count: self.feature_count(),
+            spd_len: self.spd_len(),
+            weight_count: self.weight_count(),
+            ..SampleBatch::default()
+        }
+    }
+}
+
+/// The column name of the SPD value at `nm`: `spd_380`, or `spd_380p5` for 380.5 nm.
+fn spd_column_name(nm: f64) -> String {
+    format!("spd_{nm}").replace('.', "p")
+}
+
+/// Samples held in memory, each quantity row-major (`features[row * feature_count + j]`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SampleBatch {
+    pub feature_count: usize,
+    pub spd_len: usize,
+    pub weight_count: usize,
+    /// Sample index within its generating run (or row of the imported file).
+    pub samples: Vec<u64>,
+    pub families: Vec<String>,
+    pub features: Vec<f64>,
+    pub spds: Vec<f64>,
+    pub weights: Vec<f64>,
+    /// Lights drawn for this sample, the accepted one included.
+    pub attempts: Vec<u32>,
+}
+
+/// One sample borrowed from a batch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleRow<'a> {
+    pub sample: u64,
+    pub family: &'a str,
+    pub features: &'a [f64],
+    pub spd: &'a [f64],
+    pub weights: &'a [f64],
+    pub attempts: u32,
+}
+
+impl SampleBatch {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// Whether the batch holds no sample.
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// The features of row `i`.
+    pub fn features_of(&self, i: usize) -> &[f64] {
+        &self.features[i * self.feature_count..(i + 1) * self.feature_count]
+    }
+
+    /// The SPD of row `i`.
+    pub fn spd_of(&self, i: usize) -> &[f64] {
+        &self.spds[i * self.spd_len..(i + 1) * self.spd_len]
+    }
+
+    /// The weights of row `i` (empty when the dataset has none).
+    pub fn weights_of(&self, i: usize) -> &[f64] {
+        &self.weights[i * self.weight_count..(i + 1) * self.weight_count]
+    }
+
+    /// Row `i`.
+    pub fn row(&self, i: usize) -> SampleRow<'_> {
+        SampleRow {
+            sample: self.samples[i],
+            family: &self.families[i],
+            features: self.features_of(i),
+            spd: self.spd_of(i),
+            weights: self.weights_of(i),
+            attempts: self.attempts[i],
+        }
+    }
+
+    /// Appends one row, checking its lengths against the batch's layout.
+    pub fn push(&mut self, row: SampleRow<'_>) -> Result<()> {
+        let lengths = (row.features.len(), row.spd.len(), row.weights.len());
+        if lengths != (self.feature_count, self.spd_len, self.weight_count) {
+            return Err(Error::invalid(format!(
+                "sample {} has {} features, {} SPD values and {} weights; the dataset needs {}, {} and {}",
+                row.sample,
+                lengths.0,
+                lengths.1,
+                lengths.2,
+                self.feature_count,
+                self.spd_len,
+                self.weight_count
+            )));
+        }
+        self.samples.push(row.sample);
+        self.families.push(row.family.to_string());
+        self.features.extend_from_slice(row.features);
+        self.spds.extend_from_slice(row.spd);
+        self.weights.extend_from_slice(row.weights);
+        self.attempts.push(row.attempts);
+        Ok(())
+    }
+
+    /// Moves every row of `other` (same layout) to the end of this batch.
+    pub fn append(&mut self, mut other: SampleBatch) {
+        debug_assert_eq!(
+            (other.feature_count, other.spd_len, other.weight_count),
+            (self.feature_count, self.spd_len, self.weight_count)
+        );
+        self.samples.append(&mut other.samples);
+        self.families.append(&mut other.families);
+        self.features.append(&mut other.features);
+        self.spds.append(&mut other.spds);
+        self.weights.append(&mut other.weights);
+        self.attempts.append(&mut other.attempts);
+    }
+}
+
+/// Counts gathered over the samples of a dataset.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Counts {
+    pub samples: u64,
+    pub attempts: u64,
+    pub families: BTreeMap<String, u64>,
+}
+
+impl Counts {
+    /// Adds the samples of `batch`.
+    pub fn add(&mut self, batch: &SampleBatch) {
+        self.samples += batch.len() as u64;
+        self.attempts += batch.attempts.iter().map(|&a| a as u64).sum::<u64>();
+        for f in &batch.families {
+            match self.families.get_mut(f) {
+                Some(n) => *n += 1,
+                None => {
+                    self.families.insert(f.clone(), 1);
+                }
+            }
+        }
+    }
+}

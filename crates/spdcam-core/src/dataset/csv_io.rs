@@ -1,0 +1,330 @@
+//! The thesis's CSV layout in and out: `features.csv` (one row per sample, columns
+//! `p01_r,p01_g,…`) and `spds.csv` (one row per sample, header = wavelengths in nm).
+
+use super::batch::{Columns, Precision, SampleBatch, SampleRow};
+use super::manifest::{ImportSource, Manifest, Origin, FEATURE_SCALE};
+use super::reader::Dataset;
+use super::spd_map::SpdMap;
+use super::writer::{prepare_output, DatasetWriter};
+use crate::error::{Error, Result};
+use crate::fsio;
+use crate::spectral::Grid;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Settings of [`import_csv`].
+#[derive(Debug, Clone)]
+pub struct ImportOptions {
+    /// The scale of the features in the file: 255 (0–255) or 1 (0–1, multiplied by 255).
+    pub feature_scale: f64,
+    /// The grid the SPDs are stored on.
+    pub spd_grid: Grid,
+    /// The family name every imported sample gets.
+    pub family: String,
+    /// Samples per file.
+    pub chunk_size: u64,
+}
+
+/// What [`import_csv`] did.
+#[derive(Debug, Clone)]
+pub struct ImportReport {
+    pub manifest: Manifest,
+    /// The largest feature value in the file, before scaling (a 0–1 file read as 0–255
+    /// shows here).
+    pub largest_feature: f64,
+}
+
+fn reader(path: &Path) -> Result<csv::Reader<std::fs::File>> {
+    csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| Error::parse(path.display().to_string(), e.to_string()))
+}
+
+fn header(reader: &mut csv::Reader<std::fs::File>, path: &Path) -> Result<Vec<String>> {
+    let header = reader
+        .headers()
+        .map_err(|e| Error::parse(path.display().to_string(), format!("line 1: {e}")))?;
+    let names: Vec<String> = header.iter().map(str::to_string).collect();
+    if names.iter().all(String::is_empty) {
+        return Err(Error::parse(
+            path.display().to_string(),
+            "the file is empty",
+        ));
+    }
+    Ok(names)
+}
+
+/// Parses the numbers of one CSV record; errors name the file, line and column.
+fn numbers(record: &csv::StringRecord, names: &[String], path: &Path) -> Result<Vec<f64>> {
+    let line = record.position().map_or(0, |p| p.line());
+    let err = |msg: String| Error::parse(path.display().to_string(), format!("line {line}: {msg}"));
+    if record.len() != names.len() {
+        return Err(err(format!(
+            "{} cells, the header has {}",
+            record.len(),
+            names.len()
+        )));
+    }
+    record
+        .iter()
+        .zip(names)
+        .map(|(cell, name)| {
+            cell.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| err(format!("column '{name}': '{cell}' is not a number")))
+        })
+        .collect()
+}
+
+/// Imports samples from a features CSV and an SPDs CSV (same rows) into the dataset
+/// directory `out`. Features are stored as DOUBLE on 0–255 (multiplied by 255 when the file
+/// is on 0–1); SPDs are moved onto `options.spd_grid`, keeping the values at the file's
+/// own wavelengths exactly and setting wavelengths outside the file's range to zero.
+pub fn import_csv(
+    features: &Path,
+    spds: &Path,
+    out: &Path,
+    options: &ImportOptions,
+    overwrite: bool,
+) -> Result<ImportReport> {
+    if options.feature_scale != 255.0 && options.feature_scale != 1.0 {
+        return Err(Error::invalid(format!(
+            "feature scale {} is not 255 or 1",
+            options.feature_scale
+        )));
+    }
+    let mut feature_reader = reader(features)?;
+    let feature_names = header(&mut feature_reader, features)?;
+    let mut spd_reader = reader(spds)?;
+    let spd_header = header(&mut spd_reader, spds)?;
+    let wavelengths: Vec<f64> = spd_header
+        .iter()
+        .map(|h| {
+            h.trim_end_matches("nm")
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|w| w.is_finite())
+                .ok_or_else(|| {
+                    Error::parse(
+                        spds.display().to_string(),
+                        format!("line 1: header cell '{h}' is not a wavelength in nm"),
+                    )
+                })
+        })
+        .collect::<Result<_>>()?;
+    if let Some(w) = wavelengths.windows(2).find(|w| w[1] <= w[0]) {
+        return Err(Error::parse(
+            spds.display().to_string(),
+            format!(
+                "line 1: wavelength {} nm follows {} nm; they must increase",
+                w[1], w[0]
+            ),
+        ));
+    }
+    let map = SpdMap::new(&wavelengths, &options.spd_grid)
+        .map_err(|e| Error::parse(spds.display().to_string(), e.to_string()))?;
+    let columns = Columns {
+        feature_names,
+        feature_precision: Precision::Float64,
+        spd_grid: options.spd_grid,
+        weight_names: Vec::new(),
+    };
+    columns
+        .validate()
+        .map_err(|e| Error::parse(features.display().to_string(), e.to_string()))?;
+    prepare_output(out, overwrite)?;
+    let mut writer = DatasetWriter::new(out, columns.clone(), options.chunk_size)?;
+    let mut feature_rows = feature_reader.records();
+    let mut spd_rows = spd_reader.records();
+    let mut largest_feature = f64::NEG_INFINITY;
+    let mut spd = Vec::with_capacity(columns.spd_len());
+    for sample in 0u64.. {
+        let (f, s) = match (feature_rows.next(), spd_rows.next()) {
+            (None, None) => break,
+            (Some(f), Some(s)) => (f, s),
+            (f, _) => {
+                let (longer, shorter) = if f.is_some() {
+                    (features, spds)
+                } else {
+                    (spds, features)
+                };
+                return Err(Error::invalid(format!(
+                    "{} has more rows than {} ({sample}): rows must be the same samples",
+                    longer.display(),
+                    shorter.display()
+                )));
+            }
+        };
+        let f = f.map_err(|e| Error::parse(features.display().to_string(), e.to_string()))?;
+        let s = s.map_err(|e| Error::parse(spds.display().to_string(), e.to_string()))?;
+        let mut values = numbers(&f, &columns.feature_names, features)?;
+        for (v, name) in values.iter_mut().zip(&columns.feature_names) {
+            if *v < 0.0 || *v > options.feature_scale {
+                let line = f.position().map_or(0, |p| p.line());
+                let hint = if options.feature_scale == 1.0 {
+                    " (a 0–255 file? use a feature scale of 255)"
+                } else {
+                    ""
+                };
+                return Err(Error::parse(
+                    features.display().to_string(),
+                    format!(
+                        "line {line}, column '{name}': {v} is outside 0–{}{hint}",
+                        options.feature_scale
+                    ),
+                ));
+            }
+            largest_feature = largest_feature.max(*v);
+            *v *= FEATURE_SCALE / options.feature_scale;
+        }
+        spd.clear();
+        map.apply(&numbers(&s, &spd_header, spds)?, &mut spd)?;
+        writer.push(SampleRow {
+            sample,
+            family: &options.family,
+            features: &values,
+            spd: &spd,
+            weights: &[],
+            attempts: 1,
+        })?;
+    }
+    let origin = Origin::Imported(ImportSource {
+        features_file: features.display().to_string(),
+        spds_file: spds.display().to_string(),
+        feature_scale: options.feature_scale,
+        source_wavelengths: wavelengths,
+        resampling: map.report().cloned(),
+    });
+    Ok(ImportReport {
+        manifest: writer.finish(origin)?,
+        largest_feature,
+    })
+}
+
+/// Settings of [`export_csv`].
+#[derive(Debug, Clone)]
+pub struct ExportOptions {
+    /// The scale to write features on: 255 (as stored) or 1 (divided by 255).
+    pub feature_scale: f64,
+    /// The wavelengths to write SPDs at; the dataset's grid when `None`.
+    pub spd_grid: Option<Grid>,
+}
+
+/// Writes one CSV file from every sample of `dataset`, atomically.
+fn write_table(
+    dataset: &Dataset,
+    path: &Path,
+    header: &[String],
+    mut row: impl FnMut(&SampleBatch, usize, &mut String) -> Result<()>,
+) -> Result<()> {
+    let mut failure = None;
+    let written = fsio::write_atomic_with(path, |w| {
+        writeln!(w, "{}", header.join(","))?;
+        let mut line = String::new();
+        for batch in dataset.batches() {
+            let batch = batch.map_err(|e| {
+                failure = Some(e);
+                std::io::Error::other("reading the dataset failed")
+            })?;
+            for i in 0..batch.len() {
+                line.clear();
+                if let Err(e) = row(&batch, i, &mut line) {
+                    failure = Some(e);
+                    return Err(std::io::Error::other("formatting a row failed"));
+                }
+                line.push('\n');
+                w.write_all(line.as_bytes())?;
+            }
+        }
+        Ok(())
+    });
+    match (failure, written) {
+        (Some(e), _) => Err(e),
+        (None, r) => r,
+    }
+}
+
+fn join_numbers(line: &mut String, values: impl Iterator<Item = String>) {
+    for (k, v) in values.enumerate() {
+        if k > 0 {
+            line.push(',');
+        }
+        line.push_str(&v);
+    }
+}
+
+/// Writes `dataset` into `out` in the thesis's CSV layout: `features.csv`, `spds.csv`,
+/// `weights.csv` (when the dataset has weights) and `samples.csv` (sample, family,
+/// attempts), rows in dataset order. Returns the files written.
+pub fn export_csv(
+    dataset: &Dataset,
+    out: &Path,
+    options: &ExportOptions,
+    overwrite: bool,
+) -> Result<Vec<PathBuf>> {
+    if options.feature_scale != 255.0 && options.feature_scale != 1.0 {
+        return Err(Error::invalid(format!(
+            "feature scale {} is not 255 or 1",
+            options.feature_scale
+        )));
+    }
+    let columns = dataset.columns();
+    let grid = options.spd_grid.unwrap_or(columns.spd_grid);
+    let map = SpdMap::new(&columns.spd_grid.wavelengths(), &grid)?;
+    prepare_output(out, overwrite)?;
+    let mut written = Vec::new();
+
+    let path = out.join("features.csv");
+    let single = columns.feature_precision == Precision::Float32;
+    let divisor = FEATURE_SCALE / options.feature_scale;
+    write_table(dataset, &path, &columns.feature_names, |b, i, line| {
+        let values = b
+            .features_of(i)
+            .iter()
+            .map(|&v| match (single, divisor == 1.0) {
+                (true, true) => format!("{}", v as f32),
+                _ => format!("{}", v / divisor),
+            });
+        join_numbers(line, values);
+        Ok(())
+    })?;
+    written.push(path);
+
+    let path = out.join("spds.csv");
+    let header: Vec<String> = grid.wavelengths().iter().map(|w| format!("{w}")).collect();
+    let mut spd = Vec::new();
+    write_table(dataset, &path, &header, |b, i, line| {
+        spd.clear();
+        map.apply(b.spd_of(i), &mut spd)?;
+        join_numbers(line, spd.iter().map(|v| format!("{v}")));
+        Ok(())
+    })?;
+    written.push(path);
+
+    if !columns.weight_names.is_empty() {
+        let path = out.join("weights.csv");
+        write_table(dataset, &path, &columns.weight_names, |b, i, line| {
+            join_numbers(line, b.weights_of(i).iter().map(|v| format!("{v}")));
+            Ok(())
+        })?;
+        written.push(path);
+    }
+
+    let path = out.join("samples.csv");
+    let header = ["sample", "family", "attempts"].map(String::from);
+    write_table(dataset, &path, &header, |b, i, line| {
+        let family = &b.families[i];
+        let family = if family.contains([',', '"', '\n']) {
+            format!("\"{}\"", family.replace('"', "\"\""))
+        } else {
+            family.clone()
+        };
+        line.push_str(&format!("{},{family},{}", b.samples[i], b.attempts[i]));
+        Ok(())
+    })?;
+    written.push(path);
+    Ok(written)
+}

@@ -1,0 +1,495 @@
+//! `spdcam generate`: samples from the virtual camera under lights of a lighting recipe,
+//! written file by file so that memory stays flat, shards tile one run and an interrupted
+//! run resumes.
+
+use super::batch::{Columns, Counts, Precision, SampleBatch, SampleRow};
+use super::file;
+use super::manifest::{
+    CameraInfo, ChartInfo, FileEntry, GenerateSettings, LightingInfo, Manifest, Origin, Pipeline,
+    Shard,
+};
+use super::spd_map::SpdMap;
+use super::writer::{
+    create_dir, is_empty_dir, prepare_output, remove_partials, sample_file_name, write_sample_file,
+    IMAGES_DIR, RUN_FILE, SAMPLES_DIR,
+};
+use super::DEFAULT_CHUNK_SIZE;
+use crate::camera::{Camera, RenderBuffers};
+use crate::error::{Error, Result};
+use crate::lighting::Lighting;
+use crate::spectral::Grid;
+use crate::{fsio, imageio, seed};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// Samples one worker renders between progress reports.
+const BLOCK: u64 = 64;
+
+/// What to generate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GenerateOptions {
+    /// Samples of the whole run (all shards together).
+    pub count: u64,
+    pub seed: u64,
+    /// Generate only this part of the run.
+    pub shard: Option<Shard>,
+    pub pipeline: Pipeline,
+    /// The grid SPDs are stored on (inside the simulation grid).
+    pub spd_grid: Grid,
+    /// Also write every rendered chart as PNG (full pipeline only).
+    pub images: bool,
+    /// Samples per file.
+    pub chunk_size: u64,
+}
+
+impl GenerateOptions {
+    /// `count` samples from `seed`: whole run, full pipeline, SPDs on the simulation grid,
+    /// no images, [`DEFAULT_CHUNK_SIZE`] samples per file.
+    pub fn new(count: u64, seed: u64) -> GenerateOptions {
+        GenerateOptions {
+            count,
+            seed,
+            shard: None,
+            pipeline: Pipeline::Full,
+            spd_grid: Grid::SIMULATION,
+            images: false,
+            chunk_size: DEFAULT_CHUNK_SIZE,
+        }
+    }
+}
+
+/// A camera, a lighting recipe and the options: renders samples in memory or into a
+/// dataset directory.
+pub struct Generator<'a> {
+    camera: &'a Camera,
+    lighting: &'a Lighting,
+    options: GenerateOptions,
+    columns: Columns,
+    spd_map: SpdMap,
+}
+
+/// The work of one run in one directory: which files are already there.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    dir: PathBuf,
+    chunks: Vec<PlannedChunk>,
+}
+
+#[derive(Debug, Clone)]
+struct PlannedChunk {
+    index: u64,
+    samples: Range<u64>,
+    done: bool,
+}
+
+impl Plan {
+    /// Samples this run (or shard) holds when finished.
+    pub fn total(&self) -> u64 {
+        self.chunks
+            .iter()
+            .map(|c| c.samples.end - c.samples.start)
+            .sum()
+    }
+
+    /// Samples already written by an earlier, interrupted run.
+    pub fn done(&self) -> u64 {
+        self.chunks
+            .iter()
+            .filter(|c| c.done)
+            .map(|c| c.samples.end - c.samples.start)
+            .sum()
+    }
+}
+
+/// What identifies a run, kept in the directory while it is unfinished.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct RunRecord {
+    spdcam_version: String,
+    columns: Columns,
+    settings: GenerateSettings,
+}
+
+/// Per-worker scratch space.
+struct Workspace {
+    buffers: Option<RenderBuffers>,
+    raw: Vec<[f32; 3]>,
+    features: Vec<f32>,
+    features_f64: Vec<f64>,
+    spd: Vec<f64>,
+}
+
+impl<'a> Generator<'a> {
+    /// Checks the options against the camera and lighting.
+    pub fn new(
+        camera: &'a Camera,
+        lighting: &'a Lighting,
+        options: GenerateOptions,
+    ) -> Result<Generator<'a>> {
+        if options.count == 0 {
+            return Err(Error::invalid("the sample count must be at least 1"));
+        }
+        if options.chunk_size == 0 {
+            return Err(Error::invalid("the chunk size must be at least 1 sample"));
+        }
+        if options.images && options.pipeline == Pipeline::Fast {
+            return Err(Error::invalid(
+                "images need the full pipeline; the fast path renders no image",
+            ));
+        }
+        let sim = camera.grid();
+        let g = options.spd_grid;
+        if g.start_nm < sim.start_nm - 1e-9 || g.end_nm() > sim.end_nm() + 1e-9 {
+            return Err(Error::invalid(format!(
+                "the SPD grid {g} reaches outside the simulation grid {sim}"
+            )));
+        }
+        let columns = Columns {
+            feature_names: camera.chart().feature_names(),
+            feature_precision: Precision::Float32,
+            spd_grid: g,
+            weight_names: lighting.weight_names().unwrap_or_default(),
+        };
+        columns.validate()?;
+        let spd_map = SpdMap::new(&sim.wavelengths(), &g)?;
+        Ok(Generator {
+            camera,
+            lighting,
+            options,
+            columns,
+            spd_map,
+        })
+    }
+
+    /// The columns of the samples.
+    pub fn columns(&self) -> &Columns {
+        &self.columns
+    }
+
+    /// The sample files `[start, end)` this run (or shard) writes.
+    fn chunk_range(&self) -> Range<u64> {
+        let total = self.options.count.div_ceil(self.options.chunk_size);
+        match self.options.shard {
+            None => 0..total,
+            Some(Shard { index, count }) => {
+                let at = |k: u32| (total as u128 * k as u128 / count as u128) as u64;
+                at(index)..at(index + 1)
+            }
+        }
+    }
+
+    /// The samples of file `k`.
+    fn chunk_samples(&self, k: u64) -> Range<u64> {
+        let size = self.options.chunk_size;
+        k * size..((k + 1) * size).min(self.options.count)
+    }
+
+    /// The settings recorded in the manifest.
+    pub fn settings(&self) -> GenerateSettings {
+        let chunks = self.chunk_range();
+        let start = (chunks.start * self.options.chunk_size).min(self.options.count);
+        let end = (chunks.end * self.options.chunk_size).min(self.options.count);
+        let chart = self.camera.chart();
+        GenerateSettings {
+            count: self.options.count,
+            seed: self.options.seed,
+            shard: self.options.shard,
+            sample_range: [start, end],
+            pipeline: self.options.pipeline,
+            chunk_size: self.options.chunk_size,
+            images: self.options.images,
+            simulation_grid: *self.camera.grid(),
+            seeding: "sample i: light = lighting.draw(seed, i); camera noise seed = \
+                      seed::derive(seed, i) (SplitMix64 of seed and i)"
+                .to_string(),
+            lighting: LightingInfo {
+                spec: self.lighting.spec().to_string(),
+                description: self.lighting.describe(),
+            },
+            chart: ChartInfo {
+                name: chart.name.clone(),
+                layout: chart.layout,
+                feature_patches: chart.feature_patches.clone(),
+                background_reflectance: chart.background_reflectance,
+            },
+            camera: CameraInfo {
+                name: self.camera.camera_name().to_string(),
+                config: *self.camera.config(),
+                correction_matrix: self
+                    .camera
+                    .correction_matrix()
+                    .map(|m| std::array::from_fn(|r| std::array::from_fn(|c| m[(r, c)]))),
+            },
+        }
+    }
+
+    fn workspace(&self) -> Workspace {
+        Workspace {
+            buffers: (self.options.pipeline == Pipeline::Full).then(|| self.camera.buffers()),
+            raw: Vec::new(),
+            features: Vec::new(),
+            features_f64: Vec::new(),
+            spd: Vec::new(),
+        }
+    }
+
+    /// Renders sample `i` and appends it to `out`; writes its image into `images` if given.
+    fn sample_into(
+        &self,
+        i: u64,
+        ws: &mut Workspace,
+        out: &mut SampleBatch,
+        images: Option<&Path>,
+    ) -> Result<()> {
+        let seed = self.options.seed;
+        let draw = self.lighting.draw(seed, i)?;
+        let light = self.camera.light(&draw.spd).map_err(|e| {
+            Error::invalid(format!(
+                "sample {i}: lighting '{}' drew a light the camera cannot render: {e}",
+                self.lighting.spec()
+            ))
+        })?;
+        ws.features.clear();
+        match ws.buffers.as_mut() {
+            None => self
+                .camera
+                .features_fast(&light, &mut ws.raw, &mut ws.features),
+            Some(buffers) => {
+                let noise_seed = seed::derive(seed, i);
+                match images {
+                    None => self.camera.render_features_into(
+                        &light,
+                        noise_seed,
+                        buffers,
+                        &mut ws.features,
+                    ),
+                    Some(dir) => {
+                        self.camera.render_into(&light, noise_seed, buffers, None);
+                        ws.features.extend(self.camera.features(&buffers.image));
+                        let path = dir.join(format!("sample-{i:08}.png"));
+                        let depth = self.camera.config().colour.bit_depth;
+                        imageio::write_png(&path, &buffers.image, depth)?;
+                    }
+                }
+            }
+        }
+        ws.features_f64.clear();
+        ws.features_f64
+            .extend(ws.features.iter().map(|&v| f64::from(v)));
+        ws.spd.clear();
+        self.spd_map.apply(&draw.spd, &mut ws.spd)?;
+        let weights = draw.weights.as_deref().unwrap_or_default();
+        if weights.len() != self.columns.weight_count() {
+            return Err(Error::invalid(format!(
+                "sample {i}: lighting '{}' gave {} weights for its {} weight names",
+                self.lighting.spec(),
+                weights.len(),
+                self.columns.weight_count()
+            )));
+        }
+        out.push(SampleRow {
+            sample: i,
+            family: &draw.family,
+            features: &ws.features_f64,
+            spd: &ws.spd,
+            weights,
+            attempts: draw.attempts,
+        })
+    }
+
+    /// Renders samples `range` in memory, in parallel, rows in sample order; writes their
+    /// images into `images` if given. `progress` is told how many samples were finished.
+    pub fn samples(
+        &self,
+        range: Range<u64>,
+        images: Option<&Path>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<SampleBatch> {
+        let blocks: Vec<Range<u64>> = range
+            .clone()
+            .step_by(BLOCK as usize)
+            .map(|s| s..(s + BLOCK).min(range.end))
+            .collect();
+        let parts = blocks
+            .into_par_iter()
+            .map_init(
+                || self.workspace(),
+                |ws, block| {
+                    let mut part = self.columns.batch();
+                    for i in block.clone() {
+                        self.sample_into(i, ws, &mut part, images)?;
+                    }
+                    progress(block.end - block.start);
+                    Ok(part)
+                },
+            )
+            .collect::<Result<Vec<SampleBatch>>>()?;
+        let mut all = self.columns.batch();
+        for part in parts {
+            all.append(part);
+        }
+        Ok(all)
+    }
+
+    fn record(&self) -> RunRecord {
+        RunRecord {
+            spdcam_version: env!("CARGO_PKG_VERSION").to_string(),
+            columns: self.columns.clone(),
+            settings: self.settings(),
+        }
+    }
+
+    /// The run an existing directory holds, from its run record or its manifest.
+    fn existing_run(dir: &Path) -> Option<RunRecord> {
+        let text = std::fs::read_to_string(dir.join(RUN_FILE)).ok();
+        if let Some(record) = text.and_then(|t| serde_json::from_str(&t).ok()) {
+            return Some(record);
+        }
+        let manifest = Manifest::read(dir).ok()?;
+        match manifest.origin {
+            Origin::Generated(settings) => Some(RunRecord {
+                spdcam_version: manifest.spdcam_version,
+                columns: manifest.columns,
+                settings: *settings,
+            }),
+            _ => None,
+        }
+    }
+
+    /// Prepares `dir` for this run and finds the files an earlier run of the same command
+    /// finished. A directory holding anything else is refused unless `overwrite`, which
+    /// starts afresh.
+    pub fn prepare(&self, dir: &Path, overwrite: bool) -> Result<Plan> {
+        let record = self.record();
+        let resuming = dir.is_dir()
+            && !is_empty_dir(dir)?
+            && !overwrite
+            && match Self::existing_run(dir) {
+                Some(previous) if previous == record => true,
+                Some(previous) => {
+                    let differs = differing_settings(&previous, &record);
+                    return Err(Error::invalid(format!(
+                        "output directory {} holds a generate run with other settings ({}); \
+                         use --force to replace it, or choose another directory",
+                        dir.display(),
+                        differs.join(", ")
+                    )));
+                }
+                None => false,
+            };
+        if !resuming {
+            prepare_output(dir, overwrite)?;
+        }
+        remove_partials(dir)?;
+        let mut text = serde_json::to_string_pretty(&record)
+            .map_err(|e| Error::invalid(format!("run record: {e}")))?;
+        text.push('\n');
+        fsio::write_atomic(&dir.join(RUN_FILE), text.as_bytes())?;
+        let mut folders = vec![SAMPLES_DIR];
+        if self.options.images {
+            folders.push(IMAGES_DIR);
+        }
+        for folder in folders {
+            create_dir(&dir.join(folder))?;
+            remove_partials(&dir.join(folder))?;
+        }
+        let chunks = self
+            .chunk_range()
+            .map(|index| {
+                let samples = self.chunk_samples(index);
+                let path = dir.join(sample_file_name(index));
+                let done = path.is_file()
+                    && file::row_count(&path, &self.columns).ok()
+                        == Some(samples.end - samples.start);
+                PlannedChunk {
+                    index,
+                    samples,
+                    done,
+                }
+            })
+            .collect();
+        Ok(Plan {
+            dir: dir.to_path_buf(),
+            chunks,
+        })
+    }
+
+    /// Renders the files `plan` still lacks, then writes the manifest. `progress` is told how
+    /// many new samples were finished. Each file is encoded and written on a second thread
+    /// while the next one renders; at most one finished file waits in between, so memory
+    /// stays flat whatever the count.
+    pub fn run(&self, plan: &Plan, progress: &(dyn Fn(u64) + Sync)) -> Result<Manifest> {
+        let dir = plan.dir.as_path();
+        let images = self.options.images.then(|| dir.join(IMAGES_DIR));
+        let mut counts = Counts::default();
+        let mut files = Vec::with_capacity(plan.chunks.len());
+        std::thread::scope(|scope| {
+            let (sender, receiver) = std::sync::mpsc::sync_channel::<(String, SampleBatch)>(1);
+            let writer = scope.spawn(move || -> Result<()> {
+                for (name, batch) in receiver {
+                    write_sample_file(dir, name, &self.columns, &batch)?;
+                }
+                Ok(())
+            });
+            let rendered = (|| -> Result<()> {
+                for chunk in &plan.chunks {
+                    let name = sample_file_name(chunk.index);
+                    let batch = if chunk.done {
+                        file::decode(&dir.join(&name), &self.columns)?
+                    } else {
+                        self.samples(chunk.samples.clone(), images.as_deref(), progress)?
+                    };
+                    counts.add(&batch);
+                    files.push(FileEntry {
+                        name: name.clone(),
+                        rows: batch.len() as u64,
+                    });
+                    // A closed channel means the writer failed; its error is returned below.
+                    if !chunk.done && sender.send((name, batch)).is_err() {
+                        break;
+                    }
+                }
+                Ok(())
+            })();
+            drop(sender);
+            let written = writer
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            rendered.and(written)
+        })?;
+        let manifest = Manifest::new(
+            self.columns.clone(),
+            counts,
+            files,
+            Origin::Generated(Box::new(self.settings())),
+        );
+        manifest.write(dir)?;
+        let run_file = dir.join(RUN_FILE);
+        std::fs::remove_file(&run_file).map_err(|e| Error::io(&run_file, e))?;
+        Ok(manifest)
+    }
+}
+
+/// The names of the top-level settings in which two runs differ.
+fn differing_settings(a: &RunRecord, b: &RunRecord) -> Vec<String> {
+    let (va, vb) = (
+        serde_json::to_value(a).unwrap_or_default(),
+        serde_json::to_value(b).unwrap_or_default(),
+    );
+    let mut names = Vec::new();
+    if va["spdcam_version"] != vb["spdcam_version"] {
+        names.push("spdcam version".to_string());
+    }
+    if va["columns"] != vb["columns"] {
+        names.push("columns".to_string());
+    }
+    if let (Some(sa), Some(sb)) = (va["settings"].as_object(), vb["settings"].as_object()) {
+        names.extend(
+            sa.iter()
+                .filter(|(k, v)| sb.get(*k) != Some(v))
+                .map(|(k, _)| k.clone()),
+        );
+    }
+    names
+}

@@ -1,0 +1,260 @@
+//! `manifest.json`: everything needed to read, trust and reproduce a dataset.
+
+use super::batch::{Columns, Counts};
+use crate::camera::CameraConfig;
+use crate::chart::Layout;
+use crate::error::{Error, Result};
+use crate::fsio;
+use crate::spectral::{Grid, ResampleReport};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The manifest's file name inside a dataset directory.
+pub const MANIFEST_FILE: &str = "manifest.json";
+/// The value of [`Manifest::format`].
+pub const FORMAT: &str = "spdcam-dataset";
+/// The layout version this program writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+/// The scale features are stored on: mean encoded sRGB, 0–255.
+pub const FEATURE_SCALE: f64 = 255.0;
+
+/// The manifest of a dataset directory. Written last, atomically: a directory without one is
+/// an unfinished run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    pub format: String,
+    pub format_version: u32,
+    /// Version of the spdcam that wrote the dataset.
+    pub spdcam_version: String,
+    /// Number of samples (rows) in this directory.
+    pub samples: u64,
+    /// Lights drawn in all, rejected ones included.
+    pub attempts: u64,
+    /// `samples / attempts`: the share of drawn lights that were valid.
+    pub valid_ratio: Option<f64>,
+    /// Samples per light family.
+    pub families: BTreeMap<String, u64>,
+    /// Features are mean encoded sRGB of each patch's central region on 0…`feature_scale`.
+    pub feature_scale: f64,
+    pub columns: Columns,
+    /// The sample files in row order.
+    pub files: Vec<FileEntry>,
+    /// Where the samples came from.
+    pub origin: Origin,
+}
+
+/// One sample file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FileEntry {
+    pub name: String,
+    pub rows: u64,
+}
+
+/// Where a dataset's samples came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Origin {
+    /// Made by `spdcam generate` (one run, or all its shards merged).
+    Generated(Box<GenerateSettings>),
+    /// Brought in from feature and SPD CSV files.
+    Imported(ImportSource),
+    /// Several datasets joined one after the other.
+    Merged { sources: Vec<Origin> },
+    /// One part of a seeded train/val/test split of another dataset.
+    Split {
+        part: String,
+        fractions: [f64; 3],
+        seed: u64,
+        source_samples: u64,
+        source: Box<Origin>,
+    },
+}
+
+impl Origin {
+    /// The generation settings behind the samples, looking through splits.
+    pub fn generated(&self) -> Option<&GenerateSettings> {
+        match self {
+            Origin::Generated(s) => Some(s),
+            Origin::Split { source, .. } => source.generated(),
+            _ => None,
+        }
+    }
+}
+
+/// Which camera pipeline renders the samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Pipeline {
+    /// The whole virtual camera: noise, demosaicing, white balance, aberration, colour.
+    Full,
+    /// Noise-free patch-level features without an image (`Camera::features_fast`).
+    Fast,
+}
+
+/// Part `index` of `count` of a run: a contiguous range of its sample files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl Shard {
+    /// Parses `K/N` with 0 ≤ K < N.
+    pub fn parse(text: &str) -> Result<Shard> {
+        let bad = || {
+            Error::invalid(format!(
+                "shard '{text}' is not K/N with 0 <= K < N (e.g. 0/3, 1/3, 2/3)"
+            ))
+        };
+        let (k, n) = text.split_once('/').ok_or_else(bad)?;
+        let index: u32 = k.trim().parse().map_err(|_| bad())?;
+        let count: u32 = n.trim().parse().map_err(|_| bad())?;
+        if index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// Every setting of a `spdcam generate` run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GenerateSettings {
+    /// Samples of the whole run (all shards).
+    pub count: u64,
+    pub seed: u64,
+    /// This part of the run; `None` for a whole run.
+    pub shard: Option<Shard>,
+    /// The samples `[start, end)` this directory holds.
+    pub sample_range: [u64; 2],
+    pub pipeline: Pipeline,
+    /// Samples per file; file `k` holds samples `[k·chunk_size, (k+1)·chunk_size)`.
+    pub chunk_size: u64,
+    /// Whether each rendered chart was also written as `images/sample-NNNNNNNN.png`.
+    pub images: bool,
+    /// The grid lights are simulated on.
+    pub simulation_grid: Grid,
+    /// How sample `i`'s light and noise are seeded.
+    pub seeding: String,
+    pub lighting: LightingInfo,
+    pub chart: ChartInfo,
+    pub camera: CameraInfo,
+}
+
+/// The lighting recipe.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LightingInfo {
+    pub spec: String,
+    pub description: String,
+}
+
+/// The chart the camera photographs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChartInfo {
+    pub name: String,
+    pub layout: Layout,
+    pub feature_patches: Vec<usize>,
+    pub background_reflectance: f64,
+}
+
+/// The camera.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CameraInfo {
+    /// Name of the sensitivities.
+    pub name: String,
+    pub config: CameraConfig,
+    /// The D65-fitted camera RGB → XYZ matrix (rows), when colour correction is on.
+    pub correction_matrix: Option<[[f64; 3]; 3]>,
+}
+
+/// Where imported samples came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImportSource {
+    pub features_file: String,
+    pub spds_file: String,
+    /// The scale of the features in the file (255 or 1); they are stored on 0–255.
+    pub feature_scale: f64,
+    /// Wavelengths of the SPD file's columns.
+    pub source_wavelengths: Vec<f64>,
+    /// How wavelengths the file lacks were filled, if any were.
+    pub resampling: Option<ResampleReport>,
+}
+
+impl Manifest {
+    /// A manifest for samples with `columns`, `counts` and `files`, from `origin`.
+    pub fn new(
+        columns: Columns,
+        counts: Counts,
+        files: Vec<FileEntry>,
+        origin: Origin,
+    ) -> Manifest {
+        Manifest {
+            format: FORMAT.to_string(),
+            format_version: FORMAT_VERSION,
+            spdcam_version: env!("CARGO_PKG_VERSION").to_string(),
+            samples: counts.samples,
+            attempts: counts.attempts,
+            valid_ratio: (counts.attempts > 0)
+                .then(|| counts.samples as f64 / counts.attempts as f64),
+            families: counts.families,
+            feature_scale: FEATURE_SCALE,
+            columns,
+            files,
+            origin,
+        }
+    }
+
+    /// Reads and checks `DIR/manifest.json`.
+    pub fn read(dir: &Path) -> Result<Manifest> {
+        let path = dir.join(MANIFEST_FILE);
+        if !path.is_file() {
+            let hint = if dir.is_dir() {
+                " (an unfinished `spdcam generate`? run the same command again to finish it)"
+            } else {
+                ""
+            };
+            return Err(Error::invalid(format!(
+                "{} is not a dataset: it has no {MANIFEST_FILE}{hint}",
+                dir.display()
+            )));
+        }
+        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let source = path.display().to_string();
+        let value: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| Error::parse(&source, format!("not valid JSON: {e}")))?;
+        if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
+            return Err(Error::parse(&source, format!("not an {FORMAT} manifest")));
+        }
+        let version = value.get("format_version").and_then(|v| v.as_u64());
+        if version != Some(FORMAT_VERSION as u64) {
+            return Err(Error::parse(
+                &source,
+                format!(
+                    "format version {} is not {FORMAT_VERSION}, the one this spdcam reads",
+                    version.map_or("missing".to_string(), |v| v.to_string())
+                ),
+            ));
+        }
+        let manifest: Manifest =
+            serde_json::from_value(value).map_err(|e| Error::parse(&source, e.to_string()))?;
+        manifest
+            .columns
+            .validate()
+            .map_err(|e| Error::parse(&source, e.to_string()))?;
+        Ok(manifest)
+    }
+
+    /// Writes `DIR/manifest.json` atomically.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        let mut text = serde_json::to_string_pretty(self)
+            .map_err(|e| Error::invalid(format!("manifest: {e}")))?;
+        text.push('\n');
+        fsio::write_atomic(&dir.join(MANIFEST_FILE), text.as_bytes())
+    }
+}

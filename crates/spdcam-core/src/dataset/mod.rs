@@ -1,0 +1,47 @@
+//! Datasets: samples of (features, SPD, weights, family) generated with the virtual camera or
+//! imported from CSV, stored as a directory that any Parquet reader understands.
+//!
+//! ```text
+//! DIR/manifest.json                 every setting, the columns, counts, the files (last)
+//! DIR/samples/part-00000.parquet    rows 0…4095: sample, family, p01_r…, spd_380…, w_…, attempts
+//! DIR/samples/part-00001.parquet    …
+//! DIR/images/sample-00000000.png    with `--images`
+//! ```
+//!
+//! `DIR/samples` holds nothing but the Parquet files, so it reads as one table:
+//! `pandas.read_parquet("DIR/samples")`, `polars.read_parquet("DIR/samples/*.parquet")`,
+//! `SELECT * FROM 'DIR/samples/*.parquet'` in DuckDB, `spark.read.parquet("DIR/samples")`.
+//!
+//! Sample `i` of a generated set depends only on (seed, i): its light is
+//! `lighting.draw(seed, i)` and its camera noise is seeded with [`crate::seed::derive`]`(seed, i)`.
+//! File `k` holds samples `[k·chunk, (k+1)·chunk)`, so shards, resumed runs and merged shards
+//! give the same files as one uninterrupted run. Every file is written to a temporary name
+//! and renamed, and the manifest comes last: an interrupted run leaves no damaged file and
+//! resumes where it stopped.
+
+mod batch;
+mod csv_io;
+mod file;
+mod generate;
+mod manifest;
+mod merge;
+mod reader;
+mod spd_map;
+mod split;
+mod writer;
+
+pub use batch::{Columns, Counts, Precision, SampleBatch, SampleRow};
+pub use csv_io::{export_csv, import_csv, ExportOptions, ImportOptions, ImportReport};
+pub use file::encode_parquet;
+pub use generate::{GenerateOptions, Generator, Plan};
+pub use manifest::{
+    CameraInfo, ChartInfo, FileEntry, GenerateSettings, ImportSource, LightingInfo, Manifest,
+    Origin, Pipeline, Shard, FEATURE_SCALE, FORMAT, FORMAT_VERSION, MANIFEST_FILE,
+};
+pub use merge::merge;
+pub use reader::Dataset;
+pub use split::{assign_parts, split};
+pub use writer::SAMPLES_DIR;
+
+/// Samples per file unless told otherwise.
+pub const DEFAULT_CHUNK_SIZE: u64 = 4096;

@@ -1,0 +1,318 @@
+//! Virtual lighting: families of lights named by a recipe (`gaussian:7`, `telelumen:config1`,
+//! `daylight`, `mix:…`), each drawn at random but reproducibly: draw `i` of a recipe depends
+//! only on (seed, i). Every SPD is on the simulation grid and normalised by its maximum.
+
+mod channels;
+mod luminaire;
+mod measured;
+mod parametric;
+
+pub use channels::{Channels, WeightRule};
+pub use luminaire::{Luminaire, PowerBudget, TELELUMEN_BUDGET, TELELUMEN_FILE};
+pub use measured::MeasuredSpds;
+pub use parametric::{daylight, fluorescent, planck, CctRange, PhosphorLeds};
+
+use crate::builtin::DataDir;
+use crate::error::{Error, Result};
+use crate::illuminant::{DAYLIGHT_CCT_MAX_K, DAYLIGHT_CCT_MIN_K};
+use crate::seed;
+use crate::spectral::Grid;
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
+
+/// One drawn light.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightDraw {
+    /// The SPD on the lighting's grid, maximum 1.
+    pub spd: Vec<f64>,
+    /// The family it came from (`gaussian`, `leds`, `daylight`, …).
+    pub family: String,
+    /// The channel weights, for families that have them (in [`Lighting::weight_names`] order).
+    pub weights: Option<Vec<f64>>,
+    /// Lights drawn for this one, itself included (> 1 when a power budget rejected some).
+    pub attempts: u32,
+}
+
+/// A lighting recipe, parsed and ready to draw from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lighting {
+    spec: String,
+    grid: Grid,
+    family: Family,
+}
+
+/// Random-stream index that separates light draws from the camera noise of the same sample.
+const LIGHT_STREAM: u64 = 0x4C49_4748_5400_0001;
+
+/// The recipes `spdcam generate --lighting` accepts, with what they draw.
+pub fn catalogue() -> Vec<(&'static str, &'static str)> {
+    vec![
+        ("gaussian:N", "N Gaussian channels (N = 4–7: the thesis's centres and widths; others evenly over 400–700 nm), weights uniform on [0, 1) in steps of 0.01"),
+        ("leds:FILE[:OPTION]…", "channels of a multi-channel LED luminaire (spectral CSV); options lit=3-19 (channels that may light, 1-based, ranges joined by /), k=7 (how many light at once), max=1 (weights uniform on [0, max)), step=0.01, budget=B with power=uniform|optical (reject settings with Σ wᵢ·powerᵢ > B)"),
+        ("telelumen:PRESET", "the thesis's 24-channel Telelumen luminaire (data directory: thesis/telelumen_24_channels.csv): config1 (7 of the 17 visible, max 1), config2 (9, max 0.75), config3 (17, max 0.4), each under the calibrated power budget; h1 (7 of 24), h2 (all 24)"),
+        ("daylight[:MIN-MAX]", "CIE daylight at a CCT uniform in mired, default 4000-25000 K"),
+        ("planck[:MIN-MAX]", "Planckian radiator at a CCT uniform in mired, default 1500-10000 K"),
+        ("phosphor", "phosphor-converted white LED: blue pump 440–460 nm + yellow-green and red phosphor bands, heights set for a CCT of 2700–6500 K and |Duv| ≤ 0.006"),
+        ("fluorescent", "fluorescent-like lamp: mercury lines and tri-phosphor bands of random strength on a broad Planckian base"),
+        ("spds:FILE[:mix]", "measured SPDs from a spectral CSV: one at random, or with :mix a random mixture of two"),
+        ("mix:RECIPE=P,RECIPE=P,…", "a mixture of recipes drawn with the given proportions, e.g. mix:telelumen:config1=0.5,daylight=0.3,planck=0.2"),
+    ]
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Family {
+    Gaussian(Channels),
+    Leds(Luminaire),
+    Daylight(CctRange),
+    Planck(CctRange),
+    Phosphor(PhosphorLeds),
+    Fluorescent,
+    Measured(MeasuredSpds),
+    Mix(Vec<(Lighting, f64)>),
+}
+
+impl Lighting {
+    /// Parses a recipe (see [`catalogue`]) for lights on `grid`; files are paths or names
+    /// under the data directory.
+    pub fn parse(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Lighting> {
+        let (head, rest) = spec.split_once(':').unwrap_or((spec, ""));
+        let family = match head {
+            "gaussian" => {
+                let n: usize = rest.parse().map_err(|_| {
+                    Error::invalid(format!(
+                        "'{spec}': the number of Gaussian channels must be a whole number, e.g. gaussian:7"
+                    ))
+                })?;
+                Family::Gaussian(Channels::gaussian(n, grid)?)
+            }
+            "leds" => Family::Leds(Luminaire::parse(rest, spec, data_dir, grid)?),
+            "telelumen" => Family::Leds(Luminaire::telelumen(rest, spec, data_dir, grid)?),
+            "daylight" => Family::Daylight(CctRange::parse(
+                rest,
+                CctRange {
+                    min_k: DAYLIGHT_CCT_MIN_K,
+                    max_k: DAYLIGHT_CCT_MAX_K,
+                },
+                CctRange {
+                    min_k: DAYLIGHT_CCT_MIN_K,
+                    max_k: DAYLIGHT_CCT_MAX_K,
+                },
+                spec,
+            )?),
+            "planck" => Family::Planck(CctRange::parse(
+                rest,
+                CctRange {
+                    min_k: 1500.0,
+                    max_k: 10000.0,
+                },
+                CctRange {
+                    min_k: 500.0,
+                    max_k: 100_000.0,
+                },
+                spec,
+            )?),
+            "phosphor" | "fluorescent" if !rest.is_empty() => {
+                return Err(Error::invalid(format!(
+                    "'{spec}': {head} takes no parameters"
+                )))
+            }
+            "phosphor" => Family::Phosphor(PhosphorLeds::new(grid)?),
+            "fluorescent" => Family::Fluorescent,
+            "spds" => Family::Measured(MeasuredSpds::parse(rest, spec, data_dir, grid)?),
+            "mix" => Family::Mix(parse_mix(rest, spec, data_dir, grid)?),
+            _ => {
+                let forms: Vec<&str> = catalogue().iter().map(|(form, _)| *form).collect();
+                return Err(Error::UnknownName {
+                    kind: "lighting family",
+                    name: head.to_string(),
+                    valid: forms.join(", "),
+                });
+            }
+        };
+        Ok(Lighting {
+            spec: spec.to_string(),
+            grid: *grid,
+            family,
+        })
+    }
+
+    /// The grid the lights are drawn on.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The recipe as given.
+    pub fn spec(&self) -> &str {
+        &self.spec
+    }
+
+    /// The channels whose weights make the light, for the Gaussian and LED families.
+    pub fn channels(&self) -> Option<&Channels> {
+        match &self.family {
+            Family::Gaussian(c) => Some(c),
+            Family::Leds(l) => Some(&l.channels),
+            _ => None,
+        }
+    }
+
+    /// Names of the weights every draw records, or `None` when the recipe has none. A
+    /// mixture concatenates its members' names (prefixed by the member's position when
+    /// more than one member has weights); members without weights record zeros.
+    pub fn weight_names(&self) -> Option<Vec<String>> {
+        match &self.family {
+            Family::Mix(members) => {
+                let named: Vec<(usize, Vec<String>)> = members
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, (m, _))| m.weight_names().map(|n| (i, n)))
+                    .collect();
+                match named.len() {
+                    0 => None,
+                    1 => Some(named.into_iter().next().map(|(_, n)| n).unwrap_or_default()),
+                    _ => Some(
+                        named
+                            .into_iter()
+                            .flat_map(|(i, names)| {
+                                names.into_iter().map(move |n| format!("m{}_{n}", i + 1))
+                            })
+                            .collect(),
+                    ),
+                }
+            }
+            _ => self.channels().map(|c| c.names.clone()),
+        }
+    }
+
+    /// A readable account of the recipe, for manifests.
+    pub fn describe(&self) -> String {
+        match &self.family {
+            Family::Gaussian(c) => format!(
+                "{} Gaussian channels, weights uniform on [0, 1) in steps of 0.01",
+                c.len()
+            ),
+            Family::Leds(l) => l.describe(),
+            Family::Daylight(r) => format!(
+                "CIE daylight, CCT {}–{} K uniform in mired",
+                r.min_k, r.max_k
+            ),
+            Family::Planck(r) => format!(
+                "Planckian radiator, CCT {}–{} K uniform in mired",
+                r.min_k, r.max_k
+            ),
+            Family::Phosphor(_) => {
+                "phosphor-converted white LEDs, 2700–6500 K, |Duv| ≤ 0.006".to_string()
+            }
+            Family::Fluorescent => "fluorescent-like line spectra on a broad base".to_string(),
+            Family::Measured(m) => m.describe(),
+            Family::Mix(members) => {
+                let parts: Vec<String> = members
+                    .iter()
+                    .map(|(m, p)| format!("{:.3} × {}", p, m.describe()))
+                    .collect();
+                format!("mixture: {}", parts.join("; "))
+            }
+        }
+    }
+
+    /// Draw `index` of this recipe under `seed`: the same (seed, index) always gives the same
+    /// light, whatever the order or the machine of the draws.
+    pub fn draw(&self, seed: u64, index: u64) -> Result<LightDraw> {
+        let mut rng =
+            SmallRng::seed_from_u64(seed::derive(seed::derive(seed, index), LIGHT_STREAM));
+        self.draw_with(&mut rng)
+    }
+
+    fn draw_with(&self, rng: &mut SmallRng) -> Result<LightDraw> {
+        let simple = |family: &str, spd: Vec<f64>| LightDraw {
+            spd,
+            family: family.to_string(),
+            weights: None,
+            attempts: 1,
+        };
+        Ok(match &self.family {
+            Family::Gaussian(channels) => {
+                let weights = WeightRule::all(channels.len()).draw(channels.len(), rng);
+                LightDraw {
+                    spd: channels.combine(&weights)?,
+                    family: "gaussian".to_string(),
+                    weights: Some(weights),
+                    attempts: 1,
+                }
+            }
+            Family::Leds(luminaire) => {
+                let (weights, attempts) = luminaire.draw(rng, &self.spec)?;
+                LightDraw {
+                    spd: luminaire.channels.combine(&weights)?,
+                    family: "leds".to_string(),
+                    weights: Some(weights),
+                    attempts,
+                }
+            }
+            Family::Daylight(range) => simple("daylight", daylight(range.draw(rng), &self.grid)?),
+            Family::Planck(range) => simple("planck", planck(range.draw(rng), &self.grid)?),
+            Family::Phosphor(leds) => simple("phosphor", leds.draw(rng)?),
+            Family::Fluorescent => simple("fluorescent", fluorescent(&self.grid, rng)?),
+            Family::Measured(set) => simple("spds", set.draw(rng)),
+            Family::Mix(members) => self.draw_member(members, rng)?,
+        })
+    }
+
+    fn draw_member(&self, members: &[(Lighting, f64)], rng: &mut SmallRng) -> Result<LightDraw> {
+        let u = rng.random::<f64>();
+        let mut cumulative = 0.0;
+        let chosen = members
+            .iter()
+            .position(|(_, p)| {
+                cumulative += p;
+                u < cumulative
+            })
+            .unwrap_or(members.len() - 1);
+        let mut draw = members[chosen].0.draw_with(rng)?;
+        if let Some(names) = self.weight_names() {
+            let mut weights = vec![0.0; names.len()];
+            let offset: usize = members[..chosen]
+                .iter()
+                .filter_map(|(m, _)| m.weight_names().map(|n| n.len()))
+                .sum();
+            if let Some(own) = &draw.weights {
+                weights[offset..offset + own.len()].copy_from_slice(own);
+            }
+            draw.weights = Some(weights);
+        }
+        Ok(draw)
+    }
+}
+
+fn parse_mix(
+    rest: &str,
+    spec: &str,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Vec<(Lighting, f64)>> {
+    let mut members = Vec::new();
+    for part in rest.split(',') {
+        let (member, share) = part.rsplit_once('=').ok_or_else(|| {
+            Error::invalid(format!(
+                "'{spec}': mixture member '{part}' needs a proportion, e.g. daylight=0.3"
+            ))
+        })?;
+        let share: f64 = share
+            .parse()
+            .ok()
+            .filter(|p: &f64| *p > 0.0 && p.is_finite())
+            .ok_or_else(|| {
+                Error::invalid(format!(
+                "'{spec}': the proportion of '{member}' must be a positive number, not '{share}'"
+            ))
+            })?;
+        if member.starts_with("mix:") {
+            return Err(Error::invalid(format!(
+                "'{spec}': a mixture cannot contain a mixture"
+            )));
+        }
+        members.push((Lighting::parse(member, data_dir, grid)?, share));
+    }
+    let total: f64 = members.iter().map(|(_, p)| p).sum();
+    members.iter_mut().for_each(|(_, p)| *p /= total);
+    Ok(members)
+}

@@ -1,0 +1,152 @@
+//! `spdcam generate`: a dataset of (features, SPD) samples from the virtual camera.
+
+use crate::render::CameraArgs;
+use anyhow::Result;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use spdcam_core::builtin::DataDir;
+use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline, Shard, DEFAULT_CHUNK_SIZE};
+use spdcam_core::lighting::Lighting;
+use spdcam_core::spectral::Grid;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Options of `spdcam generate`.
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    /// Lighting recipe (`spdcam list lighting` shows the forms).
+    #[arg(long)]
+    lighting: String,
+    /// Number of samples of the whole run (all shards together).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_count)]
+    count: u64,
+    /// Seed: sample i depends only on (seed, i).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Output dataset directory (manifest.json + samples-NNNNN.parquet).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also write each rendered chart as images/sample-NNNNNNNN.png.
+    #[arg(long)]
+    images: bool,
+    /// Generate only part K of N (K = 0…N-1), e.g. on N machines; join the parts with
+    /// `spdcam dataset merge`.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    shard: Option<Shard>,
+    /// Noise-free patch-level features without an image, for very large sets.
+    #[arg(long)]
+    fast: bool,
+    /// Wavelengths the SPDs are stored at, START-END[:STEP] in nm (inside 380-780).
+    #[arg(long, default_value = "380-780:5", value_name = "START-END[:STEP]")]
+    spd_grid: String,
+    /// Samples per Parquet file (shards of one run must use the same).
+    #[arg(long, default_value_t = DEFAULT_CHUNK_SIZE)]
+    chunk_size: u64,
+    /// Replace what the output directory holds instead of refusing or resuming.
+    #[arg(long)]
+    force: bool,
+    #[command(flatten)]
+    camera: CameraArgs,
+}
+
+fn parse_count(text: &str) -> Result<u64, String> {
+    match text.trim().parse::<i128>() {
+        Ok(n) if n >= 1 && n <= u64::MAX as i128 => Ok(n as u64),
+        Ok(_) => Err("the sample count must be at least 1".into()),
+        Err(_) => Err("the sample count must be a whole number, e.g. 10000".into()),
+    }
+}
+
+fn parse_shard(text: &str) -> Result<Shard, String> {
+    Shard::parse(text).map_err(|e| e.to_string())
+}
+
+/// A progress bar with rate and ETA on a terminal; nothing when stderr is piped.
+pub fn progress_bar(total: u64, unit: &str) -> Option<ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let style = ProgressStyle::with_template(&format!(
+        "{{elapsed_precise}} [{{wide_bar}}] {{human_pos}}/{{human_len}} {unit}, {{rate}}, ETA {{eta}}"
+    ))
+    .unwrap_or_else(|_| ProgressStyle::default_bar())
+    .with_key(
+        "rate",
+        |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+            let _ = write!(w, "{:.0}/s", state.per_sec());
+        },
+    );
+    Some(ProgressBar::new(total).with_style(style))
+}
+
+/// Runs `spdcam generate`.
+pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
+    let grid = Grid::SIMULATION;
+    let options = GenerateOptions {
+        count: args.count,
+        seed: args.seed,
+        shard: args.shard,
+        pipeline: if args.fast {
+            Pipeline::Fast
+        } else {
+            Pipeline::Full
+        },
+        spd_grid: Grid::parse(&args.spd_grid)?,
+        images: args.images,
+        chunk_size: args.chunk_size,
+    };
+    let camera = args.camera.camera(data_dir, &grid)?;
+    let lighting = Lighting::parse(&args.lighting, data_dir, &grid)?;
+    let generator = Generator::new(&camera, &lighting, options)?;
+    let plan = generator.prepare(&args.output, args.force)?;
+    if plan.total() == 0 {
+        eprintln!(
+            "warning: this shard holds no samples: the run has fewer files of {} samples than shards",
+            args.chunk_size
+        );
+    } else if plan.done() == plan.total() {
+        eprintln!(
+            "{} already holds all {} samples of this run",
+            args.output.display(),
+            plan.total()
+        );
+    } else if plan.done() > 0 {
+        eprintln!(
+            "resuming: {} of {} samples were already written",
+            plan.done(),
+            plan.total()
+        );
+    }
+    let new = plan.total() - plan.done();
+    let bar = progress_bar(new, "samples");
+    let started = Instant::now();
+    let manifest = generator.run(&plan, &|n| {
+        if let Some(bar) = &bar {
+            bar.inc(n);
+        }
+    })?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let seconds = started.elapsed().as_secs_f64();
+    println!(
+        "{} samples in {} ({new} new in {seconds:.1} s, {:.0} samples/s)",
+        manifest.samples,
+        args.output.display(),
+        new as f64 / seconds.max(1e-9)
+    );
+    if let Some(ratio) = manifest.valid_ratio {
+        println!(
+            "valid ratio {ratio:.4} ({} lights drawn), families: {}",
+            manifest.attempts,
+            manifest
+                .families
+                .iter()
+                .map(|(f, n)| format!("{f} {n}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    Ok(())
+}
