@@ -326,6 +326,7 @@ fn import_of_the_measured_dev_set_keeps_every_number() {
             spd_grid: GRID,
             family: "telelumen_dev".into(),
             chunk_size: 100,
+            weights_of: None,
         },
         false,
     )
@@ -384,6 +385,7 @@ fn unit_scale_features_are_stored_on_0_255_and_bad_files_are_named() {
         spd_grid: Grid::ESTIMATION,
         family: "x".into(),
         chunk_size: 4096,
+        weights_of: None,
     };
     let out = dir.join("data");
     dataset::import_csv(&f, &s, &out, &opts(1.0), false).unwrap();
@@ -444,6 +446,7 @@ fn split_is_seeded_complete_and_merges_back() {
             spd_grid: GRID,
             family: "dev".into(),
             chunk_size: 4096,
+            weights_of: None,
         },
         false,
     )
@@ -472,5 +475,85 @@ fn split_is_seeded_complete_and_merges_back() {
     assert_eq!(samples, (0..640).collect::<Vec<u64>>());
     let rows = data.rows_at(&[639, 3]).unwrap();
     assert_eq!(rows.samples, vec![3, 639]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn import_of_thesis_weights_makes_the_thesis_spds() {
+    let src = shared_data::data_dir().join("thesis/virtual/gaussian_5ch_cc24_val");
+    let dir = scratch("weights");
+    let lighting = Lighting::parse("gaussian:5", &DataDir::default(), &GRID).unwrap();
+    dataset::import_csv(
+        &src.join("features.csv"),
+        &src.join("weights.csv"),
+        &dir,
+        &ImportOptions {
+            feature_scale: 1.0,
+            spd_grid: Grid::ESTIMATION,
+            family: "g2".into(),
+            chunk_size: 4096,
+            weights_of: Some(lighting.clone()),
+        },
+        false,
+    )
+    .unwrap();
+    let batch = Dataset::open(&dir).unwrap().load().unwrap();
+    assert_eq!(batch.len(), 889);
+    // Row 0 by hand: Σ wᵢ·exp(−(λ−μᵢ)²/2σᵢ²) with the thesis's 5-channel centres and
+    // widths, divided by its maximum over 380–780 nm.
+    let text = std::fs::read_to_string(src.join("weights.csv")).unwrap();
+    let w: Vec<f64> = text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert_eq!(batch.weights_of(0), w.as_slice());
+    let shapes = [
+        (430.0, 15.0),
+        (490.0, 20.0),
+        (550.0, 20.0),
+        (610.0, 20.0),
+        (670.0, 15.0),
+    ];
+    let spd = |l: f64| -> f64 {
+        w.iter()
+            .zip(shapes)
+            .map(|(w, (mu, s)): (&f64, (f64, f64))| {
+                w * (-(l - mu) * (l - mu) / (2.0 * s * s)).exp()
+            })
+            .sum()
+    };
+    let max = (0..81)
+        .map(|i| spd(380.0 + 5.0 * i as f64))
+        .fold(0.0, f64::max);
+    for (k, &value) in batch.spd_of(0).iter().enumerate() {
+        let expected = spd(400.0 + 5.0 * k as f64) / max;
+        assert!(
+            (value - expected).abs() < 1e-12,
+            "{k}: {value} vs {expected}"
+        );
+    }
+    let wrong = Lighting::parse("gaussian:4", &DataDir::default(), &GRID).unwrap();
+    let err = dataset::import_csv(
+        &src.join("features.csv"),
+        &src.join("weights.csv"),
+        &scratch("weights-wrong"),
+        &ImportOptions {
+            feature_scale: 1.0,
+            spd_grid: Grid::ESTIMATION,
+            family: "g2".into(),
+            chunk_size: 4096,
+            weights_of: Some(wrong),
+        },
+        false,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("5 weight columns, but lighting 'gaussian:4' has 4 channels"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -3,11 +3,13 @@
 use crate::generate::progress_bar;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, Subcommand};
+use spdcam_core::builtin::DataDir;
 use spdcam_core::dataset::{
     self, Dataset, ExportOptions, ImportOptions, Manifest, Origin, DEFAULT_CHUNK_SIZE,
     FEATURE_SCALE,
 };
 use spdcam_core::fsio;
+use spdcam_core::lighting::Lighting;
 use spdcam_core::spectral::Grid;
 use std::path::{Path, PathBuf};
 
@@ -38,8 +40,20 @@ struct ImportArgs {
     #[arg(long, value_name = "F.csv")]
     features: PathBuf,
     /// SPDs CSV: header = wavelengths in nm; one row per sample, same order as the features.
-    #[arg(long, value_name = "S.csv")]
-    spds: PathBuf,
+    #[arg(
+        long,
+        value_name = "S.csv",
+        required_unless_present = "weights",
+        conflicts_with = "weights"
+    )]
+    spds: Option<PathBuf>,
+    /// Instead of SPDs: channel weights (one column per channel of --lighting, one row per
+    /// sample); each SPD is the weighted sum of the channels, normalised by its maximum.
+    #[arg(long, value_name = "W.csv", requires = "lighting")]
+    weights: Option<PathBuf>,
+    /// The lighting whose channels the weights drive (gaussian:N, leds:FILE, telelumen:PRESET).
+    #[arg(long, value_name = "RECIPE", requires = "weights")]
+    lighting: Option<String>,
     /// Scale of the features in the file: 255 (0–255) or 1 (0–1). Stored on 0–255.
     #[arg(long, default_value = "255", value_parser = ["255", "1"])]
     feature_scale: String,
@@ -119,9 +133,9 @@ struct InfoArgs {
 }
 
 /// Runs `spdcam dataset …`.
-pub fn run(args: DatasetArgs) -> Result<()> {
+pub fn run(args: DatasetArgs, data_dir: &DataDir) -> Result<()> {
     match args.command {
-        DatasetCommand::Import(a) => import(a),
+        DatasetCommand::Import(a) => import(a, data_dir),
         DatasetCommand::Export(a) => export(a),
         DatasetCommand::Merge(a) => merge(a),
         DatasetCommand::Split(a) => split(a),
@@ -129,7 +143,7 @@ pub fn run(args: DatasetArgs) -> Result<()> {
     }
 }
 
-fn import(args: ImportArgs) -> Result<()> {
+fn import(args: ImportArgs, data_dir: &DataDir) -> Result<()> {
     let feature_scale: f64 = args.feature_scale.parse()?;
     let family = match args.family {
         Some(f) => f,
@@ -140,25 +154,29 @@ fn import(args: ImportArgs) -> Result<()> {
             .and_then(|p| Some(p.parent()?.file_name()?.to_string_lossy().into_owned()))
             .unwrap_or_else(|| "imported".to_string()),
     };
+    let weights_of = match &args.lighting {
+        Some(spec) => Some(Lighting::parse(spec, data_dir, &Grid::SIMULATION)?),
+        None => None,
+    };
     let options = ImportOptions {
         feature_scale,
         spd_grid: Grid::parse(&args.spd_grid)?,
         family,
         chunk_size: DEFAULT_CHUNK_SIZE,
+        weights_of,
     };
-    let report = dataset::import_csv(
-        &args.features,
-        &args.spds,
-        &args.output,
-        &options,
-        args.force,
-    )?;
+    let second = args
+        .spds
+        .as_ref()
+        .or(args.weights.as_ref())
+        .context("give --spds S.csv, or --weights W.csv with --lighting")?;
+    let report = dataset::import_csv(&args.features, second, &args.output, &options, args.force)?;
     let m = &report.manifest;
     if let Origin::Imported(source) = &m.origin {
         if let Some(r) = source.resampling.as_ref().filter(|r| r.extrapolated()) {
             eprintln!(
                 "warning: {}",
-                r.describe(&args.spds.display().to_string(), &options.spd_grid)
+                r.describe(&second.display().to_string(), &options.spd_grid)
             );
         }
     }

@@ -39,7 +39,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::run(*args, &data_dir),
         Command::Generate(args) => generate::run(*args, &data_dir),
-        Command::Dataset(args) => dataset::run(args),
+        Command::Dataset(args) => dataset::run(args, &data_dir),
         Command::List(args) => list::run(args, &data_dir),
     };
     match result {

@@ -8,6 +8,7 @@ use super::spd_map::SpdMap;
 use super::writer::{prepare_output, DatasetWriter};
 use crate::error::{Error, Result};
 use crate::fsio;
+use crate::lighting::Lighting;
 use crate::spectral::Grid;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -23,6 +24,10 @@ pub struct ImportOptions {
     pub family: String,
     /// Samples per file.
     pub chunk_size: u64,
+    /// When set, the second file holds channel weights (one column per channel of this
+    /// lighting, in its order) instead of SPDs: each SPD is the channels' weighted sum,
+    /// normalised by its maximum, and the weights are kept.
+    pub weights_of: Option<Lighting>,
 }
 
 /// What [`import_csv`] did.
@@ -99,38 +104,17 @@ pub fn import_csv(
     let feature_names = header(&mut feature_reader, features)?;
     let mut spd_reader = reader(spds)?;
     let spd_header = header(&mut spd_reader, spds)?;
-    let wavelengths: Vec<f64> = spd_header
-        .iter()
-        .map(|h| {
-            h.trim_end_matches("nm")
-                .trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|w| w.is_finite())
-                .ok_or_else(|| {
-                    Error::parse(
-                        spds.display().to_string(),
-                        format!("line 1: header cell '{h}' is not a wavelength in nm"),
-                    )
-                })
-        })
-        .collect::<Result<_>>()?;
-    if let Some(w) = wavelengths.windows(2).find(|w| w[1] <= w[0]) {
-        return Err(Error::parse(
-            spds.display().to_string(),
-            format!(
-                "line 1: wavelength {} nm follows {} nm; they must increase",
-                w[1], w[0]
-            ),
-        ));
-    }
+    let (wavelengths, weight_names) = match &options.weights_of {
+        Some(lighting) => weight_columns(lighting, &spd_header, spds)?,
+        None => (wavelength_columns(&spd_header, spds)?, Vec::new()),
+    };
     let map = SpdMap::new(&wavelengths, &options.spd_grid)
         .map_err(|e| Error::parse(spds.display().to_string(), e.to_string()))?;
     let columns = Columns {
         feature_names,
         feature_precision: Precision::Float64,
         spd_grid: options.spd_grid,
-        weight_names: Vec::new(),
+        weight_names,
     };
     columns
         .validate()
@@ -181,19 +165,34 @@ pub fn import_csv(
             *v *= FEATURE_SCALE / options.feature_scale;
         }
         spd.clear();
-        map.apply(&numbers(&s, &spd_header, spds)?, &mut spd)?;
+        let second = numbers(&s, &spd_header, spds)?;
+        let weights = match &options.weights_of {
+            Some(lighting) => {
+                let line = s.position().map_or(0, |p| p.line());
+                let light = weighted_spd(lighting, &second).map_err(|e| {
+                    Error::parse(spds.display().to_string(), format!("line {line}: {e}"))
+                })?;
+                map.apply(&light, &mut spd)?;
+                second.as_slice()
+            }
+            None => {
+                map.apply(&second, &mut spd)?;
+                &[]
+            }
+        };
         writer.push(SampleRow {
             sample,
             family: &options.family,
             features: &values,
             spd: &spd,
-            weights: &[],
+            weights,
             attempts: 1,
         })?;
     }
     let origin = Origin::Imported(ImportSource {
         features_file: features.display().to_string(),
         spds_file: spds.display().to_string(),
+        weights_of: options.weights_of.as_ref().map(|l| l.spec().to_string()),
         feature_scale: options.feature_scale,
         source_wavelengths: wavelengths,
         resampling: map.report().cloned(),
@@ -202,6 +201,74 @@ pub fn import_csv(
         manifest: writer.finish(origin)?,
         largest_feature,
     })
+}
+
+/// The wavelengths named by an SPD file's header.
+fn wavelength_columns(header: &[String], path: &Path) -> Result<Vec<f64>> {
+    let wavelengths: Vec<f64> = header
+        .iter()
+        .map(|h| {
+            h.trim_end_matches("nm")
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|w| w.is_finite())
+                .ok_or_else(|| {
+                    Error::parse(
+                        path.display().to_string(),
+                        format!("line 1: header cell '{h}' is not a wavelength in nm"),
+                    )
+                })
+        })
+        .collect::<Result<_>>()?;
+    if let Some(w) = wavelengths.windows(2).find(|w| w[1] <= w[0]) {
+        return Err(Error::parse(
+            path.display().to_string(),
+            format!(
+                "line 1: wavelength {} nm follows {} nm; they must increase",
+                w[1], w[0]
+            ),
+        ));
+    }
+    Ok(wavelengths)
+}
+
+/// For a weights file: the lighting's grid (where the SPDs are made) and its weight names,
+/// after checking that the file has one column per channel.
+fn weight_columns(
+    lighting: &Lighting,
+    header: &[String],
+    path: &Path,
+) -> Result<(Vec<f64>, Vec<String>)> {
+    let channels = lighting.channels().ok_or_else(|| {
+        Error::invalid(format!(
+            "lighting '{}' has no channels to weight; use gaussian:N, leds:FILE or telelumen:PRESET",
+            lighting.spec()
+        ))
+    })?;
+    if header.len() != channels.len() {
+        return Err(Error::parse(
+            path.display().to_string(),
+            format!(
+                "line 1: {} weight columns, but lighting '{}' has {} channels",
+                header.len(),
+                lighting.spec(),
+                channels.len()
+            ),
+        ));
+    }
+    Ok((lighting.grid().wavelengths(), channels.names.clone()))
+}
+
+/// The SPD made by `weights` of the lighting's channels; negative weights are refused.
+fn weighted_spd(lighting: &Lighting, weights: &[f64]) -> Result<Vec<f64>> {
+    if let Some(w) = weights.iter().find(|w| **w < 0.0) {
+        return Err(Error::invalid(format!("weight {w} is negative")));
+    }
+    lighting
+        .channels()
+        .ok_or_else(|| Error::invalid("the lighting has no channels"))?
+        .combine(weights)
 }
 
 /// Settings of [`export_csv`].

@@ -178,6 +178,9 @@ pub struct CameraInfo {
 pub struct ImportSource {
     pub features_file: String,
     pub spds_file: String,
+    /// When the second file held channel weights: the lighting whose channels made the SPDs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weights_of: Option<String>,
     /// The scale of the features in the file (255 or 1); they are stored on 0–255.
     pub feature_scale: f64,
     /// Wavelengths of the SPD file's columns.
