@@ -95,6 +95,7 @@ pub struct RenderBuffers {
     pub image: RgbImage,
     scratch: Vec<f32>,
     binned: RgbImage,
+    region: aberration::RegionPlanes,
 }
 
 /// The intermediate images of one render, for inspection (`--stages`).
@@ -254,6 +255,7 @@ impl Camera {
             image: RgbImage::new(l.width, l.height),
             scratch: Vec::new(),
             binned: RgbImage::new(l.width / 2, l.height / 2),
+            region: aberration::RegionPlanes::default(),
         }
     }
 
@@ -331,21 +333,34 @@ impl Camera {
         out: &mut Vec<f32>,
     ) {
         self.capture_balanced(light, seed, buffers, None);
-        let image = &buffers.image;
+        let RenderBuffers { image, region, .. } = buffers;
         let layout = &self.chart.layout;
         for &p in &self.chart.feature_patches {
-            let (x0, y0, side) = layout.sampling_region(p);
-            let mut sum = [0.0f64; 3];
-            for y in y0..y0 + side {
-                for x in x0..x0 + side {
-                    let rgb = match &self.config.aberration {
-                        Some(ab) => ab.pixel(image, x, y),
-                        None => image.pixel(x, y),
-                    };
-                    let lin = self.colour.to_linear_srgb(rgb);
-                    for c in 0..3 {
-                        sum[c] += self.colour.quantise(self.colour.encode(lin[c])) as f64;
+            let (x, y, side) = layout.sampling_region(p);
+            let area = aberration::Region {
+                x,
+                y,
+                width: side,
+                height: side,
+            };
+            match &self.config.aberration {
+                Some(ab) => ab.region(image, area, region),
+                None => {
+                    for (plane, src) in region.planes.iter_mut().zip(&image.planes) {
+                        plane.clear();
+                        for row in y..y + side {
+                            let start = row * image.width + x;
+                            plane.extend_from_slice(&src[start..start + side]);
+                        }
                     }
+                }
+            }
+            let [r, g, b] = &region.planes;
+            let mut sum = [0.0f64; 3];
+            for ((&r, &g), &b) in r.iter().zip(g).zip(b) {
+                let lin = self.colour.to_linear_srgb([r, g, b]);
+                for (total, v) in sum.iter_mut().zip(lin) {
+                    *total += f64::from(self.colour.quantise(self.colour.encode(v)));
                 }
             }
             out.extend(sum.map(|s| (255.0 * s / (side * side) as f64) as f32));
