@@ -145,7 +145,11 @@ pub const CHART_NAMES: &[(&str, &str)] = &[
     ("colorchecker24", "ColorChecker Classic 24, 4×6, built in"),
     (
         "colorchecker_sg96",
-        "ColorChecker Digital SG, the thesis's 96 centre patches (i1Pro2), 8×12; data directory",
+        "ColorChecker Digital SG, the 96 centre patches (the thesis's i1Pro2 set) where they sit on the chart, 8×12, features row by row as in photos; data directory",
+    ),
+    (
+        "colorchecker_sg96_thesis",
+        "the same 96 patches in file order, 12 per row, as the thesis rendered them; data directory",
     ),
     (
         "colorchecker_sg140",
@@ -232,17 +236,24 @@ impl Chart {
     ) -> Result<Chart> {
         let (name, set) = match spec {
             "colorchecker24" => return Chart::colorchecker24(grid),
-            "colorchecker_sg96" => (
-                spec.to_string(),
-                builtin::resolve_table(
+            "colorchecker_sg96" | "colorchecker_sg96_thesis" => {
+                let (_, set) = builtin::resolve_table(
                     "colorchecker_digital_sg_96_i1pro2",
                     "chart",
                     &[],
                     data_dir,
                     &["thesis"],
-                )?
-                .1,
-            ),
+                )?;
+                if spec == "colorchecker_sg96" {
+                    // The file lists the SG's centre patches column by column (B2…B9,
+                    // C2…C9, …, M2…M9): position (row r, column c) holds file patch c·8 + r.
+                    let order: Vec<usize> = (0..8)
+                        .flat_map(|r| (0..12).map(move |c| c * 8 + r))
+                        .collect();
+                    return Chart::from_reflectances(spec, &set.select(&order), 8, 12, grid);
+                }
+                (spec.to_string(), set)
+            }
             "colorchecker_sg140" => (
                 spec.to_string(),
                 builtin::resolve_table("colorchecker_sg", "chart", &[], data_dir, &["charts"])?.1,

@@ -13,6 +13,8 @@ pub mod illuminant;
 pub mod imageio;
 pub mod light;
 pub mod lighting;
+pub mod metrics;
+pub mod photo;
 pub mod raster;
 pub mod seed;
 pub mod spectral;

@@ -1,0 +1,138 @@
+//! Photo speed (issue targets): a 24-megapixel JPEG to its features, decoding included
+//! (≤ 1 s), and chart detection alone (≤ 300 ms). The photo is a synthetic ColorChecker 24
+//! scene (the test suite's generator) enlarged to 6000 × 4000 and JPEG-encoded at quality 92.
+//!
+//! First a summary prints median times, their ratio to the targets, and the speed-up over a
+//! simple baseline measured in the same run: the same detector run directly on the full
+//! resolution photo, without the pyramid. Then criterion measures each step.
+
+#[path = "../tests/photo_support/mod.rs"]
+mod photo_support;
+
+use criterion::{criterion_group, Criterion};
+use spdcam_core::photo::{
+    analyse, decode_photo, detect, detect_at, AnalyseOptions, ChartTemplate, Photo,
+};
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+const WIDTH: u32 = 6000;
+const HEIGHT: u32 = 4000;
+
+struct Fixture {
+    jpeg: Vec<u8>,
+    photo: Photo,
+    templates: Vec<ChartTemplate>,
+}
+
+fn fixture() -> Fixture {
+    let setup = photo_support::colorchecker24();
+    let scene = photo_support::scene(
+        &setup,
+        3,
+        photo_support::SceneSize {
+            width: 1500,
+            height: 1000,
+        },
+    );
+    let small = image::load_from_memory(&scene.jpeg).expect("scene decodes");
+    let big = small
+        .resize_exact(WIDTH, HEIGHT, image::imageops::FilterType::Triangle)
+        .to_rgb8();
+    let mut jpeg = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 92)
+        .encode(big.as_raw(), WIDTH, HEIGHT, image::ExtendedColorType::Rgb8)
+        .expect("encode");
+    let photo = decode_photo(&jpeg, "bench.jpg").expect("decode");
+    Fixture {
+        jpeg,
+        photo,
+        templates: vec![setup.template],
+    }
+}
+
+fn median(runs: usize, mut f: impl FnMut()) -> Duration {
+    f();
+    let mut t: Vec<Duration> = (0..runs)
+        .map(|_| {
+            let s = Instant::now();
+            f();
+            s.elapsed()
+        })
+        .collect();
+    t.sort();
+    t[t.len() / 2]
+}
+
+fn summary(fx: &Fixture) {
+    let options = AnalyseOptions {
+        templates: fx.templates.clone(),
+        ..AnalyseOptions::default()
+    };
+    let decode = median(5, || {
+        black_box(decode_photo(&fx.jpeg, "bench.jpg").expect("decode"));
+    });
+    let detection = median(7, || {
+        black_box(detect(&fx.photo, &fx.templates).expect("chart found"));
+    });
+    let whole = median(5, || {
+        let photo = decode_photo(&fx.jpeg, "bench.jpg").expect("decode");
+        black_box(analyse(&photo, &options).expect("analysis"));
+    });
+    let naive = median(3, || {
+        let (found, _) = detect_at(&fx.photo, &fx.templates, usize::MAX).expect("search");
+        black_box(found.expect("chart found at full resolution"));
+    });
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    println!(
+        "24-megapixel JPEG ({} MB), median of runs:",
+        fx.jpeg.len() / 1_000_000
+    );
+    println!("  decode                  {:8.1} ms", ms(decode));
+    println!(
+        "  photo → features        {:8.1} ms  ({:.2} of the 1 s target)",
+        ms(whole),
+        whole.as_secs_f64() / 1.0
+    );
+    println!(
+        "  detection (pyramid)     {:8.1} ms  ({:.2} of the 300 ms target)",
+        ms(detection),
+        detection.as_secs_f64() / 0.3
+    );
+    println!(
+        "  detection, baseline at full resolution {:8.1} ms: the pyramid is {:.1}× faster",
+        ms(naive),
+        naive.as_secs_f64() / detection.as_secs_f64()
+    );
+}
+
+fn benches(c: &mut Criterion) {
+    let fx = fixture();
+    summary(&fx);
+    let options = AnalyseOptions {
+        templates: fx.templates.clone(),
+        ..AnalyseOptions::default()
+    };
+    let mut g = c.benchmark_group("photo_24mp");
+    g.sample_size(10);
+    g.bench_function("decode", |b| {
+        b.iter(|| decode_photo(black_box(&fx.jpeg), "bench.jpg").expect("decode"))
+    });
+    g.bench_function("detect", |b| {
+        b.iter(|| detect(black_box(&fx.photo), &fx.templates).expect("found"))
+    });
+    g.bench_function("jpeg_to_features", |b| {
+        b.iter(|| {
+            let photo = decode_photo(black_box(&fx.jpeg), "bench.jpg").expect("decode");
+            analyse(&photo, &options).expect("analysis")
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(photo, benches);
+
+fn main() {
+    photo();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -1,0 +1,239 @@
+//! One call from a photo file to its feature row: decode ─► find (or place) the chart ─►
+//! sample ─► features, confidence, flags and warnings; several photos in parallel.
+
+use super::detect::{detect_traced, from_corners, no_chart};
+use super::geometry::Homography;
+use super::load::{load_photo, Photo};
+use super::overlay::{debug_overlay, write_overlay};
+use super::sample::{sample, PatchSample};
+use super::{ChartTemplate, Detection};
+use crate::error::{Error, Result};
+use crate::fsio;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// A warning is given when more than this share of the feature patches is clipped.
+const CLIPPED_WARNING_SHARE: f64 = 0.1;
+/// A warning is given below this confidence (results above [`super::MIN_CONFIDENCE`]).
+const LOW_CONFIDENCE: f64 = 0.8;
+
+/// How to analyse photos.
+#[derive(Debug, Clone, Default)]
+pub struct AnalyseOptions {
+    /// The charts to look for; with [`AnalyseOptions::corners`], the first is the chart
+    /// those corners outline.
+    pub templates: Vec<ChartTemplate>,
+    /// The chart's four outer corners in photo pixels, any order; `None` to detect.
+    pub corners: Option<Vec<[f64; 2]>>,
+    /// Where to write the debug image (written also when no chart is found). With several
+    /// photos, each gets its own file, see [`debug_path`].
+    pub debug: Option<PathBuf>,
+}
+
+/// What a photo gave.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PhotoAnalysis {
+    /// The photo's file (or name).
+    pub source: String,
+    /// Photo width in pixels (after EXIF orientation).
+    pub width: usize,
+    /// Photo height in pixels.
+    pub height: usize,
+    /// `"detected"` or `"corners"`.
+    pub method: &'static str,
+    /// The chart found.
+    pub chart: String,
+    /// 0…1: how sure the chart's placement and orientation are.
+    pub confidence: f64,
+    /// Outer corners of the patch grid (photo pixels): the chart's TL, TR, BR, BL.
+    pub corners: [[f64; 2]; 4],
+    /// Chart coordinates (patch pitch units) → photo pixels, row-major.
+    pub homography: [[f64; 3]; 3],
+    /// Feature column names, `p01_r, p01_g, …`.
+    pub feature_names: Vec<String>,
+    /// Mean encoded sRGB (0–255) of each feature patch, in feature order: the model's input.
+    pub features: Vec<f32>,
+    /// Every patch of the chart, row-major, with its statistics and flags.
+    pub patches: Vec<PatchSample>,
+    /// What the user should know (clipping, low confidence, dark patches).
+    pub warnings: Vec<String>,
+}
+
+/// Decodes, finds the chart, samples it. Writes the debug image when asked, also when no
+/// chart is found (then the error says so).
+pub fn analyse_photo(path: &Path, options: &AnalyseOptions) -> Result<PhotoAnalysis> {
+    let photo = load_photo(path)?;
+    analyse(&photo, options)
+}
+
+/// [`analyse_photo`] for a decoded photo.
+pub fn analyse(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnalysis> {
+    let templates = &options.templates;
+    let Some(first) = templates.first() else {
+        return Err(Error::invalid("no chart to look for"));
+    };
+    let (detection, trace, method) = match &options.corners {
+        Some(corners) => (Some(from_corners(photo, first, corners)?), None, "corners"),
+        None => {
+            let (d, trace) = detect_traced(photo, templates)?;
+            (d, Some(trace), "detected")
+        }
+    };
+    let Some(detection) = detection else {
+        if let Some(path) = &options.debug {
+            write_overlay(path, &debug_overlay(photo, None, trace.as_ref()))?;
+        }
+        return Err(no_chart(photo, templates));
+    };
+    let template = templates
+        .iter()
+        .find(|t| t.name == detection.chart)
+        .ok_or_else(|| Error::invalid("detected chart has no template"))?;
+    let h = Homography(nalgebra::Matrix3::from_fn(|r, c| {
+        detection.homography[r][c]
+    }));
+    let patches = sample(photo, template, &h)?;
+    if let Some(path) = &options.debug {
+        let image = debug_overlay(photo, Some((template, &detection, &patches)), None);
+        write_overlay(path, &image)?;
+    }
+    Ok(assemble(photo, template, detection, method, patches))
+}
+
+fn assemble(
+    photo: &Photo,
+    template: &ChartTemplate,
+    detection: Detection,
+    method: &'static str,
+    patches: Vec<PatchSample>,
+) -> PhotoAnalysis {
+    let features: Vec<f32> = template
+        .feature_patches
+        .iter()
+        .flat_map(|&p| patches[p].rgb)
+        .collect();
+    let mut warnings = Vec::new();
+    let clipped: Vec<usize> = template
+        .feature_patches
+        .iter()
+        .enumerate()
+        .filter(|(_, &p)| patches[p].clipped)
+        .map(|(k, _)| k + 1)
+        .collect();
+    let n = template.feature_patches.len();
+    if clipped.len() as f64 > CLIPPED_WARNING_SHARE * n as f64 {
+        warnings.push(format!(
+            "{} of {n} feature patches are clipped (features {}): the photo is over-exposed \
+             and the estimate will be biased",
+            clipped.len(),
+            list(&clipped)
+        ));
+    }
+    let dark: Vec<usize> = template
+        .feature_patches
+        .iter()
+        .enumerate()
+        .filter(|(_, &p)| patches[p].dark)
+        .map(|(k, _)| k + 1)
+        .collect();
+    if !dark.is_empty() {
+        warnings.push(format!(
+            "feature patches {} are very dark: their colour is mostly noise",
+            list(&dark)
+        ));
+    }
+    if detection.confidence < LOW_CONFIDENCE {
+        warnings.push(format!(
+            "chart placement confidence is only {:.2}; check the debug image",
+            detection.confidence
+        ));
+    }
+    PhotoAnalysis {
+        source: photo.source.clone(),
+        width: photo.width,
+        height: photo.height,
+        method,
+        chart: detection.chart,
+        confidence: detection.confidence,
+        corners: detection.corners,
+        homography: detection.homography,
+        feature_names: template.feature_names.clone(),
+        features,
+        patches,
+        warnings,
+    }
+}
+
+fn list(items: &[usize]) -> String {
+    items
+        .iter()
+        .map(|k| k.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Analyses several photos in parallel; one result per photo, in order. With several
+/// photos the debug image of each goes to [`debug_path`].
+pub fn analyse_photos(paths: &[PathBuf], options: &AnalyseOptions) -> Vec<Result<PhotoAnalysis>> {
+    let count = paths.len();
+    paths
+        .par_iter()
+        .map(|path| {
+            let mut own = options.clone();
+            own.debug = options.debug.as_ref().map(|d| debug_path(d, path, count));
+            analyse_photo(path, &own)
+        })
+        .collect()
+}
+
+/// The debug image of `photo` when `count` photos share the base name `base`:
+/// `base` itself for one photo, else `<base stem>-<photo stem>.<base extension>`.
+pub fn debug_path(base: &Path, photo: &Path, count: usize) -> PathBuf {
+    if count <= 1 {
+        return base.to_path_buf();
+    }
+    let stem = base
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "debug".into());
+    let ext = base
+        .extension()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "png".into());
+    let photo_stem = photo
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    base.with_file_name(format!("{stem}-{photo_stem}.{ext}"))
+}
+
+/// The feature rows as CSV: a header of feature names and one row per analysis (the
+/// layout of a dataset's `features.csv`). All analyses must be of the same chart.
+pub fn features_csv(analyses: &[PhotoAnalysis]) -> Result<String> {
+    let Some(first) = analyses.first() else {
+        return Err(Error::invalid("no photo analysed: no features to write"));
+    };
+    if let Some(other) = analyses
+        .iter()
+        .find(|a| a.feature_names != first.feature_names)
+    {
+        return Err(Error::invalid(format!(
+            "{} shows {} and {} shows {}: their features cannot share one table",
+            first.source, first.chart, other.source, other.chart
+        )));
+    }
+    let mut out = first.feature_names.join(",");
+    out.push('\n');
+    for a in analyses {
+        let row: Vec<String> = a.features.iter().map(|v| format!("{v:.4}")).collect();
+        let _ = writeln!(out, "{}", row.join(","));
+    }
+    Ok(out)
+}
+
+/// Writes [`features_csv`] to `path` atomically.
+pub fn write_features_csv(path: &Path, analyses: &[PhotoAnalysis]) -> Result<()> {
+    fsio::write_atomic(path, features_csv(analyses)?.as_bytes())
+}

@@ -1,0 +1,371 @@
+//! Finding a chart: patch candidates ─► lattices ─► placed on each chart template in each
+//! of the four in-plane rotations ─► the placement whose neutral patches are ordered by
+//! lightness as their reflectances are (which any light keeps) and which covers the most
+//! candidates wins. Or, from four corners the user gives, the rotation by the same rule.
+
+use super::geometry::{sort_corners, Homography};
+use super::lattice::{find_lattices, Lattice};
+use super::load::Photo;
+use super::pyramid::Level;
+use super::segment::{find_blobs, Blob};
+use super::{ChartTemplate, Detection, MIN_CONFIDENCE};
+use crate::error::{Error, Result};
+use nalgebra::Matrix3;
+
+/// Longer side (px) of the pyramid level searched first.
+pub const DETECTION_SIZE: usize = 1000;
+/// Fewest blobs a lattice needs before it is placed on a template.
+const MIN_LATTICE: usize = 6;
+
+/// What the search saw, for the debug image when it fails.
+#[derive(Debug, Clone, Default)]
+pub struct SearchTrace {
+    /// Patch candidates, centre and side in photo pixels.
+    pub blobs: Vec<([f64; 2], f64)>,
+    /// Best placement's outline (photo pixels) and confidence, even when rejected.
+    pub best: Option<([[f64; 2]; 4], f64)>,
+}
+
+/// One placement of a lattice on a template.
+#[derive(Debug, Clone)]
+struct Candidate {
+    template: usize,
+    /// Chart → level coordinates.
+    map: Homography,
+    tau: f64,
+    coverage: f64,
+    /// Best score among the placements in the other three rotations.
+    other_rotation_score: f64,
+    fit_rms: f64,
+}
+
+impl Candidate {
+    fn score(&self) -> f64 {
+        self.coverage + self.tau
+    }
+
+    fn confidence(&self) -> f64 {
+        let cov = (self.coverage / 0.6).min(1.0);
+        let order = self.tau.max(0.0);
+        let margin = (0.5 + (self.score() - self.other_rotation_score)).clamp(0.0, 1.0);
+        let fit = (1.0 - self.fit_rms / 0.25).clamp(0.0, 1.0);
+        cov * order * margin * fit.sqrt()
+    }
+}
+
+/// Finds one of `templates` in `photo`. Fails with a message that says so when no
+/// placement reaches [`MIN_CONFIDENCE`].
+pub fn detect(photo: &Photo, templates: &[ChartTemplate]) -> Result<Detection> {
+    let (found, _) = detect_traced(photo, templates)?;
+    found.ok_or_else(|| no_chart(photo, templates))
+}
+
+/// The error for a photo that shows none of `templates`.
+pub(crate) fn no_chart(photo: &Photo, templates: &[ChartTemplate]) -> Error {
+    Error::invalid(format!(
+        "{}: no chart found (looked for {}); give its corners with --corners x1,y1,…,x4,y4",
+        photo.source,
+        templates
+            .iter()
+            .map(|t| t.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ))
+}
+
+/// [`detect`] that also returns what it saw.
+pub fn detect_traced(
+    photo: &Photo,
+    templates: &[ChartTemplate],
+) -> Result<(Option<Detection>, SearchTrace)> {
+    detect_at(photo, templates, DETECTION_SIZE)
+}
+
+/// [`detect_traced`] searching first a level of about `size` px on its longer side (then
+/// finer levels down to full resolution while nothing is found).
+pub fn detect_at(
+    photo: &Photo,
+    templates: &[ChartTemplate],
+    size: usize,
+) -> Result<(Option<Detection>, SearchTrace)> {
+    if templates.is_empty() {
+        return Err(Error::invalid("no chart template to look for"));
+    }
+    let mut factor = Level::factor_for(photo.width, photo.height, size.max(1));
+    let mut trace = SearchTrace::default();
+    loop {
+        let level = Level::new(photo, factor);
+        let (best, blobs) = search_level(&level, templates);
+        if trace.blobs.is_empty() || best.is_some() {
+            let f = factor as f64;
+            trace.blobs = blobs
+                .iter()
+                .map(|b| ([b.centre[0] * f, b.centre[1] * f], b.side() * f))
+                .collect();
+        }
+        if let Some(c) = &best {
+            let map = c.map.scaled_output(factor as f64);
+            let t = &templates[c.template];
+            let corners = t.corners().map(|p| map.apply(p));
+            let confidence = c.confidence();
+            trace.best = Some((corners, confidence));
+            if confidence >= MIN_CONFIDENCE {
+                return Ok((
+                    Some(Detection {
+                        chart: t.name.clone(),
+                        corners,
+                        homography: map.to_rows(),
+                        confidence,
+                    }),
+                    trace,
+                ));
+            }
+        }
+        // Small charts may need a finer level.
+        if factor <= 1 {
+            return Ok((None, trace));
+        }
+        factor /= 2;
+    }
+}
+
+/// The best placement on one level, and the level's blobs.
+fn search_level(level: &Level, templates: &[ChartTemplate]) -> (Option<Candidate>, Vec<Blob>) {
+    let blobs = find_blobs(level);
+    let lattices = find_lattices(&blobs, MIN_LATTICE);
+    let mut best: Option<Candidate> = None;
+    for lattice in &lattices {
+        for (ti, t) in templates.iter().enumerate() {
+            if let Some(c) = place(level, &blobs, lattice, ti, t) {
+                if best.as_ref().is_none_or(|b| c.score() > b.score()) {
+                    best = Some(c);
+                }
+            }
+        }
+    }
+    (best, blobs)
+}
+
+/// Grid position (i, j) of a lattice → patch (column, row) of the chart for rotation `k`
+/// (quarter turns) and shift `t`.
+fn rotate(k: usize, p: [i32; 2]) -> [i32; 2] {
+    match k {
+        0 => p,
+        1 => [p[1], -p[0]],
+        2 => [-p[0], -p[1]],
+        _ => [-p[1], p[0]],
+    }
+}
+
+/// The lattice→chart-patch map as a matrix on homogeneous (i, j, 1).
+fn rotation_matrix(k: usize, t: [i32; 2]) -> Matrix3<f64> {
+    let (a, b, c, d) = match k {
+        0 => (1.0, 0.0, 0.0, 1.0),
+        1 => (0.0, 1.0, -1.0, 0.0),
+        2 => (-1.0, 0.0, 0.0, -1.0),
+        _ => (0.0, -1.0, 1.0, 0.0),
+    };
+    Matrix3::new(a, b, t[0] as f64, c, d, t[1] as f64, 0.0, 0.0, 1.0)
+}
+
+/// The best placement of `lattice` on template `t`, over rotations and shifts.
+fn place(
+    level: &Level,
+    blobs: &[Blob],
+    lattice: &Lattice,
+    ti: usize,
+    t: &ChartTemplate,
+) -> Option<Candidate> {
+    let n = t.patch_count() as f64;
+    let (cols, rows) = (t.cols as i32, t.rows as i32);
+    let half = t.patch_fraction / 2.0;
+    // Chart coordinates → patch grid (column, row) as integers at patch centres.
+    let chart_to_patch = Matrix3::new(1.0, 0.0, -half, 0.0, 1.0, -half, 0.0, 0.0, 1.0);
+    let mut per_rotation: Vec<Option<Candidate>> = vec![None, None, None, None];
+    for (k, slot) in per_rotation.iter_mut().enumerate() {
+        let rotated: Vec<[i32; 2]> = lattice.members.iter().map(|m| rotate(k, m.1)).collect();
+        let min_c = rotated.iter().map(|p| p[0]).min()?;
+        let max_c = rotated.iter().map(|p| p[0]).max()?;
+        let min_r = rotated.iter().map(|p| p[1]).min()?;
+        let max_r = rotated.iter().map(|p| p[1]).max()?;
+        for tc in (-max_c)..=(cols - 1 - min_c) {
+            for tr in (-max_r)..=(rows - 1 - min_r) {
+                let inside: Vec<usize> = (0..rotated.len())
+                    .filter(|&m| {
+                        let (c, r) = (rotated[m][0] + tc, rotated[m][1] + tr);
+                        (0..cols).contains(&c) && (0..rows).contains(&r)
+                    })
+                    .collect();
+                let inliers = inside.len();
+                if inliers < MIN_LATTICE || (inliers as f64) < 0.25 * n {
+                    continue;
+                }
+                let outside = rotated.len() - inliers;
+                let coverage = inliers as f64 / (n + outside as f64);
+                if slot.as_ref().is_some_and(|s| s.coverage > coverage + 0.3) {
+                    continue;
+                }
+                // patch (c, r) → lattice (i, j) → level.
+                let to_patch = rotation_matrix(k, [tc, tr]);
+                let patch_to_lattice = to_patch.try_inverse()?;
+                let map = Homography(lattice.map.0 * patch_to_lattice * chart_to_patch);
+                let Some(tau) = neutral_order(level, t, &map) else {
+                    continue;
+                };
+                let fit_rms = {
+                    let from: Vec<[f64; 2]> = inside
+                        .iter()
+                        .map(|&m| {
+                            let p = lattice.members[m].1;
+                            [p[0] as f64, p[1] as f64]
+                        })
+                        .collect();
+                    let to: Vec<[f64; 2]> = inside
+                        .iter()
+                        .map(|&m| blobs[lattice.members[m].0].centre)
+                        .collect();
+                    let pitch = lattice_pitch(&lattice.map, &from);
+                    lattice.map.rms_error(&from, &to) / pitch.max(1e-9)
+                };
+                let c = Candidate {
+                    template: ti,
+                    map,
+                    tau,
+                    coverage,
+                    other_rotation_score: -1.0,
+                    fit_rms,
+                };
+                if slot.as_ref().is_none_or(|s| c.score() > s.score()) {
+                    *slot = Some(c);
+                }
+            }
+        }
+    }
+    let best_k = (0..4)
+        .filter(|&k| per_rotation[k].is_some())
+        .max_by(|&a, &b| {
+            let sa = per_rotation[a].as_ref().map_or(f64::MIN, |c| c.score());
+            let sb = per_rotation[b].as_ref().map_or(f64::MIN, |c| c.score());
+            sa.total_cmp(&sb)
+        })?;
+    let other = (0..4)
+        .filter(|&k| k != best_k)
+        .filter_map(|k| per_rotation[k].as_ref().map(|c| c.score()))
+        .fold(-1.0, f64::max);
+    let mut best = per_rotation[best_k].take()?;
+    best.other_rotation_score = other;
+    Some(best)
+}
+
+/// Mean grid pitch (level px) of a lattice map around the given grid points.
+fn lattice_pitch(map: &Homography, points: &[[f64; 2]]) -> f64 {
+    let mut s = 0.0;
+    for p in points {
+        let a = map.apply(*p);
+        let b = map.apply([p[0] + 1.0, p[1]]);
+        let c = map.apply([p[0], p[1] + 1.0]);
+        s += 0.5 * ((b[0] - a[0]).hypot(b[1] - a[1]) + (c[0] - a[0]).hypot(c[1] - a[1]));
+    }
+    s / points.len().max(1) as f64
+}
+
+/// Mean colour of the centre of every patch, sampled on `level` through `map` (chart →
+/// level); `None` when a patch centre falls outside the level.
+fn patch_colours(level: &Level, t: &ChartTemplate, map: &Homography) -> Option<Vec<[f32; 3]>> {
+    let q = t.patch_fraction / 4.0;
+    (0..t.patch_count())
+        .map(|p| {
+            let [cx, cy] = t.patch_centre(p);
+            let centre = map.apply([cx, cy]);
+            if !(centre[0] >= 0.0
+                && centre[1] >= 0.0
+                && centre[0] < level.width as f64
+                && centre[1] < level.height as f64)
+            {
+                return None;
+            }
+            let mut sum = [0.0f32; 3];
+            for dy in [-q, 0.0, q] {
+                for dx in [-q, 0.0, q] {
+                    let v = level.bilinear(map.apply([cx + dx, cy + dy]));
+                    for c in 0..3 {
+                        sum[c] += v[c] / 9.0;
+                    }
+                }
+            }
+            Some(sum)
+        })
+        .collect()
+}
+
+/// Kendall's τ between the neutral patches' reflectances and their measured lightness
+/// (sum of the channels): +1 when the photo orders them as the chart does. Pairs whose
+/// lightness differs by less than the quantisation (clipped or black) count as ties.
+fn neutral_order(level: &Level, t: &ChartTemplate, map: &Homography) -> Option<f64> {
+    let colours = patch_colours(level, t, map)?;
+    let light: Vec<(f64, f64)> = t
+        .neutrals
+        .iter()
+        .map(|&(p, r)| (r, colours[p].iter().map(|&v| v as f64).sum()))
+        .collect();
+    let (mut s, mut pairs) = (0.0, 0usize);
+    for a in 0..light.len() {
+        for b in a + 1..light.len() {
+            let dr = light[a].0 - light[b].0;
+            if dr.abs() < 0.02 * light[a].0.max(light[b].0) {
+                continue;
+            }
+            pairs += 1;
+            let dl = light[a].1 - light[b].1;
+            if dl.abs() > 3.0 / 255.0 {
+                s += (dr.signum() * dl.signum()) as f32 as f64;
+            }
+        }
+    }
+    (pairs > 0).then(|| s / pairs as f64)
+}
+
+/// The chart's placement from four outer corners given in any order (photo pixels): the
+/// corners are sorted and checked (inside the photo, convex), and of the four ways to lay
+/// the chart on them the one whose sides fit the chart's aspect and whose neutral patches
+/// are in lightness order is taken.
+pub fn from_corners(
+    photo: &Photo,
+    template: &ChartTemplate,
+    corners: &[[f64; 2]],
+) -> Result<Detection> {
+    let quad = sort_corners(corners, photo.width, photo.height)?;
+    let factor = Level::factor_for(photo.width, photo.height, DETECTION_SIZE);
+    let level = Level::new(photo, factor);
+    let (w, h) = template.size();
+    let side = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let mut best: Option<(f64, usize, Homography)> = None;
+    let mut taus = Vec::new();
+    for s in 0..4 {
+        let image: Vec<[f64; 2]> = (0..4).map(|k| quad[(s + k) % 4]).collect();
+        let map = Homography::fit(&template.corners(), &image)?;
+        let across = 0.5 * (side(image[0], image[1]) + side(image[2], image[3]));
+        let down = 0.5 * (side(image[1], image[2]) + side(image[3], image[0]));
+        let aspect_error = ((across / down) / (w / h)).ln().abs();
+        let tau = neutral_order(&level, template, &map.scaled_output(1.0 / factor as f64))
+            .unwrap_or(-1.0);
+        let score = tau - 2.0 * aspect_error;
+        taus.push((tau, score));
+        if best.as_ref().is_none_or(|b| score > b.0) {
+            best = Some((score, s, map));
+        }
+    }
+    let (_, chosen, map) = best.ok_or_else(|| Error::invalid("no placement for the corners"))?;
+    let (tau, score) = taus[chosen];
+    let other = (0..4)
+        .filter(|&s| s != chosen)
+        .map(|s| taus[s].1)
+        .fold(-1.0, f64::max);
+    let confidence = tau.max(0.0) * (0.5 + score - other).clamp(0.0, 1.0);
+    Ok(Detection {
+        chart: template.name.clone(),
+        corners: template.corners().map(|p| map.apply(p)),
+        homography: map.to_rows(),
+        confidence,
+    })
+}

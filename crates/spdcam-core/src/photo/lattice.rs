@@ -1,0 +1,235 @@
+//! Grouping patch candidates into a lattice: integer grid positions for blobs that sit on
+//! one projected grid of similar squares.
+//!
+//! From a seed blob and two of its neighbours (an approximately orthogonal pair), the grid
+//! grows: every blob whose position, mapped back through the current grid-to-image map,
+//! lies close to an integer grid point next to those already taken joins, and the map is
+//! refitted (affine while few points are known, then a homography by least squares). A
+//! blob far from every grid point never enters, so outliers do not bend the fit.
+
+use super::geometry::Homography;
+use super::segment::Blob;
+use nalgebra::Matrix3;
+
+/// Blobs on one grid.
+#[derive(Debug, Clone)]
+pub struct Lattice {
+    /// (blob index, integer grid position), grid positions shifted to start at (0, 0).
+    pub members: Vec<(usize, [i32; 2])>,
+    /// Grid position → level coordinates. The grid's first axis points along the image's
+    /// x axis as seen from the second, as (x, y) do on screen: the grid is never mirrored.
+    pub map: Homography,
+}
+
+/// Largest distance (in grid units) from a blob to its grid point.
+const SNAP: f64 = 0.22;
+/// Most seeds tried.
+const MAX_SEEDS: usize = 40;
+/// Patch side over patch pitch assumed before the chart is known (between the
+/// ColorCheckers' 0.84 and 0.88).
+const TYPICAL_FRACTION: f64 = 0.86;
+
+/// Lattices of at least `min_members` blobs, largest first.
+pub fn find_lattices(blobs: &[Blob], min_members: usize) -> Vec<Lattice> {
+    let neighbours = neighbour_lists(blobs);
+    let mut order: Vec<usize> = (0..blobs.len())
+        .filter(|&i| neighbours[i].len() >= 2)
+        .collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(neighbours[i].len()));
+    let mut taken = vec![false; blobs.len()];
+    let mut out: Vec<Lattice> = Vec::new();
+    for &seed in order.iter() {
+        if out.len() >= MAX_SEEDS {
+            break;
+        }
+        if taken[seed] {
+            continue;
+        }
+        let Some(lattice) = grow(blobs, &neighbours[seed], seed) else {
+            continue;
+        };
+        if lattice.members.len() >= min_members {
+            for &(b, _) in &lattice.members {
+                taken[b] = true;
+            }
+            out.push(lattice);
+        }
+    }
+    out.sort_by_key(|l| std::cmp::Reverse(l.members.len()));
+    out
+}
+
+/// For each blob, the blobs of similar size at about one patch pitch.
+fn neighbour_lists(blobs: &[Blob]) -> Vec<Vec<usize>> {
+    let mut idx: Vec<usize> = (0..blobs.len()).collect();
+    idx.sort_by(|&a, &b| blobs[a].centre[0].total_cmp(&blobs[b].centre[0]));
+    let xs: Vec<f64> = idx.iter().map(|&i| blobs[i].centre[0]).collect();
+    let mut out = vec![Vec::new(); blobs.len()];
+    for (k, &i) in idx.iter().enumerate() {
+        let bi = &blobs[i];
+        let pitch = bi.side() / TYPICAL_FRACTION;
+        let reach = 2.0 * pitch;
+        let lo = xs.partition_point(|&x| x < bi.centre[0] - reach);
+        for &j in &idx[lo..] {
+            let bj = &blobs[j];
+            if bj.centre[0] > bi.centre[0] + reach {
+                break;
+            }
+            if j == i {
+                continue;
+            }
+            let d = (bj.centre[0] - bi.centre[0]).hypot(bj.centre[1] - bi.centre[1]);
+            let ratio = bj.area / bi.area;
+            if (0.7 * pitch..=1.6 * pitch).contains(&d) && (0.4..=2.5).contains(&ratio) {
+                out[i].push(j);
+            }
+        }
+        let _ = k;
+    }
+    out
+}
+
+/// An affine grid map from a seed and its neighbours, or `None` without an orthogonal pair.
+fn seed_map(blobs: &[Blob], neighbours: &[usize], seed: usize) -> Option<Homography> {
+    let c = blobs[seed].centre;
+    let mut vecs: Vec<[f64; 2]> = neighbours
+        .iter()
+        .map(|&j| [blobs[j].centre[0] - c[0], blobs[j].centre[1] - c[1]])
+        .collect();
+    vecs.sort_by(|a, b| a[0].hypot(a[1]).total_cmp(&b[0].hypot(b[1])));
+    let u = *vecs.first()?;
+    let lu = u[0].hypot(u[1]);
+    let v = vecs.iter().skip(1).find(|v| {
+        let lv = v[0].hypot(v[1]);
+        let cos = (u[0] * v[0] + u[1] * v[1]) / (lu * lv);
+        cos.abs() < 0.45 && (lv / lu) < 1.6
+    })?;
+    // Keep the grid unmirrored: (u, v) turn like the screen's (x, y).
+    let v = if u[0] * v[1] - u[1] * v[0] > 0.0 {
+        *v
+    } else {
+        [-v[0], -v[1]]
+    };
+    Some(Homography(Matrix3::new(
+        u[0], v[0], c[0], u[1], v[1], c[1], 0.0, 0.0, 1.0,
+    )))
+}
+
+/// Grows a lattice from `seed`.
+fn grow(blobs: &[Blob], neighbours: &[usize], seed: usize) -> Option<Lattice> {
+    let mut map = seed_map(blobs, neighbours, seed)?;
+    let seed_area = blobs[seed].area;
+    let candidates: Vec<usize> = (0..blobs.len())
+        .filter(|&j| (0.25..=4.0).contains(&(blobs[j].area / seed_area)))
+        .collect();
+    let mut members: Vec<(usize, [i32; 2])> = vec![(seed, [0, 0])];
+    for _ in 0..40 {
+        let inverse = map.inverse()?;
+        let mut claims: std::collections::HashMap<[i32; 2], (f64, usize)> =
+            std::collections::HashMap::new();
+        let known: std::collections::HashSet<[i32; 2]> = members.iter().map(|m| m.1).collect();
+        for &j in &candidates {
+            let q = inverse.apply(blobs[j].centre);
+            if !q[0].is_finite() || !q[1].is_finite() {
+                continue;
+            }
+            let n = [q[0].round() as i32, q[1].round() as i32];
+            let r = (q[0] - n[0] as f64).hypot(q[1] - n[1] as f64);
+            if r > SNAP {
+                continue;
+            }
+            let near =
+                (-1..=1).any(|di| (-1..=1).any(|dj| known.contains(&[n[0] + di, n[1] + dj])));
+            if !near {
+                continue;
+            }
+            // The blob's size must agree with the local grid pitch.
+            let p0 = map.apply([n[0] as f64, n[1] as f64]);
+            let px = map.apply([n[0] as f64 + 1.0, n[1] as f64]);
+            let py = map.apply([n[0] as f64, n[1] as f64 + 1.0]);
+            let cell =
+                ((px[0] - p0[0]) * (py[1] - p0[1]) - (px[1] - p0[1]) * (py[0] - p0[0])).abs();
+            let fill = blobs[j].area / cell.max(1e-9);
+            if !(0.3..=1.05).contains(&fill) {
+                continue;
+            }
+            let e = claims.entry(n).or_insert((r, j));
+            if r < e.0 {
+                *e = (r, j);
+            }
+        }
+        let mut next: Vec<(usize, [i32; 2])> =
+            claims.into_iter().map(|(n, (_, j))| (j, n)).collect();
+        next.sort_by_key(|m| (m.1[1], m.1[0]));
+        // A blob may claim only one grid point.
+        let mut seen = std::collections::HashSet::new();
+        next.retain(|m| seen.insert(m.0));
+        if next.iter().all(|m| m.0 != seed) {
+            return None;
+        }
+        let from: Vec<[f64; 2]> = next
+            .iter()
+            .map(|m| [m.1[0] as f64, m.1[1] as f64])
+            .collect();
+        let to: Vec<[f64; 2]> = next.iter().map(|m| blobs[m.0].centre).collect();
+        let new_map = fit_map(&from, &to).unwrap_or(map);
+        let unchanged = next == members;
+        members = next;
+        map = new_map;
+        if unchanged {
+            break;
+        }
+    }
+    // Shift the grid to start at (0, 0).
+    let i0 = members.iter().map(|m| m.1[0]).min()?;
+    let j0 = members.iter().map(|m| m.1[1]).min()?;
+    for m in &mut members {
+        m.1 = [m.1[0] - i0, m.1[1] - j0];
+    }
+    let shift = Matrix3::new(1.0, 0.0, i0 as f64, 0.0, 1.0, j0 as f64, 0.0, 0.0, 1.0);
+    Some(Lattice {
+        members,
+        map: Homography(map.0 * shift),
+    })
+}
+
+/// Least-squares grid map: a homography when the points span at least 3 × 3 grid
+/// positions (enough to pin perspective), else an affine map, else `None`.
+pub(crate) fn fit_map(from: &[[f64; 2]], to: &[[f64; 2]]) -> Option<Homography> {
+    let span = |k: usize| {
+        let lo = from.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+        let hi = from.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+        hi - lo
+    };
+    if from.len() >= 6 && span(0) >= 2.0 && span(1) >= 2.0 {
+        if let Ok(h) = Homography::fit(from, to) {
+            return Some(h);
+        }
+    }
+    fit_affine(from, to)
+}
+
+/// Least-squares affine map, `None` for fewer than three non-collinear points.
+fn fit_affine(from: &[[f64; 2]], to: &[[f64; 2]]) -> Option<Homography> {
+    if from.len() < 3 {
+        return None;
+    }
+    let mut ata = nalgebra::Matrix3::<f64>::zeros();
+    let mut atx = nalgebra::Vector3::<f64>::zeros();
+    let mut aty = nalgebra::Vector3::<f64>::zeros();
+    for (f, t) in from.iter().zip(to) {
+        let a = nalgebra::Vector3::new(f[0], f[1], 1.0);
+        ata += a * a.transpose();
+        atx += a * t[0];
+        aty += a * t[1];
+    }
+    let inv = ata.try_inverse()?;
+    if ata.determinant().abs() < 1e-9 {
+        return None;
+    }
+    let px = inv * atx;
+    let py = inv * aty;
+    Some(Homography(Matrix3::new(
+        px[0], px[1], px[2], py[0], py[1], py[2], 0.0, 0.0, 1.0,
+    )))
+}

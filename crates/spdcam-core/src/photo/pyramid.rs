@@ -1,0 +1,68 @@
+//! A downscaled copy of a photo for detection: box-averaged by an integer factor, planar
+//! f32 (encoded sRGB, 0…1), so that a 50-megapixel photo is searched at about 1000 px.
+
+use super::load::Photo;
+use rayon::prelude::*;
+
+/// A photo reduced by an integer `factor`: pixel (i, j) averages the photo's block
+/// `[i·factor, (i+1)·factor) × [j·factor, (j+1)·factor)`; edge pixels that do not fill a
+/// block are dropped.
+#[derive(Debug, Clone)]
+pub struct Level {
+    pub width: usize,
+    pub height: usize,
+    /// R, G, B planes, row-major.
+    pub planes: [Vec<f32>; 3],
+}
+
+impl Level {
+    /// The photo reduced by `factor` (≥ 1).
+    pub fn new(photo: &Photo, factor: usize) -> Level {
+        let k = factor.max(1);
+        let (w, h) = (photo.width / k, photo.height / k);
+        let norm = 1.0 / (k * k) as f32;
+        let mut interleaved = vec![[0.0f32; 3]; w * h];
+        interleaved
+            .par_chunks_mut(w.max(1))
+            .enumerate()
+            .for_each(|(y, row)| {
+                for dy in 0..k {
+                    let py = y * k + dy;
+                    for (x, out) in row.iter_mut().enumerate() {
+                        let s = photo.row_sum(py, x * k, x * k + k);
+                        for c in 0..3 {
+                            out[c] += s[c];
+                        }
+                    }
+                }
+                row.iter_mut().for_each(|v| *v = v.map(|s| s * norm));
+            });
+        let planes = std::array::from_fn(|c| interleaved.iter().map(|v| v[c]).collect());
+        Level {
+            width: w,
+            height: h,
+            planes,
+        }
+    }
+
+    /// The factor that brings a photo of `width × height` to about `target` px on its
+    /// longer side (never below 1).
+    pub fn factor_for(width: usize, height: usize, target: usize) -> usize {
+        (width.max(height) as f64 / target as f64).round().max(1.0) as usize
+    }
+
+    /// Bilinear value at a continuous point (pixel centres at +0.5), clamped to the image.
+    pub fn bilinear(&self, p: [f64; 2]) -> [f32; 3] {
+        let x = (p[0] - 0.5).clamp(0.0, (self.width - 1) as f64);
+        let y = (p[1] - 0.5).clamp(0.0, (self.height - 1) as f64);
+        let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+        let (x1, y1) = ((x0 + 1).min(self.width - 1), (y0 + 1).min(self.height - 1));
+        let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
+        std::array::from_fn(|c| {
+            let p = &self.planes[c];
+            let top = p[y0 * self.width + x0] * (1.0 - fx) + p[y0 * self.width + x1] * fx;
+            let bottom = p[y1 * self.width + x0] * (1.0 - fx) + p[y1 * self.width + x1] * fx;
+            top * (1.0 - fy) + bottom * fy
+        })
+    }
+}
