@@ -10,8 +10,10 @@ use spdcam_core::camera::sensor::{Sensitivities, SensorMode};
 use spdcam_core::camera::white_balance::WhiteBalance;
 use spdcam_core::camera::{Camera, CameraConfig, WhiteBalanceStatistics};
 use spdcam_core::chart::{Chart, Layout};
+use spdcam_core::photo::scene::{self, SceneOptions};
+use spdcam_core::photo::ChartTemplate;
 use spdcam_core::raster::CfaPattern;
-use spdcam_core::spectral::Grid;
+use spdcam_core::spectral::{Grid, SpectralSet};
 use spdcam_core::{fsio, imageio, light};
 use std::path::{Path, PathBuf};
 
@@ -164,6 +166,11 @@ impl CameraArgs {
 
     /// The camera: sensitivities, chart and settings.
     pub fn camera(&self, data_dir: &DataDir, grid: &Grid) -> Result<Camera> {
+        self.camera_for(self.chart(data_dir, grid)?, data_dir, grid)
+    }
+
+    /// The camera with these sensitivities and settings, photographing `chart`.
+    pub fn camera_for(&self, chart: Chart, data_dir: &DataDir, grid: &Grid) -> Result<Camera> {
         let (name, measured) = builtin::resolve_table(
             &self.camera,
             "camera",
@@ -172,12 +179,7 @@ impl CameraArgs {
             &["cameras", "thesis"],
         )?;
         let sensitivities = Sensitivities::new(&name, &measured, grid)?;
-        Ok(Camera::new(
-            &sensitivities,
-            self.chart(data_dir, grid)?,
-            self.config()?,
-            grid,
-        )?)
+        Ok(Camera::new(&sensitivities, chart, self.config()?, grid)?)
     }
 }
 
@@ -187,7 +189,7 @@ pub struct RenderArgs {
     /// The light: D65, A, D50, cct:T, daylight:T, planck:T, or a spectral CSV (FILE.csv[:COLUMN]).
     #[arg(long)]
     spd: String,
-    /// Output PNG.
+    /// Output PNG (JPEG with --scene).
     #[arg(short, long)]
     output: PathBuf,
     /// Also write the feature row (mean sRGB 0–255 of each patch) as CSV.
@@ -196,9 +198,18 @@ pub struct RenderArgs {
     /// Also write every intermediate stage as an image into this directory.
     #[arg(long, value_name = "DIR")]
     stages: Option<PathBuf>,
-    /// Seed of the noise.
+    /// Seed of the noise (and of the scene).
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Photograph the chart in a scene of WxH px instead: placed at a random position,
+    /// rotation and perspective on a cluttered background under the same light, with blur,
+    /// vignetting, noise, written as a JPEG (`-o photo.jpg`).
+    #[arg(long, value_name = "WxH")]
+    scene: Option<String>,
+    /// Also write the light's SPD (normalised to a maximum of 1) as spectral CSV, e.g. as
+    /// the truth beside a scene photo.
+    #[arg(long, value_name = "FILE.csv")]
+    spd_out: Option<PathBuf>,
     #[command(flatten)]
     camera: CameraArgs,
 }
@@ -214,12 +225,41 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
             bail!("stages directory {} does not exist", dir.display());
         }
     }
+    if let Some(path) = &args.spd_out {
+        fsio::check_parent_dir(path)?;
+    }
+    let scene = args
+        .scene
+        .as_deref()
+        .map(|s| parse_pair(s, "scene"))
+        .transpose()?;
+    let extension = args
+        .output
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match (&scene, extension.as_deref()) {
+        (Some(_), Some("jpg" | "jpeg")) | (None, Some("png")) => {}
+        (Some(_), _) => bail!("a scene is written as JPEG: name the output FILE.jpg"),
+        (None, _) => bail!("the chart is written as PNG: name the output FILE.png"),
+    }
     let spd = light::resolve_spd(&args.spd, data_dir, &grid)?;
     if let Some(report) = spd.resampling.as_ref().filter(|r| r.extrapolated()) {
         eprintln!(
             "warning: {}",
             report.describe(&format!("light {}", spd.name), &grid)
         );
+    }
+    if let Some(path) = &args.spd_out {
+        let mut values = spd.values.clone();
+        let max = values.iter().cloned().fold(0.0f64, f64::max);
+        if max > 0.0 {
+            values.iter_mut().for_each(|v| *v /= max);
+        }
+        SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?.write_csv(path)?;
+        println!("light SPD: {}", path.display());
+    }
+    if let Some((width, height)) = scene {
+        return render_scene(&args, &spd.values, &spd.name, (width, height), data_dir);
     }
     let camera = args.camera.camera(data_dir, &grid)?;
     let rendering = camera.render(&spd.values, args.seed, args.stages.is_some())?;
@@ -245,6 +285,50 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         l.height,
         depth,
         args.output.display()
+    );
+    Ok(())
+}
+
+/// `render --scene`: the chart rendered at the scene pitch and photographed in a scene.
+fn render_scene(
+    args: &RenderArgs,
+    spd: &[f64],
+    light_name: &str,
+    (width, height): (usize, usize),
+    data_dir: &DataDir,
+) -> Result<()> {
+    let grid = Grid::SIMULATION;
+    let chart = args.camera.chart(data_dir, &grid)?;
+    let template = ChartTemplate::from_chart(&chart)?;
+    let chart = chart.with_layout(scene::scene_layout(&template))?;
+    let camera = args.camera.camera_for(chart, data_dir, &grid)?;
+    let rendering = camera.render(spd, args.seed, false)?;
+    let options = SceneOptions {
+        width,
+        height,
+        ..SceneOptions::default()
+    };
+    let chart = camera.chart();
+    let shot = scene::photograph(
+        &rendering.image,
+        &chart.layout,
+        &template,
+        &chart.feature_patches,
+        args.seed,
+        &options,
+    )?;
+    fsio::write_atomic(&args.output, &shot.jpeg)?;
+    let corners: Vec<String> = shot
+        .corners
+        .iter()
+        .map(|[x, y]| format!("{x:.1},{y:.1}"))
+        .collect();
+    println!(
+        "photographed {} under {light_name} with {} in a {width}×{height} scene: {} (chart corners {})",
+        chart.name,
+        camera.camera_name(),
+        args.output.display(),
+        corners.join(",")
     );
     Ok(())
 }

@@ -20,6 +20,7 @@ mod load;
 mod overlay;
 mod pyramid;
 mod sample;
+pub mod scene;
 mod segment;
 
 pub use batch::{
