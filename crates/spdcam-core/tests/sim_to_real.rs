@@ -117,3 +117,46 @@ fn real_photos_follow_the_charts_physical_patch_order() {
     assert!(physical > 0.7, "physical order: {physical}");
     assert!(file_order.abs() < 0.2, "file order: {file_order}");
 }
+
+#[test]
+fn sg96_features_are_the_centre_patches_of_the_full_sg() {
+    // Two independent measurements of the same chart: the thesis's 96 centre patches
+    // (i1Pro2) and the full 140-patch SG. Feature k of both must be the same surface.
+    let data_dir = DataDir::new(Some(shared_data::data_dir()));
+    let sg96 = Chart::resolve("colorchecker_sg96", None, &data_dir, &GRID).unwrap();
+    let sg140 = Chart::resolve("colorchecker_sg140", None, &data_dir, &GRID).unwrap();
+    let rms = |a: &[f64], b: &[f64]| {
+        (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+    };
+    let mut nearest_at_same_position = 0;
+    let mut differences = Vec::new();
+    for (k, &p) in sg140.feature_patches.iter().enumerate() {
+        let ours = sg96.reflectances.item(sg96.feature_patches[k]);
+        let same = rms(ours, sg140.reflectances.item(p));
+        let closest = sg140
+            .feature_patches
+            .iter()
+            .map(|&q| rms(ours, sg140.reflectances.item(q)))
+            .fold(f64::INFINITY, f64::min);
+        nearest_at_same_position += usize::from(same <= closest + 1e-12);
+        differences.push(same);
+    }
+    differences.sort_by(f64::total_cmp);
+    let median = differences[differences.len() / 2];
+    println!(
+        "same surface at the same position: {nearest_at_same_position} of 96 nearest, median RMS difference {median:.4}"
+    );
+    assert!(nearest_at_same_position >= 85, "{nearest_at_same_position}");
+    assert!(median < 0.015, "{median}");
+    let template =
+        spdcam_core::photo::ChartTemplate::for_chart("colorchecker_sg96", &data_dir, &GRID)
+            .unwrap();
+    assert_eq!((template.rows, template.cols), (10, 14));
+    assert_eq!(template.feature_patches, sg140.feature_patches);
+    assert!(spdcam_core::photo::ChartTemplate::for_chart(
+        "colorchecker_sg96_thesis",
+        &data_dir,
+        &GRID
+    )
+    .is_none());
+}

@@ -33,12 +33,15 @@ pub use load::{decode_photo, load_photo, Photo, MIN_PHOTO_SIDE};
 pub use overlay::{debug_overlay, write_overlay, OVERLAY_SIZE};
 pub use sample::{sample, PatchSample};
 
+use crate::builtin::DataDir;
 use crate::chart::Chart;
 use crate::error::{Error, Result};
+use crate::spectral::Grid;
 
 /// What detection and sampling need to know about a chart: its grid, its geometry, its
 /// feature patches, and the neutral patches whose lightness order fixes its orientation.
-#[derive(Debug, Clone, PartialEq)]
+/// Small and self-contained, so a model file can carry the template of its chart.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ChartTemplate {
     /// The chart's name (as [`Chart::name`]).
     pub name: String,
@@ -119,6 +122,21 @@ impl ChartTemplate {
             feature_names: chart.feature_names(),
             neutrals,
         })
+    }
+
+    /// The physical chart to look for in photos when features come from the chart named
+    /// `chart`: the ColorChecker 24 for `colorchecker24`; the full Digital SG (whose 96
+    /// centre patches, row by row, are the features) for `colorchecker_sg96` and
+    /// `colorchecker_sg140`; any other chart as itself. `None` for a chart no photo shows
+    /// in that order (`colorchecker_sg96_thesis`, the file order) or that has no template.
+    pub fn for_chart(chart: &str, data_dir: &DataDir, grid: &Grid) -> Option<ChartTemplate> {
+        let physical = match chart {
+            "colorchecker_sg96_thesis" => return None,
+            "colorchecker_sg96" | "colorchecker_sg140" => "colorchecker_sg140",
+            other => other,
+        };
+        let chart = Chart::resolve(physical, None, data_dir, grid).ok()?;
+        ChartTemplate::from_chart(&chart).ok()
     }
 
     /// Number of patches.
