@@ -10,6 +10,7 @@ use spdcam_core::camera::sensor::{Sensitivities, SensorMode};
 use spdcam_core::camera::white_balance::WhiteBalance;
 use spdcam_core::camera::{Camera, CameraConfig, WhiteBalanceStatistics};
 use spdcam_core::chart::{Chart, Layout};
+use spdcam_core::lighting::Lighting;
 use spdcam_core::photo::scene::{self, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::raster::CfaPattern;
@@ -187,8 +188,19 @@ impl CameraArgs {
 #[derive(Debug, Args)]
 pub struct RenderArgs {
     /// The light: D65, A, D50, cct:T, daylight:T, planck:T, or a spectral CSV (FILE.csv[:COLUMN]).
-    #[arg(long)]
-    spd: String,
+    #[arg(
+        long,
+        required_unless_present = "lighting",
+        conflicts_with = "lighting"
+    )]
+    spd: Option<String>,
+    /// Instead of --spd: a light drawn from a lighting recipe (`spdcam list lighting`), the
+    /// one `spdcam generate --lighting RECIPE --seed SEED` draws for sample --draw.
+    #[arg(long, value_name = "RECIPE", requires = "draw")]
+    lighting: Option<String>,
+    /// Which draw of --lighting (the sample index of a generated dataset).
+    #[arg(long, value_name = "INDEX", requires = "lighting")]
+    draw: Option<u64>,
     /// Output PNG (JPEG with --scene).
     #[arg(short, long)]
     output: PathBuf,
@@ -242,7 +254,18 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         (Some(_), _) => bail!("a scene is written as JPEG: name the output FILE.jpg"),
         (None, _) => bail!("the chart is written as PNG: name the output FILE.png"),
     }
-    let spd = light::resolve_spd(&args.spd, data_dir, &grid)?;
+    let spd = match (&args.spd, &args.lighting, args.draw) {
+        (Some(spec), _, _) => light::resolve_spd(spec, data_dir, &grid)?,
+        (None, Some(recipe), Some(index)) => {
+            let draw = Lighting::parse(recipe, data_dir, &grid)?.draw(args.seed, index)?;
+            light::ResolvedSpd {
+                name: format!("{recipe} draw {index} (seed {})", args.seed),
+                values: draw.spd,
+                resampling: None,
+            }
+        }
+        _ => bail!("give the light as --spd, or as --lighting RECIPE --draw INDEX"),
+    };
     if let Some(report) = spd.resampling.as_ref().filter(|r| r.extrapolated()) {
         eprintln!(
             "warning: {}",
