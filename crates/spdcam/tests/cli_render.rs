@@ -189,3 +189,47 @@ fn list_prints_builtins() {
         assert!(text.contains(expected), "{expected} missing from: {text}");
     }
 }
+
+#[test]
+fn scene_photos_and_drawn_lights() {
+    let dir = scratch("scene");
+    let photo = dir.join("scene.jpg");
+    let truth = dir.join("truth.csv");
+    let o = spdcam(&[
+        "render",
+        "--lighting",
+        "phosphor",
+        "--draw",
+        "4",
+        "--scene",
+        "640x480",
+        "-o",
+        photo.to_str().unwrap(),
+        "--spd-out",
+        truth.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let decoded = image::open(&photo).unwrap();
+    assert_eq!((decoded.width(), decoded.height()), (640, 480));
+    let text = std::fs::read_to_string(&truth).unwrap();
+    assert!(text.starts_with("wavelength_nm,phosphor draw 4 (seed 0)\n380,"));
+    let max = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse::<f64>().unwrap())
+        .fold(0.0, f64::max);
+    assert_eq!(max, 1.0);
+
+    let bad = dir.join("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    fails(
+        &bad,
+        &["--spd", "D65", "--scene", "640x480"],
+        "name the output FILE.jpg",
+    );
+    fails(
+        &bad,
+        &["--lighting", "candle", "--draw", "0"],
+        "unknown lighting family 'candle'",
+    );
+}
