@@ -1,10 +1,14 @@
 //! `spdcam generate`: a dataset of (features, SPD) samples from the virtual camera.
 
 use crate::render::CameraArgs;
-use anyhow::Result;
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::sensor::Sensitivities;
+use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::chart::Chart;
+use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
 use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline, Shard, DEFAULT_CHUNK_SIZE};
 use spdcam_core::lighting::Lighting;
 use spdcam_core::spectral::Grid;
@@ -46,6 +50,20 @@ pub struct GenerateArgs {
     /// Replace what the output directory holds instead of refusing or resuming.
     #[arg(long)]
     force: bool,
+    /// The camera's in-camera rendering, as written by `spdcam calibrate` (JSON).
+    #[arg(long, value_name = "FILE.json")]
+    in_camera: Option<PathBuf>,
+    /// Domain randomisation per sample, comma-separated: camera (draw the camera from
+    /// --cameras), exposure, wb, tone, jpeg (draw those in-camera parameters).
+    #[arg(long, value_delimiter = ',', value_name = "GROUPS")]
+    randomise: Vec<String>,
+    /// Cameras to draw from with --randomise camera: a directory of sensitivity CSVs or a
+    /// comma-separated list of names or files.
+    #[arg(long, value_name = "DIR|LIST")]
+    cameras: Option<String>,
+    /// Perturbed copies of each camera in the pool (shift ±5 nm, gain ±10 %).
+    #[arg(long, default_value_t = 3)]
+    camera_variants: usize,
     #[command(flatten)]
     camera: CameraArgs,
 }
@@ -80,6 +98,65 @@ pub fn progress_bar(total: u64, unit: &str) -> Option<ProgressBar> {
     Some(ProgressBar::new(total).with_style(style))
 }
 
+/// The randomisation `--randomise` asks for: a camera pool (built once) and parameter ranges.
+fn randomisation(
+    args: &GenerateArgs,
+    base: &Sensitivities,
+    chart: &Chart,
+    config: CameraConfig,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Option<Randomisation>> {
+    if args.randomise.is_empty() {
+        if args.cameras.is_some() {
+            bail!("--cameras needs --randomise camera");
+        }
+        return Ok(None);
+    }
+    let groups: Vec<&str> = args.randomise.iter().map(|g| g.trim()).collect();
+    let ranges = InCameraRanges::for_groups(
+        &groups
+            .iter()
+            .copied()
+            .filter(|g| *g != "camera")
+            .collect::<Vec<_>>(),
+    )?;
+    let mut sens = vec![base.clone()];
+    if groups.contains(&"camera") {
+        let spec = args
+            .cameras
+            .as_deref()
+            .context("--randomise camera needs --cameras DIR or a list")?;
+        let dir = std::path::Path::new(spec);
+        sens = Vec::new();
+        if dir.is_dir() {
+            let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+                .with_context(|| format!("reading {}", dir.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+                .collect();
+            files.sort();
+            for f in files {
+                match crate::calibrate::sensitivities(&f.to_string_lossy(), data_dir, grid) {
+                    Ok(s) => sens.push(s),
+                    Err(e) => eprintln!("warning: skipping camera {}: {e:#}", f.display()),
+                }
+            }
+        } else {
+            for name in spec.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+                sens.push(crate::calibrate::sensitivities(name, data_dir, grid)?);
+            }
+        }
+    }
+    let variants = if groups.contains(&"camera") {
+        args.camera_variants
+    } else {
+        0
+    };
+    let pool = camera_pool(&sens, variants, args.seed, chart, config, grid)?;
+    Ok(Some(Randomisation::new(pool, ranges)?))
+}
+
 /// Runs `spdcam generate`.
 pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
     let grid = Grid::SIMULATION;
@@ -96,9 +173,19 @@ pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
         images: args.images,
         chunk_size: args.chunk_size,
     };
-    let camera = args.camera.camera(data_dir, &grid)?;
+    let mut config = args.camera.config()?;
+    if let Some(path) = &args.in_camera {
+        config.in_camera = Some(crate::calibrate::read_in_camera(path)?);
+    }
+    let chart = args.camera.chart(data_dir, &grid)?;
+    let base = crate::calibrate::sensitivities(&args.camera.camera, data_dir, &grid)?;
+    let camera = Camera::new(&base, chart.clone(), config, &grid)?;
     let lighting = Lighting::parse(&args.lighting, data_dir, &grid)?;
-    let generator = Generator::new(&camera, &lighting, options)?;
+    let randomisation = randomisation(&args, &base, &chart, config, data_dir, &grid)?;
+    let mut generator = Generator::new(&camera, &lighting, options)?;
+    if let Some(r) = &randomisation {
+        generator = generator.with_randomisation(r)?;
+    }
     let plan = generator.prepare(&args.output, args.force)?;
     if plan.total() == 0 {
         eprintln!(

@@ -1,9 +1,19 @@
 //! spdcam: what light is in the room, from a photo of a colour chart.
 
+mod calibrate;
 mod dataset;
+mod estimate;
+mod evaluate;
+mod experiment;
+mod experiment_sim2real;
+mod finetune;
 mod generate;
 mod list;
+mod photo_args;
+mod plot_file;
 mod render;
+mod sim2real_curve;
+mod train;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -31,9 +41,35 @@ enum Command {
     Dataset(dataset::DatasetArgs),
     /// List built-in cameras, charts, illuminants, lighting recipes and presets.
     List(list::ListArgs),
+    /// Train a model (1D CNN, MLP or ridge baseline) on a dataset.
+    Train(Box<train::TrainArgs>),
+    /// Estimate the light's SPD from photos of a colour chart (or chart features).
+    Estimate(Box<estimate::EstimateArgs>),
+    /// Score a model on a dataset: metrics, per-band error, plots.
+    Evaluate(evaluate::EvaluateArgs),
+    /// Adapt a trained model to a small new dataset (transfer learning).
+    Finetune(Box<finetune::FinetuneArgs>),
+    /// Reproduce the thesis's experiments on its own datasets.
+    Experiment(experiment::ExperimentArgs),
+    /// Fit a real camera's in-camera rendering to a few of its chart photos with known light.
+    Calibrate(Box<calibrate::CalibrateArgs>),
+    /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
+    Sim2real(experiment_sim2real::Sim2realArgs),
+}
+
+/// Output piped into a program that stops reading (`spdcam … | head`) ends spdcam quietly,
+/// as it ends other command-line tools, instead of failing a write.
+#[cfg(unix)]
+fn exit_quietly_on_closed_pipe() {
+    // SAFETY: sets the disposition of one signal to its default, before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
 }
 
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     let data_dir = spdcam_core::builtin::DataDir::new(cli.data_dir);
     let result = match cli.command {
@@ -41,6 +77,13 @@ fn main() -> ExitCode {
         Command::Generate(args) => generate::run(*args, &data_dir),
         Command::Dataset(args) => dataset::run(args, &data_dir),
         Command::List(args) => list::run(args, &data_dir),
+        Command::Train(args) => train::run(*args, &data_dir),
+        Command::Estimate(args) => estimate::run(*args, &data_dir),
+        Command::Evaluate(args) => evaluate::run(args),
+        Command::Finetune(args) => finetune::run(*args),
+        Command::Experiment(args) => experiment::run(args, &data_dir),
+        Command::Calibrate(args) => calibrate::run(*args, &data_dir),
+        Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

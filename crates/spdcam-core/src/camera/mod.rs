@@ -8,6 +8,7 @@
 pub mod aberration;
 pub mod colour;
 pub mod demosaic;
+pub mod in_camera;
 pub mod noise;
 pub mod sensor;
 pub mod white_balance;
@@ -22,6 +23,7 @@ use crate::spectral::Grid;
 use aberration::LateralAberration;
 use colour::{ColourConfig, ColourTransform};
 use demosaic::DemosaicMethod;
+use in_camera::InCamera;
 use noise::NoiseParams;
 use sensor::{Sensitivities, SensorConfig, SensorMode, SpectralResponse};
 use serde::{Deserialize, Serialize};
@@ -39,6 +41,10 @@ pub struct CameraConfig {
     pub white_balance_statistics: WhiteBalanceStatistics,
     pub aberration: Option<LateralAberration>,
     pub colour: ColourConfig,
+    /// The JPEG camera's own rendering (auto exposure, partial white balance, tone curve…);
+    /// `None` (the default) renders as the thesis did.
+    #[serde(default)]
+    pub in_camera: Option<InCamera>,
 }
 
 /// The image white balance estimates the light from; the gains are always applied to the
@@ -67,6 +73,7 @@ impl Default for CameraConfig {
             white_balance_statistics: WhiteBalanceStatistics::default(),
             aberration: Some(LateralAberration::THESIS),
             colour: ColourConfig::default(),
+            in_camera: None,
         }
     }
 }
@@ -135,6 +142,9 @@ impl Camera {
                 config.sensor.exposure
             )));
         }
+        if let Some(ic) = &config.in_camera {
+            ic.validate()?;
+        }
         if chart.reflectances.len() >= u16::MAX as usize {
             return Err(Error::invalid("a chart may have at most 65534 patches"));
         }
@@ -167,7 +177,8 @@ impl Camera {
         let d65 = StandardIlluminant::D65.spd(&self.grid)?;
         let light = self.light(&d65)?;
         let mut balanced = Vec::new();
-        self.balanced_regions(&light, &mut balanced);
+        // The matrix is the factory calibration: fitted without the in-camera rendering.
+        self.balanced_regions(None, &light, &mut balanced);
         let observer = Observer::cie1931(&self.grid)?;
         let patches = self.chart.reflectances.len();
         let rgb: Vec<[f64; 3]> = balanced[..patches]
@@ -259,27 +270,51 @@ impl Camera {
         }
     }
 
-    /// Exposed raw values of every region under `light` (into `raw`).
-    fn exposed_regions(&self, light: &[f32], raw: &mut Vec<[f32; 3]>) {
+    /// Exposed raw values of every region under `light` (into `raw`); with an in-camera
+    /// stage, flare, auto exposure and clipping at full scale too.
+    fn exposed_regions(&self, ic: Option<&InCamera>, light: &[f32], raw: &mut Vec<[f32; 3]>) {
         self.response.raw_into(light, raw);
-        let scale = sensor::exposure_scale(
-            raw,
-            self.chart.layout.shows_background(),
-            self.config.sensor.exposure,
-        );
-        raw.iter_mut().for_each(|v| *v = v.map(|x| x * scale));
+        let patches = self.chart.reflectances.len();
+        if let Some(ic) = ic {
+            ic.add_flare(raw, patches);
+        }
+        let scale = ic
+            .and_then(|ic| ic.exposure_scale(raw, patches))
+            .unwrap_or_else(|| {
+                sensor::exposure_scale(
+                    raw,
+                    self.chart.layout.shows_background(),
+                    self.config.sensor.exposure,
+                )
+            });
+        let full_scale = if ic.is_some() { 1.0 } else { f32::INFINITY };
+        raw.iter_mut()
+            .for_each(|v| *v = v.map(|x| (x * scale).min(full_scale)));
     }
 
     /// Patch-level white-balanced values (noise-free) into `raw`, used by the D65 fit and
     /// the fast path.
-    fn balanced_regions(&self, light: &[f32], raw: &mut Vec<[f32; 3]>) {
-        self.exposed_regions(light, raw);
-        let gains = self
+    fn balanced_regions(&self, ic: Option<&InCamera>, light: &[f32], raw: &mut Vec<[f32; 3]>) {
+        self.exposed_regions(ic, light, raw);
+        let mut gains = self
             .config
             .white_balance
             .gains_for_regions(raw, &self.geometry);
+        if let Some(ic) = ic {
+            gains = ic.adapt(gains);
+        }
         raw.iter_mut()
             .for_each(|v| *v = std::array::from_fn(|c| v[c] * gains[c]));
+    }
+
+    /// White-balanced camera RGB → encoded sRGB (0…1, unquantised), through the in-camera
+    /// tone stages when `ic` is given.
+    #[inline]
+    fn finish_pixel(&self, ic: Option<&InCamera>, rgb: [f32; 3]) -> [f32; 3] {
+        match ic {
+            None => self.colour.encode_pixel(rgb),
+            Some(ic) => ic.tone(&self.colour, self.colour.to_linear_srgb(rgb)),
+        }
     }
 
     /// Runs the full pipeline for one light and returns the image, features and stages.
@@ -311,14 +346,26 @@ impl Camera {
         buffers: &mut RenderBuffers,
         mut stages: Option<&mut Stages>,
     ) -> [f32; 3] {
-        let gains = self.capture_balanced(light, seed, buffers, stages.as_deref_mut());
+        let ic = self.config.in_camera.as_ref();
+        let gains = self.capture_balanced(ic, light, seed, buffers, stages.as_deref_mut());
         if let Some(ab) = &self.config.aberration {
             ab.apply(&mut buffers.image, &mut buffers.scratch);
         }
         if let Some(s) = stages {
             s.aberrated = Some(buffers.image.clone());
         }
-        self.colour.apply(&mut buffers.image);
+        match ic {
+            None => self.colour.apply(&mut buffers.image),
+            Some(_) => {
+                let [r, g, b] = &mut buffers.image.planes;
+                for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
+                    let v = self
+                        .finish_pixel(ic, [*r, *g, *b])
+                        .map(|v| self.colour.quantise(v));
+                    (*r, *g, *b) = (v[0], v[1], v[2]);
+                }
+            }
+        }
         gains
     }
 
@@ -332,7 +379,20 @@ impl Camera {
         buffers: &mut RenderBuffers,
         out: &mut Vec<f32>,
     ) {
-        self.capture_balanced(light, seed, buffers, None);
+        self.render_features_with(self.config.in_camera.as_ref(), light, seed, buffers, out);
+    }
+
+    /// [`Camera::render_features_into`] with the in-camera stage `ic` in place of the
+    /// configured one (domain randomisation draws one per sample).
+    pub fn render_features_with(
+        &self,
+        ic: Option<&InCamera>,
+        light: &[f32],
+        seed: u64,
+        buffers: &mut RenderBuffers,
+        out: &mut Vec<f32>,
+    ) {
+        self.capture_balanced(ic, light, seed, buffers, None);
         let RenderBuffers { image, region, .. } = buffers;
         let layout = &self.chart.layout;
         for &p in &self.chart.feature_patches {
@@ -358,9 +418,9 @@ impl Camera {
             let [r, g, b] = &region.planes;
             let mut sum = [0.0f64; 3];
             for ((&r, &g), &b) in r.iter().zip(g).zip(b) {
-                let lin = self.colour.to_linear_srgb([r, g, b]);
-                for (total, v) in sum.iter_mut().zip(lin) {
-                    *total += f64::from(self.colour.quantise(self.colour.encode(v)));
+                let encoded = self.finish_pixel(ic, [r, g, b]);
+                for (total, v) in sum.iter_mut().zip(encoded) {
+                    *total += f64::from(self.colour.quantise(v));
                 }
             }
             out.extend(sum.map(|s| (255.0 * s / (side * side) as f64) as f32));
@@ -370,6 +430,7 @@ impl Camera {
     /// Sensor, noise, demosaicing and white balance into `buffers.image`; returns the gains.
     fn capture_balanced(
         &self,
+        ic: Option<&InCamera>,
         light: &[f32],
         seed: u64,
         buffers: &mut RenderBuffers,
@@ -383,7 +444,7 @@ impl Camera {
             ..
         } = buffers;
         let mut from_raw = false;
-        self.exposed_regions(light, raw);
+        self.exposed_regions(ic, light, raw);
         match self.config.sensor.mode {
             SensorMode::SingleSensor(_) => {
                 sensor::form_mosaic(&self.region_map, raw, mosaic);
@@ -411,10 +472,13 @@ impl Camera {
         if let Some(s) = stages.as_deref_mut() {
             s.demosaiced = Some(image.clone());
         }
-        let gains = self
+        let mut gains = self
             .config
             .white_balance
             .gains(if from_raw { binned } else { image });
+        if let Some(ic) = ic {
+            gains = ic.adapt(gains);
+        }
         white_balance::apply_gains(image, gains);
         if let Some(s) = stages {
             s.white_balanced = Some(image.clone());
@@ -448,9 +512,21 @@ impl Camera {
     /// aberration, no quantisation): what [`Camera::render`] gives with noise off, up to
     /// quantisation, at a fraction of the cost. Appends to `out`.
     pub fn features_fast(&self, light: &[f32], raw: &mut Vec<[f32; 3]>, out: &mut Vec<f32>) {
-        self.balanced_regions(light, raw);
+        self.features_fast_with(self.config.in_camera.as_ref(), light, raw, out);
+    }
+
+    /// [`Camera::features_fast`] with the in-camera stage `ic` in place of the configured
+    /// one (calibration and domain randomisation vary it per call).
+    pub fn features_fast_with(
+        &self,
+        ic: Option<&InCamera>,
+        light: &[f32],
+        raw: &mut Vec<[f32; 3]>,
+        out: &mut Vec<f32>,
+    ) {
+        self.balanced_regions(ic, light, raw);
         for &p in &self.chart.feature_patches {
-            let encoded = self.colour.encode_pixel(raw[p]);
+            let encoded = self.finish_pixel(ic, raw[p]);
             out.extend(encoded.map(|v| 255.0 * v));
         }
     }

@@ -8,6 +8,7 @@ use super::manifest::{
     CameraInfo, ChartInfo, FileEntry, GenerateSettings, LightingInfo, Manifest, Origin, Pipeline,
     Shard,
 };
+use super::randomise::Randomisation;
 use super::spd_map::SpdMap;
 use super::writer::{
     create_dir, is_empty_dir, prepare_output, remove_partials, sample_file_name, write_sample_file,
@@ -68,6 +69,7 @@ pub struct Generator<'a> {
     options: GenerateOptions,
     columns: Columns,
     spd_map: SpdMap,
+    randomisation: Option<&'a Randomisation>,
 }
 
 /// The work of one run in one directory: which files are already there.
@@ -159,7 +161,31 @@ impl<'a> Generator<'a> {
             options,
             columns,
             spd_map,
+            randomisation: None,
         })
+    }
+
+    /// Draws each sample's camera from `randomisation`'s pool and its in-camera parameters
+    /// from its ranges; the pool must photograph this generator's chart on its grid.
+    pub fn with_randomisation(mut self, randomisation: &'a Randomisation) -> Result<Self> {
+        let pool = randomisation.cameras();
+        if let Some(c) = pool.iter().find(|c| {
+            c.grid() != self.camera.grid()
+                || c.chart().feature_names() != self.camera.chart().feature_names()
+                || c.chart().layout != self.camera.chart().layout
+        }) {
+            return Err(Error::invalid(format!(
+                "randomisation camera '{}' does not photograph the generator's chart on its grid",
+                c.camera_name()
+            )));
+        }
+        if self.options.images {
+            return Err(Error::invalid(
+                "images are not written with domain randomisation; drop --images",
+            ));
+        }
+        self.randomisation = Some(randomisation);
+        Ok(self)
     }
 
     /// The columns of the samples.
@@ -221,6 +247,7 @@ impl<'a> Generator<'a> {
                     .correction_matrix()
                     .map(|m| std::array::from_fn(|r| std::array::from_fn(|c| m[(r, c)]))),
             },
+            randomisation: self.randomisation.map(Randomisation::info),
         }
     }
 
@@ -244,7 +271,12 @@ impl<'a> Generator<'a> {
     ) -> Result<()> {
         let seed = self.options.seed;
         let draw = self.lighting.draw(seed, i)?;
-        let light = self.camera.light(&draw.spd).map_err(|e| {
+        let (camera, drawn) = match self.randomisation {
+            Some(r) => r.draw(seed, i),
+            None => (self.camera, None),
+        };
+        let ic = drawn.as_ref().or(camera.config().in_camera.as_ref());
+        let light = camera.light(&draw.spd).map_err(|e| {
             Error::invalid(format!(
                 "sample {i}: lighting '{}' drew a light the camera cannot render: {e}",
                 self.lighting.spec()
@@ -252,13 +284,12 @@ impl<'a> Generator<'a> {
         })?;
         ws.features.clear();
         match ws.buffers.as_mut() {
-            None => self
-                .camera
-                .features_fast(&light, &mut ws.raw, &mut ws.features),
+            None => camera.features_fast_with(ic, &light, &mut ws.raw, &mut ws.features),
             Some(buffers) => {
                 let noise_seed = seed::derive(seed, i);
                 match images {
-                    None => self.camera.render_features_into(
+                    None => camera.render_features_with(
+                        ic,
                         &light,
                         noise_seed,
                         buffers,

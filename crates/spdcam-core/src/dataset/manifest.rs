@@ -145,6 +145,9 @@ pub struct GenerateSettings {
     pub lighting: LightingInfo,
     pub chart: ChartInfo,
     pub camera: CameraInfo,
+    /// Domain randomisation (cameras and in-camera parameters drawn per sample), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub randomisation: Option<super::randomise::RandomisationInfo>,
 }
 
 /// The lighting recipe.

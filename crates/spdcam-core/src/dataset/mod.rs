@@ -25,6 +25,7 @@ mod file;
 mod generate;
 mod manifest;
 mod merge;
+pub mod randomise;
 mod reader;
 mod spd_map;
 mod split;

@@ -1,0 +1,406 @@
+//! In-camera rendering of a JPEG camera, beyond the thesis's pipeline: veiling glare,
+//! automatic exposure with sensor saturation, auto white balance with incomplete
+//! adaptation, colour saturation, a highlight shoulder, a tone curve beyond the sRGB gamma,
+//! and JPEG-like quantisation. Every stage is a parameter whose neutral value leaves the
+//! image unchanged; the whole stage is off unless [`crate::camera::CameraConfig::in_camera`]
+//! is set.
+//!
+//! Order: raw ─► flare ─► exposure (auto) ─► clip at full scale ─► white-balance gains raised
+//! to `adaptation` ─► colour matrix ─► saturation ─► shoulder ─► gamma ─► sRGB encode ─►
+//! contrast S-curve ─► JPEG quantisation.
+//!
+//! [`calibrate`] fits the parameters to a few real photos of the chart under known lights.
+
+use super::colour::ColourTransform;
+use super::Camera;
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// Rec. 709 / sRGB luminance weights of linear R, G, B.
+const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// The in-camera settings. [`InCamera::NEUTRAL`] changes nothing but the sensor clipping.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct InCamera {
+    /// Veiling glare: each region's raw value gains `flare` × the mean raw value of the
+    /// chart's patches (0 = none; sensible 0–0.5).
+    pub flare: f64,
+    /// Automatic exposure: the mean green raw value of the chart's patches is scaled to this
+    /// fraction of full scale (sensible 0.05–0.6), replacing the sensor's normalisation to
+    /// the maximum; raw values above full scale clip. `None` keeps the sensor's exposure.
+    pub exposure_target: Option<f64>,
+    /// Fraction of the white-balance correction applied, as a power of the gains (1 = full
+    /// correction, 0 = none: the light's cast stays; sensible 0.5–1).
+    pub adaptation: f64,
+    /// Colour saturation in linear sRGB about the luminance (1 = unchanged; sensible 0.5–1.5).
+    pub saturation: f64,
+    /// Highlight shoulder: linear values above `1 − shoulder` roll off smoothly towards 1
+    /// instead of clipping (0 = hard clip; sensible 0–0.5).
+    pub shoulder: f64,
+    /// Power on linear values before encoding (1 = the sRGB curve alone; below 1 brightens
+    /// mid-tones; sensible 0.6–1.4).
+    pub gamma: f64,
+    /// S-curve on encoded values `y + contrast·y(1−y)(2y−1)` (0 = none; −1…1).
+    pub contrast: f64,
+    /// JPEG quality (1–100) whose DC quantisation steps (libjpeg's tables) round each
+    /// pixel's Y, Cb, Cr: what JPEG does to flat patches. `None` = no JPEG quantisation.
+    pub jpeg_quality: Option<u8>,
+}
+
+impl Default for InCamera {
+    fn default() -> Self {
+        InCamera::NEUTRAL
+    }
+}
+
+/// Parameter names and ranges, for messages and for calibration bounds.
+const RANGES: [(&str, f64, f64); 7] = [
+    ("exposure_target", 0.01, 1.0),
+    ("flare", 0.0, 1.0),
+    ("adaptation", 0.0, 1.5),
+    ("saturation", 0.0, 2.0),
+    ("shoulder", 0.0, 0.9),
+    ("gamma", 0.3, 3.0),
+    ("contrast", -1.0, 1.0),
+];
+
+impl InCamera {
+    /// Every stage neutral: no flare, the sensor's exposure, full white balance, no
+    /// saturation change, hard clip, sRGB curve alone, no JPEG.
+    pub const NEUTRAL: InCamera = InCamera {
+        flare: 0.0,
+        exposure_target: None,
+        adaptation: 1.0,
+        saturation: 1.0,
+        shoulder: 0.0,
+        gamma: 1.0,
+        contrast: 0.0,
+        jpeg_quality: None,
+    };
+
+    /// The fitted parameters as a vector in [`RANGES`] order (exposure target 0 when off).
+    fn to_vector(self) -> [f64; 7] {
+        [
+            self.exposure_target.unwrap_or(0.0),
+            self.flare,
+            self.adaptation,
+            self.saturation,
+            self.shoulder,
+            self.gamma,
+            self.contrast,
+        ]
+    }
+
+    /// The inverse of [`InCamera::to_vector`], keeping `self`'s JPEG quality.
+    fn with_vector(self, v: [f64; 7]) -> InCamera {
+        InCamera {
+            exposure_target: Some(v[0]),
+            flare: v[1],
+            adaptation: v[2],
+            saturation: v[3],
+            shoulder: v[4],
+            gamma: v[5],
+            contrast: v[6],
+            ..self
+        }
+    }
+
+    /// Checks every parameter against its range.
+    pub fn validate(&self) -> Result<()> {
+        let v = self.to_vector();
+        for (k, &(name, lo, hi)) in RANGES.iter().enumerate() {
+            let x = v[k];
+            if k == 0 && self.exposure_target.is_none() {
+                continue;
+            }
+            if !(x.is_finite() && x >= lo && x <= hi) {
+                return Err(Error::invalid(format!(
+                    "in-camera {name} {x} is outside [{lo}, {hi}]"
+                )));
+            }
+        }
+        if let Some(q) = self.jpeg_quality {
+            if !(1..=100).contains(&q) {
+                return Err(Error::invalid(format!(
+                    "in-camera JPEG quality {q} is outside 1–100"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds the veiling glare to the raw region values in place; `patches` is the number
+    /// of chart patches (the regions before the background).
+    pub fn add_flare(&self, raw: &mut [[f32; 3]], patches: usize) {
+        if self.flare > 0.0 {
+            let mean = patch_mean(raw, patches);
+            let f = self.flare as f32;
+            raw.iter_mut()
+                .for_each(|v| *v = std::array::from_fn(|c| v[c] + f * mean[c]));
+        }
+    }
+
+    /// The automatic exposure scale: brings the mean green raw value of the `patches` to
+    /// `exposure_target` of full scale; `None` when auto exposure is off or there is no
+    /// green signal.
+    pub fn exposure_scale(&self, raw: &[[f32; 3]], patches: usize) -> Option<f32> {
+        let target = self.exposure_target?;
+        let green = patch_mean(raw, patches)[1];
+        (green > 0.0).then(|| target as f32 / green)
+    }
+
+    /// The white-balance gains with incomplete adaptation: `gain^adaptation`.
+    pub fn adapt(&self, gains: [f32; 3]) -> [f32; 3] {
+        if self.adaptation == 1.0 {
+            return gains;
+        }
+        let a = self.adaptation as f32;
+        gains.map(|g| if g > 0.0 { g.powf(a) } else { g })
+    }
+
+    /// Linear sRGB (from the colour matrix) → encoded sRGB on 0…1, unquantised.
+    pub fn tone(&self, colour: &ColourTransform, linear: [f32; 3]) -> [f32; 3] {
+        let mut v = linear;
+        if self.saturation != 1.0 {
+            let y = LUMA[0] * v[0] + LUMA[1] * v[1] + LUMA[2] * v[2];
+            let s = self.saturation as f32;
+            v = v.map(|x| y + s * (x - y));
+        }
+        let knee = 1.0 - self.shoulder as f32;
+        let width = self.shoulder as f32;
+        let gamma = self.gamma as f32;
+        let c = self.contrast as f32;
+        let encoded = v.map(|x| {
+            let mut x = x.max(0.0);
+            if width > 0.0 && x > knee {
+                x = knee + width * (1.0 - (-(x - knee) / width).exp());
+            }
+            x = x.min(1.0);
+            if gamma != 1.0 {
+                x = x.powf(gamma);
+            }
+            let y = colour.encode(x);
+            (y + c * y * (1.0 - y) * (2.0 * y - 1.0)).clamp(0.0, 1.0)
+        });
+        match self.jpeg_quality {
+            Some(q) => jpeg_quantise(encoded, q),
+            None => encoded,
+        }
+    }
+}
+
+/// Mean raw value of the first `patches` regions.
+fn patch_mean(raw: &[[f32; 3]], patches: usize) -> [f32; 3] {
+    let n = patches.min(raw.len()).max(1);
+    std::array::from_fn(|c| raw[..n].iter().map(|v| v[c]).sum::<f32>() / n as f32)
+}
+
+/// libjpeg's quality scaling of a base table entry: the quantisation step.
+fn jpeg_step(base: u32, quality: u8) -> f32 {
+    let q = u32::from(quality.clamp(1, 100));
+    let scale = if q < 50 { 5000 / q } else { 200 - 2 * q };
+    ((base * scale + 50) / 100).clamp(1, 255) as f32
+}
+
+/// Rounds an encoded pixel's JFIF Y, Cb, Cr (8-bit units) to the DC quantisation steps of
+/// `quality` divided by 8 (the DC coefficient of an 8×8 block is 8 × its mean), then back.
+pub fn jpeg_quantise(rgb: [f32; 3], quality: u8) -> [f32; 3] {
+    // Standard tables' DC entries: luminance 16, chrominance 17.
+    let (sy, sc) = (jpeg_step(16, quality) / 8.0, jpeg_step(17, quality) / 8.0);
+    let [r, g, b] = rgb.map(|v| v * 255.0);
+    let y = 0.299 * r + 0.587 * g + 0.114 * b;
+    let cb = -0.168_736 * r - 0.331_264 * g + 0.5 * b;
+    let cr = 0.5 * r - 0.418_688 * g - 0.081_312 * b;
+    let round = |v: f32, s: f32| (v / s).round() * s;
+    let (y, cb, cr) = (round(y, sy), round(cb, sc), round(cr, sc));
+    [
+        y + 1.402 * cr,
+        y - 0.344_136 * cb - 0.714_136 * cr,
+        y + 1.772 * cb,
+    ]
+    .map(|v| (v / 255.0).clamp(0.0, 1.0))
+}
+
+/// One real photo of the chart: its features (0–255, the camera's feature order) and the
+/// measured SPD of its light on the camera's simulation grid.
+#[derive(Debug, Clone)]
+pub struct CalibrationPhoto {
+    pub features: Vec<f64>,
+    pub spd: Vec<f64>,
+}
+
+/// The result of [`calibrate`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Calibration {
+    pub in_camera: InCamera,
+    /// Root-mean-square feature error (0–255) over the photos, before (neutral in-camera
+    /// stage with auto exposure at the photos' level) and after the fit.
+    pub rms_before: f64,
+    pub rms_after: f64,
+    /// Objective evaluations used.
+    pub evaluations: usize,
+}
+
+/// Fits the in-camera parameters (all but the JPEG quality, kept from `start`) of `camera`
+/// to `photos` by least squares on the features, with Nelder–Mead inside the parameter
+/// ranges, from `start`.
+pub fn calibrate(
+    camera: &Camera,
+    photos: &[CalibrationPhoto],
+    start: InCamera,
+    max_evaluations: usize,
+) -> Result<Calibration> {
+    if photos.is_empty() {
+        return Err(Error::invalid("calibration needs at least one photo"));
+    }
+    let expected = camera.chart().feature_patches.len() * 3;
+    let mut lights = Vec::with_capacity(photos.len());
+    for (i, p) in photos.iter().enumerate() {
+        if p.features.len() != expected {
+            return Err(Error::invalid(format!(
+                "calibration photo {i} has {} features; the chart needs {expected}",
+                p.features.len()
+            )));
+        }
+        if p.features.iter().any(|v| !v.is_finite()) {
+            return Err(Error::invalid(format!(
+                "calibration photo {i} has a feature that is not a number"
+            )));
+        }
+        lights.push(
+            camera
+                .light(&p.spd)
+                .map_err(|e| Error::invalid(format!("calibration photo {i}: {e}")))?,
+        );
+    }
+    start.validate()?;
+    let mut raw = Vec::new();
+    let mut out = Vec::new();
+    let mut objective = |ic: &InCamera| -> f64 {
+        let mut sum = 0.0;
+        for (light, photo) in lights.iter().zip(photos) {
+            out.clear();
+            camera.features_fast_with(Some(ic), light, &mut raw, &mut out);
+            sum += out
+                .iter()
+                .zip(&photo.features)
+                .map(|(&a, &b)| (f64::from(a) - b).powi(2))
+                .sum::<f64>();
+        }
+        (sum / (photos.len() * expected) as f64).sqrt()
+    };
+    let start = InCamera {
+        exposure_target: Some(start.exposure_target.unwrap_or(0.18)),
+        ..start
+    };
+    let rms_before = objective(&InCamera {
+        jpeg_quality: None,
+        ..start
+    });
+    let clamp =
+        |v: [f64; 7]| -> [f64; 7] { std::array::from_fn(|k| v[k].clamp(RANGES[k].1, RANGES[k].2)) };
+    let mut evaluations = 0;
+    let mut f = |v: &[f64; 7]| {
+        evaluations += 1;
+        objective(&start.with_vector(clamp(*v)))
+    };
+    let best = nelder_mead(&mut f, start.to_vector(), 0.1, max_evaluations);
+    let in_camera = start.with_vector(clamp(best.0));
+    Ok(Calibration {
+        in_camera,
+        rms_before,
+        rms_after: best.1,
+        evaluations,
+    })
+}
+
+/// Nelder–Mead simplex minimisation from `x0` with initial steps `step` (relative to each
+/// coordinate's size, at least `step` absolute); standard coefficients. Returns the best
+/// point and value.
+fn nelder_mead<const N: usize>(
+    f: &mut dyn FnMut(&[f64; N]) -> f64,
+    x0: [f64; N],
+    step: f64,
+    max_evaluations: usize,
+) -> ([f64; N], f64) {
+    let mut simplex: Vec<([f64; N], f64)> = Vec::with_capacity(N + 1);
+    simplex.push((x0, f(&x0)));
+    for k in 0..N {
+        let mut x = x0;
+        x[k] += step * x[k].abs().max(1.0);
+        simplex.push((x, f(&x)));
+    }
+    let mut used = N + 1;
+    let combine = |a: &[f64; N], b: &[f64; N], t: f64| -> [f64; N] {
+        std::array::from_fn(|k| a[k] + t * (b[k] - a[k]))
+    };
+    while used < max_evaluations {
+        simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let spread = simplex[N].1 - simplex[0].1;
+        if spread.abs() < 1e-9 * simplex[0].1.abs().max(1e-12) {
+            break;
+        }
+        let centroid: [f64; N] =
+            std::array::from_fn(|k| simplex[..N].iter().map(|p| p.0[k]).sum::<f64>() / N as f64);
+        let worst = simplex[N];
+        let reflected = combine(&centroid, &worst.0, -1.0);
+        let fr = f(&reflected);
+        used += 1;
+        if fr < simplex[0].1 {
+            let expanded = combine(&centroid, &worst.0, -2.0);
+            let fe = f(&expanded);
+            used += 1;
+            simplex[N] = if fe < fr {
+                (expanded, fe)
+            } else {
+                (reflected, fr)
+            };
+        } else if fr < simplex[N - 1].1 {
+            simplex[N] = (reflected, fr);
+        } else {
+            let contracted = if fr < worst.1 {
+                combine(&centroid, &reflected, 0.5)
+            } else {
+                combine(&centroid, &worst.0, 0.5)
+            };
+            let fc = f(&contracted);
+            used += 1;
+            if fc < worst.1.min(fr) {
+                simplex[N] = (contracted, fc);
+            } else {
+                let best = simplex[0].0;
+                for p in simplex.iter_mut().skip(1) {
+                    p.0 = combine(&best, &p.0, 0.5);
+                    p.1 = f(&p.0);
+                    used += 1;
+                }
+            }
+        }
+    }
+    simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
+    simplex[0]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nelder_mead_finds_a_quadratic_minimum() {
+        let mut f = |x: &[f64; 2]| (x[0] - 1.0).powi(2) + 3.0 * (x[1] + 2.0).powi(2);
+        let (x, v) = nelder_mead(&mut f, [0.0, 0.0], 0.5, 2000);
+        assert!(
+            (x[0] - 1.0).abs() < 1e-3 && (x[1] + 2.0).abs() < 1e-3,
+            "{x:?}"
+        );
+        assert!(v < 1e-6);
+    }
+
+    #[test]
+    fn jpeg_steps_follow_libjpeg_scaling() {
+        assert_eq!(jpeg_step(16, 50), 16.0);
+        assert_eq!(jpeg_step(16, 75), 8.0);
+        assert_eq!(jpeg_step(16, 100), 1.0);
+        assert_eq!(jpeg_step(17, 10), 85.0);
+    }
+}

@@ -1,0 +1,278 @@
+//! Domain randomisation for `spdcam generate`: per sample, a camera drawn from a pool of
+//! measured sensitivities (and perturbations of them) and in-camera parameters drawn from
+//! ranges, so that a model learns what does not depend on one camera's processing.
+//!
+//! The pool is built once (each camera fits its colour matrix once); sample `i`'s draw
+//! depends only on (seed, i).
+
+use crate::camera::in_camera::InCamera;
+use crate::camera::sensor::Sensitivities;
+use crate::camera::{Camera, CameraConfig};
+use crate::chart::Chart;
+use crate::error::{Error, Result};
+use crate::seed;
+use crate::spectral::{Grid, SpectralSet};
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
+use serde::{Deserialize, Serialize};
+
+/// Stream of the per-sample randomisation draws (apart from the light's and the noise's).
+const RANDOMISE_STREAM: u64 = 0x5241_4E44_0000_0001;
+/// Stream of the camera perturbations.
+const PERTURB_STREAM: u64 = 0x5045_5254_0000_0001;
+
+/// Ranges `[low, high]` the in-camera parameters are drawn from, uniformly; a parameter
+/// whose range is `None` keeps the base camera's value.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub struct InCameraRanges {
+    pub exposure_target: Option<[f64; 2]>,
+    pub flare: Option<[f64; 2]>,
+    pub adaptation: Option<[f64; 2]>,
+    pub saturation: Option<[f64; 2]>,
+    pub shoulder: Option<[f64; 2]>,
+    pub gamma: Option<[f64; 2]>,
+    pub contrast: Option<[f64; 2]>,
+    pub jpeg_quality: Option<[u8; 2]>,
+}
+
+impl InCameraRanges {
+    /// Ranges for the named groups (`exposure`: exposure target and flare; `wb`:
+    /// adaptation; `tone`: saturation, shoulder, gamma, contrast; `jpeg`: JPEG quality),
+    /// wide enough to cover the JPEG cameras we know of.
+    pub fn for_groups(groups: &[&str]) -> Result<InCameraRanges> {
+        let mut r = InCameraRanges::default();
+        for &g in groups {
+            match g {
+                "exposure" => {
+                    r.exposure_target = Some([0.08, 0.45]);
+                    r.flare = Some([0.0, 0.3]);
+                }
+                "wb" => r.adaptation = Some([0.5, 1.0]),
+                "tone" => {
+                    r.saturation = Some([0.6, 1.3]);
+                    r.shoulder = Some([0.0, 0.4]);
+                    r.gamma = Some([0.7, 1.3]);
+                    r.contrast = Some([-0.4, 0.4]);
+                }
+                "jpeg" => r.jpeg_quality = Some([70, 98]),
+                other => {
+                    return Err(Error::UnknownName {
+                        kind: "randomisation group",
+                        name: other.to_string(),
+                        valid: "camera, exposure, wb, tone, jpeg".into(),
+                    })
+                }
+            }
+        }
+        Ok(r)
+    }
+
+    /// Whether any parameter is drawn.
+    pub fn is_empty(&self) -> bool {
+        *self == InCameraRanges::default()
+    }
+
+    /// Draws the parameters, starting from `base` for those without a range.
+    pub fn draw(&self, base: InCamera, rng: &mut SmallRng) -> InCamera {
+        let mut u = |r: Option<[f64; 2]>, v: f64| match r {
+            Some([lo, hi]) => lo + (hi - lo) * rng.random::<f64>(),
+            None => v,
+        };
+        let exposure_target = match self.exposure_target {
+            Some(r) => Some(u(Some(r), 0.0)),
+            None => base.exposure_target,
+        };
+        let drawn = InCamera {
+            exposure_target,
+            flare: u(self.flare, base.flare),
+            adaptation: u(self.adaptation, base.adaptation),
+            saturation: u(self.saturation, base.saturation),
+            shoulder: u(self.shoulder, base.shoulder),
+            gamma: u(self.gamma, base.gamma),
+            contrast: u(self.contrast, base.contrast),
+            jpeg_quality: base.jpeg_quality,
+        };
+        match self.jpeg_quality {
+            Some([lo, hi]) => InCamera {
+                jpeg_quality: Some(rng.random_range(lo.min(hi)..=hi.max(lo))),
+                ..drawn
+            },
+            None => drawn,
+        }
+    }
+}
+
+/// A pool of cameras and the in-camera ranges one sample draws from.
+#[derive(Debug, Clone)]
+pub struct Randomisation {
+    cameras: Vec<Camera>,
+    ranges: InCameraRanges,
+}
+
+/// What the manifest records of a randomised run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RandomisationInfo {
+    /// The pool's camera names (perturbed variants are named `NAME~k`).
+    pub cameras: Vec<String>,
+    pub in_camera: InCameraRanges,
+    pub seeding: String,
+}
+
+impl Randomisation {
+    /// A pool of `cameras` (all photographing the same chart on the same grid) and the
+    /// ranges; an empty pool is refused.
+    pub fn new(cameras: Vec<Camera>, ranges: InCameraRanges) -> Result<Randomisation> {
+        let first = cameras
+            .first()
+            .ok_or_else(|| Error::invalid("domain randomisation needs at least one camera"))?;
+        for c in &cameras {
+            if c.grid() != first.grid() || c.chart().name != first.chart().name {
+                return Err(Error::invalid(format!(
+                    "camera '{}' photographs {} on {}; the pool's first photographs {} on {}",
+                    c.camera_name(),
+                    c.chart().name,
+                    c.grid(),
+                    first.chart().name,
+                    first.grid()
+                )));
+            }
+        }
+        for (name, range) in [
+            ("exposure_target", ranges.exposure_target),
+            ("flare", ranges.flare),
+            ("adaptation", ranges.adaptation),
+            ("saturation", ranges.saturation),
+            ("shoulder", ranges.shoulder),
+            ("gamma", ranges.gamma),
+            ("contrast", ranges.contrast),
+        ] {
+            if let Some([lo, hi]) = range {
+                let probe = |v: f64| {
+                    let mut ic = InCamera::NEUTRAL;
+                    match name {
+                        "exposure_target" => ic.exposure_target = Some(v),
+                        "flare" => ic.flare = v,
+                        "adaptation" => ic.adaptation = v,
+                        "saturation" => ic.saturation = v,
+                        "shoulder" => ic.shoulder = v,
+                        "gamma" => ic.gamma = v,
+                        _ => ic.contrast = v,
+                    }
+                    ic.validate()
+                };
+                if lo > hi {
+                    return Err(Error::invalid(format!(
+                        "randomisation range of {name} [{lo}, {hi}] is empty"
+                    )));
+                }
+                probe(lo)?;
+                probe(hi)?;
+            }
+        }
+        Ok(Randomisation { cameras, ranges })
+    }
+
+    /// The pool.
+    pub fn cameras(&self) -> &[Camera] {
+        &self.cameras
+    }
+
+    /// The manifest's record.
+    pub fn info(&self) -> RandomisationInfo {
+        RandomisationInfo {
+            cameras: self
+                .cameras
+                .iter()
+                .map(|c| c.camera_name().to_string())
+                .collect(),
+            in_camera: self.ranges,
+            seeding: "sample i: rng = SmallRng(seed::derive(seed::derive(seed, i), \
+                      RANDOMISE_STREAM)); camera = pool[uniform index], then the in-camera \
+                      parameters in declaration order"
+                .to_string(),
+        }
+    }
+
+    /// Sample `i`'s camera and in-camera stage (`None`: the camera's own configuration).
+    pub fn draw(&self, seed: u64, i: u64) -> (&Camera, Option<InCamera>) {
+        let mut rng =
+            SmallRng::seed_from_u64(seed::derive(seed::derive(seed, i), RANDOMISE_STREAM));
+        let camera = &self.cameras[rng.random_range(0..self.cameras.len())];
+        if self.ranges.is_empty() {
+            return (camera, None);
+        }
+        let base = camera.config().in_camera.unwrap_or(InCamera::NEUTRAL);
+        (camera, Some(self.ranges.draw(base, &mut rng)))
+    }
+}
+
+/// A smooth random perturbation of measured sensitivities: each channel shifted by up to
+/// ±`shift_nm` and multiplied by `exp` of a sum of three Gaussian bumps of amplitude up to
+/// ±`gain` (60 nm wide), deterministic in `seed`. Named `NAME~seed`.
+pub fn perturb(
+    camera: &Sensitivities,
+    seed: u64,
+    shift_nm: f64,
+    gain: f64,
+    grid: &Grid,
+) -> Result<Sensitivities> {
+    let mut rng = SmallRng::seed_from_u64(seed::derive(seed, PERTURB_STREAM));
+    let w = grid.wavelengths();
+    let mut curves = Vec::with_capacity(3);
+    for c in 0..3 {
+        let src = camera.curves.item(c);
+        let shift = shift_nm * (2.0 * rng.random::<f64>() - 1.0);
+        let bumps: Vec<(f64, f64)> = (0..3)
+            .map(|_| {
+                let centre = 400.0 + 300.0 * rng.random::<f64>();
+                (centre, gain * (2.0 * rng.random::<f64>() - 1.0))
+            })
+            .collect();
+        let curve: Vec<f64> = w
+            .iter()
+            .map(|&l| {
+                let x = (l - shift - grid.start_nm) / grid.step_nm;
+                let k = x.floor();
+                let f = x - k;
+                let at = |j: f64| {
+                    if j < 0.0 || j as usize >= src.len() {
+                        0.0
+                    } else {
+                        src[j as usize]
+                    }
+                };
+                let v = (1.0 - f) * at(k) + f * at(k + 1.0);
+                let m: f64 = bumps
+                    .iter()
+                    .map(|&(mu, a)| a * (-(l - mu).powi(2) / (2.0 * 30.0f64.powi(2))).exp())
+                    .sum();
+                v.max(0.0) * m.exp()
+            })
+            .collect();
+        curves.push(curve);
+    }
+    let set = SpectralSet::on_grid(grid, vec!["r".into(), "g".into(), "b".into()], curves)?;
+    Sensitivities::new(&format!("{}~{seed}", camera.name), &set, grid)
+}
+
+/// Builds the pool: each camera as measured and `variants` perturbed copies of it (shift up
+/// to ±5 nm, gain up to ±10 %), each with `config` photographing `chart`. A camera the chart
+/// cannot be fitted for (a degenerate colour matrix) is an error naming it.
+pub fn camera_pool(
+    sensitivities: &[Sensitivities],
+    variants: usize,
+    seed: u64,
+    chart: &Chart,
+    config: CameraConfig,
+    grid: &Grid,
+) -> Result<Vec<Camera>> {
+    let mut pool = Vec::with_capacity(sensitivities.len() * (variants + 1));
+    for (k, s) in sensitivities.iter().enumerate() {
+        pool.push(Camera::new(s, chart.clone(), config, grid)?);
+        for v in 0..variants {
+            let p = perturb(s, seed::derive(seed, (k * 1000 + v) as u64), 5.0, 0.1, grid)?;
+            pool.push(Camera::new(&p, chart.clone(), config, grid)?);
+        }
+    }
+    Ok(pool)
+}

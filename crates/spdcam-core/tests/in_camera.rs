@@ -1,0 +1,260 @@
+//! The in-camera rendering stage against hand-computed cases, its identity when neutral,
+//! calibration on photos rendered with known parameters, and deterministic domain
+//! randomisation.
+
+use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::camera::colour::ColourTransform;
+use spdcam_core::camera::in_camera::{calibrate, jpeg_quantise, CalibrationPhoto, InCamera};
+use spdcam_core::camera::sensor::Sensitivities;
+use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::chart::Chart;
+use spdcam_core::colorimetry;
+use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
+use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
+use spdcam_core::illuminant::StandardIlluminant;
+use spdcam_core::lighting::Lighting;
+use spdcam_core::spectral::Grid;
+
+const GRID: Grid = Grid::SIMULATION;
+
+fn nikon() -> Sensitivities {
+    let set = builtin::CAMERAS[0].load().unwrap();
+    Sensitivities::new("nikon_d5100_npl", &set, &GRID).unwrap()
+}
+
+fn camera(in_camera: Option<InCamera>) -> Camera {
+    let config = CameraConfig {
+        noise: None,
+        in_camera,
+        ..CameraConfig::default()
+    };
+    Camera::new(
+        &nikon(),
+        Chart::colorchecker24(&GRID).unwrap(),
+        config,
+        &GRID,
+    )
+    .unwrap()
+}
+
+fn fast(camera: &Camera, ic: Option<&InCamera>, spd: &[f64]) -> Vec<f32> {
+    let light = camera.light(spd).unwrap();
+    let (mut raw, mut out) = (Vec::new(), Vec::new());
+    camera.features_fast_with(ic, &light, &mut raw, &mut out);
+    out
+}
+
+#[test]
+fn neutral_stage_changes_nothing() {
+    let off = camera(None);
+    let neutral = camera(Some(InCamera::NEUTRAL));
+    for ill in [StandardIlluminant::A, StandardIlluminant::D65] {
+        let spd = ill.spd(&GRID).unwrap();
+        let a = off.render(&spd, 1, false).unwrap().features;
+        let b = neutral.render(&spd, 1, false).unwrap().features;
+        assert_eq!(a, b);
+        let mut raw = Vec::new();
+        let (mut fa, mut fb) = (Vec::new(), Vec::new());
+        off.features_fast(&off.light(&spd).unwrap(), &mut raw, &mut fa);
+        neutral.features_fast(&neutral.light(&spd).unwrap(), &mut raw, &mut fb);
+        assert_eq!(fa, fb);
+    }
+    assert_eq!(
+        off.correction_matrix(),
+        camera(Some(InCamera {
+            gamma: 0.5,
+            ..InCamera::NEUTRAL
+        }))
+        .correction_matrix(),
+        "the colour matrix is fitted without the in-camera stage"
+    );
+}
+
+#[test]
+fn tone_stages_match_hand_computed_values() {
+    let ct = ColourTransform::new(None, 16).unwrap();
+    let enc = |x: f64| colorimetry::srgb_encode(x) as f32;
+    // Contrast: y + c·y(1−y)(2y−1) on the encoded value.
+    let ic = InCamera {
+        contrast: 0.5,
+        ..InCamera::NEUTRAL
+    };
+    let y = enc(0.1);
+    let want = y + 0.5 * y * (1.0 - y) * (2.0 * y - 1.0);
+    assert!((ic.tone(&ct, [0.1; 3])[0] - want).abs() < 1e-5);
+    // Shoulder 0.4: 1.2 rolls off to 0.6 + 0.4·(1 − e^−1.5); 0.5 is below the knee.
+    let ic = InCamera {
+        shoulder: 0.4,
+        ..InCamera::NEUTRAL
+    };
+    let rolled = 0.6 + 0.4 * (1.0 - (-1.5f64).exp());
+    assert!((ic.tone(&ct, [1.2, 0.5, 0.0])[0] - enc(rolled)).abs() < 1e-5);
+    assert!((ic.tone(&ct, [1.2, 0.5, 0.0])[1] - enc(0.5)).abs() < 1e-5);
+    // Gamma 2 on linear 0.3 → 0.09.
+    let ic = InCamera {
+        gamma: 2.0,
+        ..InCamera::NEUTRAL
+    };
+    assert!((ic.tone(&ct, [0.3; 3])[2] - enc(0.09)).abs() < 1e-5);
+    // Saturation 0 turns a colour into its luminance; greys are kept at any saturation.
+    let ic = InCamera {
+        saturation: 0.0,
+        ..InCamera::NEUTRAL
+    };
+    let lum = 0.2126 * 0.8 + 0.7152 * 0.2 + 0.0722 * 0.1;
+    for v in ic.tone(&ct, [0.8, 0.2, 0.1]) {
+        assert!((v - enc(lum)).abs() < 1e-5);
+    }
+    // Incomplete adaptation: gains^a.
+    let ic = InCamera {
+        adaptation: 0.5,
+        ..InCamera::NEUTRAL
+    };
+    let g = ic.adapt([2.0, 1.0, 0.25]);
+    assert!((g[0] - 2f32.sqrt()).abs() < 1e-6 && g[1] == 1.0 && (g[2] - 0.5).abs() < 1e-6);
+    // Flare adds flare × the patch mean; auto exposure brings the mean green to the target.
+    let ic = InCamera {
+        flare: 0.5,
+        exposure_target: Some(0.2),
+        ..InCamera::NEUTRAL
+    };
+    let mut raw = vec![[1.0, 2.0, 3.0], [3.0, 4.0, 5.0], [100.0, 100.0, 100.0]];
+    ic.add_flare(&mut raw, 2);
+    assert_eq!(raw[0], [2.0, 3.5, 5.0]);
+    assert_eq!(raw[2], [101.0, 101.5, 102.0]);
+    // Patch means were (2, 3, 4): patch 2 becomes (4, 5.5, 7), so the mean green is 4.5.
+    assert_eq!(ic.exposure_scale(&raw, 2), Some(0.2 / 4.5));
+    // JPEG at quality 50: DC steps 16/8 = 2 (luma) and 17/8 (chroma) levels; a grey of
+    // 101 levels has Y = 101 → 102 (nearest multiple of 2), Cb = Cr = 0.
+    let q = jpeg_quantise([101.0 / 255.0; 3], 50);
+    for v in q {
+        assert!((v * 255.0 - 102.0).abs() < 1e-3, "{q:?}");
+    }
+    assert!(InCamera {
+        contrast: 2.0,
+        ..InCamera::NEUTRAL
+    }
+    .validate()
+    .is_err());
+    assert!(InCamera {
+        jpeg_quality: Some(0),
+        ..InCamera::NEUTRAL
+    }
+    .validate()
+    .is_err());
+}
+
+#[test]
+fn auto_exposure_brightens_and_saturates_bright_patches() {
+    let cam = camera(None);
+    let spd = StandardIlluminant::D65.spd(&GRID).unwrap();
+    let base = fast(&cam, None, &spd);
+    let bright = InCamera {
+        exposure_target: Some(0.6),
+        ..InCamera::NEUTRAL
+    };
+    let out = fast(&cam, Some(&bright), &spd);
+    let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len() as f32;
+    assert!(mean(&out) > mean(&base) + 20.0);
+    // Bright patches saturate: more values at full scale than at the thesis's exposure.
+    let saturated = |v: &[f32]| v.iter().filter(|&&x| x > 254.5).count();
+    assert!(saturated(&out) > saturated(&base) + 3, "{out:?}");
+}
+
+#[test]
+fn calibration_recovers_known_parameters() {
+    let truth = InCamera {
+        flare: 0.05,
+        exposure_target: Some(0.3),
+        adaptation: 0.7,
+        saturation: 0.85,
+        shoulder: 0.2,
+        gamma: 0.9,
+        contrast: 0.2,
+        jpeg_quality: None,
+    };
+    let cam = camera(None);
+    let lights = [
+        StandardIlluminant::A,
+        StandardIlluminant::D65,
+        StandardIlluminant::D50,
+    ];
+    let mut photos: Vec<CalibrationPhoto> = lights
+        .iter()
+        .map(|l| {
+            let spd = l.spd(&GRID).unwrap();
+            let features = fast(&cam, Some(&truth), &spd)
+                .iter()
+                .map(|&v| f64::from(v))
+                .collect();
+            CalibrationPhoto { features, spd }
+        })
+        .collect();
+    // A bluish light too: D65 with its red end attenuated.
+    let mut blue = StandardIlluminant::D65.spd(&GRID).unwrap();
+    for (k, v) in blue.iter_mut().enumerate() {
+        *v *= 1.5 - k as f64 / GRID.count as f64;
+    }
+    photos.push(CalibrationPhoto {
+        features: fast(&cam, Some(&truth), &blue)
+            .iter()
+            .map(|&v| f64::from(v))
+            .collect(),
+        spd: blue,
+    });
+    let fit = calibrate(&cam, &photos, InCamera::NEUTRAL, 6000).unwrap();
+    println!("{fit:?}");
+    assert!(fit.rms_before > 5.0, "{}", fit.rms_before);
+    assert!(fit.rms_after < 0.3, "{}", fit.rms_after);
+    let ic = fit.in_camera;
+    assert!((ic.exposure_target.unwrap() - 0.3).abs() < 0.03, "{ic:?}");
+    assert!((ic.adaptation - 0.7).abs() < 0.05, "{ic:?}");
+    assert!((ic.saturation - 0.85).abs() < 0.05, "{ic:?}");
+    // Bad input is an error, not a panic.
+    let bad = [CalibrationPhoto {
+        features: vec![1.0; 5],
+        spd: photos[0].spd.clone(),
+    }];
+    assert!(calibrate(&cam, &bad, InCamera::NEUTRAL, 100).is_err());
+    assert!(calibrate(&cam, &[], InCamera::NEUTRAL, 100).is_err());
+}
+
+#[test]
+fn randomised_generation_is_deterministic_per_seed_and_sample() {
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let config = CameraConfig {
+        noise: None,
+        ..CameraConfig::default()
+    };
+    let base = Camera::new(&nikon(), chart.clone(), config, &GRID).unwrap();
+    let sens: Vec<Sensitivities> = builtin::CAMERAS
+        .iter()
+        .map(|t| Sensitivities::new(t.name, &t.load().unwrap(), &GRID).unwrap())
+        .collect();
+    let pool = camera_pool(&sens, 2, 7, &chart, config, &GRID).unwrap();
+    assert_eq!(pool.len(), sens.len() * 3);
+    let ranges = InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg"]).unwrap();
+    assert!(InCameraRanges::for_groups(&["nonsense"]).is_err());
+    let randomisation = Randomisation::new(pool, ranges).unwrap();
+    let lighting =
+        Lighting::parse("gaussian:4", &DataDir::new(None), &GRID).unwrap_or_else(|e| panic!("{e}"));
+    let mut options = GenerateOptions::new(40, 3);
+    options.pipeline = Pipeline::Fast;
+    let run = |r: Option<&Randomisation>, range: std::ops::Range<u64>| {
+        let mut g = Generator::new(&base, &lighting, options.clone()).unwrap();
+        if let Some(r) = r {
+            g = g.with_randomisation(r).unwrap();
+        }
+        g.samples(range, None, &|_| {}).unwrap()
+    };
+    let a = run(Some(&randomisation), 0..40);
+    let b = run(Some(&randomisation), 20..40);
+    assert_eq!(&a.features[20 * 72..], &b.features[..]);
+    let plain = run(None, 0..40);
+    assert_eq!(a.spds, plain.spds, "randomisation leaves the lights alone");
+    assert_ne!(a.features, plain.features);
+    let (c1, p1) = randomisation.draw(3, 5);
+    let (c2, p2) = randomisation.draw(3, 5);
+    assert_eq!(c1.camera_name(), c2.camera_name());
+    assert_eq!(p1, p2);
+}

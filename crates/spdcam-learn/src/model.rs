@@ -1,0 +1,522 @@
+//! A trained model and its file, `.spdm`: one self-contained binary file.
+//!
+//! ```text
+//! magic      8 bytes  "SPDCAMMD"
+//! version    u32 LE   FORMAT_VERSION
+//! header     u64 LE length, then UTF-8 JSON (ModelHeader): architecture, grid, chart,
+//!                      camera, feature names, scalings, PCA basis and mean (or channel
+//!                      spectra), training record, and the parameter list (name, shape)
+//! weights    u64 LE length, then the parameters' values, f32 LE, in the header's order
+//! checksum   u64 LE   FNV-1a 64 of every byte before it
+//! ```
+//!
+//! Reading checks all of it, so a wrong, damaged or incompatible file is an error naming what
+//! is wrong, never a panic.
+
+use crate::error::{LearnError, Result};
+use crate::network::{Architecture, Network, Parameter};
+use crate::scale::{FeatureScaler, TargetScaler};
+use crate::target::Target;
+use crate::train::{TrainOptions, TrainingSet};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use spdcam_core::dataset::Dataset;
+use spdcam_core::photo::ChartTemplate;
+use spdcam_core::spectral::Grid;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The first bytes of every model file.
+pub const MAGIC: &[u8; 8] = b"SPDCAMMD";
+/// The version of the file layout and header this build writes (and the newest it reads).
+pub const FORMAT_VERSION: u32 = 1;
+/// The usual file extension.
+pub const EXTENSION: &str = "spdm";
+
+/// Where a training (or validation) set came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DataInfo {
+    /// The dataset directory as given on the command line (or a description).
+    pub path: String,
+    /// Number of samples.
+    pub samples: usize,
+    /// The chart the features were taken from, when known.
+    pub chart: Option<String>,
+    /// The camera, when known.
+    pub camera: Option<String>,
+    /// Samples per light family.
+    pub families: BTreeMap<String, u64>,
+    /// The dataset manifest's `origin` (generation settings, import source…).
+    pub origin: Option<serde_json::Value>,
+}
+
+impl DataInfo {
+    /// The description of an opened dataset directory, labelled `path`.
+    pub fn from_dataset(dataset: &Dataset, path: &str) -> DataInfo {
+        let manifest = dataset.manifest();
+        let generated = manifest.origin.generated();
+        DataInfo {
+            path: path.to_string(),
+            samples: manifest.samples as usize,
+            chart: generated.map(|g| g.chart.name.clone()),
+            camera: generated.map(|g| g.camera.name.clone()),
+            families: manifest.families.clone(),
+            origin: serde_json::to_value(&manifest.origin).ok(),
+        }
+    }
+}
+
+/// How a model was trained.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainingRecord {
+    /// The training data.
+    pub data: DataInfo,
+    /// A separate validation set, when one was given.
+    pub validation: Option<DataInfo>,
+    /// Rows trained on.
+    pub train_samples: usize,
+    /// Rows validated on.
+    pub val_samples: usize,
+    /// The settings.
+    pub options: TrainOptions,
+    /// Epochs run (0 for `linear`).
+    pub epochs_run: usize,
+    /// The epoch whose weights were kept.
+    pub best_epoch: usize,
+    /// Validation loss (MSE of the scaled targets) of the kept weights.
+    pub val_loss: f64,
+    /// Mean validation GFC of the kept weights.
+    pub val_gfc: f64,
+    /// Wall-clock seconds of the whole run.
+    pub seconds: f64,
+    /// The training of the model this one was fine-tuned from.
+    pub finetuned_from: Option<Box<TrainingRecord>>,
+}
+
+/// Name and shape of one stored parameter array.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TensorEntry {
+    /// `layer.weight` or `layer.bias`.
+    pub name: String,
+    /// The array's shape.
+    pub shape: Vec<usize>,
+}
+
+/// Everything in a model file but the weights.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelHeader {
+    /// Always `spdcam-model`.
+    pub format: String,
+    /// [`FORMAT_VERSION`] of the writer.
+    pub format_version: u32,
+    /// Version of the spdcam that wrote it.
+    pub spdcam_version: String,
+    /// The network's layers.
+    pub architecture: Architecture,
+    /// Feature column names, in input order (`p01_r, p01_g, …`).
+    pub feature_names: Vec<String>,
+    /// The chart the model was trained for, when known.
+    pub chart: Option<String>,
+    /// The camera the model was trained for, when known.
+    pub camera: Option<String>,
+    /// The training chart as photos show it (grid, feature patches, neutral patches), so a
+    /// photo can be analysed with the model file alone; `None` when no photo shows it.
+    #[serde(default)]
+    pub photo_chart: Option<ChartTemplate>,
+    /// Input scaling.
+    pub feature_scaler: FeatureScaler,
+    /// What the network predicts and how an SPD is made from it.
+    pub target: Target,
+    /// Target scaling.
+    pub target_scaler: TargetScaler,
+    /// The grid of the estimated SPDs.
+    pub grid: Grid,
+    /// How it was trained.
+    pub training: TrainingRecord,
+    /// The stored parameter arrays, in order.
+    pub tensors: Vec<TensorEntry>,
+}
+
+/// A trained model: scalings, target decoding and network.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    header: ModelHeader,
+    network: Network,
+}
+
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        hash ^= u64::from(b);
+        hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    hash
+}
+
+/// Reads little-endian numbers from a byte slice, with errors instead of panics.
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Cursor<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let end = self.at.checked_add(n)?;
+        let out = self.bytes.get(self.at..end)?;
+        self.at = end;
+        Some(out)
+    }
+
+    fn u32(&mut self) -> Option<u32> {
+        Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
+    }
+
+    fn u64(&mut self) -> Option<u64> {
+        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+}
+
+impl Model {
+    /// Puts a model together after training.
+    pub(crate) fn assemble(
+        network: Network,
+        feature_scaler: FeatureScaler,
+        target: Target,
+        target_scaler: TargetScaler,
+        grid: Grid,
+        data: &TrainingSet,
+        training: TrainingRecord,
+    ) -> Result<Model> {
+        let header = ModelHeader {
+            format: "spdcam-model".into(),
+            format_version: FORMAT_VERSION,
+            spdcam_version: env!("CARGO_PKG_VERSION").into(),
+            architecture: network.architecture().clone(),
+            feature_names: data.columns.feature_names.clone(),
+            chart: data.info.chart.clone(),
+            camera: data.info.camera.clone(),
+            photo_chart: None,
+            feature_scaler,
+            target,
+            target_scaler,
+            grid,
+            training,
+            tensors: network
+                .parameters()
+                .iter()
+                .map(|p| TensorEntry {
+                    name: p.name.clone(),
+                    shape: p.shape.clone(),
+                })
+                .collect(),
+        };
+        let model = Model { header, network };
+        model.validate()?;
+        Ok(model)
+    }
+
+    /// Checks that all the parts agree with each other.
+    fn validate(&self) -> Result<()> {
+        let h = &self.header;
+        h.architecture.validate()?;
+        h.feature_scaler.validate()?;
+        h.target.validate()?;
+        h.target_scaler.validate()?;
+        let inputs = self.network.inputs();
+        let outputs = self.network.outputs();
+        if h.feature_names.len() != inputs || h.feature_scaler.width() != inputs {
+            return Err(LearnError::invalid(format!(
+                "the model has {} feature names and {} feature scalings for a network of {inputs} inputs",
+                h.feature_names.len(),
+                h.feature_scaler.width()
+            )));
+        }
+        if h.target.len() != outputs || h.target_scaler.width() != outputs {
+            return Err(LearnError::invalid(format!(
+                "the model has {} targets and {} target scalings for a network of {outputs} outputs",
+                h.target.len(),
+                h.target_scaler.width()
+            )));
+        }
+        if h.target.spd_len() != h.grid.count {
+            return Err(LearnError::invalid(format!(
+                "the model's SPDs have {} values for a grid of {} ({})",
+                h.target.spd_len(),
+                h.grid.count,
+                h.grid.label()
+            )));
+        }
+        Ok(())
+    }
+
+    /// The header (everything but the weights).
+    pub fn header(&self) -> &ModelHeader {
+        &self.header
+    }
+
+    /// The network.
+    pub fn network(&self) -> &Network {
+        &self.network
+    }
+
+    /// The grid of the estimated SPDs.
+    pub fn grid(&self) -> Grid {
+        self.header.grid
+    }
+
+    /// The feature column names the model reads, in order.
+    pub fn feature_names(&self) -> &[String] {
+        &self.header.feature_names
+    }
+
+    /// The input scaling.
+    pub fn feature_scaler(&self) -> &FeatureScaler {
+        &self.header.feature_scaler
+    }
+
+    /// The target space.
+    pub fn target(&self) -> &Target {
+        &self.header.target
+    }
+
+    /// The target scaling.
+    pub fn target_scaler(&self) -> &TargetScaler {
+        &self.header.target_scaler
+    }
+
+    /// How it was trained.
+    pub fn training(&self) -> &TrainingRecord {
+        &self.header.training
+    }
+
+    /// The training chart as photos show it, when known.
+    pub fn photo_chart(&self) -> Option<&ChartTemplate> {
+        self.header.photo_chart.as_ref()
+    }
+
+    /// Records how photos show the training chart; its features must be the model's inputs.
+    pub fn set_photo_chart(&mut self, template: ChartTemplate) -> Result<()> {
+        self.check_features(&template.feature_names, &format!("chart {}", template.name))?;
+        self.header.photo_chart = Some(template);
+        Ok(())
+    }
+
+    /// A one-line description: architecture, inputs, targets, grid, chart and camera.
+    pub fn describe(&self) -> String {
+        let h = &self.header;
+        let target = match &h.target {
+            Target::Pca(p) => format!(
+                "{} PCA components ({:.2} % of the variance)",
+                p.len(),
+                100.0 * p.explained_variance()
+            ),
+            Target::Weights(c) => format!("{} channel weights", c.names.len()),
+        };
+        format!(
+            "{} on {} features → {target}, SPD {} nm; chart {}, camera {}",
+            h.architecture.name(),
+            h.feature_names.len(),
+            h.grid.label(),
+            h.chart.as_deref().unwrap_or("unknown"),
+            h.camera.as_deref().unwrap_or("unknown")
+        )
+    }
+
+    /// Checks that features with these column names (from `source`) fit the model.
+    pub fn check_features(&self, names: &[String], source: &str) -> Result<()> {
+        if names == self.header.feature_names.as_slice() {
+            return Ok(());
+        }
+        let show = |n: &[String]| match n {
+            [] => "none".to_string(),
+            [only] => only.clone(),
+            [first, .., last] => format!("{first}…{last}"),
+        };
+        let chart = self
+            .header
+            .chart
+            .as_deref()
+            .map(|c| format!(" (chart {c})"))
+            .unwrap_or_default();
+        Err(LearnError::invalid(format!(
+            "{source}: {} feature columns ({}) do not match the model's {} ({}){chart}; \
+             the features must come from the chart the model was trained for",
+            names.len(),
+            show(names),
+            self.header.feature_names.len(),
+            show(&self.header.feature_names)
+        )))
+    }
+
+    /// SPD estimates for rows of features (row-major, in the model's column order, on any
+    /// brightness scale): one max-normalised SPD on [`Model::grid`] per row.
+    pub fn estimate_rows(&self, features: &[f64]) -> Result<Vec<f64>> {
+        let x = self.header.feature_scaler.transform(features)?;
+        let outputs = self.network.forward(&x)?;
+        let k = self.network.outputs();
+        let d = self.header.grid.count;
+        let rows = outputs.len() / k;
+        let mut spds = vec![0.0; rows * d];
+        let decode = |(out, spd): (&[f32], &mut [f64])| {
+            let mut t = vec![0.0; k];
+            self.header.target_scaler.unscale_into(out, &mut t);
+            self.header.target.decode_into(&t, spd);
+        };
+        if rows > 512 {
+            outputs
+                .par_chunks(k)
+                .zip(spds.par_chunks_mut(d))
+                .for_each(decode);
+        } else {
+            outputs.chunks(k).zip(spds.chunks_mut(d)).for_each(decode);
+        }
+        Ok(spds)
+    }
+
+    /// The SPD estimate for one row of features.
+    pub fn estimate(&self, features: &[f64]) -> Result<Vec<f64>> {
+        if features.len() != self.network.inputs() {
+            return Err(LearnError::invalid(format!(
+                "{} features given, the model reads {}",
+                features.len(),
+                self.network.inputs()
+            )));
+        }
+        self.estimate_rows(features)
+    }
+
+    /// The model as the bytes of a `.spdm` file.
+    pub fn to_bytes(&self) -> Result<Vec<u8>> {
+        let header = serde_json::to_vec(&self.header)
+            .map_err(|e| LearnError::invalid(format!("encoding the model header: {e}")))?;
+        let blob_len: usize = self.network.parameter_count() * 4;
+        let mut out = Vec::with_capacity(8 + 4 + 8 + header.len() + 8 + blob_len + 8);
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+        out.extend_from_slice(&(header.len() as u64).to_le_bytes());
+        out.extend_from_slice(&header);
+        out.extend_from_slice(&(blob_len as u64).to_le_bytes());
+        for p in self.network.parameters() {
+            for v in &p.data {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        let checksum = fnv1a(&out);
+        out.extend_from_slice(&checksum.to_le_bytes());
+        Ok(out)
+    }
+
+    /// Writes the model to `path` atomically.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        spdcam_core::fsio::write_atomic(path, &self.to_bytes()?)?;
+        Ok(())
+    }
+
+    /// Reads a model file.
+    pub fn load(path: &Path) -> Result<Model> {
+        let bytes = std::fs::read(path).map_err(|source| LearnError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Model::from_bytes(&bytes).map_err(|e| match e {
+            LearnError::ModelFile { message, .. } => LearnError::ModelFile {
+                path: path.to_path_buf(),
+                message,
+            },
+            other => LearnError::ModelFile {
+                path: path.to_path_buf(),
+                message: other.to_string(),
+            },
+        })
+    }
+
+    /// A model from the bytes of a `.spdm` file.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Model> {
+        let bad = |message: String| LearnError::ModelFile {
+            path: "<bytes>".into(),
+            message,
+        };
+        if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+            return Err(bad(format!(
+                "not a spdcam model file (a .{EXTENSION} file starts with {:?})",
+                String::from_utf8_lossy(MAGIC)
+            )));
+        }
+        let mut c = Cursor { bytes, at: 8 };
+        let truncated = || bad("the file is truncated".into());
+        let version = c.u32().ok_or_else(truncated)?;
+        if version == 0 || version > FORMAT_VERSION {
+            return Err(bad(format!(
+                "model format version {version}; this spdcam reads versions 1 to {FORMAT_VERSION} \
+                 (a newer spdcam wrote it?)"
+            )));
+        }
+        if bytes.len() < 8 + 4 + 8 + 8 + 8 {
+            return Err(truncated());
+        }
+        let body = &bytes[..bytes.len() - 8];
+        let stored = u64::from_le_bytes(
+            bytes[bytes.len() - 8..]
+                .try_into()
+                .map_err(|_| truncated())?,
+        );
+        if fnv1a(body) != stored {
+            return Err(bad(
+                "the file is damaged (checksum mismatch): it was cut short or changed".into(),
+            ));
+        }
+        let mut c = Cursor {
+            bytes: body,
+            at: 12,
+        };
+        let header_len = c.u64().ok_or_else(truncated)? as usize;
+        let header_bytes = c.take(header_len).ok_or_else(truncated)?;
+        let header: ModelHeader = serde_json::from_slice(header_bytes)
+            .map_err(|e| bad(format!("the model header is not valid: {e}")))?;
+        if header.format != "spdcam-model" {
+            return Err(bad(format!(
+                "the header names the format '{}', not 'spdcam-model'",
+                header.format
+            )));
+        }
+        let blob_len = c.u64().ok_or_else(truncated)? as usize;
+        let blob = c.take(blob_len).ok_or_else(truncated)?;
+        if c.at != body.len() {
+            return Err(bad("unexpected bytes after the weights".into()));
+        }
+        let expected: usize = header
+            .tensors
+            .iter()
+            .map(|t| t.shape.iter().product::<usize>())
+            .sum();
+        if expected.checked_mul(4) != Some(blob_len) {
+            return Err(bad(format!(
+                "the weights hold {blob_len} bytes, the header lists {expected} values"
+            )));
+        }
+        let mut values = blob
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        let parameters: Vec<Parameter> = header
+            .tensors
+            .iter()
+            .map(|t| {
+                let n = t.shape.iter().product();
+                Parameter {
+                    name: t.name.clone(),
+                    shape: t.shape.clone(),
+                    data: values.by_ref().take(n).collect(),
+                }
+            })
+            .collect();
+        let inputs = header.feature_names.len();
+        let outputs = header.target.len();
+        let network = Network::new(header.architecture.clone(), inputs, outputs, parameters)
+            .map_err(|e| bad(format!("the weights do not fit the architecture: {e}")))?;
+        let model = Model { header, network };
+        model
+            .validate()
+            .map_err(|e| bad(format!("the model is inconsistent: {e}")))?;
+        Ok(model)
+    }
+}

@@ -1,0 +1,811 @@
+//! Training: one loop for the networks (Adam, MSE, seeded shuffling, validation every epoch,
+//! early stopping keeping the best epoch, learning rate halved on plateaus), the closed-form
+//! ridge fit for `linear`, and transfer learning on a new dataset.
+
+use crate::burn_net::{dropout_masks, prepare, BurnNet};
+use crate::error::{LearnError, Result};
+use crate::model::{DataInfo, Model, TrainingRecord};
+use crate::network::{Architecture, Network, Parameter};
+use crate::pca::Pca;
+use crate::scale::{FeatureScaler, TargetScaler};
+use crate::target::{normalise, Channels, Target, TargetKind};
+use burn::optim::{AdamConfig, GradientsParams};
+use burn::tensor::{Device, Tensor, TensorData};
+use faer::{linalg::solvers::Solve, Mat, Side};
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use serde::{Deserialize, Serialize};
+use spdcam_core::dataset::{Columns, SampleBatch};
+use spdcam_core::spectral::Grid;
+use std::time::Instant;
+
+/// Where the networks train.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Backend {
+    /// burn's flex backend on the CPU (always available).
+    #[default]
+    Cpu,
+    /// burn's CUDA backend, GPU 0 (cargo feature `cuda`).
+    Cuda,
+    /// burn's wgpu backend, the default adapter (cargo feature `wgpu`).
+    Wgpu,
+}
+
+impl Backend {
+    /// The burn device with autodiff; an error when this build lacks the backend.
+    fn device(self) -> Result<Device> {
+        let device = match self {
+            Backend::Cpu => Device::flex(),
+            #[cfg(feature = "cuda")]
+            Backend::Cuda => Device::cuda(0),
+            #[cfg(feature = "wgpu")]
+            Backend::Wgpu => Device::wgpu(Default::default()),
+            #[allow(unreachable_patterns)]
+            other => {
+                return Err(LearnError::invalid(format!(
+                    "this build has no {other:?} backend; rebuild spdcam-learn with the cargo feature {}",
+                    format!("{other:?}").to_lowercase()
+                )))
+            }
+        };
+        Ok(device.autodiff())
+    }
+}
+
+/// The optimisation schedule.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Schedule {
+    /// The most epochs to run.
+    pub epochs: usize,
+    /// Samples per optimiser step.
+    pub batch: usize,
+    /// Adam's initial learning rate.
+    pub lr: f64,
+    /// Stop after this many epochs without a better validation loss (`None`: run all).
+    pub patience: Option<usize>,
+    /// Halve the learning rate after this many epochs without improvement (`None`: constant).
+    pub plateau: Option<usize>,
+}
+
+impl Schedule {
+    /// The thesis's set-up: 200 epochs, batch 64, learning rate 1e-3, constant, no early
+    /// stopping (the best validation epoch is still the one kept).
+    pub fn thesis() -> Schedule {
+        Schedule {
+            epochs: 200,
+            batch: 64,
+            lr: 1e-3,
+            patience: None,
+            plateau: None,
+        }
+    }
+
+    /// Our default, chosen by validation measurements (docs/learning-results.md): larger
+    /// batches run faster per epoch on a CPU, and halving the learning rate on plateaus
+    /// reaches a lower loss than a constant rate.
+    pub fn default_for(architecture: &Architecture) -> Schedule {
+        match architecture {
+            Architecture::Mlp(_) => Schedule {
+                epochs: 400,
+                batch: 128,
+                lr: 1e-3,
+                patience: Some(30),
+                plateau: Some(8),
+            },
+            _ => Schedule {
+                epochs: 300,
+                batch: 128,
+                lr: 2e-3,
+                patience: Some(25),
+                plateau: Some(6),
+            },
+        }
+    }
+
+    fn validate(&self) -> Result<()> {
+        if self.epochs == 0 || self.batch == 0 {
+            return Err(LearnError::invalid(format!(
+                "epochs ({}) and batch size ({}) must be at least 1",
+                self.epochs, self.batch
+            )));
+        }
+        if !(self.lr.is_finite() && self.lr > 0.0) {
+            return Err(LearnError::invalid(format!(
+                "the learning rate {} must be positive",
+                self.lr
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Everything a training run needs besides the data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainOptions {
+    /// The model.
+    pub architecture: Architecture,
+    /// PCA coefficients or channel weights.
+    pub target: TargetKind,
+    /// The grid the model estimates SPDs on (a sub-grid of the dataset's).
+    pub grid: Grid,
+    /// The optimisation schedule (ignored by `linear`).
+    pub schedule: Schedule,
+    /// Seed of the split, the initial weights, the shuffling and the dropout.
+    pub seed: u64,
+    /// The share of the data held out for validation when no validation set is given.
+    pub val_split: f64,
+    /// Where to train.
+    pub backend: Backend,
+}
+
+/// A dataset in memory with what the model file records about it.
+#[derive(Debug, Clone)]
+pub struct TrainingSet {
+    /// The samples.
+    pub samples: SampleBatch,
+    /// Their columns (feature names, SPD grid, weight names).
+    pub columns: Columns,
+    /// Where they came from.
+    pub info: DataInfo,
+}
+
+/// One epoch of a training log.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EpochRecord {
+    /// 1-based epoch number.
+    pub epoch: usize,
+    /// Mean training loss (MSE of the scaled targets).
+    pub train_loss: f64,
+    /// Validation loss.
+    pub val_loss: f64,
+    /// Mean validation GFC of the SPDs.
+    pub val_gfc: f64,
+    /// The learning rate used.
+    pub lr: f64,
+    /// Seconds the epoch's training steps took.
+    pub seconds: f64,
+}
+
+/// What the training loop reports while it runs.
+#[derive(Debug, Clone, Copy)]
+pub enum Progress {
+    /// Steps done of an epoch.
+    Step {
+        /// 1-based epoch.
+        epoch: usize,
+        /// Steps done.
+        done: usize,
+        /// Steps in the epoch.
+        total: usize,
+    },
+    /// An epoch finished.
+    Epoch(EpochRecord),
+}
+
+/// A trained model and its log.
+#[derive(Debug, Clone)]
+pub struct Trained {
+    /// The model (best validation epoch).
+    pub model: Model,
+    /// One record per epoch run (empty for `linear`).
+    pub log: Vec<EpochRecord>,
+}
+
+/// Features, scaled targets and true SPDs of a set of rows, ready for the loop.
+struct Prepared {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    spds: Vec<f64>,
+    rows: usize,
+}
+
+/// The SPDs of `batch` on `grid` (a sub-grid of `columns.spd_grid`), each max-normalised.
+pub fn spds_on_grid(batch: &SampleBatch, columns: &Columns, grid: &Grid) -> Result<Vec<f64>> {
+    let source = &columns.spd_grid;
+    let indices: Option<Vec<usize>> = grid
+        .wavelengths()
+        .iter()
+        .map(|&nm| source.index_of(nm))
+        .collect();
+    let indices = indices.ok_or_else(|| {
+        LearnError::invalid(format!(
+            "the model grid {} is not part of the dataset's SPD grid {}",
+            grid.label(),
+            source.label()
+        ))
+    })?;
+    let mut out = Vec::with_capacity(batch.len() * indices.len());
+    let mut spd = vec![0.0; indices.len()];
+    for i in 0..batch.len() {
+        let row = batch.spd_of(i);
+        for (v, &j) in spd.iter_mut().zip(&indices) {
+            *v = row[j];
+        }
+        normalise(&mut spd);
+        out.extend_from_slice(&spd);
+    }
+    Ok(out)
+}
+
+/// Rows `idx` of a row-major array of width `w`.
+fn take_rows(data: &[f64], w: usize, idx: &[usize]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(idx.len() * w);
+    for &i in idx {
+        out.extend_from_slice(&data[i * w..(i + 1) * w]);
+    }
+    out
+}
+
+/// The targets (unscaled) of rows of SPDs (and weights).
+fn targets_of(target: &Target, spds: &[f64], weights: &[f64]) -> Vec<f64> {
+    match target {
+        Target::Pca(p) => spds
+            .chunks_exact(p.dim())
+            .flat_map(|s| p.project(s))
+            .collect(),
+        Target::Weights(_) => weights.to_vec(),
+    }
+}
+
+/// Model-independent pieces fitted on the training rows.
+struct Fitted {
+    features: FeatureScaler,
+    target: Target,
+    targets: TargetScaler,
+}
+
+/// Decodes network outputs to SPDs and scores them against `spds`: (MSE of the outputs
+/// against `y`, mean GFC).
+fn score(fitted: &Fitted, outputs: &[f32], y: &[f32], spds: &[f64]) -> Result<(f64, f64)> {
+    let k = fitted.target.len();
+    let d = fitted.target.spd_len();
+    let rows = outputs.len() / k;
+    let mse = outputs
+        .iter()
+        .zip(y)
+        .map(|(a, b)| f64::from(a - b).powi(2))
+        .sum::<f64>()
+        / outputs.len().max(1) as f64;
+    let mut t = vec![0.0; k];
+    let mut spd = vec![0.0; d];
+    let mut gfc = 0.0;
+    for r in 0..rows {
+        fitted
+            .targets
+            .unscale_into(&outputs[r * k..(r + 1) * k], &mut t);
+        fitted.target.decode_into(&t, &mut spd);
+        gfc += spdcam_core::metrics::gfc(&spds[r * d..(r + 1) * d], &spd)?;
+    }
+    Ok((mse, gfc / rows.max(1) as f64))
+}
+
+fn prepare_rows(
+    fitted: &Fitted,
+    set: &TrainingSet,
+    spds: &[f64],
+    idx: &[usize],
+) -> Result<Prepared> {
+    let f = set.samples.feature_count;
+    let d = fitted.target.spd_len();
+    let features = take_rows(&set.samples.features, f, idx);
+    let spd_rows = take_rows(spds, d, idx);
+    let weights = take_rows(&set.samples.weights, set.samples.weight_count, idx);
+    let raw = targets_of(&fitted.target, &spd_rows, &weights);
+    Ok(Prepared {
+        x: fitted.features.transform(&features)?,
+        y: fitted.targets.scale(&raw),
+        spds: spd_rows,
+        rows: idx.len(),
+    })
+}
+
+/// Checks a dataset can train or be scored by a model with these columns.
+fn check_set(set: &TrainingSet) -> Result<()> {
+    if set.samples.is_empty() {
+        return Err(LearnError::invalid(format!(
+            "{}: the dataset has no samples",
+            set.info.path
+        )));
+    }
+    if let Some(v) = set.samples.features.iter().find(|v| !v.is_finite()) {
+        return Err(LearnError::invalid(format!(
+            "{}: a feature is {v}",
+            set.info.path
+        )));
+    }
+    Ok(())
+}
+
+/// A seeded split of `n` rows into (train, validation) indices.
+fn split_indices(n: usize, val_split: f64, seed: u64) -> Result<(Vec<usize>, Vec<usize>)> {
+    if !(val_split > 0.0 && val_split < 1.0) {
+        return Err(LearnError::invalid(format!(
+            "the validation split {val_split} must lie strictly between 0 and 1"
+        )));
+    }
+    if n < 2 {
+        return Err(LearnError::invalid(format!(
+            "at least 2 samples are needed to hold some out for validation, got {n}"
+        )));
+    }
+    let mut idx: Vec<usize> = (0..n).collect();
+    idx.shuffle(&mut rand::rngs::SmallRng::seed_from_u64(seed ^ 0x5eed_5711));
+    let n_val = ((n as f64 * val_split).round() as usize).clamp(1, n - 1);
+    let val = idx[..n_val].to_vec();
+    let mut train = idx[n_val..].to_vec();
+    train.sort_unstable();
+    Ok((train, val))
+}
+
+/// Trains a model on `data`, validating on `validation` or, without one, on a seeded
+/// `val_split` share of `data`.
+pub fn train(
+    data: &TrainingSet,
+    validation: Option<&TrainingSet>,
+    options: &TrainOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Trained> {
+    let started = Instant::now();
+    options.architecture.validate()?;
+    options.schedule.validate()?;
+    check_set(data)?;
+    let d = options.grid.count;
+    let spds = spds_on_grid(&data.samples, &data.columns, &options.grid)?;
+    let (train_idx, val_idx, val_set, val_spds) = match validation {
+        Some(v) => {
+            check_set(v)?;
+            if v.columns.feature_names != data.columns.feature_names {
+                return Err(LearnError::invalid(format!(
+                    "{} and {} have different feature columns",
+                    data.info.path, v.info.path
+                )));
+            }
+            let vs = spds_on_grid(&v.samples, &v.columns, &options.grid)?;
+            (
+                (0..data.samples.len()).collect(),
+                (0..v.samples.len()).collect(),
+                v,
+                vs,
+            )
+        }
+        None => {
+            let (t, v) = split_indices(data.samples.len(), options.val_split, options.seed)?;
+            (t, v, data, spds.clone())
+        }
+    };
+    let f = data.samples.feature_count;
+    let train_features = take_rows(&data.samples.features, f, &train_idx);
+    let train_spds = take_rows(&spds, d, &train_idx);
+    let target = match options.target {
+        TargetKind::Pca(components) => Target::Pca(Pca::fit(&train_spds, d, components)?),
+        TargetKind::Weights => {
+            let k = data.samples.weight_count;
+            if k == 0 {
+                return Err(LearnError::invalid(format!(
+                    "{}: the dataset has no weight columns; train on PCA targets instead",
+                    data.info.path
+                )));
+            }
+            let weights = take_rows(&data.samples.weights, k, &train_idx);
+            let channels =
+                Channels::fit(data.columns.weight_names.clone(), &weights, &train_spds, d)?;
+            if channels.fit_rmse > 0.02 {
+                return Err(LearnError::invalid(format!(
+                    "{}: the SPDs are not weighted sums of fixed channels (fit RMSE {:.4}); \
+                     train on PCA targets instead",
+                    data.info.path, channels.fit_rmse
+                )));
+            }
+            Target::Weights(channels)
+        }
+    };
+    let weights = take_rows(&data.samples.weights, data.samples.weight_count, &train_idx);
+    let raw_targets = targets_of(&target, &train_spds, &weights);
+    let fitted = Fitted {
+        features: FeatureScaler::fit(&train_features, f, true)?,
+        targets: TargetScaler::fit(&raw_targets, target.len())?,
+        target,
+    };
+    let train_rows = prepare_rows(&fitted, data, &spds, &train_idx)?;
+    let val_rows = prepare_rows(&fitted, val_set, &val_spds, &val_idx)?;
+    let k = fitted.target.len();
+    let (network, log, best) = match &options.architecture {
+        Architecture::Linear { ridge } => {
+            let net = fit_ridge(&train_rows, &val_rows, f, k, *ridge, &fitted)?;
+            (net, Vec::new(), 0)
+        }
+        arch => {
+            let init = Network::init(arch.clone(), f, k, options.seed)?;
+            fit_network(
+                init,
+                &train_rows,
+                &val_rows,
+                &fitted,
+                &options.schedule,
+                options.seed,
+                false,
+                options.backend,
+                progress,
+            )?
+        }
+    };
+    let outputs = network.forward(&val_rows.x)?;
+    let (val_loss, val_gfc) = score(&fitted, &outputs, &val_rows.y, &val_rows.spds)?;
+    let record = TrainingRecord {
+        data: data.info.clone(),
+        validation: validation.map(|v| v.info.clone()),
+        train_samples: train_rows.rows,
+        val_samples: val_rows.rows,
+        options: options.clone(),
+        epochs_run: log.len(),
+        best_epoch: best,
+        val_loss,
+        val_gfc,
+        seconds: started.elapsed().as_secs_f64(),
+        finetuned_from: None,
+    };
+    let model = Model::assemble(
+        network,
+        fitted.features,
+        fitted.target,
+        fitted.targets,
+        options.grid,
+        data,
+        record,
+    )?;
+    Ok(Trained { model, log })
+}
+
+/// Closed-form ridge regression from normalised features (plus a bias) to scaled targets;
+/// with `ridge` 0, λ is chosen on the validation rows among 10⁻⁸…10⁰ (times the row count).
+fn fit_ridge(
+    train: &Prepared,
+    val: &Prepared,
+    f: usize,
+    k: usize,
+    ridge: f64,
+    fitted: &Fitted,
+) -> Result<Network> {
+    let n = train.rows;
+    let x = Mat::<f64>::from_fn(n, f + 1, |i, j| {
+        if j < f {
+            f64::from(train.x[i * f + j])
+        } else {
+            1.0
+        }
+    });
+    let y = Mat::<f64>::from_fn(n, k, |i, j| f64::from(train.y[i * k + j]));
+    let gram = x.transpose() * &x;
+    let xty = x.transpose() * &y;
+    let candidates: Vec<f64> = if ridge > 0.0 {
+        vec![ridge]
+    } else {
+        (-8..=0).map(|e| 10f64.powi(e)).collect()
+    };
+    let mut best: Option<(f64, Network)> = None;
+    for lambda in candidates {
+        let mut a = gram.clone();
+        for j in 0..f {
+            a[(j, j)] += lambda * n as f64;
+        }
+        a[(f, f)] += 1e-12 * n as f64;
+        let b = a
+            .llt(Side::Lower)
+            .map_err(|e| LearnError::Numerical(format!("ridge regression: {e:?}")))?
+            .solve(&xty);
+        let weight: Vec<f32> = (0..f)
+            .flat_map(|i| (0..k).map(move |j| (i, j)))
+            .map(|(i, j)| b[(i, j)] as f32)
+            .collect();
+        let bias: Vec<f32> = (0..k).map(|j| b[(f, j)] as f32).collect();
+        let net = Network::new(
+            Architecture::Linear { ridge: lambda },
+            f,
+            k,
+            vec![
+                Parameter {
+                    name: "output.weight".into(),
+                    shape: vec![f, k],
+                    data: weight,
+                },
+                Parameter {
+                    name: "output.bias".into(),
+                    shape: vec![k],
+                    data: bias,
+                },
+            ],
+        )?;
+        let (loss, _) = score(fitted, &net.forward(&val.x)?, &val.y, &val.spds)?;
+        if best.as_ref().is_none_or(|(l, _)| loss < *l) {
+            best = Some((loss, net));
+        }
+    }
+    best.map(|(_, net)| net)
+        .ok_or_else(|| LearnError::invalid("no ridge penalty to try"))
+}
+
+/// Keeps freed memory in the process: glibc otherwise hands each large freed block back to
+/// the system at once, so every training step page-faults its temporaries in anew (about a
+/// third of a CNN step on 2 cores).
+fn keep_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        static ONCE: std::sync::Once = std::sync::Once::new();
+        // SAFETY: mallopt only changes allocator thresholds; it is called once, before the
+        // training allocates.
+        ONCE.call_once(|| unsafe {
+            libc::mallopt(libc::M_MMAP_THRESHOLD, 1 << 30);
+            libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
+        });
+    }
+}
+
+/// The gradient loop: returns the best-validation network, the log and the best epoch.
+#[allow(clippy::too_many_arguments)]
+fn fit_network(
+    init: Network,
+    train: &Prepared,
+    val: &Prepared,
+    fitted: &Fitted,
+    schedule: &Schedule,
+    seed: u64,
+    freeze_features: bool,
+    backend: Backend,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(Network, Vec<EpochRecord>, usize)> {
+    keep_freed_memory();
+    let device = backend.device()?;
+    device.seed(seed);
+    let architecture = init.architecture().clone();
+    let f = init.inputs();
+    let k = init.outputs();
+    let mut net = BurnNet::from_network(&init, &device)?;
+    if freeze_features {
+        net = net.freeze_features();
+    }
+    let mut optimizer = AdamConfig::new().with_epsilon(1e-7).init();
+    let mut rng = rand::rngs::SmallRng::seed_from_u64(seed.wrapping_add(1));
+    let mut order: Vec<usize> = (0..train.rows).collect();
+    let batch = schedule.batch.min(train.rows.max(1));
+    let steps = train.rows.div_ceil(batch);
+    let mut lr = schedule.lr;
+    let mut best: Option<(f64, Network, usize)> = None;
+    let mut since_best = 0;
+    let mut since_decay = 0;
+    let mut log = Vec::new();
+    let mut xb = Vec::with_capacity(batch * f);
+    let mut yb = Vec::with_capacity(batch * k);
+    for epoch in 1..=schedule.epochs {
+        let t0 = Instant::now();
+        order.shuffle(&mut rng);
+        let mut loss_sum = 0.0;
+        for (step, chunk) in order.chunks(batch).enumerate() {
+            xb.clear();
+            yb.clear();
+            for &i in chunk {
+                xb.extend_from_slice(&train.x[i * f..(i + 1) * f]);
+                yb.extend_from_slice(&train.y[i * k..(i + 1) * k]);
+            }
+            let rows = chunk.len();
+            let input = prepare(&architecture, &xb, rows, f, &device)?;
+            let target = Tensor::<2>::from_data(TensorData::new(yb.clone(), [rows, k]), &device);
+            let masks = dropout_masks(&architecture, rows, f, &mut rng, &device)?;
+            let output = net.forward(&architecture, input, masks)?;
+            let loss = (output - target).square().mean();
+            let grads = loss.backward();
+            loss_sum += f64::from(loss.into_scalar::<f32>()) * rows as f64;
+            let grads = GradientsParams::from_grads(grads, &net);
+            net = optimizer.step(lr, net, grads);
+            progress(Progress::Step {
+                epoch,
+                done: step + 1,
+                total: steps,
+            });
+        }
+        let seconds = t0.elapsed().as_secs_f64();
+        let snapshot = net.to_network(&init)?;
+        let outputs = snapshot.forward(&val.x)?;
+        let (val_loss, val_gfc) = score(fitted, &outputs, &val.y, &val.spds)?;
+        if !val_loss.is_finite() {
+            return Err(LearnError::Numerical(format!(
+                "training diverged at epoch {epoch} (validation loss {val_loss}); try a smaller learning rate"
+            )));
+        }
+        let record = EpochRecord {
+            epoch,
+            train_loss: loss_sum / train.rows as f64,
+            val_loss,
+            val_gfc,
+            lr,
+            seconds,
+        };
+        log.push(record);
+        progress(Progress::Epoch(record));
+        if best.as_ref().is_none_or(|(l, _, _)| val_loss < *l) {
+            best = Some((val_loss, snapshot, epoch));
+            since_best = 0;
+            since_decay = 0;
+        } else {
+            since_best += 1;
+            since_decay += 1;
+        }
+        if schedule.patience.is_some_and(|p| since_best >= p) {
+            break;
+        }
+        if schedule.plateau.is_some_and(|p| since_decay >= p) {
+            lr *= 0.5;
+            since_decay = 0;
+        }
+    }
+    let (_, network, epoch) = best.ok_or_else(|| LearnError::invalid("no epoch was run"))?;
+    Ok((network, log, epoch))
+}
+
+/// How to fine-tune a model on new data (the thesis's transfer learning, section 6.4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FinetuneOptions {
+    /// The optimisation schedule.
+    pub schedule: Schedule,
+    /// Train only the new output layer, keeping the others fixed.
+    pub freeze_features: bool,
+    /// Fit a new PCA (and target scaling) on the new data instead of keeping the model's.
+    pub refit_pca: bool,
+    /// Keep the trained output layer instead of starting a new one: for a handful of
+    /// samples of the same kind of target, where a new layer would be fitted to too little.
+    pub keep_output: bool,
+    /// Seed of the split, the new layer, the shuffling and the dropout.
+    pub seed: u64,
+    /// The share of the data held out for validation when no validation set is given.
+    pub val_split: f64,
+    /// Where to train.
+    pub backend: Backend,
+}
+
+impl FinetuneOptions {
+    /// The thesis's transfer learning: 100 epochs, batch 64, learning rate 1e-3, all layers.
+    pub fn thesis() -> FinetuneOptions {
+        FinetuneOptions {
+            schedule: Schedule {
+                epochs: 100,
+                ..Schedule::thesis()
+            },
+            freeze_features: false,
+            refit_pca: false,
+            keep_output: false,
+            seed: 1,
+            val_split: 0.2,
+            backend: Backend::Cpu,
+        }
+    }
+}
+
+/// Fine-tunes `model` on `data`: a new output layer, then all layers (or only the new one)
+/// trained on the new samples. The input scaling of the model is kept.
+pub fn finetune(
+    model: &Model,
+    data: &TrainingSet,
+    validation: Option<&TrainingSet>,
+    options: &FinetuneOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Trained> {
+    let started = Instant::now();
+    options.schedule.validate()?;
+    check_set(data)?;
+    model.check_features(&data.columns.feature_names, &data.info.path)?;
+    if matches!(model.network().architecture(), Architecture::Linear { .. }) {
+        return Err(LearnError::invalid(
+            "a linear model has no layers to transfer; train a new one on the data instead",
+        ));
+    }
+    if options.keep_output && options.refit_pca {
+        return Err(LearnError::invalid(
+            "a refitted PCA needs a new output layer; drop keeping the output layer",
+        ));
+    }
+    let grid = model.grid();
+    let d = grid.count;
+    let spds = spds_on_grid(&data.samples, &data.columns, &grid)?;
+    let (train_idx, val_idx, val_set, val_spds) = match validation {
+        Some(v) => {
+            check_set(v)?;
+            model.check_features(&v.columns.feature_names, &v.info.path)?;
+            let vs = spds_on_grid(&v.samples, &v.columns, &grid)?;
+            (
+                (0..data.samples.len()).collect(),
+                (0..v.samples.len()).collect(),
+                v,
+                vs,
+            )
+        }
+        None => {
+            let (t, v) = split_indices(data.samples.len(), options.val_split, options.seed)?;
+            (t, v, data, spds.clone())
+        }
+    };
+    let train_spds = take_rows(&spds, d, &train_idx);
+    let (target, targets) = match (model.target(), options.refit_pca) {
+        (Target::Pca(pca), true) => {
+            let pca = Pca::fit(&train_spds, d, crate::pca::Components::Count(pca.len()))?;
+            let target = Target::Pca(pca);
+            let raw = targets_of(&target, &train_spds, &[]);
+            let scaler = TargetScaler::fit(&raw, target.len())?;
+            (target, scaler)
+        }
+        (Target::Weights(_), true) => {
+            return Err(LearnError::invalid(
+                "the model predicts channel weights; there is no PCA to refit",
+            ))
+        }
+        (t, false) => {
+            if let Target::Weights(c) = t {
+                if data.columns.weight_names != c.names {
+                    return Err(LearnError::invalid(format!(
+                        "{}: the weight columns {:?} differ from the model's channels {:?}",
+                        data.info.path, data.columns.weight_names, c.names
+                    )));
+                }
+            }
+            (t.clone(), model.target_scaler().clone())
+        }
+    };
+    let fitted = Fitted {
+        features: model.feature_scaler().clone(),
+        target,
+        targets,
+    };
+    let train_rows = prepare_rows(&fitted, data, &spds, &train_idx)?;
+    let val_rows = prepare_rows(&fitted, val_set, &val_spds, &val_idx)?;
+    let init = if options.keep_output {
+        model.network().clone()
+    } else {
+        model
+            .network()
+            .with_new_output(fitted.target.len(), options.seed)?
+    };
+    let (network, log, best) = fit_network(
+        init,
+        &train_rows,
+        &val_rows,
+        &fitted,
+        &options.schedule,
+        options.seed,
+        options.freeze_features,
+        options.backend,
+        progress,
+    )?;
+    let outputs = network.forward(&val_rows.x)?;
+    let (val_loss, val_gfc) = score(&fitted, &outputs, &val_rows.y, &val_rows.spds)?;
+    let previous = model.training().clone();
+    let mut train_options = previous.options.clone();
+    train_options.schedule = options.schedule.clone();
+    train_options.seed = options.seed;
+    train_options.val_split = options.val_split;
+    train_options.backend = options.backend;
+    let record = TrainingRecord {
+        data: data.info.clone(),
+        validation: validation.map(|v| v.info.clone()),
+        train_samples: train_rows.rows,
+        val_samples: val_rows.rows,
+        options: train_options,
+        epochs_run: log.len(),
+        best_epoch: best,
+        val_loss,
+        val_gfc,
+        seconds: started.elapsed().as_secs_f64(),
+        finetuned_from: Some(Box::new(previous)),
+    };
+    let mut tuned = Model::assemble(
+        network,
+        fitted.features,
+        fitted.target,
+        fitted.targets,
+        grid,
+        data,
+        record,
+    )?;
+    if let Some(template) = model.photo_chart() {
+        tuned.set_photo_chart(template.clone())?;
+    }
+    Ok(Trained { model: tuned, log })
+}

@@ -1,0 +1,169 @@
+//! `spdcam calibrate`: fits the in-camera rendering (auto exposure, partial white balance,
+//! tone curve, flare) of a real camera to a few of its photos of the chart under known
+//! lights, and writes it as JSON for `spdcam generate --in-camera`.
+
+use crate::render::CameraArgs;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, InCamera};
+use spdcam_core::camera::sensor::Sensitivities;
+use spdcam_core::camera::Camera;
+use spdcam_core::chart::Chart;
+use spdcam_core::fsio::write_atomic;
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use std::path::{Path, PathBuf};
+
+/// Options of `spdcam calibrate`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// Features of the real photos: CSV with a header, one row per photo (0–255, the
+    /// chart's feature order, e.g. p01_r,p01_g,…).
+    #[arg(long)]
+    features: PathBuf,
+    /// The lights' SPDs: CSV whose header row holds the wavelengths (nm), one row per photo.
+    #[arg(long)]
+    spds: PathBuf,
+    /// How many photos to fit on (the first N rows).
+    #[arg(long, default_value_t = 10)]
+    photos: usize,
+    /// Objective evaluations of the Nelder–Mead search.
+    #[arg(long, default_value_t = 3000)]
+    evaluations: usize,
+    /// Output JSON (the fitted in-camera stage and the fit's error).
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    camera: CameraArgs,
+}
+
+/// Real photos: features (0–255) per row, and SPDs on the simulation grid per row.
+pub struct Measured {
+    pub features: Vec<Vec<f64>>,
+    pub spds: Vec<Vec<f64>>,
+}
+
+fn read_rows(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let header: Vec<String> = lines
+        .next()
+        .with_context(|| format!("{} is empty", path.display()))?
+        .split(',')
+        .map(|s| s.trim().to_string())
+        .collect();
+    let mut rows = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let row = line
+            .split(',')
+            .map(|c| c.trim().parse::<f64>())
+            .collect::<std::result::Result<Vec<f64>, _>>()
+            .with_context(|| format!("{} line {}: not all numbers", path.display(), k + 2))?;
+        if row.len() != header.len() {
+            bail!(
+                "{} line {}: {} values for {} columns",
+                path.display(),
+                k + 2,
+                row.len(),
+                header.len()
+            );
+        }
+        rows.push(row);
+    }
+    Ok((header, rows))
+}
+
+/// Reads a measured set (features + SPDs), the SPDs resampled onto `grid` (zero outside).
+pub fn read_measured(features: &Path, spds: &Path, grid: &Grid) -> Result<Measured> {
+    let (_, features_rows) = read_rows(features)?;
+    let (header, spd_rows) = read_rows(spds)?;
+    if features_rows.len() != spd_rows.len() {
+        bail!(
+            "{} has {} photos but {} has {} SPDs",
+            features.display(),
+            features_rows.len(),
+            spds.display(),
+            spd_rows.len()
+        );
+    }
+    let wavelengths = header
+        .iter()
+        .map(|h| h.parse::<f64>())
+        .collect::<std::result::Result<Vec<f64>, _>>()
+        .with_context(|| format!("{}: the header must be wavelengths in nm", spds.display()))?;
+    let names = (0..spd_rows.len()).map(|i| format!("s{i}")).collect();
+    let set = SpectralSet::new(wavelengths, names, spd_rows)?;
+    let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
+    Ok(Measured {
+        features: features_rows,
+        spds: (0..set.len()).map(|i| set.item(i).to_vec()).collect(),
+    })
+}
+
+/// Measured sensitivities by name (built-in, data directory `cameras/` or `thesis/`, or file).
+pub fn sensitivities(name: &str, data_dir: &DataDir, grid: &Grid) -> Result<Sensitivities> {
+    let (name, measured) = builtin::resolve_table(
+        name,
+        "camera",
+        builtin::CAMERAS,
+        data_dir,
+        &["cameras", "thesis"],
+    )?;
+    Ok(Sensitivities::new(&name, &measured, grid)?)
+}
+
+/// The photos `indices` of a measured set as calibration photos.
+pub fn photos(measured: &Measured, indices: &[usize]) -> Vec<CalibrationPhoto> {
+    indices
+        .iter()
+        .map(|&i| CalibrationPhoto {
+            features: measured.features[i].clone(),
+            spd: measured.spds[i].clone(),
+        })
+        .collect()
+}
+
+/// Reads an in-camera stage written by `spdcam calibrate` (or a bare in-camera JSON object).
+pub fn read_in_camera(path: &Path) -> Result<InCamera> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let inner = value.get("in_camera").cloned().unwrap_or(value);
+    let ic: InCamera = serde_json::from_value(inner)
+        .with_context(|| format!("{}: not an in-camera stage", path.display()))?;
+    ic.validate()?;
+    Ok(ic)
+}
+
+/// Runs `spdcam calibrate`.
+pub fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
+    let grid = Grid::SIMULATION;
+    let chart: Chart = args.camera.chart(data_dir, &grid)?;
+    let sens = sensitivities(&args.camera.camera, data_dir, &grid)?;
+    let camera = Camera::new(&sens, chart, args.camera.config()?, &grid)?;
+    let measured = read_measured(&args.features, &args.spds, &grid)?;
+    if args.photos == 0 {
+        bail!("--photos must be at least 1");
+    }
+    let n = args.photos.min(measured.features.len());
+    let indices: Vec<usize> = (0..n).collect();
+    let fit = calibrate(
+        &camera,
+        &photos(&measured, &indices),
+        InCamera::NEUTRAL,
+        args.evaluations,
+    )?;
+    let mut text = serde_json::to_string_pretty(&fit)?;
+    text.push('\n');
+    write_atomic(&args.output, text.as_bytes())?;
+    println!(
+        "fitted on {n} photos: feature RMS {:.2} → {:.2} (0–255), {} evaluations; {}",
+        fit.rms_before,
+        fit.rms_after,
+        fit.evaluations,
+        args.output.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,374 @@
+//! `spdcam experiment thesis`: the thesis's model-selection experiment (section 4.6, Tables
+//! 4.2–4.4) on its own virtual datasets — Gaussian G1–G4 (4–7 channels) and the 24-channel
+//! Telelumen set, ColorChecker 24 — with our models, beside the thesis's numbers.
+//!
+//! Each set's `_train` part trains (a seeded 10 % of it selects the epoch), its `_val` part
+//! is the test set (the thesis's own test parts are kept aside). SPDs are made from the
+//! weights with the thesis's channels (`THESIS-PARAMETERS.md`), then normalised to a maximum
+//! of 1. Models predict PCA coefficients of the SPD (`--target weights`: the channel weights,
+//! as the thesis did for these sets).
+
+use crate::estimate::read_features;
+use crate::evaluate::metrics_table;
+use crate::train::{reporter, ModelKind, Preset, TargetArg};
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use spdcam_core::dataset::{Columns, Precision, SampleBatch};
+use spdcam_core::fsio::write_atomic;
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_learn::evaluate::evaluate;
+use spdcam_learn::model::DataInfo;
+use spdcam_learn::pca::Components;
+use spdcam_learn::target::TargetKind;
+use spdcam_learn::train::{train, Schedule, TrainOptions, TrainingSet};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Options of `spdcam experiment`.
+#[derive(Debug, Args)]
+pub struct ExperimentArgs {
+    #[command(subcommand)]
+    command: ExperimentCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum ExperimentCommand {
+    /// Train and test on the thesis's virtual datasets; compare with its Tables 4.2–4.4.
+    Thesis(ThesisArgs),
+}
+
+/// One of the thesis's virtual sets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum SetName {
+    G1,
+    G2,
+    G3,
+    G4,
+    /// All 24 Telelumen channels (the thesis's H2 used the SG chart; this set uses CC24).
+    T24,
+}
+
+impl SetName {
+    fn dir(self) -> &'static str {
+        match self {
+            SetName::G1 => "gaussian_4ch_cc24",
+            SetName::G2 => "gaussian_5ch_cc24",
+            SetName::G3 => "gaussian_6ch_cc24",
+            SetName::G4 => "gaussian_7ch_cc24",
+            SetName::T24 => "telelumen_24ch_cc24",
+        }
+    }
+
+    fn label(self) -> &'static str {
+        match self {
+            SetName::G1 => "G1",
+            SetName::G2 => "G2",
+            SetName::G3 => "G3",
+            SetName::G4 => "G4",
+            SetName::T24 => "T24",
+        }
+    }
+
+    /// The thesis's Gaussian channels, (centre, width) in nm.
+    fn gaussians(self) -> Option<&'static [(f64, f64)]> {
+        match self {
+            SetName::G1 => Some(&[(430.0, 15.0), (510.0, 20.0), (590.0, 20.0), (670.0, 15.0)]),
+            SetName::G2 => Some(&[
+                (430.0, 15.0),
+                (490.0, 20.0),
+                (550.0, 20.0),
+                (610.0, 20.0),
+                (670.0, 15.0),
+            ]),
+            SetName::G3 => Some(&[
+                (420.0, 15.0),
+                (470.0, 20.0),
+                (520.0, 20.0),
+                (570.0, 20.0),
+                (620.0, 20.0),
+                (670.0, 15.0),
+            ]),
+            SetName::G4 => Some(&[
+                (430.0, 15.0),
+                (470.0, 20.0),
+                (510.0, 20.0),
+                (550.0, 20.0),
+                (590.0, 20.0),
+                (630.0, 20.0),
+                (670.0, 15.0),
+            ]),
+            SetName::T24 => None,
+        }
+    }
+
+    /// Mean GFC the thesis published: (1D CNN, DNN) where it has them.
+    fn thesis_gfc(self) -> (Option<f64>, Option<f64>) {
+        match self {
+            SetName::G1 => (Some(0.9997), Some(0.9989)),
+            SetName::G2 => (Some(0.9994), Some(0.9988)),
+            SetName::G3 => (Some(0.9992), Some(0.9982)),
+            SetName::G4 => (Some(0.9990), Some(0.9972)),
+            SetName::T24 => (None, None),
+        }
+    }
+}
+
+/// Options of `spdcam experiment thesis`.
+#[derive(Debug, Args)]
+struct ThesisArgs {
+    /// The thesis's data directory (holding `virtual/` and `telelumen_24_channels.csv`);
+    /// default: `thesis` under --data-dir / $SPDCAM_DATA.
+    #[arg(long, value_name = "DIR")]
+    thesis_data: Option<PathBuf>,
+    /// Report directory.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Sets to run.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "g1,g2,g3,g4,t24"
+    )]
+    sets: Vec<SetName>,
+    /// Models to run.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "cnn1d,mlp,linear"
+    )]
+    models: Vec<ModelKind>,
+    /// Schedule preset.
+    #[arg(long, value_enum, default_value = "default")]
+    preset: Preset,
+    /// Override the preset's epochs.
+    #[arg(long)]
+    epochs: Option<usize>,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Targets: PCA coefficients of the SPD (measured best) or the channel weights (the
+    /// thesis's choice for these sets).
+    #[arg(long, value_enum, default_value = "pca")]
+    target: TargetArg,
+    /// Grid the SPDs are scored on.
+    #[arg(long, default_value = "400-700:5", value_name = "START-END[:STEP]")]
+    grid: String,
+}
+
+/// Channel spectra of a set on the simulation grid.
+fn channels(set: SetName, root: &Path) -> Result<Vec<Vec<f64>>> {
+    let grid = Grid::SIMULATION;
+    if let Some(g) = set.gaussians() {
+        return Ok(g
+            .iter()
+            .map(|&(mu, s)| {
+                grid.wavelengths()
+                    .iter()
+                    .map(|l| (-(l - mu) * (l - mu) / (2.0 * s * s)).exp())
+                    .collect()
+            })
+            .collect());
+    }
+    let path = root.join("telelumen_24_channels.csv");
+    let raw =
+        SpectralSet::read_csv(&path).with_context(|| format!("reading {}", path.display()))?;
+    let (set, _) = raw.resample(&grid, Interpolation::Linear, Extrapolation::Zero)?;
+    // The thesis's code set the channels to 0 above 700 nm.
+    Ok((0..set.len())
+        .map(|i| {
+            set.item(i)
+                .iter()
+                .enumerate()
+                .map(|(k, v)| {
+                    if grid.wavelength(k) > 700.0 {
+                        0.0
+                    } else {
+                        v.max(0.0)
+                    }
+                })
+                .collect()
+        })
+        .collect())
+}
+
+/// One part (`train` or `val`) of a set, with SPDs made from its weights.
+fn load_part(set: SetName, part: &str, root: &Path, ch: &[Vec<f64>]) -> Result<TrainingSet> {
+    let dir = root.join("virtual").join(format!("{}_{part}", set.dir()));
+    let features = read_features(&dir.join("features.csv"))?;
+    let weights = read_features(&dir.join("weights.csv"))?;
+    if weights.rows != features.rows || weights.names.len() != ch.len() {
+        bail!(
+            "{}: {} feature rows, {} weight rows of {} channels (expected {})",
+            dir.display(),
+            features.rows,
+            weights.rows,
+            weights.names.len(),
+            ch.len()
+        );
+    }
+    let grid = Grid::SIMULATION;
+    let k = ch.len();
+    let mut samples = SampleBatch {
+        feature_count: features.names.len(),
+        spd_len: grid.count,
+        weight_count: k,
+        features: features.values.clone(),
+        weights: weights.values.clone(),
+        ..SampleBatch::default()
+    };
+    for (i, w) in weights.values.chunks_exact(k).enumerate() {
+        let mut spd: Vec<f64> = (0..grid.count)
+            .map(|j| w.iter().zip(ch).map(|(wi, c)| wi * c[j]).sum())
+            .collect();
+        let max = spd.iter().copied().fold(0.0, f64::max);
+        if max > 0.0 {
+            spd.iter_mut().for_each(|v| *v /= max);
+        }
+        samples.spds.extend(spd);
+        samples.samples.push(i as u64);
+        samples.families.push(set.label().into());
+        samples.attempts.push(1);
+    }
+    Ok(TrainingSet {
+        samples,
+        columns: Columns {
+            feature_names: features.names,
+            feature_precision: Precision::Float64,
+            spd_grid: grid,
+            weight_names: weights.names,
+        },
+        info: DataInfo {
+            path: format!("thesis virtual/{}_{part}", set.dir()),
+            samples: features.rows,
+            chart: Some("colorchecker-24".into()),
+            camera: Some("canon-eos-5d-mark-ii (thesis)".into()),
+            families: BTreeMap::from([(set.label().to_string(), features.rows as u64)]),
+            origin: None,
+        },
+    })
+}
+
+/// Runs `spdcam experiment`.
+pub fn run(args: ExperimentArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
+    match args.command {
+        ExperimentCommand::Thesis(a) => thesis(a, data_dir),
+    }
+}
+
+fn thesis(args: ThesisArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
+    let root = match (&args.thesis_data, data_dir.root()) {
+        (Some(p), _) => p.clone(),
+        (None, Some(r)) => r.join("thesis"),
+        (None, None) => {
+            bail!("give --thesis-data DIR, or --data-dir / SPDCAM_DATA holding thesis/")
+        }
+    };
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("creating {}", args.output.display()))?;
+    let grid = Grid::parse(&args.grid)?;
+    let mut table = String::from(
+        "| set | model | GFC mean | GFC std | RMSE | SAM | SID | thesis GFC | epochs (best) | train s | s/epoch |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut results = Vec::new();
+    let mut details = String::new();
+    for &set in &args.sets {
+        let ch = channels(set, &root)?;
+        let train_set = load_part(set, "train", &root, &ch)?;
+        let test_set = load_part(set, "val", &root, &ch)?;
+        for &kind in &args.models {
+            let architecture = kind.architecture();
+            let mut schedule = match args.preset {
+                Preset::Thesis => Schedule::thesis(),
+                Preset::Default => Schedule::default_for(&architecture),
+            };
+            if let Some(e) = args.epochs {
+                schedule.epochs = e;
+            }
+            let options = TrainOptions {
+                architecture,
+                target: match args.target {
+                    TargetArg::Weights => TargetKind::Weights,
+                    TargetArg::Pca => TargetKind::Pca(Components::default()),
+                },
+                grid,
+                schedule,
+                seed: args.seed,
+                val_split: 0.1,
+                backend: spdcam_learn::train::Backend::Cpu,
+            };
+            let name = kind
+                .to_possible_value()
+                .map(|v| v.get_name().to_string())
+                .unwrap_or_default();
+            eprintln!(
+                "{} {name}: training on {} samples",
+                set.label(),
+                train_set.samples.len()
+            );
+            let (mut report, bar) = reporter(options.schedule.epochs);
+            let trained = train(&train_set, None, &options, &mut report)?;
+            if let Some(bar) = bar {
+                bar.finish_and_clear();
+            }
+            let e = evaluate(&trained.model, &test_set)?;
+            let t = trained.model.training();
+            let per_epoch = if trained.log.is_empty() {
+                0.0
+            } else {
+                trained.log.iter().map(|r| r.seconds).sum::<f64>() / trained.log.len() as f64
+            };
+            let thesis = match kind {
+                ModelKind::Cnn1d => set.thesis_gfc().0,
+                ModelKind::Mlp => set.thesis_gfc().1,
+                ModelKind::Linear => None,
+            };
+            let s = &e.summary;
+            let line = format!(
+                "| {} | {name} | {:.5} | {:.5} | {:.4} | {:.4} | {:.4} | {} | {} ({}) | {:.0} | {:.2} |\n",
+                set.label(),
+                s.gfc.mean,
+                s.gfc.std,
+                s.rmse.mean,
+                s.sam.mean,
+                s.sid.mean,
+                thesis.map_or("–".to_string(), |g| format!("{g:.4}")),
+                t.epochs_run,
+                t.best_epoch,
+                t.seconds,
+                per_epoch
+            );
+            eprint!("{line}");
+            table.push_str(&line);
+            details.push_str(&format!(
+                "\n## {} — {name}\n\n{}",
+                set.label(),
+                metrics_table(&e)
+            ));
+            results.push(serde_json::json!({
+                "set": set.label(), "model": name, "metrics": e.summary,
+                "thesis_gfc": thesis, "epochs_run": t.epochs_run, "best_epoch": t.best_epoch,
+                "train_seconds": t.seconds, "seconds_per_epoch": per_epoch,
+                "train_samples": t.train_samples, "test_samples": e.per_sample.len(),
+            }));
+        }
+    }
+    let md = format!(
+        "# The thesis's virtual datasets\n\nTrained on `_train` (10 % of it held out to select \
+         the epoch), tested on `_val`; targets {:?}; SPDs scored on {} nm; preset {:?}, \
+         seed {}.\n\n{table}{details}",
+        args.target,
+        grid.label(),
+        args.preset,
+        args.seed
+    );
+    write_atomic(&args.output.join("results.md"), md.as_bytes())?;
+    write_atomic(
+        &args.output.join("results.json"),
+        serde_json::to_string_pretty(&results)?.as_bytes(),
+    )?;
+    println!("{table}\nreport: {}", args.output.display());
+    Ok(())
+}

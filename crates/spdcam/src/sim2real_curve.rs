@@ -1,0 +1,164 @@
+//! The fine-tuning learning curve of `spdcam sim2real --finetune MODEL`: mean GFC on real
+//! photos against the number of real photos a virtual-trained model is fine-tuned on,
+//! k-fold cross-validated on each real set (the photos come from the folds outside the test
+//! fold), beside ridge regression trained on the same photos alone.
+
+use crate::calibrate::Measured;
+use anyhow::Result;
+use rand::rngs::SmallRng;
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use spdcam_core::dataset::{Columns, Precision, SampleBatch};
+use spdcam_core::metrics;
+use spdcam_core::spectral::Grid;
+use spdcam_learn::model::{DataInfo, Model};
+use spdcam_learn::train::{finetune, FinetuneOptions, Schedule, TrainingSet};
+use std::collections::BTreeMap;
+
+/// How the curve is measured.
+pub struct CurveOptions {
+    /// Numbers of real photos to fine-tune on (0: the model as it is).
+    pub sizes: Vec<usize>,
+    /// Cross-validation folds.
+    pub folds: usize,
+    /// Seed of the photo picks and the fine-tuning.
+    pub seed: u64,
+}
+
+/// One set's curve: per size, the mean GFC of the fine-tuned model and of ridge on the same
+/// photos (`None` where the folds hold fewer photos than the size).
+pub struct Curve {
+    /// (size, fine-tuned model, ridge on real photos only).
+    pub points: Vec<(usize, Option<f64>, Option<f64>)>,
+}
+
+/// The photos `indices` of `set` as a training set on `grid` (the grid of the set's SPDs).
+fn training_set(set: &Measured, indices: &[usize], names: &[String], grid: &Grid) -> TrainingSet {
+    let mut samples = SampleBatch {
+        feature_count: names.len(),
+        spd_len: grid.count,
+        ..SampleBatch::default()
+    };
+    for (k, &i) in indices.iter().enumerate() {
+        samples.samples.push(k as u64);
+        samples.families.push("measured".into());
+        samples.features.extend(&set.features[i]);
+        samples.spds.extend(&set.spds[i]);
+        samples.attempts.push(1);
+    }
+    TrainingSet {
+        samples,
+        columns: Columns {
+            feature_names: names.to_vec(),
+            feature_precision: Precision::Float64,
+            spd_grid: *grid,
+            weight_names: Vec::new(),
+        },
+        info: DataInfo {
+            path: format!("{} real photos", indices.len()),
+            samples: indices.len(),
+            chart: None,
+            camera: None,
+            families: BTreeMap::from([("measured".to_string(), indices.len() as u64)]),
+            origin: None,
+        },
+    }
+}
+
+/// The truth of photo `i` on the model's grid, peak-normalised.
+fn truth_on(set: &Measured, i: usize, set_grid: &Grid, model_grid: &Grid) -> Vec<f64> {
+    let values: Vec<f64> = model_grid
+        .wavelengths()
+        .iter()
+        .map(|nm| set.spds[i][((nm - set_grid.start_nm) / set_grid.step_nm).round() as usize])
+        .collect();
+    metrics::normalise_by_max(&values)
+}
+
+/// Mean GFC of `model` on the photos `test`.
+fn model_gfc(model: &Model, set: &Measured, test: &[usize], set_grid: &Grid) -> Result<f64> {
+    let features: Vec<f64> = test.iter().flat_map(|&i| set.features[i].clone()).collect();
+    let spds = model.estimate_rows(&features)?;
+    let grid = model.grid();
+    let mut total = 0.0;
+    for (k, &i) in test.iter().enumerate() {
+        let est = &spds[k * grid.count..(k + 1) * grid.count];
+        total += metrics::gfc(&truth_on(set, i, set_grid, &grid), est)?;
+    }
+    Ok(total / test.len() as f64)
+}
+
+/// The fine-tuning recipe for `n` photos: the model's output layer kept, all layers
+/// trained with a small learning rate for about 600 steps. There are too few photos to hold
+/// some back for early stopping: the photos themselves validate, so the kept epoch is the
+/// one that fits them best.
+fn recipe(n: usize, seed: u64) -> FinetuneOptions {
+    let batch = 16.min(n);
+    FinetuneOptions {
+        schedule: Schedule {
+            epochs: (600 / n.div_ceil(batch)).clamp(10, 200),
+            batch,
+            lr: 2e-4,
+            patience: None,
+            plateau: None,
+        },
+        keep_output: true,
+        seed,
+        ..FinetuneOptions::thesis()
+    }
+}
+
+/// The learning curve of `model` on one real set; `ridge` fits and scores the real-only
+/// baseline on (train, test) photo indices.
+pub fn learning_curve(
+    model: &Model,
+    set: &Measured,
+    set_grid: &Grid,
+    options: &CurveOptions,
+    ridge: &dyn Fn(&[usize], &[usize]) -> Result<f64>,
+) -> Result<Curve> {
+    let n = set.features.len();
+    let folds = options.folds.max(2);
+    let names = model.feature_names().to_vec();
+    let mut sums = vec![(0.0, 0.0, 0usize); options.sizes.len()];
+    for f in 0..folds {
+        let (test, mut pool): (Vec<usize>, Vec<usize>) = (0..n).partition(|i| i % folds == f);
+        pool.shuffle(&mut SmallRng::seed_from_u64(options.seed + f as u64));
+        for (s, &size) in options.sizes.iter().enumerate() {
+            if size > pool.len() {
+                continue;
+            }
+            let picked = &pool[..size];
+            let (tuned, baseline) = if size == 0 {
+                (model_gfc(model, set, &test, set_grid)?, 0.0)
+            } else {
+                let data = training_set(set, picked, &names, set_grid);
+                let trained = finetune(
+                    model,
+                    &data,
+                    Some(&data),
+                    &recipe(size, options.seed),
+                    &mut |_| {},
+                )?;
+                (
+                    model_gfc(&trained.model, set, &test, set_grid)?,
+                    ridge(picked, &test)?,
+                )
+            };
+            let w = test.len() as f64;
+            sums[s].0 += tuned * w;
+            sums[s].1 += baseline * w;
+            sums[s].2 += test.len();
+        }
+    }
+    let points = options
+        .sizes
+        .iter()
+        .zip(&sums)
+        .map(|(&size, &(t, b, count))| {
+            let mean = |v: f64| (count == n).then(|| v / n as f64);
+            (size, mean(t), if size == 0 { None } else { mean(b) })
+        })
+        .collect();
+    Ok(Curve { points })
+}

@@ -1,0 +1,254 @@
+//! `spdcam estimate PHOTO`: the main job, end to end, with the shipped model and no data
+//! directory; features of charts no model knows; bad photos.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The example photo the README's first command estimates, and its true SPD beside it.
+const EXAMPLE: &str = "../../examples/sg-telelumen.jpg";
+
+/// spdcam with no data directory: what it does here works on a fresh clone.
+fn spdcam(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_spdcam"))
+        .args(args)
+        .env_remove("SPDCAM_DATA")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("spdcam runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = spdcam(args);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "spdcam {args:?} failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+fn fails(args: &[&str]) -> String {
+    let out = spdcam(args);
+    assert!(!out.status.success(), "spdcam {args:?} should fail");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("spdcam-cli-estimate-{name}"));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// The number after `key` in `text`.
+fn number_after(text: &str, key: &str) -> f64 {
+    let at = text
+        .find(key)
+        .unwrap_or_else(|| panic!("no '{key}' in:\n{text}"))
+        + key.len();
+    text[at..]
+        .trim_start()
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no number after '{key}' in:\n{text}"))
+}
+
+#[test]
+fn the_example_photo_is_estimated_with_the_shipped_model() {
+    let dir = scratch("example");
+    let csv = dir.join("spd.csv");
+    let plot = dir.join("spd.svg");
+    let debug = dir.join("debug.png");
+    let out = ok(&[
+        "estimate",
+        EXAMPLE,
+        "-o",
+        &s(&csv),
+        "--plot",
+        &s(&plot),
+        "--debug",
+        &s(&debug),
+    ]);
+    assert!(out.contains("colorchecker_sg140 detected"), "{out}");
+    assert!(out.contains("shipped default model"), "{out}");
+    // The truth file beside the photo is found and scored.
+    let gfc = number_after(&out, "GFC");
+    assert!(gfc > 0.9 && gfc <= 1.0, "GFC {gfc}:\n{out}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(
+        text.starts_with("wavelength_nm,sg-telelumen.jpg\n400,"),
+        "{text}"
+    );
+    assert_eq!(text.lines().count(), 62);
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("xy ("));
+    let overlay = image::open(&debug).unwrap();
+    assert_eq!((overlay.width(), overlay.height()), (2000, 1500));
+
+    // JSON: the SPD, colorimetry, score and the photo's analysis.
+    let json: serde_json::Value = serde_json::from_str(&ok(&["estimate", EXAMPLE, "--json"]))
+        .expect("--json prints JSON alone");
+    let item = &json[0];
+    assert_eq!(item["spd"].as_array().unwrap().len(), 61);
+    assert_eq!(item["wavelength_nm"][0].as_f64(), Some(400.0));
+    assert!((item["truth"]["gfc"].as_f64().unwrap() - gfc).abs() < 1e-4);
+    assert!(item["photo"]["confidence"].as_f64().unwrap() > 0.8);
+    assert_eq!(item["photo"]["features"].as_array().unwrap().len(), 288);
+    assert_eq!(item["photo"]["patches"].as_array().unwrap().len(), 140);
+    let xy = item["colorimetry"]["xy"].as_array().unwrap();
+    assert!(xy.iter().all(|v| (0.0..1.0).contains(&v.as_f64().unwrap())));
+
+    // An explicit truth file that does not match the photo scores worse.
+    let flat = dir.join("flat.csv");
+    let mut text = String::from("wavelength_nm,equal energy\n");
+    for w in (380..=780).step_by(5) {
+        text.push_str(&format!("{w},1\n"));
+    }
+    std::fs::write(&flat, text).unwrap();
+    let out = ok(&["estimate", EXAMPLE, "--truth", &s(&flat)]);
+    assert!(number_after(&out, "GFC") < gfc, "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn features_of_a_chart_no_model_knows_are_written_alone() {
+    let dir = scratch("cc24");
+    let photo = dir.join("cc24.jpg");
+    ok(&[
+        "render",
+        "--spd",
+        "D65",
+        "--scene",
+        "1200x900",
+        "-o",
+        &s(&photo),
+    ]);
+    let features = dir.join("f.csv");
+    let out = ok(&[
+        "estimate",
+        &s(&photo),
+        "--chart",
+        "colorchecker24",
+        "--features-out",
+        &s(&features),
+    ]);
+    assert!(out.contains("no estimate"), "{out}");
+    let text = std::fs::read_to_string(&features).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 72);
+    assert_eq!((header[0], header[71]), ("p01_r", "p24_b"));
+    let row: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    // Under D65 with white balance, patch 19 (white) is the lightest and near neutral.
+    let white = &row[54..57];
+    assert!(white.iter().all(|&v| v > 150.0), "{white:?}");
+    assert!(
+        white.iter().fold(0.0f64, |m, &v| m.max(v)) - white.iter().fold(255.0f64, |m, &v| m.min(v))
+            < 20.0
+    );
+
+    // The shipped model looks for its own chart, the Digital SG: none here.
+    let csv = dir.join("never.csv");
+    let err = fails(&["estimate", &s(&photo), "-o", &s(&csv)]);
+    assert!(
+        err.contains("no chart found") && err.contains("colorchecker_sg140"),
+        "{err}"
+    );
+    assert!(!csv.exists(), "no partial output");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_photos_give_clear_errors_and_no_output() {
+    let dir = scratch("bad");
+    let csv = dir.join("out.csv");
+    let text = dir.join("notes.jpg");
+    std::fs::write(&text, "not a photo").unwrap();
+    let err = fails(&["estimate", &s(&text), "-o", &s(&csv)]);
+    assert!(err.contains("notes.jpg"), "{err}");
+
+    let bytes = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join(EXAMPLE)).unwrap();
+    let truncated = dir.join("truncated.jpg");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 3]).unwrap();
+    let err = fails(&["estimate", &s(&truncated), "-o", &s(&csv)]);
+    assert!(err.contains("truncated.jpg"), "{err}");
+
+    let err = fails(&["estimate", &s(&dir.join("missing.jpg")), "-o", &s(&csv)]);
+    assert!(err.contains("missing.jpg"), "{err}");
+
+    let err = fails(&[
+        "estimate",
+        EXAMPLE,
+        "--corners",
+        "0,0,10,0,10,10,0,10,5",
+        "-o",
+        &s(&csv),
+    ]);
+    assert!(err.contains("eight numbers"), "{err}");
+    let err = fails(&[
+        "estimate",
+        EXAMPLE,
+        "--corners",
+        "-50,-50,5000,0,5000,4000,0,4000",
+        "-o",
+        &s(&csv),
+    ]);
+    assert!(err.contains("outside"), "{err}");
+
+    let err = fails(&["estimate", EXAMPLE, "--features", &s(&text)]);
+    assert!(err.contains("cannot be used with"), "{err}");
+    let err = fails(&["estimate", EXAMPLE, "--model", &s(&text)]);
+    assert!(err.contains("not a spdcam model"), "{err}");
+    assert!(!csv.exists(), "no partial output");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The shared data directory (for the SG 96 reflectances and the Canon curves).
+fn data_dir() -> PathBuf {
+    let root = std::env::var_os("SPDCAM_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    assert!(root.is_dir(), "shared data not found at {}", root.display());
+    root
+}
+
+#[test]
+fn a_chart_image_from_render_is_estimated() {
+    let dir = scratch("render");
+    let data = s(&data_dir());
+    let chart = dir.join("chart.png");
+    let truth = dir.join("chart.truth.csv");
+    ok(&[
+        "--data-dir",
+        &data,
+        "render",
+        "--chart",
+        "colorchecker_sg96",
+        "--camera",
+        "canon_eos_5d_mark_ii_mod_bw486",
+        "--spd",
+        "D65",
+        "-o",
+        &s(&chart),
+        "--spd-out",
+        &s(&truth),
+    ]);
+    let out = ok(&["--data-dir", &data, "estimate", &s(&chart)]);
+    assert!(out.contains("colorchecker_sg96 detected"), "{out}");
+    let gfc = number_after(&out, "GFC");
+    assert!(gfc > 0.99, "GFC {gfc}:\n{out}");
+    let cct = number_after(&out, "CCT");
+    assert!((5800.0..7200.0).contains(&cct), "CCT {cct}:\n{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}

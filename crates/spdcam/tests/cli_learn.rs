@@ -1,0 +1,231 @@
+//! `spdcam train / estimate / evaluate / finetune` end to end on a small synthetic dataset
+//! brought in with `spdcam dataset import`.
+
+use spdcam_learn::synthetic::gaussian_set;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn spdcam(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_spdcam"))
+        .args(args)
+        .output()
+        .expect("running spdcam")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = spdcam(args);
+    assert!(
+        out.status.success(),
+        "spdcam {args:?} failed:\n{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn fails(args: &[&str]) -> String {
+    let out = spdcam(args);
+    assert!(!out.status.success(), "spdcam {args:?} should fail");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("spdcam-cli-learn-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes features.csv and spds.csv of a synthetic set and imports them as a dataset.
+fn dataset(dir: &Path, name: &str, rows: usize, patches: usize, seed: u64) -> (PathBuf, PathBuf) {
+    let set = gaussian_set(rows, patches, seed, 2);
+    let f = set.samples.feature_count;
+    let mut features = set.columns.feature_names.join(",") + "\n";
+    for row in set.samples.features.chunks_exact(f) {
+        let cells: Vec<String> = row.iter().map(|v| format!("{v:.4}")).collect();
+        features.push_str(&(cells.join(",") + "\n"));
+    }
+    let grid = set.columns.spd_grid;
+    let header: Vec<String> = grid.wavelengths().iter().map(|w| format!("{w}")).collect();
+    let mut spds = header.join(",") + "\n";
+    for row in set.samples.spds.chunks_exact(grid.count) {
+        let cells: Vec<String> = row.iter().map(|v| format!("{v:.6}")).collect();
+        spds.push_str(&(cells.join(",") + "\n"));
+    }
+    let fp = dir.join(format!("{name}-features.csv"));
+    let sp = dir.join(format!("{name}-spds.csv"));
+    std::fs::write(&fp, features).unwrap();
+    std::fs::write(&sp, spds).unwrap();
+    let out = dir.join(name);
+    ok(&[
+        "dataset",
+        "import",
+        "--features",
+        fp.to_str().unwrap(),
+        "--spds",
+        sp.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    (out, fp)
+}
+
+#[test]
+fn train_estimate_evaluate_finetune() {
+    let dir = scratch("all");
+    let (data, features) = dataset(&dir, "train", 800, 24, 1);
+    let (small, _) = dataset(&dir, "small", 200, 24, 2);
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let model = dir.join("m.spdm");
+    let out = ok(&[
+        "train",
+        "--data",
+        &s(&data),
+        "--model",
+        "cnn1d",
+        "-o",
+        &s(&model),
+        "--epochs",
+        "3",
+        "--batch",
+        "64",
+        "--seed",
+        "3",
+    ]);
+    assert!(out.contains("validation GFC"), "{out}");
+    assert!(model.is_file());
+    let log = std::fs::read_to_string(dir.join("m.log.csv")).unwrap();
+    assert_eq!(log.lines().count(), 4, "{log}");
+    assert!(std::fs::read_to_string(dir.join("m.loss.svg"))
+        .unwrap()
+        .contains("<svg"));
+
+    // The baseline.
+    let linear = dir.join("lin.spdm");
+    ok(&[
+        "train",
+        "--data",
+        &s(&data),
+        "--model",
+        "linear",
+        "-o",
+        &s(&linear),
+    ]);
+
+    // One row: colorimetry is printed; the CSV has one estimate column.
+    let one = dir.join("one.csv");
+    let text = std::fs::read_to_string(&features).unwrap();
+    let mut lines = text.lines();
+    std::fs::write(
+        &one,
+        format!("{}\n{}\n", lines.next().unwrap(), lines.next().unwrap()),
+    )
+    .unwrap();
+    let spd = dir.join("spd.csv");
+    let plot = dir.join("spd.svg");
+    let out = ok(&[
+        "estimate",
+        "--model",
+        &s(&linear),
+        "--features",
+        &s(&one),
+        "-o",
+        &s(&spd),
+        "--plot",
+        &s(&plot),
+    ]);
+    assert!(out.contains("xy (") && out.contains("CCT"), "{out}");
+    let csv = std::fs::read_to_string(&spd).unwrap();
+    assert!(csv.starts_with("wavelength_nm,estimate_1\n400,"), "{csv}");
+    assert_eq!(csv.lines().count(), 62);
+    assert!(plot.is_file());
+
+    // Many rows, another range.
+    let out = ok(&[
+        "estimate",
+        "--model",
+        &s(&model),
+        "--features",
+        &s(&features),
+        "-o",
+        &s(&spd),
+        "--range",
+        "420-680:10",
+    ]);
+    assert!(out.contains("800 estimate(s)"), "{out}");
+    let csv = std::fs::read_to_string(&spd).unwrap();
+    assert!(csv.starts_with("wavelength_nm,estimate_1,estimate_2,"));
+    assert_eq!(csv.lines().count(), 28);
+
+    // Evaluate writes the report.
+    let report = dir.join("report");
+    let out = ok(&[
+        "evaluate",
+        "--model",
+        &s(&linear),
+        "--data",
+        &s(&data),
+        "-o",
+        &s(&report),
+    ]);
+    assert!(out.contains("| GFC |"), "{out}");
+    for f in [
+        "samples.csv",
+        "metrics.json",
+        "metrics.md",
+        "band_mae.csv",
+        "boxplots.svg",
+        "band_mae.svg",
+        "best_median_worst.svg",
+    ] {
+        assert!(report.join(f).is_file(), "{f}");
+    }
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("metrics.json")).unwrap())
+            .unwrap();
+    let gfc = metrics["metrics"]["gfc"]["mean"].as_f64().unwrap();
+    assert!(gfc > 0.95 && gfc <= 1.0, "linear GFC {gfc}");
+
+    // Fine-tuning writes a new model.
+    let tuned = dir.join("tuned.spdm");
+    ok(&[
+        "finetune",
+        "--model",
+        &s(&model),
+        "--data",
+        &s(&small),
+        "-o",
+        &s(&tuned),
+        "--epochs",
+        "2",
+        "--freeze",
+    ]);
+    assert!(tuned.is_file());
+
+    // Features of another chart, and a file that is not a model: clear errors.
+    let (_, other) = dataset(&dir, "other", 20, 30, 4);
+    let err = fails(&[
+        "estimate",
+        "--model",
+        &s(&model),
+        "--features",
+        &s(&other),
+        "-o",
+        &s(&spd),
+    ]);
+    assert!(
+        err.contains("90 feature columns") && err.contains("72"),
+        "{err}"
+    );
+    let err = fails(&[
+        "estimate",
+        "--model",
+        &s(&one),
+        "--features",
+        &s(&one),
+        "-o",
+        &s(&spd),
+    ]);
+    assert!(err.contains("not a spdcam model"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
