@@ -108,6 +108,9 @@ fn recipe(n: usize, seed: u64) -> FinetuneOptions {
     }
 }
 
+/// Fits a baseline on the photos `train` and returns its mean GFC on the photos `test`.
+pub type Baseline<'a> = dyn Fn(&[usize], &[usize]) -> Result<f64> + 'a;
+
 /// The learning curve of `model` on one real set; `ridge` fits and scores the real-only
 /// baseline on (train, test) photo indices.
 pub fn learning_curve(
@@ -115,7 +118,7 @@ pub fn learning_curve(
     set: &Measured,
     set_grid: &Grid,
     options: &CurveOptions,
-    ridge: &dyn Fn(&[usize], &[usize]) -> Result<f64>,
+    ridge: &Baseline,
 ) -> Result<Curve> {
     let n = set.features.len();
     let folds = options.folds.max(2);
