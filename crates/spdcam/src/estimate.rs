@@ -251,6 +251,9 @@ fn truths(args: &EstimateArgs, count: usize, grid: &Grid) -> Result<Vec<Option<V
             ),
         };
     }
+    if args.photos.is_empty() {
+        return Ok(vec![None; count]);
+    }
     args.photos
         .iter()
         .map(|photo| {
