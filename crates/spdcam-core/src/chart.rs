@@ -91,6 +91,22 @@ impl Layout {
         )
     }
 
+    /// Centre of every region across the patch grid, from −½ (left, top) to ½ (right,
+    /// bottom): the patches row-major, then the background at (0, 0).
+    pub fn region_centres(&self) -> Vec<[f32; 2]> {
+        let mut centres: Vec<[f32; 2]> = (0..self.patch_count())
+            .map(|i| {
+                let (r, c) = (i / self.cols, i % self.cols);
+                [
+                    (c as f32 + 0.5) / self.cols as f32 - 0.5,
+                    (r as f32 + 0.5) / self.rows as f32 - 0.5,
+                ]
+            })
+            .collect();
+        centres.push([0.0, 0.0]);
+        centres
+    }
+
     /// Whether any background (gap, border or canvas) shows.
     pub fn shows_background(&self) -> bool {
         self.gap_px > 0

@@ -172,6 +172,7 @@ fn calibration_recovers_known_parameters() {
         gamma: 0.9,
         contrast: 0.2,
         jpeg_quality: None,
+        gradient: [0.0, 0.0],
     };
     let cam = camera(None);
     let lights = [
@@ -257,4 +258,96 @@ fn randomised_generation_is_deterministic_per_seed_and_sample() {
     let (c2, p2) = randomisation.draw(3, 5);
     assert_eq!(c1.camera_name(), c2.camera_name());
     assert_eq!(p1, p2);
+}
+
+#[test]
+fn lighting_gradient_scales_patches_by_their_position() {
+    // CC24 is 4 × 6: patch 0's centre sits at x = 0.5/6 − 0.5 = −5/12, y = 0.5/4 − 0.5 = −3/8.
+    let centres = Chart::colorchecker24(&GRID)
+        .unwrap()
+        .layout
+        .region_centres();
+    assert_eq!(centres.len(), 25, "24 patches and the background");
+    let near = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
+    assert!(
+        near(centres[0], [-5.0 / 12.0, -3.0 / 8.0]),
+        "{:?}",
+        centres[0]
+    );
+    assert!(
+        near(centres[23], [5.0 / 12.0, 3.0 / 8.0]),
+        "{:?}",
+        centres[23]
+    );
+    assert_eq!(centres[24], [0.0, 0.0]);
+    let ic = InCamera {
+        gradient: [0.4, -0.2],
+        ..InCamera::NEUTRAL
+    };
+    let mut raw = vec![[1.0f32, 2.0, 4.0]; 25];
+    ic.apply_gradient(&mut raw, &centres);
+    // Patch 0: 1 + 0.4·(−5/12) − 0.2·(−3/8) = 1 − 1/6 + 0.075.
+    let g0 = 1.0 - 1.0 / 6.0 + 0.075;
+    let g23 = 1.0 + 1.0 / 6.0 - 0.075;
+    for (c, base) in [1.0f32, 2.0, 4.0].into_iter().enumerate() {
+        assert!((raw[0][c] - base * g0 as f32).abs() < 1e-6);
+        assert!((raw[23][c] - base * g23 as f32).abs() < 1e-6);
+        assert_eq!(raw[24][c], base, "the background is at the centre");
+    }
+    // Through the camera: a left-to-right gradient brightens the right column relative to
+    // the left one; no gradient is the neutral stage.
+    let spd = StandardIlluminant::D65.spd(&GRID).unwrap();
+    let flat = fast(&camera(None), Some(&InCamera::NEUTRAL), &spd);
+    let zero = InCamera {
+        gradient: [0.0, 0.0],
+        ..InCamera::NEUTRAL
+    };
+    assert_eq!(fast(&camera(None), Some(&zero), &spd), flat);
+    let tilted = InCamera {
+        gradient: [0.5, 0.0],
+        ..InCamera::NEUTRAL
+    };
+    let lit = fast(&camera(None), Some(&tilted), &spd);
+    let green = |f: &[f32], patch: usize| f[patch * 3 + 1];
+    // Patches 18 (white, left) and 23 (black, right) on the bottom row: the exposure is
+    // normalised again, so compare the change of one against the other's.
+    let change = |p: usize| green(&lit, p) / green(&flat, p);
+    assert!(
+        change(23) > 1.2 * change(18),
+        "right {} left {}",
+        change(23),
+        change(18)
+    );
+    assert!(InCamera {
+        gradient: [2.0, 0.0],
+        ..InCamera::NEUTRAL
+    }
+    .validate()
+    .is_err());
+}
+
+#[test]
+fn randomised_gradient_stays_in_its_range() {
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let config = CameraConfig {
+        noise: None,
+        ..CameraConfig::default()
+    };
+    let pool = vec![Camera::new(&nikon(), chart, config, &GRID).unwrap()];
+    let ranges = InCameraRanges::for_groups(&["gradient"]).unwrap();
+    let max = ranges.gradient.unwrap();
+    let randomisation = Randomisation::new(pool, ranges).unwrap();
+    let draws: Vec<[f64; 2]> = (0..200)
+        .map(|i| randomisation.draw(9, i).1.unwrap().gradient)
+        .collect();
+    assert!(draws.iter().flatten().all(|g| g.abs() <= max));
+    let spread = draws
+        .iter()
+        .map(|g| g[0])
+        .fold(0.0f64, |m, g| m.max(g.abs()));
+    assert!(
+        spread > 0.8 * max,
+        "draws cover the range: largest {spread}"
+    );
+    assert_eq!(draws[7], randomisation.draw(9, 7).1.unwrap().gradient);
 }

@@ -270,6 +270,10 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
         pool,
         InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg"])?,
     )?;
+    let with_gradient = Randomisation::new(
+        randomised.cameras().to_vec(),
+        InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg", "gradient"])?,
+    )?;
     let wb_only = Randomisation::new(
         vec![make(plain_cam, sg, None)?],
         InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg"])?,
@@ -307,6 +311,11 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
         &format!("+ randomised camera ({pool_size} curves incl. perturbed) and in-camera stage"),
         &make(plain_cam, sg, None)?,
         Some(&randomised),
+    )?;
+    fixed_row(
+        "+ uneven lighting across the chart (randomised gradient)",
+        &make(plain_cam, sg, None)?,
+        Some(&with_gradient),
     )?;
     // Calibrated: per fold, fit on a few photos outside the fold, test on the fold.
     let mut calibrated = Vec::new();

@@ -1,11 +1,12 @@
-//! In-camera rendering of a JPEG camera, beyond the thesis's pipeline: veiling glare,
+//! In-camera rendering of a JPEG camera, beyond the thesis's pipeline: uneven lighting
+//! across the chart (a scene effect that real photos carry), veiling glare,
 //! automatic exposure with sensor saturation, auto white balance with incomplete
 //! adaptation, colour saturation, a highlight shoulder, a tone curve beyond the sRGB gamma,
 //! and JPEG-like quantisation. Every stage is a parameter whose neutral value leaves the
 //! image unchanged; the whole stage is off unless [`crate::camera::CameraConfig::in_camera`]
 //! is set.
 //!
-//! Order: raw ─► flare ─► exposure (auto) ─► clip at full scale ─► white-balance gains raised
+//! Order: raw ─► lighting gradient ─► flare ─► exposure (auto) ─► clip at full scale ─► white-balance gains raised
 //! to `adaptation` ─► colour matrix ─► saturation ─► shoulder ─► gamma ─► sRGB encode ─►
 //! contrast S-curve ─► JPEG quantisation.
 //!
@@ -45,6 +46,12 @@ pub struct InCamera {
     /// JPEG quality (1–100) whose DC quantisation steps (libjpeg's tables) round each
     /// pixel's Y, Cb, Cr: what JPEG does to flat patches. `None` = no JPEG quantisation.
     pub jpeg_quality: Option<u8>,
+    /// Uneven lighting (a scene effect): the light's relative gain on a patch is
+    /// `1 + gradient[0]·x + gradient[1]·y`, with x, y the patch centre's position across
+    /// the chart's patch grid from −½ (left, top) to +½ (right, bottom); [0, 0] = even
+    /// lighting (sensible magnitudes up to 0.5).
+    #[serde(default)]
+    pub gradient: [f64; 2],
 }
 
 impl Default for InCamera {
@@ -52,6 +59,9 @@ impl Default for InCamera {
         InCamera::NEUTRAL
     }
 }
+
+/// Largest lighting-gradient magnitude: the gain stays positive over the whole chart.
+const MAX_GRADIENT: f64 = 1.5;
 
 /// Parameter names and ranges, for messages and for calibration bounds.
 const RANGES: [(&str, f64, f64); 7] = [
@@ -76,6 +86,7 @@ impl InCamera {
         gamma: 1.0,
         contrast: 0.0,
         jpeg_quality: None,
+        gradient: [0.0, 0.0],
     };
 
     /// The fitted parameters as a vector in [`RANGES`] order (exposure target 0 when off).
@@ -91,7 +102,7 @@ impl InCamera {
         ]
     }
 
-    /// The inverse of [`InCamera::to_vector`], keeping `self`'s JPEG quality.
+    /// The inverse of [`InCamera::to_vector`], keeping `self`'s JPEG quality and lighting gradient.
     fn with_vector(self, v: [f64; 7]) -> InCamera {
         InCamera {
             exposure_target: Some(v[0]),
@@ -119,6 +130,16 @@ impl InCamera {
                 )));
             }
         }
+        if self
+            .gradient
+            .iter()
+            .any(|g| !(g.is_finite() && g.abs() <= MAX_GRADIENT))
+        {
+            return Err(Error::invalid(format!(
+                "in-camera lighting gradient {:?} is outside ±{MAX_GRADIENT}",
+                self.gradient
+            )));
+        }
         if let Some(q) = self.jpeg_quality {
             if !(1..=100).contains(&q) {
                 return Err(Error::invalid(format!(
@@ -127,6 +148,20 @@ impl InCamera {
             }
         }
         Ok(())
+    }
+
+    /// Multiplies each region's raw value by the lighting gradient's gain at its centre;
+    /// `centres` holds each region's (x, y) position from −½ to ½ (the background sits at
+    /// the centre).
+    pub fn apply_gradient(&self, raw: &mut [[f32; 3]], centres: &[[f32; 2]]) {
+        if self.gradient == [0.0, 0.0] {
+            return;
+        }
+        let [gx, gy] = self.gradient.map(|g| g as f32);
+        for (v, [x, y]) in raw.iter_mut().zip(centres) {
+            let gain = (1.0 + gx * x + gy * y).max(0.0);
+            *v = v.map(|c| c * gain);
+        }
     }
 
     /// Adds the veiling glare to the raw region values in place; `patches` is the number

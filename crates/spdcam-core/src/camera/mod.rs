@@ -88,6 +88,8 @@ pub struct Camera {
     chart: Chart,
     response: SpectralResponse,
     region_map: Vec<u16>,
+    /// Each region's centre across the chart, for the lighting gradient.
+    region_centres: Vec<[f32; 2]>,
     geometry: RegionGeometry,
     camera_to_xyz: Option<nalgebra::Matrix3<f64>>,
     colour: ColourTransform,
@@ -150,6 +152,7 @@ impl Camera {
         }
         let response = SpectralResponse::new(sensitivities, &chart, grid)?;
         let region_map = chart.layout.region_map();
+        let region_centres = chart.layout.region_centres();
         let geometry =
             RegionGeometry::from_region_map(&region_map, chart.layout.width, response.regions());
         let mut camera = Camera {
@@ -159,6 +162,7 @@ impl Camera {
             chart,
             response,
             region_map,
+            region_centres,
             geometry,
             camera_to_xyz: None,
             colour: ColourTransform::new(None, config.colour.bit_depth)?,
@@ -276,6 +280,7 @@ impl Camera {
         self.response.raw_into(light, raw);
         let patches = self.chart.reflectances.len();
         if let Some(ic) = ic {
+            ic.apply_gradient(raw, &self.region_centres);
             ic.add_flare(raw, patches);
         }
         let scale = ic

@@ -33,12 +33,16 @@ pub struct InCameraRanges {
     pub gamma: Option<[f64; 2]>,
     pub contrast: Option<[f64; 2]>,
     pub jpeg_quality: Option<[u8; 2]>,
+    /// Largest magnitude of each lighting-gradient component, drawn uniformly in ±it.
+    #[serde(default)]
+    pub gradient: Option<f64>,
 }
 
 impl InCameraRanges {
     /// Ranges for the named groups (`exposure`: exposure target and flare; `wb`:
-    /// adaptation; `tone`: saturation, shoulder, gamma, contrast; `jpeg`: JPEG quality),
-    /// wide enough to cover the JPEG cameras we know of.
+    /// adaptation; `tone`: saturation, shoulder, gamma, contrast; `jpeg`: JPEG quality;
+    /// `gradient`: uneven lighting across the chart), wide enough to cover the JPEG cameras
+    /// and photo set-ups we know of.
     pub fn for_groups(groups: &[&str]) -> Result<InCameraRanges> {
         let mut r = InCameraRanges::default();
         for &g in groups {
@@ -55,11 +59,12 @@ impl InCameraRanges {
                     r.contrast = Some([-0.4, 0.4]);
                 }
                 "jpeg" => r.jpeg_quality = Some([70, 98]),
+                "gradient" => r.gradient = Some(0.8),
                 other => {
                     return Err(Error::UnknownName {
                         kind: "randomisation group",
                         name: other.to_string(),
-                        valid: "camera, exposure, wb, tone, jpeg".into(),
+                        valid: "camera, exposure, wb, tone, jpeg, gradient".into(),
                     })
                 }
             }
@@ -91,10 +96,18 @@ impl InCameraRanges {
             gamma: u(self.gamma, base.gamma),
             contrast: u(self.contrast, base.contrast),
             jpeg_quality: base.jpeg_quality,
+            gradient: base.gradient,
         };
-        match self.jpeg_quality {
+        let drawn = match self.jpeg_quality {
             Some([lo, hi]) => InCamera {
                 jpeg_quality: Some(rng.random_range(lo.min(hi)..=hi.max(lo))),
+                ..drawn
+            },
+            None => drawn,
+        };
+        match self.gradient {
+            Some(g) => InCamera {
+                gradient: [0, 1].map(|_| g * (2.0 * rng.random::<f64>() - 1.0)),
                 ..drawn
             },
             None => drawn,
@@ -169,6 +182,13 @@ impl Randomisation {
                 probe(hi)?;
             }
         }
+        if let Some(g) = ranges.gradient {
+            InCamera {
+                gradient: [g, g],
+                ..InCamera::NEUTRAL
+            }
+            .validate()?;
+        }
         Ok(Randomisation { cameras, ranges })
     }
 
@@ -188,7 +208,7 @@ impl Randomisation {
             in_camera: self.ranges,
             seeding: "sample i: rng = SmallRng(seed::derive(seed::derive(seed, i), \
                       RANDOMISE_STREAM)); camera = pool[uniform index], then the in-camera \
-                      parameters in declaration order"
+                      parameters in declaration order, the lighting gradient (x, y) last"
                 .to_string(),
         }
     }
