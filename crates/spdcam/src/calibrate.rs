@@ -113,6 +113,25 @@ pub fn sensitivities(name: &str, data_dir: &DataDir, grid: &Grid) -> Result<Sens
     Ok(Sensitivities::new(&name, &measured, grid)?)
 }
 
+/// Every camera sensitivity CSV in `dir`, sorted by file name; a file that is not a valid
+/// sensitivity set is skipped with a warning naming it and why.
+pub fn sensitivities_in(dir: &Path, data_dir: &DataDir, grid: &Grid) -> Result<Vec<Sensitivities>> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+        .collect();
+    files.sort();
+    let mut sens = Vec::with_capacity(files.len());
+    for f in files {
+        match sensitivities(&f.to_string_lossy(), data_dir, grid) {
+            Ok(s) => sens.push(s),
+            Err(e) => eprintln!("warning: skipping camera {}: {e:#}", f.display()),
+        }
+    }
+    Ok(sens)
+}
+
 /// The photos `indices` of a measured set as calibration photos.
 pub fn photos(measured: &Measured, indices: &[usize]) -> Vec<CalibrationPhoto> {
     indices

@@ -3,7 +3,7 @@
 //! on or off, and scored (mean GFC) on the real measured sets; steps that use real photos
 //! (calibration) are cross-validated: calibrated on a few photos outside the test fold.
 
-use crate::calibrate::{photos, read_measured, sensitivities, Measured};
+use crate::calibrate::{photos, read_measured, sensitivities, sensitivities_in, Measured};
 use crate::sim2real_curve::{learning_curve, CurveOptions};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -249,20 +249,10 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
     let sg = "colorchecker_sg96";
     // The domain-randomisation pool: every camera of the data directory's cameras/.
     let chart = Chart::resolve(sg, None, data_dir, &GRID)?;
-    let mut sens = Vec::new();
-    if let Some(dir) = data_dir.root().map(|p| p.join("cameras")) {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-            .with_context(|| format!("reading {}", dir.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-            .collect();
-        files.sort();
-        for f in files {
-            if let Ok(s) = sensitivities(&f.to_string_lossy(), data_dir, &GRID) {
-                sens.push(s);
-            }
-        }
-    }
+    let mut sens = match data_dir.root().map(|p| p.join("cameras")) {
+        Some(dir) => sensitivities_in(&dir, data_dir, &GRID)?,
+        None => Vec::new(),
+    };
     sens.push(sensitivities(plain_cam, data_dir, &GRID)?);
     let pool = camera_pool(&sens, 1, 11, &chart, config, &GRID)?;
     let pool_size = pool.len();

@@ -131,18 +131,7 @@ fn randomisation(
         let dir = std::path::Path::new(spec);
         sens = Vec::new();
         if dir.is_dir() {
-            let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-                .with_context(|| format!("reading {}", dir.display()))?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-                .collect();
-            files.sort();
-            for f in files {
-                match crate::calibrate::sensitivities(&f.to_string_lossy(), data_dir, grid) {
-                    Ok(s) => sens.push(s),
-                    Err(e) => eprintln!("warning: skipping camera {}: {e:#}", f.display()),
-                }
-            }
+            sens = crate::calibrate::sensitivities_in(dir, data_dir, grid)?;
         } else {
             for name in spec.split(',').map(str::trim).filter(|n| !n.is_empty()) {
                 sens.push(crate::calibrate::sensitivities(name, data_dir, grid)?);

@@ -59,7 +59,7 @@ impl InCameraRanges {
                     r.contrast = Some([-0.4, 0.4]);
                 }
                 "jpeg" => r.jpeg_quality = Some([70, 98]),
-                "gradient" => r.gradient = Some(0.8),
+                "gradient" => r.gradient = Some(0.5),
                 other => {
                     return Err(Error::UnknownName {
                         kind: "randomisation group",
