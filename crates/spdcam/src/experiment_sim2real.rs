@@ -4,6 +4,7 @@
 //! (calibration) are cross-validated: calibrated on a few photos outside the test fold.
 
 use crate::calibrate::{photos, read_measured, sensitivities, sensitivities_in, Measured};
+use crate::ridge::Ridge;
 use crate::sim2real_curve::{learning_curve, CurveOptions};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -74,73 +75,6 @@ fn target(spd: &[f64]) -> Vec<f64> {
     metrics::normalise_by_max(&v)
 }
 
-/// Ridge weights `(XᵀX + λI)⁻¹XᵀY` by Cholesky, written out (no linear-algebra crate here).
-struct Ridge {
-    weights: Vec<Vec<f64>>,
-}
-
-impl Ridge {
-    fn fit(x: &[Vec<f64>], y: &[Vec<f64>], lambda: f64) -> Result<Ridge> {
-        let d = x[0].len();
-        let m = y[0].len();
-        let mut a = vec![0.0; d * d];
-        let mut b = vec![vec![0.0; m]; d];
-        for (xi, yi) in x.iter().zip(y) {
-            for i in 0..d {
-                for j in 0..=i {
-                    a[i * d + j] += xi[i] * xi[j];
-                }
-                for k in 0..m {
-                    b[i][k] += xi[i] * yi[k];
-                }
-            }
-        }
-        let scale = (0..d).map(|i| a[i * d + i]).sum::<f64>() / d as f64;
-        for i in 0..d {
-            a[i * d + i] += lambda * scale;
-        }
-        // Cholesky: a = L·Lᵀ in the lower triangle.
-        for j in 0..d {
-            let mut s = a[j * d + j];
-            for k in 0..j {
-                s -= a[j * d + k] * a[j * d + k];
-            }
-            if s <= 0.0 {
-                anyhow::bail!("the ridge system is not positive definite");
-            }
-            let l = s.sqrt();
-            a[j * d + j] = l;
-            for i in j + 1..d {
-                let mut s = a[i * d + j];
-                for k in 0..j {
-                    s -= a[i * d + k] * a[j * d + k];
-                }
-                a[i * d + j] = s / l;
-            }
-        }
-        let mut weights = vec![vec![0.0; d]; m];
-        for (k, w) in weights.iter_mut().enumerate() {
-            let mut z = vec![0.0; d];
-            for i in 0..d {
-                let s: f64 = (0..i).map(|j| a[i * d + j] * z[j]).sum();
-                z[i] = (b[i][k] - s) / a[i * d + i];
-            }
-            for i in (0..d).rev() {
-                let s: f64 = (i + 1..d).map(|j| a[j * d + i] * w[j]).sum();
-                w[i] = (z[i] - s) / a[i * d + i];
-            }
-        }
-        Ok(Ridge { weights })
-    }
-
-    fn predict(&self, x: &[f64]) -> Vec<f64> {
-        self.weights
-            .iter()
-            .map(|w| w.iter().zip(x).map(|(a, b)| a * b).sum::<f64>().max(0.0))
-            .collect()
-    }
-}
-
 /// Mean GFC of `model` on the photos `indices`.
 fn score(model: &Ridge, set: &Measured, indices: &[usize]) -> Result<f64> {
     let mut total = 0.0;
@@ -171,18 +105,19 @@ fn train_virtual(
         .map(|i| inputs(batch.features_of(i)))
         .collect();
     let y: Vec<Vec<f64>> = (0..batch.len()).map(|i| target(batch.spd_of(i))).collect();
-    Ridge::fit(&x, &y, ridge)
+    Ridge::fit(&x, &y, ridge, None)
 }
 
-/// Ridge trained and tested on real photos (k-fold), the reference.
-fn real_to_real(set: &Measured, folds: usize, ridge: f64) -> Result<f64> {
+/// Ridge trained and tested on real photos (k-fold; the penalty chosen by an inner
+/// cross-validation on the training folds), the reference.
+fn real_to_real(set: &Measured, folds: usize) -> Result<f64> {
     let n = set.features.len();
     let mut total = 0.0;
     for f in 0..folds {
         let (test, train): (Vec<usize>, Vec<usize>) = (0..n).partition(|i| i % folds == f);
         let x: Vec<Vec<f64>> = train.iter().map(|&i| inputs(&set.features[i])).collect();
         let y: Vec<Vec<f64>> = train.iter().map(|&i| target(&set.spds[i])).collect();
-        total += score(&Ridge::fit(&x, &y, ridge)?, set, &test)? * test.len() as f64;
+        total += score(&Ridge::fit_cv(&x, &y, folds, None)?, set, &test)? * test.len() as f64;
     }
     Ok(total / n as f64)
 }
@@ -223,9 +158,6 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
             ),
         ),
     ];
-    if let Some(path) = &args.finetune {
-        return curve_table(&args, path, &sets);
-    }
     let lighting = Lighting::parse(LIGHTING, data_dir, &GRID)?;
     let config = CameraConfig {
         noise: None,
@@ -264,6 +196,16 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
         randomised.cameras().to_vec(),
         InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg", "gradient"])?,
     )?;
+    if let Some(path) = &args.finetune {
+        let prior = train_virtual(
+            &make(plain_cam, sg, None)?,
+            Some(&with_gradient),
+            &lighting,
+            args.count,
+            args.ridge,
+        )?;
+        return curve_table(&args, path, &sets, &prior);
+    }
     let wb_only = Randomisation::new(
         vec![make(plain_cam, sg, None)?],
         InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg"])?,
@@ -339,7 +281,7 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
     ));
     let reference = sets
         .iter()
-        .map(|(_, s)| real_to_real(s, folds, args.ridge))
+        .map(|(_, s)| real_to_real(s, folds))
         .collect::<Result<Vec<f64>>>()?;
     rows.push((
         format!("reference: ridge trained on real photos ({folds}-fold CV)"),
@@ -371,31 +313,43 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
     Ok(())
 }
 
-/// Writes the fine-tuning learning curve of the model at `path` on every real set.
-fn curve_table(args: &Sim2realArgs, path: &Path, sets: &[(&str, Measured)]) -> Result<()> {
+/// Writes the fine-tuning learning curve of the model at `path` on every real set, beside
+/// two linear baselines on the same photos: ridge on the photos alone, and the virtual
+/// ridge `prior` corrected by the photos (shrunk towards it); both choose their penalty by
+/// cross-validation on the photos.
+fn curve_table(
+    args: &Sim2realArgs,
+    path: &Path,
+    sets: &[(&str, Measured)],
+    prior: &Ridge,
+) -> Result<()> {
     let model = Model::load(path)?;
     let options = CurveOptions {
         sizes: args.sizes.clone(),
         folds: args.folds.max(2),
         seed: 1,
     };
+    const COLUMNS: [&str; 3] = ["fine-tuned", "ridge", "ridge towards virtual"];
     let mut md = format!(
         "| real photos used | {} |\n|---:|{}\n",
         sets.iter()
-            .map(|(n, _)| format!("{n}: fine-tuned | ridge on the photos"))
+            .map(|(n, _)| format!("{n}: {}", COLUMNS.join(" | ")))
             .collect::<Vec<_>>()
             .join(" | "),
-        "---:|---:|".repeat(sets.len())
+        "---:|".repeat(COLUMNS.len() * sets.len())
     );
     let curves = sets
         .iter()
         .map(|(name, set)| {
-            let ridge = |train: &[usize], test: &[usize]| -> Result<f64> {
+            let baselines = |train: &[usize], test: &[usize]| -> Result<Vec<f64>> {
                 let x: Vec<Vec<f64>> = train.iter().map(|&i| inputs(&set.features[i])).collect();
                 let y: Vec<Vec<f64>> = train.iter().map(|&i| target(&set.spds[i])).collect();
-                score(&Ridge::fit(&x, &y, args.ridge)?, set, test)
+                [None, Some(prior)]
+                    .into_iter()
+                    .map(|p| score(&Ridge::fit_cv(&x, &y, 5, p)?, set, test))
+                    .collect()
             };
-            let curve = learning_curve(&model, set, &GRID, &options, &ridge)?;
+            let curve = learning_curve(&model, set, &GRID, &options, &baselines)?;
             eprintln!("{name}: {:?}", curve.points);
             Ok(curve)
         })
@@ -404,8 +358,11 @@ fn curve_table(args: &Sim2realArgs, path: &Path, sets: &[(&str, Measured)]) -> R
     for (row, &size) in args.sizes.iter().enumerate() {
         md += &format!("| {size} |");
         for curve in &curves {
-            let (_, tuned, ridge) = curve.points[row];
-            md += &format!(" {} | {} |", cell(tuned), cell(ridge));
+            let point = &curve.points[row];
+            md += &format!(" {} |", cell(point.tuned));
+            for k in 0..COLUMNS.len() - 1 {
+                md += &format!(" {} |", cell(point.baselines.get(k).copied().flatten()));
+            }
         }
         md.push('\n');
     }
@@ -413,11 +370,14 @@ fn curve_table(args: &Sim2realArgs, path: &Path, sets: &[(&str, Measured)]) -> R
         "\nMean GFC (400–700 nm; the model at 5 nm, ridge at 10 nm) on the photos of the test \
          fold, {}-fold cross-validated; the photos used come from the other folds (seeded \
          random picks). Model: `{}` ({}), fine-tuned with its output layer kept, all layers, \
-         learning rate 2e-4, batch ≤ 16, about 600 steps; ridge λ = {} (relative).\n",
+         learning rate 2e-4, batch ≤ 16, about 600 steps. Ridge: features ÷ their mean → SPD, \
+         the penalty chosen by 5-fold cross-validation on the photos used; towards virtual: \
+         shrunk towards the ridge trained on {} virtual samples (randomised cameras, \
+         in-camera stage and lighting gradient) instead of towards zero.\n",
         options.folds,
         path.display(),
         model.describe(),
-        args.ridge
+        args.count
     );
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");

@@ -12,6 +12,7 @@ mod list;
 mod photo_args;
 mod plot_file;
 mod render;
+mod ridge;
 mod sim2real_curve;
 mod train;
 

@@ -1,7 +1,7 @@
 //! The fine-tuning learning curve of `spdcam sim2real --finetune MODEL`: mean GFC on real
 //! photos against the number of real photos a virtual-trained model is fine-tuned on,
 //! k-fold cross-validated on each real set (the photos come from the folds outside the test
-//! fold), beside ridge regression trained on the same photos alone.
+//! fold), beside baselines trained on the same photos.
 
 use crate::calibrate::Measured;
 use anyhow::Result;
@@ -25,11 +25,19 @@ pub struct CurveOptions {
     pub seed: u64,
 }
 
-/// One set's curve: per size, the mean GFC of the fine-tuned model and of ridge on the same
-/// photos (`None` where the folds hold fewer photos than the size).
+/// One point of a curve: mean GFCs, `None` where the folds hold fewer photos than the size
+/// (and for the baselines at size 0).
+#[derive(Debug)]
+pub struct CurvePoint {
+    /// The fine-tuned model (at size 0: the model as it is).
+    pub tuned: Option<f64>,
+    /// Each baseline trained on the same photos.
+    pub baselines: Vec<Option<f64>>,
+}
+
+/// One set's curve, a point per size of [`CurveOptions::sizes`].
 pub struct Curve {
-    /// (size, fine-tuned model, ridge on real photos only).
-    pub points: Vec<(usize, Option<f64>, Option<f64>)>,
+    pub points: Vec<CurvePoint>,
 }
 
 /// The photos `indices` of `set` as a training set on `grid` (the grid of the set's SPDs).
@@ -108,22 +116,24 @@ fn recipe(n: usize, seed: u64) -> FinetuneOptions {
     }
 }
 
-/// Fits a baseline on the photos `train` and returns its mean GFC on the photos `test`.
-pub type Baseline<'a> = dyn Fn(&[usize], &[usize]) -> Result<f64> + 'a;
+/// Fits the baselines on the photos `train` and returns each one's mean GFC on the photos
+/// `test`.
+pub type Baselines<'a> = dyn Fn(&[usize], &[usize]) -> Result<Vec<f64>> + 'a;
 
-/// The learning curve of `model` on one real set; `ridge` fits and scores the real-only
-/// baseline on (train, test) photo indices.
+/// The learning curve of `model` on one real set; `baselines` fits and scores the
+/// baselines on (train, test) photo indices.
 pub fn learning_curve(
     model: &Model,
     set: &Measured,
     set_grid: &Grid,
     options: &CurveOptions,
-    ridge: &Baseline,
+    baselines: &Baselines,
 ) -> Result<Curve> {
     let n = set.features.len();
     let folds = options.folds.max(2);
     let names = model.feature_names().to_vec();
-    let mut sums = vec![(0.0, 0.0, 0usize); options.sizes.len()];
+    // Per size: the fine-tuned sum, the baselines' sums, the photos scored.
+    let mut sums = vec![(0.0, Vec::<f64>::new(), 0usize); options.sizes.len()];
     for f in 0..folds {
         let (test, mut pool): (Vec<usize>, Vec<usize>) = (0..n).partition(|i| i % folds == f);
         pool.shuffle(&mut SmallRng::seed_from_u64(options.seed + f as u64));
@@ -133,7 +143,7 @@ pub fn learning_curve(
             }
             let picked = &pool[..size];
             let (tuned, baseline) = if size == 0 {
-                (model_gfc(model, set, &test, set_grid)?, 0.0)
+                (model_gfc(model, set, &test, set_grid)?, Vec::new())
             } else {
                 let data = training_set(set, picked, &names, set_grid);
                 let trained = finetune(
@@ -145,22 +155,28 @@ pub fn learning_curve(
                 )?;
                 (
                     model_gfc(&trained.model, set, &test, set_grid)?,
-                    ridge(picked, &test)?,
+                    baselines(picked, &test)?,
                 )
             };
             let w = test.len() as f64;
-            sums[s].0 += tuned * w;
-            sums[s].1 += baseline * w;
-            sums[s].2 += test.len();
+            let sum = &mut sums[s];
+            sum.0 += tuned * w;
+            sum.1.resize(baseline.len(), 0.0);
+            sum.1
+                .iter_mut()
+                .zip(&baseline)
+                .for_each(|(t, b)| *t += b * w);
+            sum.2 += test.len();
         }
     }
-    let points = options
-        .sizes
+    let points = sums
         .iter()
-        .zip(&sums)
-        .map(|(&size, &(t, b, count))| {
-            let mean = |v: f64| (count == n).then(|| v / n as f64);
-            (size, mean(t), if size == 0 { None } else { mean(b) })
+        .map(|(tuned, base, count)| {
+            let mean = |v: f64| (*count == n).then(|| v / n as f64);
+            CurvePoint {
+                tuned: mean(*tuned),
+                baselines: base.iter().map(|&b| mean(b)).collect(),
+            }
         })
         .collect();
     Ok(Curve { points })
