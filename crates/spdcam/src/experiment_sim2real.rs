@@ -284,7 +284,7 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
         .map(|(_, s)| real_to_real(s, folds))
         .collect::<Result<Vec<f64>>>()?;
     rows.push((
-        format!("reference: ridge trained on real photos ({folds}-fold CV)"),
+        format!("reference: ridge trained on real photos ({folds}-fold CV, penalty by inner CV)"),
         reference,
     ));
 
@@ -305,7 +305,8 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
     }
     md += &format!(
         "\nMean GFC (400–700 nm, 10 nm). {} virtual samples per model, lighting `{LIGHTING}`, \
-         noise-free patch-level camera, ridge λ = {} (relative).\n",
+         noise-free patch-level camera, ridge λ = {} (relative) for the rows trained on virtual \
+         data.\n",
         args.count, args.ridge
     );
     write_atomic(&args.output, md.as_bytes())?;
