@@ -111,6 +111,44 @@ fn train_estimate_evaluate_finetune() {
         "-o",
         &s(&linear),
     ]);
+    // A fixed penalty is recorded in the model; it applies to linear models only.
+    let strong = dir.join("strong.spdm");
+    let out = ok(&[
+        "train",
+        "--data",
+        &s(&data),
+        "--model",
+        "linear",
+        "--ridge",
+        "0.1",
+        "-o",
+        &s(&strong),
+    ]);
+    assert!(out.contains("validation GFC"), "{out}");
+    let err = fails(&[
+        "train",
+        "--data",
+        &s(&data),
+        "--model",
+        "cnn1d",
+        "--ridge",
+        "0.1",
+        "-o",
+        &s(&strong),
+    ]);
+    assert!(err.contains("--ridge applies to --model linear"), "{err}");
+    let err = fails(&[
+        "train",
+        "--data",
+        &s(&data),
+        "--model",
+        "linear",
+        "--ridge",
+        "0",
+        "-o",
+        &s(&strong),
+    ]);
+    assert!(err.contains("positive"), "{err}");
 
     // One row: colorimetry is printed; the CSV has one estimate column.
     let one = dir.join("one.csv");
