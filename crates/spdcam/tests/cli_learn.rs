@@ -70,6 +70,13 @@ fn dataset(dir: &Path, name: &str, rows: usize, patches: usize, seed: u64) -> (P
     (out, fp)
 }
 
+/// `spdcam train` arguments with a fixed ridge penalty.
+fn with_ridge<'a>(data: &'a str, model: &'a str, ridge: &'a str, out: &'a str) -> [&'a str; 9] {
+    [
+        "train", "--data", data, "--model", model, "--ridge", ridge, "-o", out,
+    ]
+}
+
 #[test]
 fn train_estimate_evaluate_finetune() {
     let dir = scratch("all");
@@ -112,42 +119,12 @@ fn train_estimate_evaluate_finetune() {
         &s(&linear),
     ]);
     // A fixed penalty is recorded in the model; it applies to linear models only.
-    let strong = dir.join("strong.spdm");
-    let out = ok(&[
-        "train",
-        "--data",
-        &s(&data),
-        "--model",
-        "linear",
-        "--ridge",
-        "0.1",
-        "-o",
-        &s(&strong),
-    ]);
+    let (data_arg, strong) = (s(&data), s(&dir.join("strong.spdm")));
+    let out = ok(&with_ridge(&data_arg, "linear", "0.1", &strong));
     assert!(out.contains("validation GFC"), "{out}");
-    let err = fails(&[
-        "train",
-        "--data",
-        &s(&data),
-        "--model",
-        "cnn1d",
-        "--ridge",
-        "0.1",
-        "-o",
-        &s(&strong),
-    ]);
+    let err = fails(&with_ridge(&data_arg, "cnn1d", "0.1", &strong));
     assert!(err.contains("--ridge applies to --model linear"), "{err}");
-    let err = fails(&[
-        "train",
-        "--data",
-        &s(&data),
-        "--model",
-        "linear",
-        "--ridge",
-        "0",
-        "-o",
-        &s(&strong),
-    ]);
+    let err = fails(&with_ridge(&data_arg, "linear", "0", &strong));
     assert!(err.contains("positive"), "{err}");
 
     // One row: colorimetry is printed; the CSV has one estimate column.
