@@ -3,7 +3,13 @@
 use crate::train::load_set;
 use anyhow::{Context, Result};
 use clap::Args;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::chart::Chart;
 use spdcam_core::fsio::write_atomic;
+use spdcam_core::imageio::write_png;
+use spdcam_core::raster::RgbImage;
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_learn::evaluate::{
     band_mae_svg, best_median_worst_svg, boxplots_svg, evaluate, Evaluation,
 };
@@ -87,7 +93,9 @@ pub fn write_report(
     let md = format!(
         "# Evaluation\n\nModel `{model_name}` ({}) on `{}` ({} samples, {} nm).\n\n{}\n\
          Files: `samples.csv` (per sample), `metrics.json`, `band_mae.csv`, `boxplots.svg`, \
-         `band_mae.svg`, `best_median_worst.svg`.\n",
+         `band_mae.svg`, `best_median_worst.svg`, and `worst_case.png` when the model names \
+         its chart and camera (the chart under the worst case's true SPD, under its \
+         estimate, and their difference ×4).\n",
         model.describe(),
         set.info.path,
         e.per_sample.len(),
@@ -109,8 +117,60 @@ pub fn write_report(
     Ok(())
 }
 
+/// Gap between the panels of the worst-case image, in pixels.
+const PANEL_GAP: usize = 8;
+/// How much the worst-case image magnifies the difference of the two renders.
+const DIFFERENCE_GAIN: f32 = 4.0;
+
+/// Thesis Fig. 6.7: the model's chart photographed by its camera (noise off) under the
+/// true and the estimated SPD of the worst estimate, side by side, then their absolute
+/// difference magnified four times. Errs when the model does not name a chart and a camera
+/// the data directory knows.
+fn worst_case_image(model: &Model, e: &Evaluation, data_dir: &DataDir) -> Result<RgbImage> {
+    let header = model.header();
+    let (Some(chart), Some(camera)) = (&header.chart, &header.camera) else {
+        anyhow::bail!("the model does not record the chart and camera it was trained for");
+    };
+    let grid = Grid::SIMULATION;
+    let chart = Chart::resolve(chart, None, data_dir, &grid)?;
+    let config = CameraConfig {
+        noise: None,
+        ..CameraConfig::default()
+    };
+    let camera = Camera::new(
+        &crate::calibrate::sensitivities(camera, data_dir, &grid)?,
+        chart,
+        config,
+        &grid,
+    )?;
+    let worst = *e.ranking().last().context("no samples")?;
+    let d = e.grid.count;
+    let render = |spd: &[f64]| -> Result<RgbImage> {
+        let set = SpectralSet::on_grid(&e.grid, vec!["spd".into()], vec![spd.to_vec()])?;
+        let (set, _) = set.resample(&grid, Interpolation::Linear, Extrapolation::Zero)?;
+        Ok(camera.render(set.item(0), 0, false)?.image)
+    };
+    let truth = render(&e.truths[worst * d..(worst + 1) * d])?;
+    let estimate = render(&e.estimates[worst * d..(worst + 1) * d])?;
+    let (w, h) = (truth.width, truth.height);
+    let mut out = RgbImage::new(3 * w + 2 * PANEL_GAP, h);
+    for (c, plane) in out.planes.iter_mut().enumerate() {
+        plane.fill(1.0);
+        for y in 0..h {
+            for x in 0..w {
+                let (t, m) = (truth.planes[c][y * w + x], estimate.planes[c][y * w + x]);
+                let row = y * out.width;
+                plane[row + x] = t;
+                plane[row + w + PANEL_GAP + x] = m;
+                plane[row + 2 * (w + PANEL_GAP) + x] = ((t - m).abs() * DIFFERENCE_GAIN).min(1.0);
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// Runs `spdcam evaluate`.
-pub fn run(args: EvaluateArgs) -> Result<()> {
+pub fn run(args: EvaluateArgs, data_dir: &DataDir) -> Result<()> {
     let model = Model::load(&args.model)?;
     let set = load_set(&args.data)?;
     let e = evaluate(&model, &set)?;
@@ -121,6 +181,10 @@ pub fn run(args: EvaluateArgs) -> Result<()> {
         &set,
         &e,
     )?;
+    match worst_case_image(&model, &e, data_dir) {
+        Ok(image) => write_png(&args.output.join("worst_case.png"), &image, 8)?,
+        Err(err) => eprintln!("note: no worst_case.png: {err:#}"),
+    }
     println!(
         "{} on {} ({} samples):\n\n{}\nreport: {}",
         args.model.display(),

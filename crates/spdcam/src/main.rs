@@ -80,7 +80,7 @@ fn main() -> ExitCode {
         Command::List(args) => list::run(args, &data_dir),
         Command::Train(args) => train::run(*args, &data_dir),
         Command::Estimate(args) => estimate::run(*args, &data_dir),
-        Command::Evaluate(args) => evaluate::run(args),
+        Command::Evaluate(args) => evaluate::run(args, &data_dir),
         Command::Finetune(args) => finetune::run(*args),
         Command::Experiment(args) => experiment::run(args, &data_dir),
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),

@@ -195,6 +195,8 @@ fn train_estimate_evaluate_finetune() {
     ] {
         assert!(report.join(f).is_file(), "{f}");
     }
+    // Imported features name no chart or camera: nothing to render the worst case with.
+    assert!(!report.join("worst_case.png").exists());
     let metrics: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(report.join("metrics.json")).unwrap())
             .unwrap();
@@ -242,5 +244,73 @@ fn train_estimate_evaluate_finetune() {
         &s(&spd),
     ]);
     assert!(err.contains("not a spdcam model"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Thesis Fig. 6.7: a model trained on generated data (chart and camera known) gets the
+/// chart rendered under the worst case's true and estimated SPD, and their difference.
+#[test]
+fn evaluate_renders_the_worst_case() {
+    let dir = scratch("worst");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let data = dir.join("data");
+    ok(&[
+        "generate",
+        "--count",
+        "300",
+        "--seed",
+        "5",
+        "--fast",
+        "--chart",
+        "colorchecker24",
+        "--camera",
+        "nikon_d5100_npl",
+        "--lighting",
+        "gaussian:4",
+        "-o",
+        &s(&data),
+    ]);
+    let model = dir.join("lin.spdm");
+    ok(&[
+        "train",
+        "--data",
+        &s(&data),
+        "--model",
+        "linear",
+        "-o",
+        &s(&model),
+    ]);
+    let report = dir.join("report");
+    ok(&[
+        "evaluate",
+        "--model",
+        &s(&model),
+        "--data",
+        &s(&data),
+        "-o",
+        &s(&report),
+    ]);
+    let image = image::open(report.join("worst_case.png"))
+        .expect("worst_case.png")
+        .to_rgb8();
+    // Three panels of the chart's width and an 8-pixel gap between them.
+    let (w, h) = (image.width(), image.height());
+    assert_eq!((w - 16) % 3, 0, "width {w}");
+    let panel = (w - 16) / 3;
+    let pixel = |x: u32, y: u32| image.get_pixel(x, y).0;
+    let (mut differ, mut lit) = (0, 0);
+    for y in 0..h {
+        for x in 0..panel {
+            if pixel(x, y) != pixel(x + panel + 8, y) {
+                differ += 1;
+            }
+            if pixel(x + 2 * (panel + 8), y).iter().any(|&v| v > 8) {
+                lit += 1;
+            }
+        }
+    }
+    assert!(differ > 0, "the estimate's render equals the truth's");
+    assert!(lit > 0, "the difference panel is black");
+    assert_eq!(pixel(panel + 2, h / 2), [255, 255, 255], "a white gap");
     std::fs::remove_dir_all(&dir).ok();
 }
