@@ -371,7 +371,7 @@ fn curve_table(
         "\nMean GFC (400–700 nm; the model at 5 nm, ridge at 10 nm) on the photos of the test \
          fold, {}-fold cross-validated; the photos used come from the other folds (seeded \
          random picks). Model: `{}` ({}), fine-tuned with its output layer kept, all layers, \
-         learning rate 2e-4, batch ≤ 16, about 600 steps. Ridge: features ÷ their mean → SPD, \
+         learning rate 2e-4, batch ≤ 16, about 150 steps. Ridge: features ÷ their mean → SPD, \
          the penalty chosen by 5-fold cross-validation on the photos used; towards virtual: \
          shrunk towards the ridge trained on {} virtual samples (randomised cameras, \
          in-camera stage and lighting gradient) instead of towards zero.\n",
