@@ -70,6 +70,19 @@ fn dataset(dir: &Path, name: &str, rows: usize, patches: usize, seed: u64) -> (P
     (out, fp)
 }
 
+/// Trains the ridge baseline on `data` into `model`.
+fn train_linear(data: &Path, model: &Path) -> String {
+    ok(&[
+        "train",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        "linear",
+        "-o",
+        model.to_str().unwrap(),
+    ])
+}
+
 /// `spdcam train` arguments with a fixed ridge penalty.
 fn with_ridge<'a>(data: &'a str, model: &'a str, ridge: &'a str, out: &'a str) -> [&'a str; 9] {
     [
@@ -109,15 +122,7 @@ fn train_estimate_evaluate_finetune() {
 
     // The baseline.
     let linear = dir.join("lin.spdm");
-    ok(&[
-        "train",
-        "--data",
-        &s(&data),
-        "--model",
-        "linear",
-        "-o",
-        &s(&linear),
-    ]);
+    train_linear(&data, &linear);
     // A fixed penalty is recorded in the model; it applies to linear models only.
     let (data_arg, strong) = (s(&data), s(&dir.join("strong.spdm")));
     let out = ok(&with_ridge(&data_arg, "linear", "0.1", &strong));
@@ -271,15 +276,7 @@ fn evaluate_renders_the_worst_case() {
         &s(&data),
     ]);
     let model = dir.join("lin.spdm");
-    ok(&[
-        "train",
-        "--data",
-        &s(&data),
-        "--model",
-        "linear",
-        "-o",
-        &s(&model),
-    ]);
+    train_linear(&data, &model);
     let report = dir.join("report");
     ok(&[
         "evaluate",
