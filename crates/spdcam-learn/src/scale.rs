@@ -24,6 +24,21 @@ fn divide_by_max(row: &mut [f64]) {
     }
 }
 
+/// Checks stored per-column bounds: equal, non-zero lengths and finite numbers.
+fn validate_bounds(min: &[f64], max: &[f64], what: &str) -> Result<()> {
+    if min.is_empty() || min.len() != max.len() {
+        return Err(LearnError::invalid(format!(
+            "the {what} scaling has mismatched lengths"
+        )));
+    }
+    if min.iter().chain(max).any(|v| !v.is_finite()) {
+        return Err(LearnError::invalid(format!(
+            "the {what} scaling holds non-finite numbers"
+        )));
+    }
+    Ok(())
+}
+
 fn check_rows(data: &[f64], width: usize, what: &str) -> Result<usize> {
     if width == 0 || data.len() % width != 0 {
         return Err(LearnError::invalid(format!(
@@ -110,17 +125,7 @@ impl FeatureScaler {
 
     /// Checks the stored numbers (for a scaler read from a file).
     pub fn validate(&self) -> Result<()> {
-        if self.min.is_empty() || self.min.len() != self.max.len() {
-            return Err(LearnError::invalid(
-                "the feature scaling has mismatched lengths",
-            ));
-        }
-        if self.min.iter().chain(&self.max).any(|v| !v.is_finite()) {
-            return Err(LearnError::invalid(
-                "the feature scaling holds non-finite numbers",
-            ));
-        }
-        Ok(())
+        validate_bounds(&self.min, &self.max, "feature")
     }
 }
 
@@ -177,17 +182,7 @@ impl TargetScaler {
 
     /// Checks the stored numbers (for a scaler read from a file).
     pub fn validate(&self) -> Result<()> {
-        if self.min.is_empty() || self.min.len() != self.max.len() {
-            return Err(LearnError::invalid(
-                "the target scaling has mismatched lengths",
-            ));
-        }
-        if self.min.iter().chain(&self.max).any(|v| !v.is_finite()) {
-            return Err(LearnError::invalid(
-                "the target scaling holds non-finite numbers",
-            ));
-        }
-        Ok(())
+        validate_bounds(&self.min, &self.max, "target")
     }
 }
 

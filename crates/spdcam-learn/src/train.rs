@@ -318,6 +318,49 @@ fn check_set(set: &TrainingSet) -> Result<()> {
 }
 
 /// A seeded split of `n` rows into (train, validation) indices.
+/// Row indices of training and validation, the set the validation rows index, and its SPDs.
+struct TrainValSplit<'a> {
+    train: Vec<usize>,
+    val: Vec<usize>,
+    val_set: &'a TrainingSet,
+    val_spds: Vec<f64>,
+}
+
+/// Training and validation rows: all of `data` against `validation` (checked by
+/// `check_columns`), or without one a seeded `(share, seed)` split of `data`. Returns the
+/// split; the validation SPDs are on `grid` (`spds`: those of `data`).
+fn split_train_val<'a>(
+    data: &'a TrainingSet,
+    validation: Option<&'a TrainingSet>,
+    spds: &[f64],
+    grid: &Grid,
+    (share, seed): (f64, u64),
+    check_columns: impl Fn(&TrainingSet) -> Result<()>,
+) -> Result<TrainValSplit<'a>> {
+    match validation {
+        Some(v) => {
+            check_set(v)?;
+            check_columns(v)?;
+            let vs = spds_on_grid(&v.samples, &v.columns, grid)?;
+            Ok(TrainValSplit {
+                train: (0..data.samples.len()).collect(),
+                val: (0..v.samples.len()).collect(),
+                val_set: v,
+                val_spds: vs,
+            })
+        }
+        None => {
+            let (train, val) = split_indices(data.samples.len(), share, seed)?;
+            Ok(TrainValSplit {
+                train,
+                val,
+                val_set: data,
+                val_spds: spds.to_vec(),
+            })
+        }
+    }
+}
+
 fn split_indices(n: usize, val_split: f64, seed: u64) -> Result<(Vec<usize>, Vec<usize>)> {
     if !(val_split > 0.0 && val_split < 1.0) {
         return Err(LearnError::invalid(format!(
@@ -352,28 +395,28 @@ pub fn train(
     check_set(data)?;
     let d = options.grid.count;
     let spds = spds_on_grid(&data.samples, &data.columns, &options.grid)?;
-    let (train_idx, val_idx, val_set, val_spds) = match validation {
-        Some(v) => {
-            check_set(v)?;
-            if v.columns.feature_names != data.columns.feature_names {
-                return Err(LearnError::invalid(format!(
+    let TrainValSplit {
+        train: train_idx,
+        val: val_idx,
+        val_set,
+        val_spds,
+    } = split_train_val(
+        data,
+        validation,
+        &spds,
+        &options.grid,
+        (options.val_split, options.seed),
+        |v| {
+            if v.columns.feature_names == data.columns.feature_names {
+                Ok(())
+            } else {
+                Err(LearnError::invalid(format!(
                     "{} and {} have different feature columns",
                     data.info.path, v.info.path
-                )));
+                )))
             }
-            let vs = spds_on_grid(&v.samples, &v.columns, &options.grid)?;
-            (
-                (0..data.samples.len()).collect(),
-                (0..v.samples.len()).collect(),
-                v,
-                vs,
-            )
-        }
-        None => {
-            let (t, v) = split_indices(data.samples.len(), options.val_split, options.seed)?;
-            (t, v, data, spds.clone())
-        }
-    };
+        },
+    )?;
     let f = data.samples.feature_count;
     let train_features = take_rows(&data.samples.features, f, &train_idx);
     let train_spds = take_rows(&spds, d, &train_idx);
@@ -706,23 +749,19 @@ pub fn finetune(
     let grid = model.grid();
     let d = grid.count;
     let spds = spds_on_grid(&data.samples, &data.columns, &grid)?;
-    let (train_idx, val_idx, val_set, val_spds) = match validation {
-        Some(v) => {
-            check_set(v)?;
-            model.check_features(&v.columns.feature_names, &v.info.path)?;
-            let vs = spds_on_grid(&v.samples, &v.columns, &grid)?;
-            (
-                (0..data.samples.len()).collect(),
-                (0..v.samples.len()).collect(),
-                v,
-                vs,
-            )
-        }
-        None => {
-            let (t, v) = split_indices(data.samples.len(), options.val_split, options.seed)?;
-            (t, v, data, spds.clone())
-        }
-    };
+    let TrainValSplit {
+        train: train_idx,
+        val: val_idx,
+        val_set,
+        val_spds,
+    } = split_train_val(
+        data,
+        validation,
+        &spds,
+        &grid,
+        (options.val_split, options.seed),
+        |v| model.check_features(&v.columns.feature_names, &v.info.path),
+    )?;
     let train_spds = take_rows(&spds, d, &train_idx);
     let (target, targets) = match (model.target(), options.refit_pca) {
         (Target::Pca(pca), true) => {

@@ -15,6 +15,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use spdcam_core::dataset::{Columns, Precision, SampleBatch};
 use spdcam_core::fsio::write_atomic;
+use spdcam_core::lighting::Channels;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_learn::evaluate::evaluate;
 use spdcam_learn::model::DataInfo;
@@ -69,34 +70,14 @@ impl SetName {
         }
     }
 
-    /// The thesis's Gaussian channels, (centre, width) in nm.
-    fn gaussians(self) -> Option<&'static [(f64, f64)]> {
+    /// The number of the thesis's Gaussian channels ([`Channels::gaussian`]); `None` for
+    /// the Telelumen set.
+    fn gaussian_channels(self) -> Option<usize> {
         match self {
-            SetName::G1 => Some(&[(430.0, 15.0), (510.0, 20.0), (590.0, 20.0), (670.0, 15.0)]),
-            SetName::G2 => Some(&[
-                (430.0, 15.0),
-                (490.0, 20.0),
-                (550.0, 20.0),
-                (610.0, 20.0),
-                (670.0, 15.0),
-            ]),
-            SetName::G3 => Some(&[
-                (420.0, 15.0),
-                (470.0, 20.0),
-                (520.0, 20.0),
-                (570.0, 20.0),
-                (620.0, 20.0),
-                (670.0, 15.0),
-            ]),
-            SetName::G4 => Some(&[
-                (430.0, 15.0),
-                (470.0, 20.0),
-                (510.0, 20.0),
-                (550.0, 20.0),
-                (590.0, 20.0),
-                (630.0, 20.0),
-                (670.0, 15.0),
-            ]),
+            SetName::G1 => Some(4),
+            SetName::G2 => Some(5),
+            SetName::G3 => Some(6),
+            SetName::G4 => Some(7),
             SetName::T24 => None,
         }
     }
@@ -160,16 +141,8 @@ struct ThesisArgs {
 /// Channel spectra of a set on the simulation grid.
 fn channels(set: SetName, root: &Path) -> Result<Vec<Vec<f64>>> {
     let grid = Grid::SIMULATION;
-    if let Some(g) = set.gaussians() {
-        return Ok(g
-            .iter()
-            .map(|&(mu, s)| {
-                grid.wavelengths()
-                    .iter()
-                    .map(|l| (-(l - mu) * (l - mu) / (2.0 * s * s)).exp())
-                    .collect()
-            })
-            .collect());
+    if let Some(n) = set.gaussian_channels() {
+        return Ok(Channels::gaussian(n, &grid)?.spds);
     }
     let path = root.join("telelumen_24_channels.csv");
     let raw =

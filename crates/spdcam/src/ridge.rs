@@ -79,9 +79,9 @@ impl Ridge {
 
     /// Fits with the penalty among [`PENALTIES`] whose `folds`-fold cross-validated mean GFC
     /// on the rows is best (folds: rows `i % folds`), then refits on every row.
-    pub fn fit_cv(
-        x: &[Vec<f64>],
-        y: &[Vec<f64>],
+    pub fn fit_cv<'a>(
+        x: &'a [Vec<f64>],
+        y: &'a [Vec<f64>],
         folds: usize,
         prior: Option<&Ridge>,
     ) -> Result<Ridge> {
@@ -93,11 +93,10 @@ impl Ridge {
         let mut totals = [0.0; PENALTIES.len()];
         for f in 0..folds {
             let (test, train): (Vec<usize>, Vec<usize>) = (0..n).partition(|i| i % folds == f);
-            let pick = |rows: &[Vec<f64>], idx: &[usize]| -> Vec<Vec<f64>> {
-                idx.iter().map(|&i| rows[i].clone()).collect()
+            let pick = |rows: &'a [Vec<f64>]| -> Vec<&'a [f64]> {
+                train.iter().map(|&i| rows[i].as_slice()).collect()
             };
-            let (tx, ty) = (pick(x, &train), pick(y, &train));
-            let gram = Gram::new(&borrow(&tx), &borrow(&ty))?;
+            let gram = Gram::new(&pick(x), &pick(y))?;
             for (total, &penalty) in totals.iter_mut().zip(&PENALTIES) {
                 let model = gram.solve(penalty, prior)?;
                 *total += test
