@@ -320,8 +320,8 @@ fn check_set(set: &TrainingSet) -> Result<()> {
 /// A seeded split of `n` rows into (train, validation) indices.
 /// Row indices of training and validation, the set the validation rows index, and its SPDs.
 struct TrainValSplit<'a> {
-    train: Vec<usize>,
-    val: Vec<usize>,
+    train_idx: Vec<usize>,
+    val_idx: Vec<usize>,
     val_set: &'a TrainingSet,
     val_spds: Vec<f64>,
 }
@@ -343,17 +343,17 @@ fn split_train_val<'a>(
             check_columns(v)?;
             let vs = spds_on_grid(&v.samples, &v.columns, grid)?;
             Ok(TrainValSplit {
-                train: (0..data.samples.len()).collect(),
-                val: (0..v.samples.len()).collect(),
+                train_idx: (0..data.samples.len()).collect(),
+                val_idx: (0..v.samples.len()).collect(),
                 val_set: v,
                 val_spds: vs,
             })
         }
         None => {
-            let (train, val) = split_indices(data.samples.len(), share, seed)?;
+            let (train_idx, val_idx) = split_indices(data.samples.len(), share, seed)?;
             Ok(TrainValSplit {
-                train,
-                val,
+                train_idx,
+                val_idx,
                 val_set: data,
                 val_spds: spds.to_vec(),
             })
@@ -396,8 +396,8 @@ pub fn train(
     let d = options.grid.count;
     let spds = spds_on_grid(&data.samples, &data.columns, &options.grid)?;
     let TrainValSplit {
-        train: train_idx,
-        val: val_idx,
+        train_idx,
+        val_idx,
         val_set,
         val_spds,
     } = split_train_val(
@@ -750,8 +750,8 @@ pub fn finetune(
     let d = grid.count;
     let spds = spds_on_grid(&data.samples, &data.columns, &grid)?;
     let TrainValSplit {
-        train: train_idx,
-        val: val_idx,
+        train_idx,
+        val_idx,
         val_set,
         val_spds,
     } = split_train_val(
