@@ -419,7 +419,7 @@ fn info(args: InfoArgs) -> Result<()> {
         };
         if !report.problems.is_empty() {
             bail!(
-                "{} does not match its manifest: {} of {} sample files read correctly, {} problems",
+                "{} does not match its manifest: {} of {} sample files read correctly; problems: {}",
                 args.dataset.display(),
                 report.files_ok,
                 dataset.manifest().files.len(),
