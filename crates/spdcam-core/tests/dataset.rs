@@ -657,3 +657,30 @@ fn generated_sets_are_compressed_float32_and_old_float64_files_still_read() {
         std::fs::remove_dir_all(d).unwrap();
     }
 }
+
+/// A dataset spdcam generated, read and written back by pandas (pyarrow): one file snappy
+/// (pandas' default), one gzip, columns nullable (`tools/export_pandas_dataset.py`).
+#[test]
+fn files_written_by_pandas_read_back() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/pandas-dataset");
+    let data = Dataset::open(&dir).unwrap();
+    let read = data.load().unwrap();
+    let (cam, light) = (camera(CameraConfig::default()), lighting());
+    let generator = Generator::new(
+        &cam,
+        &light,
+        GenerateOptions {
+            pipeline: Pipeline::Fast,
+            chunk_size: 6,
+            spd_grid: Grid::parse("400-700:50").unwrap(),
+            ..GenerateOptions::new(12, 5)
+        },
+    )
+    .unwrap();
+    assert_eq!(data.columns(), generator.columns());
+    let mut expected = generator.samples(0..12, None, &|_| {}).unwrap();
+    for v in expected.spds.iter_mut().chain(expected.weights.iter_mut()) {
+        *v = f64::from(*v as f32);
+    }
+    assert_eq!(read, expected);
+}
