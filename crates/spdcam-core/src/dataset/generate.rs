@@ -447,48 +447,43 @@ impl<'a> Generator<'a> {
     }
 
     /// Renders the files `plan` still lacks, then writes the manifest. `progress` is told how
-    /// many new samples were finished. Each file is encoded and written on a second thread
-    /// while the next one renders; at most one finished file waits in between, so memory
-    /// stays flat whatever the count.
+    /// many new samples were finished. Files are rendered, encoded and written in parallel,
+    /// each by the thread that picks it up, the samples of one file spread over threads that
+    /// would otherwise idle; so both rendering and compression use every core, and memory
+    /// holds about one file per thread whatever the count.
     pub fn run(&self, plan: &Plan, progress: &(dyn Fn(u64) + Sync)) -> Result<Manifest> {
         let dir = plan.dir.as_path();
         let images = self.options.images.then(|| dir.join(IMAGES_DIR));
-        let mut counts = Counts::default();
-        let mut files = Vec::with_capacity(plan.chunks.len());
-        std::thread::scope(|scope| {
-            let (sender, receiver) = std::sync::mpsc::sync_channel::<(String, SampleBatch)>(1);
-            let writer = scope.spawn(move || -> Result<()> {
-                for (name, batch) in receiver {
-                    write_sample_file(dir, name, &self.columns, &batch)?;
-                }
-                Ok(())
-            });
-            let rendered = (|| -> Result<()> {
-                for chunk in &plan.chunks {
-                    let name = sample_file_name(chunk.index);
-                    let batch = if chunk.done {
-                        file::decode(&dir.join(&name), &self.columns)?
-                    } else {
-                        self.samples(chunk.samples.clone(), images.as_deref(), progress)?
-                    };
-                    counts.add(&batch);
-                    files.push(FileEntry {
-                        name: name.clone(),
+        let written = plan
+            .chunks
+            .par_iter()
+            .with_max_len(1)
+            .map(|chunk| -> Result<(FileEntry, Counts)> {
+                let name = sample_file_name(chunk.index);
+                let batch = if chunk.done {
+                    file::decode(&dir.join(&name), &self.columns)?
+                } else {
+                    self.samples(chunk.samples.clone(), images.as_deref(), progress)?
+                };
+                let mut counts = Counts::default();
+                counts.add(&batch);
+                let entry = if chunk.done {
+                    FileEntry {
+                        name,
                         rows: batch.len() as u64,
-                    });
-                    // A closed channel means the writer failed; its error is returned below.
-                    if !chunk.done && sender.send((name, batch)).is_err() {
-                        break;
                     }
-                }
-                Ok(())
-            })();
-            drop(sender);
-            let written = writer
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-            rendered.and(written)
-        })?;
+                } else {
+                    write_sample_file(dir, name, &self.columns, &batch)?
+                };
+                Ok((entry, counts))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut counts = Counts::default();
+        let mut files = Vec::with_capacity(written.len());
+        for (entry, c) in written {
+            counts.merge(c);
+            files.push(entry);
+        }
         let manifest = Manifest::new(
             self.columns.clone(),
             counts,
