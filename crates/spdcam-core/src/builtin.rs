@@ -168,7 +168,7 @@ pub fn resolve_table(
     Err(Error::UnknownName {
         kind,
         name: spec.to_string(),
-        valid: format!("{}{hint}", valid.join(", ")),
+        valid: format!("{}{hint}", crate::error::brief_list(&valid)),
     })
 }
 

@@ -241,6 +241,14 @@ fn interrupted_run_resumes_to_the_same_files() {
         })
     }));
     assert!(interrupted.is_err());
+    // The interrupted run's plan holds the directory's lock until it is dropped.
+    let e = Generator::new(&cam, &light, options(64, 5))
+        .unwrap()
+        .prepare(&dir, false)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("in use"), "{e}");
+    drop(plan);
     assert!(!dir.join("manifest.json").exists());
     assert!(Dataset::open(&dir).is_err());
     std::fs::write(dir.join(".samples-00003.parquet.999.partial"), b"PAR1 junk").unwrap();

@@ -110,8 +110,39 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The error and its causes joined by ": ", leaving out a cause the text already says (an
+/// I/O error is often both in a message and its source).
+fn error_text(error: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in error.chain() {
+        let message = cause.to_string();
+        if !text.contains(&message) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&message);
+        }
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_os_error_is_printed_once() {
+        // Issue 15: "Permission denied (os error 13): Permission denied (os error 13)".
+        let io = std::io::Error::from(std::io::ErrorKind::PermissionDenied);
+        let e = anyhow::Error::from(spdcam_core::Error::io("out.csv", io)).context("writing");
+        let text = error_text(&e);
+        assert_eq!(text.matches("denied").count(), 1, "{text}");
+        assert!(text.starts_with("writing: out.csv: "), "{text}");
     }
 }
