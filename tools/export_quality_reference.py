@@ -25,8 +25,11 @@ colour-science to 360-780 nm at 1 nm and zero outside the data, called S1 below)
   additional_data=True) (CIE 224:2017 / ANSI/IES TM-30-18, whose Rf, Rg and hue-bin values
   TM-30-20 keeps): rf, rg, and per hue bin h1..h16 the local fidelity rf_h, chroma shift rcs_h
   (a fraction, colour-science's percentage / 100) and hue shift rhs_h.
-- elr_*, der_*: luxpy.toolboxes.photbiochem.spd_to_aopicELR / spd_to_aopicDER of S (luxpy
-  interpolates to 1 nm itself; CIE S 026:2018; ELR in mW/lm).
+- elr_*, der_*: luxpy.toolboxes.photbiochem.spd_to_aopicELR / spd_to_aopicDER of S1 over
+  380-780 nm (CIE S 026:2018; ELR in mW/lm; DER against luxpy's own 1 nm CIE D65). luxpy gets
+  the 1 nm spectrum because its own interpolation of 5 nm data (cubic spline, negative lobes
+  set to 0) differs from Sprague by up to 5 % on line spectra (mercury, fluorescent), a
+  difference of resampling conventions, not of the alpha-opic method.
 - sp_ratio: colour.luminous_flux(S1, SDS_LEFS_SCOTOPIC, K_m=1700) / colour.luminous_flux(S1).
 - ppf_per_lux: PPF per lumen (umol/s/lm) from S1 by its definition, sum over 400-700 nm of
   S lambda / (h c N_A), over 683.002 sum S ybar (numpy).
@@ -132,7 +135,8 @@ def metrics(wl: np.ndarray, values: np.ndarray, name: str) -> dict:
         row[f"tm30_rcs_h{j + 1}"] = tm.R_cs[j] / 100.0
         row[f"tm30_rhs_h{j + 1}"] = tm.R_hs[j]
 
-    spd = np.vstack((wl, values))
+    inside = s1.wavelengths >= 380
+    spd = np.vstack((s1.wavelengths[inside], s1.values[inside]))
     elr = photbiochem.spd_to_aopicELR(spd)[0]
     der = photbiochem.spd_to_aopicDER(spd)[0]
     for k, a in enumerate(ALPHA):

@@ -15,6 +15,7 @@ pub mod light;
 pub mod lighting;
 pub mod metrics;
 pub mod photo;
+pub mod quality;
 pub mod raster;
 pub mod seed;
 pub mod spectral;
