@@ -9,6 +9,7 @@ mod experiment_sim2real;
 mod finetune;
 mod generate;
 mod list;
+mod metrics;
 mod photo_args;
 mod plot_file;
 mod render;
@@ -42,6 +43,8 @@ enum Command {
     Dataset(dataset::DatasetArgs),
     /// List built-in cameras, charts, illuminants, lighting recipes and presets.
     List(list::ListArgs),
+    /// Lighting-quality metrics (CCT, CRI, TM-30, α-opic, S/P, PPF) of SPDs.
+    Metrics(metrics::MetricsArgs),
     /// Train a model (1D CNN, MLP or ridge baseline) on a dataset.
     Train(Box<train::TrainArgs>),
     /// Estimate the light's SPD from photos of a colour chart (or chart features).
@@ -78,6 +81,7 @@ fn main() -> ExitCode {
         Command::Generate(args) => generate::run(*args, &data_dir),
         Command::Dataset(args) => dataset::run(args, &data_dir),
         Command::List(args) => list::run(args, &data_dir),
+        Command::Metrics(args) => metrics::run(args, &data_dir),
         Command::Train(args) => train::run(*args, &data_dir),
         Command::Estimate(args) => estimate::run(*args, &data_dir),
         Command::Evaluate(args) => evaluate::run(args, &data_dir),

@@ -144,7 +144,7 @@ impl Cam02Viewing {
         let rgb_a = self.post_adaptation(xyz);
         let a = rgb_a[0] - 12.0 * rgb_a[1] / 11.0 + rgb_a[2] / 11.0;
         let b = (rgb_a[0] + rgb_a[1] - 2.0 * rgb_a[2]) / 9.0;
-        let ab = a.hypot(b);
+        let ab = (a * a + b * b).sqrt();
         let (cos_h, sin_h) = if ab > 0.0 {
             (a / ab, b / ab)
         } else {
@@ -155,7 +155,8 @@ impl Cam02Viewing {
         let j = 100.0 * spow(self.achromatic(&rgb_a) / self.a_w, self.cz);
         let t = (50000.0 / 13.0 * SURROUND_NC * self.n_bb * e_t * ab)
             / (rgb_a[0] + rgb_a[1] + 21.0 / 20.0 * rgb_a[2]);
-        let c = spow(t, 0.9) * spow(j / 100.0, 0.5) * self.chroma_factor;
+        let root_j = (j / 100.0).signum() * (j / 100.0).abs().sqrt();
+        let c = spow(t, 0.9) * root_j * self.chroma_factor;
         let m = c * self.f_l_4;
         let m_ucs = (1.0 + UCS_C2 * m).ln() / UCS_C2;
         Cam02Ucs {

@@ -3,14 +3,14 @@
 //! CIE 13.3-1995, "Method of measuring and specifying colour rendering properties of light
 //! sources": the 14 test colour samples (shipped as `data/cie_1995_tcs14.csv`) are computed
 //! under the test light and under a reference illuminant of the same CCT
-//! ([`reference_cie1995`]) with the CIE 1931 2° observer; the test colours are adapted to the
+//! ([`ReferenceIlluminants::cie1995`]) with the CIE 1931 2° observer; the test colours are adapted to the
 //! reference white by the von Kries transform in CIE 1960 (u, v) of CIE 13.3 §5.5 (Eqs. 5–7);
 //! each colour difference ΔE_i is taken in CIE 1964 U*V*W* (W* = 25 Y^(1/3) − 17,
 //! U* = 13 W* (u − u_r), V* = 13 W* (v − v_r)); R_i = 100 − 4.6 ΔE_i, and Ra is the mean of
 //! R1–R8. Computed at 1 nm over 360–780 nm (the samples interpolated with Sprague 1880), as
 //! colour-science's `colour_rendering_index` does.
 
-use super::reference::reference_cie1995;
+use super::reference::ReferenceIlluminants;
 use super::spectrum::{observer_2deg, LightSpectrum, QUALITY_GRID};
 use super::uv::xyz_to_uv1960;
 use crate::builtin;
@@ -29,6 +29,14 @@ pub struct ColourRendering {
     pub ra: f64,
     /// Special colour rendering indices R1–R14 (index 0 is R1).
     pub r: [f64; TCS_COUNT],
+}
+
+/// The CIE 13.3 reference illuminants on [`QUALITY_GRID`], prepared once.
+fn references() -> &'static ReferenceIlluminants {
+    static R: OnceLock<ReferenceIlluminants> = OnceLock::new();
+    R.get_or_init(|| {
+        ReferenceIlluminants::on_grid(&QUALITY_GRID).expect("references on 360–780 nm")
+    })
 }
 
 /// The test colour samples times each CIE 1931 CMF on [`QUALITY_GRID`]: `[sample][channel]`.
@@ -103,7 +111,7 @@ fn c_d(uv: [f64; 2]) -> (f64, f64) {
 /// defined (CCT above 25,000 K). CIE 13.3 deems the result meaningless when the light's
 /// chromaticity lies more than 5.4e-3 from the Planckian locus; that is the caller's check.
 pub fn colour_rendering_cie1995(light: &LightSpectrum, cct: f64) -> Result<ColourRendering> {
-    let reference = reference_cie1995(cct, &QUALITY_GRID)?;
+    let reference = references().cie1995(cct)?;
     let test = sample_colours(light.values());
     let refr = sample_colours(&reference);
     let (c_k, d_k) = c_d(test.white_uv);

@@ -122,6 +122,13 @@ const CCT_KEYS: [&str; 8] = [
 impl LightingMetrics {
     /// Every metric undefined for `reason` (e.g. a spectrum with no visible light).
     pub fn undefined(reason: &str) -> LightingMetrics {
+        let mut m = LightingMetrics::empty();
+        m.set_reason(&METRIC_KEYS[..METRIC_KEYS.len() - 1], reason);
+        m
+    }
+
+    /// No value and no reason yet.
+    fn empty() -> LightingMetrics {
         LightingMetrics {
             xy: None,
             uv_1960: None,
@@ -140,10 +147,7 @@ impl LightingMetrics {
             sp_ratio: None,
             ppf_per_lux: None,
             blh_efficacy_w_per_lm: None,
-            reasons: METRIC_KEYS[..METRIC_KEYS.len() - 1]
-                .iter()
-                .map(|k| (k.to_string(), reason.to_string()))
-                .collect(),
+            reasons: BTreeMap::new(),
             warnings: Vec::new(),
         }
     }
@@ -159,8 +163,7 @@ impl LightingMetrics {
 
     /// Every metric of `light`.
     pub fn of(light: &LightSpectrum) -> LightingMetrics {
-        let mut m = LightingMetrics::undefined("");
-        m.reasons.clear();
+        let mut m = LightingMetrics::empty();
         let xyz = light.xyz();
         let uv = uv::xyz_to_uv1960(xyz);
         m.xy = Some(xyz_to_xy(xyz));

@@ -14,6 +14,9 @@ pub const QUALITY_GRID: Grid = Grid {
     count: 421,
 };
 
+/// Negative input values down to this fraction of the peak are taken as measurement noise.
+const NEGATIVE_TOLERANCE: f64 = 0.01;
+
 /// The CIE 1931 2° observer on [`QUALITY_GRID`], built once.
 pub(crate) fn observer_2deg() -> &'static Observer {
     static OBS: OnceLock<Observer> = OnceLock::new();
@@ -56,7 +59,8 @@ impl LightSpectrum {
         LightSpectrum::from_samples(&grid.wavelengths(), values)
     }
 
-    /// Item `index` of a spectral set.
+    /// Item `index` of a spectral set. Errors on values below −1 % of the spectrum's peak
+    /// (more negative than measurement noise) and on spectra without visible light.
     ///
     /// # Panics
     /// If `index` is out of range.
@@ -64,14 +68,31 @@ impl LightSpectrum {
         let w = set.wavelengths();
         let source_range_nm = (w[0], w[w.len() - 1]);
         let name = &set.names()[index];
+        let input = set.item(index);
+        let peak = input.iter().cloned().fold(0.0, f64::max);
+        if let Some((i, v)) = input
+            .iter()
+            .enumerate()
+            .find(|(_, v)| **v < -NEGATIVE_TOLERANCE * peak || (peak == 0.0 && **v < 0.0))
+        {
+            return Err(Error::invalid(format!(
+                "spectrum '{name}' is negative ({v}) at {} nm; a light's SPD cannot be below \
+                 −1 % of its peak ({peak})",
+                w[i]
+            )));
+        }
         let values = if set.grid().is_some_and(|g| same_grid(&g, &QUALITY_GRID)) {
             set.item(index).to_vec()
         } else {
-            let (resampled, _): (SpectralSet, ResampleReport) = set.select(&[index]).resample(
-                &QUALITY_GRID,
-                Interpolation::Auto,
-                Extrapolation::Zero,
-            )?;
+            let one;
+            let single = if set.len() == 1 {
+                set
+            } else {
+                one = set.select(&[index]);
+                &one
+            };
+            let (resampled, _): (SpectralSet, ResampleReport) =
+                single.resample(&QUALITY_GRID, Interpolation::Auto, Extrapolation::Zero)?;
             resampled.item(0).to_vec()
         };
         let xyz = observer_2deg().spd_to_xyz(&values);
@@ -143,6 +164,12 @@ mod tests {
         assert!(e.to_string().contains("no visible light"), "{e}");
         assert!(LightSpectrum::on_grid(&grid, &[1.0, 2.0]).is_err());
         assert!(LightSpectrum::from_samples(&[500.0, 400.0], &[1.0, 1.0]).is_err());
+        let e = LightSpectrum::from_samples(&[400.0, 500.0, 600.0], &[1.0, -0.5, 1.0]);
+        assert!(e
+            .unwrap_err()
+            .to_string()
+            .contains("negative (-0.5) at 500 nm"));
+        assert!(LightSpectrum::from_samples(&[400.0, 500.0, 600.0], &[1.0, -0.005, 1.0]).is_ok());
         // Infrared only: nothing the eye sees.
         assert!(LightSpectrum::from_samples(&[800.0, 900.0], &[1.0, 1.0]).is_err());
     }

@@ -4,7 +4,7 @@
 //! CIE 224:2017, "CIE 2017 colour fidelity index for accurate scientific use", and ANSI/IES
 //! TM-30-20, "IES method for evaluating light source color rendition". The 99 colour
 //! evaluation samples (`data/tm30_ces99.csv`) are computed under the test light and under the
-//! reference illuminant of its CCT ([`reference_cie2017`]) with the CIE 1964 10° observer,
+//! reference illuminant of its CCT ([`ReferenceIlluminants::cie2017`]) with the CIE 1964 10° observer,
 //! each light normalised to Y = 100; CIECAM02 in the CIE 224 viewing conditions gives
 //! CAM02-UCS coordinates ([`Cam02Viewing`]); ΔE_i is their Euclidean distance and
 //! Rf = 10 ln(1 + exp((100 − 6.73 ΔĒ)/10)) (CIE 224:2017 Eq. 13). TM-30 groups the samples into
@@ -17,7 +17,7 @@
 //! 5 nm data.
 
 use super::cam02::{Cam02Ucs, Cam02Viewing};
-use super::reference::reference_cie2017;
+use super::reference::ReferenceIlluminants;
 use super::spectrum::{LightSpectrum, QUALITY_GRID};
 use crate::builtin;
 use crate::colorimetry::Observer;
@@ -68,7 +68,7 @@ struct Tables {
     /// CES × 10° CMF: `[sample][channel][band]`.
     weights: Vec<[Vec<f64>; 3]>,
     cmf10: Observer,
-    cmf2: Observer,
+    references: ReferenceIlluminants,
 }
 
 fn tables() -> &'static Tables {
@@ -80,7 +80,7 @@ fn tables() -> &'static Tables {
         ces.require_grid(&TM30_GRID, "the CES table")
             .expect("the shipped CES table is 380–780 nm at 5 nm");
         let cmf10 = Observer::cie1964_10deg(&TM30_GRID).expect("CIE 1964 observer");
-        let cmf2 = Observer::cie1931(&TM30_GRID).expect("CIE 1931 observer");
+        let references = ReferenceIlluminants::on_grid(&TM30_GRID).expect("references");
         let weights = ces
             .items()
             .iter()
@@ -89,7 +89,7 @@ fn tables() -> &'static Tables {
         Tables {
             weights,
             cmf10,
-            cmf2,
+            references,
         }
     })
 }
@@ -143,7 +143,7 @@ pub fn colour_fidelity_cie2017(light: &LightSpectrum, cct: f64) -> Result<Colour
     let test_spd: Vec<f64> = (0..TM30_GRID.count)
         .map(|i| light.values()[offset + i * stride])
         .collect();
-    let reference = reference_cie2017(cct, &TM30_GRID, &t.cmf2)?;
+    let reference = t.references.cie2017(cct)?;
     let test = sample_appearance(&test_spd);
     let refr = sample_appearance(&reference);
 
