@@ -129,8 +129,17 @@ fn text_table_and_named_lights() {
     );
     let warm = lines.iter().find(|l| l.starts_with("cct:2700")).unwrap();
     assert!(warm.contains("2700"), "{warm}");
-    let fl2 = lines.iter().find(|l| l.starts_with("FL2 ")).unwrap();
-    assert!(fl2.contains("4225") && fl2.contains("64.1"), "{fl2}");
+    // FL2: CCT 4225 K, Ra 64.15 (colour-science), Rf 70.1.
+    let fl2: Vec<&str> = lines
+        .iter()
+        .find(|l| l.starts_with("FL2 "))
+        .unwrap()
+        .split_whitespace()
+        .collect();
+    assert_eq!(fl2[1], "4225", "{fl2:?}");
+    let ra: f64 = fl2[3].parse().unwrap();
+    assert!((ra - reference_ra("FL2")).abs() <= 0.06, "{fl2:?}");
+    assert_eq!(fl2[5], "70.1", "{fl2:?}");
     // HP1 (high-pressure sodium) lies off the locus far enough for a note, or has none; every
     // light has its row.
     assert!(lines.iter().any(|l| l.starts_with("HP1 ")));

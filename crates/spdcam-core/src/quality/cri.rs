@@ -11,7 +11,7 @@
 //! colour-science's `colour_rendering_index` does.
 
 use super::reference::ReferenceIlluminants;
-use super::spectrum::{observer_2deg, LightSpectrum, QUALITY_GRID};
+use super::spectrum::{observer_2deg, BandWeights, LightSpectrum, QUALITY_GRID};
 use super::uv::xyz_to_uv1960;
 use crate::builtin;
 use crate::error::Result;
@@ -39,9 +39,10 @@ fn references() -> &'static ReferenceIlluminants {
     })
 }
 
-/// The test colour samples times each CIE 1931 CMF on [`QUALITY_GRID`]: `[sample][channel]`.
-fn sample_weights() -> &'static Vec<[Vec<f64>; 3]> {
-    static W: OnceLock<Vec<[Vec<f64>; 3]>> = OnceLock::new();
+/// The test colour samples times each CIE 1931 CMF on [`QUALITY_GRID`], function
+/// `3·sample + channel`.
+fn sample_weights() -> &'static BandWeights {
+    static W: OnceLock<BandWeights> = OnceLock::new();
     W.get_or_init(|| {
         let (tcs, _) = builtin::CIE1995_TCS14
             .load()
@@ -54,10 +55,14 @@ fn sample_weights() -> &'static Vec<[Vec<f64>; 3]> {
             })
             .expect("the shipped CIE 13.3 samples cover 360–780 nm");
         let obs = observer_2deg();
-        tcs.items()
+        let functions: Vec<Vec<f64>> = tcs
+            .items()
             .iter()
-            .map(|r| [0, 1, 2].map(|c| r.iter().zip(obs.cmf(c)).map(|(r, c)| r * c).collect()))
-            .collect()
+            .flat_map(|r| {
+                (0..3).map(move |c| r.iter().zip(obs.cmf(c)).map(|(r, c)| r * c).collect())
+            })
+            .collect();
+        BandWeights::new(&functions)
     })
 }
 
@@ -73,15 +78,11 @@ fn sample_colours(spd: &[f64]) -> SampleColours {
     let white = obs.spd_to_xyz(spd);
     // The samples' sums lack the Δλ that spd_to_xyz includes.
     let k = 100.0 / white[1] * QUALITY_GRID.step_nm;
-    let weights = sample_weights();
-    let samples = std::array::from_fn(|i| {
-        weights[i]
-            .each_ref()
-            .map(|w| k * w.iter().zip(spd).map(|(w, s)| w * s).sum::<f64>())
-    });
+    let mut sums = [0.0; 3 * TCS_COUNT];
+    sample_weights().apply(spd, &mut sums);
     SampleColours {
         white_uv: xyz_to_uv1960(white),
-        samples,
+        samples: std::array::from_fn(|i| std::array::from_fn(|c| k * sums[3 * i + c])),
     }
 }
 

@@ -130,6 +130,53 @@ impl LightSpectrum {
     }
 }
 
+/// A set of weighting functions on one grid, stored band-major so that applying all of them
+/// to a spectrum runs one independent accumulator per function (vectorised), rather than one
+/// long dependent sum per function.
+#[derive(Debug, Clone)]
+pub(crate) struct BandWeights {
+    functions: usize,
+    /// `values[band * functions + function]`.
+    values: Vec<f64>,
+}
+
+impl BandWeights {
+    /// The weighting functions `functions[f][band]`, all of one length.
+    pub(crate) fn new(functions: &[Vec<f64>]) -> BandWeights {
+        let bands = functions.first().map_or(0, Vec::len);
+        assert!(
+            functions.iter().all(|f| f.len() == bands),
+            "weights of unequal length"
+        );
+        let values = (0..bands)
+            .flat_map(|b| functions.iter().map(move |f| f[b]))
+            .collect();
+        BandWeights {
+            functions: functions.len(),
+            values,
+        }
+    }
+
+    /// Σ_band w_f(band)·spd(band) for every function f, into `out` (one value per function).
+    ///
+    /// # Panics
+    /// If `spd` or `out` has the wrong length.
+    pub(crate) fn apply(&self, spd: &[f64], out: &mut [f64]) {
+        assert_eq!(
+            spd.len() * self.functions,
+            self.values.len(),
+            "spectrum length"
+        );
+        assert_eq!(out.len(), self.functions, "output length");
+        out.fill(0.0);
+        for (row, s) in self.values.chunks_exact(self.functions).zip(spd) {
+            for (acc, w) in out.iter_mut().zip(row) {
+                *acc += w * s;
+            }
+        }
+    }
+}
+
 fn same_grid(a: &Grid, b: &Grid) -> bool {
     a.count == b.count
         && (a.start_nm - b.start_nm).abs() < 1e-9
@@ -155,6 +202,15 @@ mod tests {
         assert_eq!(light.values()[701 - 360], 0.0);
         assert_eq!(light.source_range_nm(), (400.0, 700.0));
         assert!(light.xyz()[1] > 0.0);
+    }
+
+    #[test]
+    fn band_weights_equal_plain_dot_products() {
+        let f = vec![vec![1.0, 2.0, 3.0], vec![0.5, 0.0, -1.0]];
+        let w = BandWeights::new(&f);
+        let mut out = [0.0; 2];
+        w.apply(&[1.0, 10.0, 100.0], &mut out);
+        assert_eq!(out, [321.0, -99.5]);
     }
 
     #[test]

@@ -18,7 +18,7 @@
 
 use super::cam02::{Cam02Ucs, Cam02Viewing};
 use super::reference::ReferenceIlluminants;
-use super::spectrum::{LightSpectrum, QUALITY_GRID};
+use super::spectrum::{BandWeights, LightSpectrum, QUALITY_GRID};
 use crate::builtin;
 use crate::colorimetry::Observer;
 use crate::error::{Error, Result};
@@ -65,8 +65,8 @@ pub struct ColourFidelity {
 
 /// What the computation needs on [`TM30_GRID`], built once.
 struct Tables {
-    /// CES × 10° CMF: `[sample][channel][band]`.
-    weights: Vec<[Vec<f64>; 3]>,
+    /// CES × 10° CMF, function `3·sample + channel`.
+    weights: BandWeights,
     cmf10: Observer,
     references: ReferenceIlluminants,
 }
@@ -81,11 +81,15 @@ fn tables() -> &'static Tables {
             .expect("the shipped CES table is 380–780 nm at 5 nm");
         let cmf10 = Observer::cie1964_10deg(&TM30_GRID).expect("CIE 1964 observer");
         let references = ReferenceIlluminants::on_grid(&TM30_GRID).expect("references");
-        let weights = ces
+        let functions: Vec<Vec<f64>> = ces
             .items()
             .iter()
-            .map(|r| [0, 1, 2].map(|c| r.iter().zip(cmf10.cmf(c)).map(|(r, c)| r * c).collect()))
+            .flat_map(|r| {
+                let cmf10 = &cmf10;
+                (0..3).map(move |c| r.iter().zip(cmf10.cmf(c)).map(|(r, c)| r * c).collect())
+            })
             .collect();
+        let weights = BandWeights::new(&functions);
         Tables {
             weights,
             cmf10,
@@ -102,14 +106,10 @@ fn sample_appearance(spd: &[f64]) -> Vec<Cam02Ucs> {
     let view = Cam02Viewing::cie2017(white.map(|v| k * v));
     // The samples' sums lack the Δλ that spd_to_xyz includes.
     let k = k * TM30_GRID.step_nm;
-    t.weights
-        .iter()
-        .map(|w| {
-            let xyz = w
-                .each_ref()
-                .map(|w| k * w.iter().zip(spd).map(|(w, s)| w * s).sum::<f64>());
-            view.ucs(xyz)
-        })
+    let mut sums = vec![0.0; 3 * CES_COUNT];
+    t.weights.apply(spd, &mut sums);
+    sums.chunks_exact(3)
+        .map(|xyz| view.ucs([k * xyz[0], k * xyz[1], k * xyz[2]]))
         .collect()
 }
 
