@@ -178,7 +178,7 @@ fn compare(
             if dev > entry.0 {
                 *entry = (dev, format!("{name}: {key} {got} vs {want}"));
             }
-            if !(dev <= t.limit) {
+            if dev.is_nan() || dev > t.limit {
                 failures.push(format!("{name}: {key} = {got}, reference {want}"));
             }
         }

@@ -96,10 +96,12 @@ impl LightSpectrum {
             resampled.item(0).to_vec()
         };
         let xyz = observer_2deg().spd_to_xyz(&values);
-        if !(xyz[1] > 0.0) {
+        if xyz[1].is_nan() || xyz[1] <= 0.0 {
             return Err(Error::invalid(format!(
                 "spectrum '{name}' has no visible light (luminance Y = {} over {}–{} nm)",
-                xyz[1], QUALITY_GRID.start_nm, 780
+                xyz[1],
+                QUALITY_GRID.start_nm,
+                QUALITY_GRID.end_nm()
             )));
         }
         Ok(LightSpectrum {
