@@ -17,6 +17,7 @@ pub mod lighting;
 pub mod limits;
 pub mod metrics;
 pub mod photo;
+pub mod quality;
 pub mod raster;
 pub mod seed;
 pub mod spectral;

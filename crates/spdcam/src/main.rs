@@ -13,6 +13,7 @@ mod experiment_sim2real;
 mod finetune;
 mod generate;
 mod list;
+mod metrics;
 mod photo_args;
 mod plot_file;
 mod render;
@@ -49,6 +50,8 @@ enum Command {
     Dataset(dataset::DatasetArgs),
     /// List built-in cameras, charts, illuminants, lighting recipes and presets.
     List(list::ListArgs),
+    /// Lighting-quality metrics (CCT, CRI, TM-30, α-opic, S/P, PPF) of SPDs.
+    Metrics(metrics::MetricsArgs),
     #[cfg(feature = "train")]
     /// Train a model (1D CNN, MLP or ridge baseline) on a dataset.
     Train(Box<train::TrainArgs>),
@@ -94,6 +97,7 @@ fn main() -> ExitCode {
         Command::Generate(args) => generate::run(*args, &data_dir),
         Command::Dataset(args) => dataset::run(args, &data_dir),
         Command::List(args) => list::run(args, &data_dir),
+        Command::Metrics(args) => metrics::run(args, &data_dir),
         #[cfg(feature = "train")]
         Command::Train(args) => train::run(*args, &data_dir),
         Command::Estimate(args) => estimate::run(*args, &data_dir),
