@@ -17,6 +17,7 @@ pub mod metrics;
 pub mod photo;
 pub mod raster;
 pub mod seed;
+pub mod simple_camera;
 pub mod spectral;
 
 pub use error::{Error, Result};

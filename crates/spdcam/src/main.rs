@@ -1,6 +1,7 @@
 //! spdcam: what light is in the room, from a photo of a colour chart.
 
 mod calibrate;
+mod coverage;
 mod dataset;
 mod estimate;
 mod evaluate;
@@ -8,6 +9,7 @@ mod experiment;
 mod experiment_sim2real;
 mod finetune;
 mod generate;
+mod lamps;
 mod list;
 mod photo_args;
 mod plot_file;
@@ -15,6 +17,7 @@ mod render;
 mod ridge;
 mod sim2real_curve;
 mod train;
+mod validate_lamps;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -56,6 +59,10 @@ enum Command {
     Calibrate(Box<calibrate::CalibrateArgs>),
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
     Sim2real(experiment_sim2real::Sim2realArgs),
+    /// How well lighting recipes cover measured SPDs, per lamp type.
+    Coverage(Box<coverage::CoverageArgs>),
+    /// Real lamps: the validation split, the lamp-family fits, the validation protocol.
+    Lamps(lamps::LampsArgs),
 }
 
 /// Output piped into a program that stops reading (`spdcam … | head`) ends spdcam quietly,
@@ -85,6 +92,8 @@ fn main() -> ExitCode {
         Command::Experiment(args) => experiment::run(args, &data_dir),
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),
         Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
+        Command::Coverage(args) => coverage::run(*args, &data_dir),
+        Command::Lamps(args) => lamps::run(args, &data_dir),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
