@@ -8,7 +8,8 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::coverage::best_gfc;
 use spdcam_core::lighting::lamp_families::fit_lamp;
-use spdcam_core::lighting::{LampFamily, LampLibrary, LampType, Lighting};
+use spdcam_core::lighting::validation_split::LampPart;
+use spdcam_core::lighting::{LampFamily, LampLibrary, LampType, Lighting, ValidationSplit};
 use spdcam_core::spectral::Grid;
 use std::path::PathBuf;
 
@@ -24,6 +25,12 @@ pub struct CoverageArgs {
     /// it every SPD is of type "other".
     #[arg(long, value_name = "INFO.csv")]
     types: Option<PathBuf>,
+    /// Only the lamps of one part of this validation split (`spdcam lamps split`)…
+    #[arg(long, value_name = "SPLIT.json", requires = "part")]
+    split: Option<PathBuf>,
+    /// …this part: fit, validation or test.
+    #[arg(long, value_parser = ["fit", "validation", "test"], requires = "split")]
+    part: Option<String>,
     /// Draws per recipe (and per member of a mixture).
     #[arg(long, default_value_t = 20_000)]
     draws: u64,
@@ -43,7 +50,17 @@ pub struct CoverageArgs {
 /// Runs `spdcam coverage`.
 pub fn run(args: CoverageArgs, data_dir: &DataDir) -> Result<()> {
     let grid = Grid::SIMULATION;
-    let library = LampLibrary::read(&args.spds, args.types.as_deref(), &grid)?;
+    let mut library = LampLibrary::read(&args.spds, args.types.as_deref(), &grid)?;
+    if let (Some(path), Some(part)) = (&args.split, &args.part) {
+        let split = ValidationSplit::read(path)?;
+        let part = match part.as_str() {
+            "fit" => LampPart::Fit,
+            "validation" => LampPart::Validation,
+            _ => LampPart::Test,
+        };
+        let keep = library.positions(split.lamps(part), "the split")?;
+        library = library.subset(&keep);
+    }
     let mut columns: Vec<(String, Vec<f64>)> = Vec::new();
     for spec in &args.lighting {
         let lighting = Lighting::parse(spec, data_dir, &grid)?;

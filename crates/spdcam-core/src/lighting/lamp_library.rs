@@ -122,6 +122,16 @@ impl LampLibrary {
         self.names.iter().position(|n| n == name)
     }
 
+    /// The lamps at `positions`, in that order.
+    pub fn subset(&self, positions: &[usize]) -> LampLibrary {
+        LampLibrary {
+            names: positions.iter().map(|&i| self.names[i].clone()).collect(),
+            types: positions.iter().map(|&i| self.types[i]).collect(),
+            spds: positions.iter().map(|&i| self.spds[i].clone()).collect(),
+            grid: self.grid,
+        }
+    }
+
     /// The positions of `names`, or an error naming the first one the library lacks.
     pub fn positions(&self, names: &[String], what: &str) -> Result<Vec<usize>> {
         names

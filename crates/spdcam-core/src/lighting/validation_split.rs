@@ -285,14 +285,15 @@ mod tests {
                 420.0 + 20.0 * k as f64,
             );
         }
-        add("RGBA 3K-A", LampType::MixedLed, 430.0);
-        add("RGBA 3K-B", LampType::MixedLed, 500.0);
-        add("RGB one", LampType::MixedLed, 600.0);
-        add("RGB two", LampType::MixedLed, 650.0);
-        add("tube", LampType::Fluorescent, 545.0);
-        add("tube again", LampType::Fluorescent, 545.0);
-        add("other tube", LampType::Fluorescent, 611.0);
-        add("third tube", LampType::Fluorescent, 480.0);
+        // Peaks apart from the whites' (a lamp identical to a white would join it).
+        add("RGBA 3K-A", LampType::MixedLed, 431.0);
+        add("RGBA 3K-B", LampType::MixedLed, 503.0);
+        add("RGB one", LampType::MixedLed, 607.0);
+        add("RGB two", LampType::MixedLed, 653.0);
+        add("tube", LampType::Fluorescent, 547.0);
+        add("tube again", LampType::Fluorescent, 547.0);
+        add("other tube", LampType::Fluorescent, 613.0);
+        add("third tube", LampType::Fluorescent, 483.0);
         LampLibrary {
             names,
             types,
