@@ -20,6 +20,7 @@ pub mod photo;
 pub mod quality;
 pub mod raster;
 pub mod seed;
+pub mod simple_camera;
 pub mod spectral;
 
 pub use error::{Error, Result};

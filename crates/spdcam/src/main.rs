@@ -1,6 +1,7 @@
 //! spdcam: what light is in the room, from a photo of a colour chart.
 
 mod calibrate;
+mod coverage;
 mod dataset;
 mod estimate;
 #[cfg(feature = "train")]
@@ -12,6 +13,7 @@ mod experiment_sim2real;
 #[cfg(feature = "train")]
 mod finetune;
 mod generate;
+mod lamps;
 mod list;
 mod metrics;
 mod photo_args;
@@ -23,6 +25,7 @@ mod ridge;
 mod sim2real_curve;
 #[cfg(feature = "train")]
 mod train;
+mod validate_lamps;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -71,6 +74,10 @@ enum Command {
     #[cfg(feature = "train")]
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
     Sim2real(experiment_sim2real::Sim2realArgs),
+    /// How well lighting recipes cover measured SPDs, per lamp type.
+    Coverage(Box<coverage::CoverageArgs>),
+    /// Real lamps: the validation split, the lamp-family fits, the validation protocol.
+    Lamps(lamps::LampsArgs),
 }
 
 /// Output piped into a program that stops reading (`spdcam … | head`) ends spdcam quietly,
@@ -110,6 +117,8 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),
         #[cfg(feature = "train")]
         Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
+        Command::Coverage(args) => coverage::run(*args, &data_dir),
+        Command::Lamps(args) => lamps::run(args, &data_dir),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
