@@ -17,8 +17,10 @@ pub mod lighting;
 pub mod limits;
 pub mod metrics;
 pub mod photo;
+pub mod quality;
 pub mod raster;
 pub mod seed;
+pub mod simple_camera;
 pub mod spectral;
 
 pub use error::{Error, Result};

@@ -1,20 +1,31 @@
 //! spdcam: what light is in the room, from a photo of a colour chart.
 
 mod calibrate;
+mod coverage;
 mod dataset;
 mod estimate;
+#[cfg(feature = "train")]
 mod evaluate;
+#[cfg(feature = "train")]
 mod experiment;
+#[cfg(feature = "train")]
 mod experiment_sim2real;
+#[cfg(feature = "train")]
 mod finetune;
 mod generate;
+mod lamps;
 mod list;
+mod metrics;
 mod photo_args;
 mod plot_file;
 mod render;
+#[cfg(feature = "train")]
 mod ridge;
+#[cfg(feature = "train")]
 mod sim2real_curve;
+#[cfg(feature = "train")]
 mod train;
+mod validate_lamps;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -42,20 +53,31 @@ enum Command {
     Dataset(dataset::DatasetArgs),
     /// List built-in cameras, charts, illuminants, lighting recipes and presets.
     List(list::ListArgs),
+    /// Lighting-quality metrics (CCT, CRI, TM-30, α-opic, S/P, PPF) of SPDs.
+    Metrics(metrics::MetricsArgs),
+    #[cfg(feature = "train")]
     /// Train a model (1D CNN, MLP or ridge baseline) on a dataset.
     Train(Box<train::TrainArgs>),
     /// Estimate the light's SPD from photos of a colour chart (or chart features).
     Estimate(Box<estimate::EstimateArgs>),
+    #[cfg(feature = "train")]
     /// Score a model on a dataset: metrics, per-band error, plots.
     Evaluate(evaluate::EvaluateArgs),
+    #[cfg(feature = "train")]
     /// Adapt a trained model to a small new dataset (transfer learning).
     Finetune(Box<finetune::FinetuneArgs>),
+    #[cfg(feature = "train")]
     /// Reproduce the thesis's experiments on its own datasets.
     Experiment(experiment::ExperimentArgs),
     /// Fit a real camera's in-camera rendering to a few of its chart photos with known light.
     Calibrate(Box<calibrate::CalibrateArgs>),
+    #[cfg(feature = "train")]
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
     Sim2real(experiment_sim2real::Sim2realArgs),
+    /// How well lighting recipes cover measured SPDs, per lamp type.
+    Coverage(Box<coverage::CoverageArgs>),
+    /// Real lamps: the validation split, the lamp-family fits, the validation protocol.
+    Lamps(lamps::LampsArgs),
 }
 
 /// Output piped into a program that stops reading (`spdcam … | head`) ends spdcam quietly,
@@ -73,18 +95,30 @@ fn main() -> ExitCode {
     exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     let data_dir = spdcam_core::builtin::DataDir::new(cli.data_dir);
+    if let Err(e) = data_dir.check() {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Render(args) => render::run(*args, &data_dir),
         Command::Generate(args) => generate::run(*args, &data_dir),
         Command::Dataset(args) => dataset::run(args, &data_dir),
         Command::List(args) => list::run(args, &data_dir),
+        Command::Metrics(args) => metrics::run(args, &data_dir),
+        #[cfg(feature = "train")]
         Command::Train(args) => train::run(*args, &data_dir),
         Command::Estimate(args) => estimate::run(*args, &data_dir),
+        #[cfg(feature = "train")]
         Command::Evaluate(args) => evaluate::run(args, &data_dir),
+        #[cfg(feature = "train")]
         Command::Finetune(args) => finetune::run(*args),
+        #[cfg(feature = "train")]
         Command::Experiment(args) => experiment::run(args, &data_dir),
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),
+        #[cfg(feature = "train")]
         Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
+        Command::Coverage(args) => coverage::run(*args, &data_dir),
+        Command::Lamps(args) => lamps::run(args, &data_dir),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

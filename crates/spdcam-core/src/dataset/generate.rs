@@ -476,56 +476,43 @@ impl<'a> Generator<'a> {
     }
 
     /// Renders the files `plan` still lacks, then writes the manifest. `progress` is told how
-    /// many new samples were finished. Each file is encoded and written on a second thread
-    /// while the next one renders; at most one finished file waits in between, so memory
-    /// stays flat whatever the count.
+    /// many new samples were finished. Files are rendered, encoded and written in parallel,
+    /// each by the thread that picks it up, the samples of one file spread over threads that
+    /// would otherwise idle; so both rendering and compression use every core, and memory
+    /// holds about one file per thread whatever the count.
     pub fn run(&self, plan: &Plan, progress: &(dyn Fn(u64) + Sync)) -> Result<Manifest> {
         let dir = plan.dir.as_path();
         let images = self.options.images.then(|| dir.join(IMAGES_DIR));
-        let mut counts = Counts::default();
-        let mut written = std::thread::scope(|scope| {
-            let (sender, receiver) = std::sync::mpsc::sync_channel::<(String, SampleBatch)>(1);
-            let writer = scope.spawn(move || -> Result<HashMap<String, FileEntry>> {
-                let mut written = HashMap::new();
-                for (name, batch) in receiver {
-                    let entry = write_sample_file(dir, name, &self.columns, &batch)?;
-                    append_to_journal(dir, &entry)?;
-                    written.insert(entry.name.clone(), entry);
-                }
-                Ok(written)
-            });
-            let rendered = (|| -> Result<()> {
-                for chunk in &plan.chunks {
-                    let name = sample_file_name(chunk.index);
-                    let batch = if let Some(entry) = &chunk.done {
-                        read_sample_file(dir, entry, &self.columns)?
-                    } else {
-                        self.samples(chunk.samples.clone(), images.as_deref(), progress)?
-                    };
-                    counts.add(&batch);
-                    // A closed channel means the writer failed; its error is returned below.
-                    if chunk.done.is_none() && sender.send((name, batch)).is_err() {
-                        break;
-                    }
-                }
-                Ok(())
-            })();
-            drop(sender);
-            let written = writer
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-            rendered.and(written)
-        })?;
-        let files = plan
+        // Resumed runs append to the journal from several threads; one line at a time.
+        let journal = std::sync::Mutex::new(());
+        let written = plan
             .chunks
-            .iter()
-            .map(|chunk| match &chunk.done {
-                Some(entry) => Ok(entry.clone()),
-                None => written
-                    .remove(&sample_file_name(chunk.index))
-                    .ok_or_else(|| Error::invalid("a sample file was not written")),
+            .par_iter()
+            .with_max_len(1)
+            .map(|chunk| -> Result<(FileEntry, Counts)> {
+                let (entry, batch) = match &chunk.done {
+                    Some(entry) => (entry.clone(), read_sample_file(dir, entry, &self.columns)?),
+                    None => {
+                        let name = sample_file_name(chunk.index);
+                        let batch =
+                            self.samples(chunk.samples.clone(), images.as_deref(), progress)?;
+                        let entry = write_sample_file(dir, name, &self.columns, &batch)?;
+                        let _line = journal.lock().unwrap_or_else(|e| e.into_inner());
+                        append_to_journal(dir, &entry)?;
+                        (entry, batch)
+                    }
+                };
+                let mut counts = Counts::default();
+                counts.add(&batch);
+                Ok((entry, counts))
             })
-            .collect::<Result<Vec<FileEntry>>>()?;
+            .collect::<Result<Vec<_>>>()?;
+        let mut counts = Counts::default();
+        let mut files = Vec::with_capacity(written.len());
+        for (entry, c) in written {
+            counts.merge(c);
+            files.push(entry);
+        }
         let manifest = Manifest::new(
             self.columns.clone(),
             counts,
