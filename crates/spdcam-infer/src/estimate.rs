@@ -14,6 +14,7 @@ use serde::Serialize;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
+use spdcam_core::feature_check;
 use spdcam_core::metrics;
 use spdcam_core::photo::{self, AnalyseOptions, ChartTemplate, PhotoAnalysis};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
@@ -36,12 +37,17 @@ pub struct FeatureRows {
 impl FeatureRows {
     /// Reads a features CSV: a header naming the columns, then one numeric row per estimate.
     pub fn read_csv(path: &Path) -> Result<FeatureRows> {
-        let shown = path.display();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| InferError::invalid(format!("reading {}: {e}", path.display())))?;
+        FeatureRows::from_csv_str(&text, &path.display().to_string())
+    }
+
+    /// Parses features CSV text (see [`FeatureRows::read_csv`]); `shown` names it in errors.
+    pub fn from_csv_str(text: &str, shown: &str) -> Result<FeatureRows> {
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .flexible(true)
-            .from_path(path)
-            .map_err(|e| InferError::invalid(format!("reading {shown}: {e}")))?;
+            .from_reader(text.as_bytes());
         let names: Vec<String> = reader
             .headers()
             .map_err(|e| InferError::invalid(format!("{shown}: {e}")))?
@@ -128,6 +134,7 @@ pub fn estimate_rows(
     grid: &Grid,
 ) -> Result<SpectralSet> {
     model.check_features(&features.names, source)?;
+    check_rows(features, source)?;
     let mg = model.grid();
     if grid.start_nm < mg.start_nm - 1e-9 || grid.end_nm() > mg.end_nm() + 1e-9 {
         return Err(InferError::invalid(format!(
@@ -144,6 +151,25 @@ pub fn estimate_rows(
     }
     let (resampled, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
     Ok(resampled)
+}
+
+/// Refuses rows that say nothing about the light (values outside the encoding's range, a
+/// black chart, a chart without colour; see [`feature_check`]), naming the row when there
+/// are several. Rows on 0–1 are told from rows on 0–255 by their largest value.
+fn check_rows(features: &FeatureRows, source: &str) -> Result<()> {
+    let width = features.names.len().max(1);
+    for (i, row) in features.values.chunks(width).enumerate() {
+        let scale = if row.iter().any(|&v| v > 1.0) { 255.0 } else { 1.0 };
+        feature_check::check_feature_row(row, &features.names, scale).map_err(|e| {
+            let at = if features.rows > 1 {
+                format!(" row {}", i + 1)
+            } else {
+                String::new()
+            };
+            InferError::invalid(format!("{source}{at}: {e}"))
+        })?;
+    }
+    Ok(())
 }
 
 /// CIE 1931 xy, and CCT and Duv where the chromaticity is near enough the Planckian locus.

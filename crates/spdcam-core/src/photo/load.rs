@@ -226,10 +226,11 @@ pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
     image.apply_orientation(orientation);
     let mut photo = Photo::from_image(source, image)?;
     if format == ImageFormat::Jpeg && jpeg_is_truncated(bytes) {
-        photo.warnings.push(format!(
-            "{source}: the JPEG file is truncated (it ends before its end-of-image marker); \
-             the missing part of the picture is filled in by the decoder"
-        ));
+        photo.warnings.push(
+            "the JPEG file is truncated (it ends before its end-of-image marker); the \
+             missing part of the picture is filled in by the decoder"
+                .to_string(),
+        );
     }
     Ok(photo)
 }
