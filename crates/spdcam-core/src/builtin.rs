@@ -108,6 +108,19 @@ impl DataDir {
         DataDir { root }
     }
 
+    /// Checks that a directory that is set exists, so a mistyped `--data-dir` or
+    /// `SPDCAM_DATA` is named at once instead of surfacing as an unknown camera or chart.
+    pub fn check(&self) -> Result<()> {
+        match &self.root {
+            Some(root) if !root.is_dir() => Err(Error::invalid(format!(
+                "the data directory {} does not exist (given by --data-dir or {DATA_DIR_ENV}); \
+                 it holds measured cameras, charts and luminaires, see data/PROVENANCE.md",
+                root.display()
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     /// The directory, if one is set.
     pub fn root(&self) -> Option<&Path> {
         self.root.as_deref()
@@ -191,7 +204,7 @@ pub fn resolve_table(
     Err(Error::UnknownName {
         kind,
         name: spec.to_string(),
-        valid: format!("{}{hint}", valid.join(", ")),
+        valid: format!("{}{hint}", crate::error::brief_list(&valid)),
     })
 }
 
@@ -226,6 +239,17 @@ mod tests {
         for c in CAMERAS {
             assert_eq!(c.load().unwrap().names(), ["r", "g", "b"]);
         }
+    }
+
+    #[test]
+    fn a_missing_data_directory_is_named() {
+        assert!(DataDir::default().check().is_ok());
+        let missing = DataDir::new(Some(PathBuf::from("no/such/dir")));
+        let msg = missing.check().unwrap_err().to_string();
+        assert!(
+            msg.contains("no/such/dir") && msg.contains("does not exist"),
+            "{msg}"
+        );
     }
 
     #[test]
