@@ -19,13 +19,13 @@ pub struct Limit {
     pub default: u64,
 }
 
-/// Pixels of a photo, read from the file's header before it is decoded. 150 Mpx covers
-/// the largest camera photos (100–200 Mpx modes excepted); an 8-bit photo of that size
-/// takes 450 MB decoded.
+/// Pixels of a photo, read from the file's header before it is decoded (pixels wider than
+/// 16-bit RGB count as several). 120 Mpx covers medium-format cameras (102 Mpx); a 16-bit
+/// photo of that size takes 720 MB decoded, an 8-bit one 360 MB.
 pub const IMAGE_PIXELS: Limit = Limit {
     what: "image pixels",
     env: "SPDCAM_MAX_IMAGE_PIXELS",
-    default: 150_000_000,
+    default: 120_000_000,
 };
 
 /// Pixels of a rendered chart or scene (`render --patch-px/--size/--scene`, `generate`):
@@ -85,7 +85,12 @@ impl Limit {
     pub fn check_f64(&self, requested: f64, context: &str) -> Result<()> {
         let limit = self.value();
         if requested.is_nan() || requested > limit as f64 {
-            return Err(self.error(&format!("{requested}"), limit, requested.ceil(), context));
+            let text = if requested.fract() == 0.0 && requested < u64::MAX as f64 {
+                group_digits(requested as u64)
+            } else {
+                format!("{requested}")
+            };
+            return Err(self.error(&text, limit, requested.ceil(), context));
         }
         Ok(())
     }
@@ -142,15 +147,15 @@ mod tests {
     #[test]
     fn error_names_the_limit_and_how_to_raise_it() {
         let e = IMAGE_PIXELS
-            .check_against(400_000_000, 150_000_000, "bomb.png (20000×20000)")
+            .check_against(400_000_000, 120_000_000, "bomb.png (20000×20000)")
             .unwrap_err()
             .to_string();
         assert!(e.contains("bomb.png"), "{e}");
         assert!(e.contains("400,000,000 image pixels"), "{e}");
-        assert!(e.contains("150,000,000"), "{e}");
+        assert!(e.contains("120,000,000"), "{e}");
         assert!(e.contains("SPDCAM_MAX_IMAGE_PIXELS=400000000"), "{e}");
         assert!(IMAGE_PIXELS
-            .check_against(150_000_000, 150_000_000, "ok")
+            .check_against(120_000_000, 120_000_000, "ok")
             .is_ok());
     }
 

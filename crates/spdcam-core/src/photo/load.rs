@@ -10,8 +10,10 @@ use std::path::Path;
 /// Smallest width and height of a photo that can show a chart.
 pub const MIN_PHOTO_SIDE: usize = 16;
 /// Largest memory the decoder may allocate (a 50-megapixel 16-bit RGBA photo needs 400 MB),
-/// and the largest photo file read.
+/// and the largest photo file read; a safety net below [`limits::IMAGE_PIXELS`].
 const MAX_DECODE_BYTES: u64 = 1 << 30;
+/// Bytes of a 16-bit RGB pixel, the widest a photo is kept in.
+const RGB16_BYTES: u64 = 6;
 
 /// The pixels of a photo, interleaved RGB, as the file stored them.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,14 +76,18 @@ impl Photo {
     }
 
     /// A photo from a decoded image (any colour type; alpha is dropped, grey becomes RGB).
+    /// RGBA is turned into RGB in place, so that a large photo is not held twice.
     pub fn from_image(source: &str, image: DynamicImage) -> Result<Photo> {
         let (w, h) = (image.width() as usize, image.height() as usize);
         match image {
             DynamicImage::ImageRgb8(b) => Photo::from_rgb8(source, w, h, b.into_raw()),
             DynamicImage::ImageRgb16(b) => Photo::from_rgb16(source, w, h, b.into_raw()),
+            DynamicImage::ImageRgba8(b) => Photo::from_rgb8(source, w, h, drop_alpha(b.into_raw())),
+            DynamicImage::ImageRgba16(b) => {
+                Photo::from_rgb16(source, w, h, drop_alpha(b.into_raw()))
+            }
             DynamicImage::ImageLuma16(_)
             | DynamicImage::ImageLumaA16(_)
-            | DynamicImage::ImageRgba16(_)
             | DynamicImage::ImageRgb32F(_)
             | DynamicImage::ImageRgba32F(_) => {
                 Photo::from_rgb16(source, w, h, image.to_rgb16().into_raw())
@@ -143,6 +149,19 @@ impl Photo {
     }
 }
 
+/// Interleaved RGBA values as interleaved RGB, in the same buffer.
+fn drop_alpha<T: Copy>(mut rgba: Vec<T>) -> Vec<T> {
+    let pixels = rgba.len() / 4;
+    for i in 0..pixels {
+        for c in 0..3 {
+            rgba[3 * i + c] = rgba[4 * i + c];
+        }
+    }
+    rgba.truncate(3 * pixels);
+    rgba.shrink_to_fit();
+    rgba
+}
+
 /// Reads a photo file (JPEG, PNG 8/16-bit, TIFF; format from the content), applying its
 /// EXIF orientation.
 pub fn load_photo(path: &Path) -> Result<Photo> {
@@ -186,18 +205,19 @@ pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
         .into_decoder()
         .map_err(|e| image_error(format!("cannot decode: {e}")))?;
     let (w, h) = decoder.dimensions();
-    limits::IMAGE_PIXELS.check_against(
-        limits::product(&[w.into(), h.into()]),
-        max_pixels,
-        &format!("{source} ({w}×{h} px)"),
-    )?;
-    if decoder.total_bytes() > MAX_DECODE_BYTES {
-        return Err(image_error(format!(
-            "{w}×{h} px of {:?} take {} bytes decoded, more than {MAX_DECODE_BYTES}",
-            decoder.color_type(),
-            decoder.total_bytes()
-        )));
-    }
+    let pixels = limits::product(&[w.into(), h.into()]);
+    // Pixels wider than 16-bit RGB (alpha, floats) count as as many 16-bit RGB pixels as
+    // their bytes fill, so that the limit bounds the decoded bytes too.
+    let weighted = decoder.total_bytes().div_ceil(RGB16_BYTES);
+    let context = if weighted > pixels {
+        format!(
+            "{source} ({w}×{h} px of {:?}, counted as 16-bit RGB pixels)",
+            decoder.color_type()
+        )
+    } else {
+        format!("{source} ({w}×{h} px)")
+    };
+    limits::IMAGE_PIXELS.check_against(pixels.max(weighted), max_pixels, &context)?;
     let orientation = decoder
         .orientation()
         .unwrap_or(image::metadata::Orientation::NoTransforms);
@@ -372,6 +392,28 @@ mod tests {
         // Under the limit, the same header reaches the decoder, which finds no image data.
         let e = decode_photo(&png_bomb(100, 100), "small.png").unwrap_err();
         assert!(!e.to_string().contains("SPDCAM_MAX_IMAGE_PIXELS"), "{e}");
+    }
+
+    #[test]
+    fn alpha_is_dropped_in_place_keeping_the_colours() {
+        let img = image::ImageBuffer::<image::Rgba<u16>, _>::from_fn(17, 16, |x, y| {
+            image::Rgba([x as u16 * 100, y as u16 * 200, 7, 123])
+        });
+        let mut bytes = Vec::new();
+        DynamicImage::ImageRgba16(img)
+            .write_to(&mut Cursor::new(&mut bytes), ImageFormat::Png)
+            .unwrap();
+        let p = decode_photo(&bytes, "alpha.png").unwrap();
+        assert_eq!(p.bit_depth(), 16);
+        let v = p.pixel(16, 15);
+        let expect = [1600.0, 3000.0, 7.0].map(|x: f32| x / 65535.0);
+        for c in 0..3 {
+            assert!((v[c] - expect[c]).abs() < 1e-7, "{v:?}");
+        }
+        assert_eq!(
+            drop_alpha(vec![1u8, 2, 3, 4, 5, 6, 7, 8]),
+            [1, 2, 3, 5, 6, 7]
+        );
     }
 
     #[test]
