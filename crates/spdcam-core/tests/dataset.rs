@@ -2,6 +2,7 @@
 //! runs give the files of one run, generated features are the camera's, and imports keep
 //! every number of the thesis's data.
 
+#[cfg(feature = "measured-data")]
 mod shared_data;
 
 use spdcam_core::builtin::{self, DataDir};
@@ -240,6 +241,14 @@ fn interrupted_run_resumes_to_the_same_files() {
         })
     }));
     assert!(interrupted.is_err());
+    // The interrupted run's plan holds the directory's lock until it is dropped.
+    let e = Generator::new(&cam, &light, options(64, 5))
+        .unwrap()
+        .prepare(&dir, false)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("in use"), "{e}");
+    drop(plan);
     assert!(!dir.join("manifest.json").exists());
     assert!(Dataset::open(&dir).is_err());
     std::fs::write(dir.join(".samples-00003.parquet.999.partial"), b"PAR1 junk").unwrap();
@@ -311,6 +320,7 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     (header, rows)
 }
 
+#[cfg(feature = "measured-data")]
 #[test]
 fn import_of_the_measured_dev_set_keeps_every_number() {
     let src = shared_data::data_dir().join("thesis/measured/telelumen_canon5d4_dev");
@@ -431,6 +441,7 @@ fn unit_scale_features_are_stored_on_0_255_and_bad_files_are_named() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[cfg(feature = "measured-data")]
 #[test]
 fn split_is_seeded_complete_and_merges_back() {
     let src = shared_data::data_dir().join("thesis/measured/telelumen_canon5d4_dev");
@@ -478,6 +489,7 @@ fn split_is_seeded_complete_and_merges_back() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[cfg(feature = "measured-data")]
 #[test]
 fn import_of_thesis_weights_makes_the_thesis_spds() {
     let src = shared_data::data_dir().join("thesis/virtual/gaussian_5ch_cc24_val");

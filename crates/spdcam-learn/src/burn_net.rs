@@ -90,12 +90,12 @@ impl BurnNet {
                 data: bias,
             });
         }
-        Network::new(
+        Ok(Network::new(
             template.architecture().clone(),
             template.inputs(),
             template.outputs(),
             parameters,
-        )
+        )?)
     }
 
     /// Replaces the freezable layers (all but the output layer) by frozen copies.

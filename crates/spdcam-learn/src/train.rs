@@ -4,9 +4,10 @@
 
 use crate::burn_net::{dropout_masks, prepare, BurnNet};
 use crate::error::{LearnError, Result};
-use crate::model::{DataInfo, Model, TrainingRecord};
+use crate::model::Model;
 use crate::network::{Architecture, Network, Parameter};
 use crate::pca::Pca;
+use crate::record::{DataInfo, TrainingRecord};
 use crate::scale::{FeatureScaler, TargetScaler};
 use crate::target::{normalise, Channels, Target, TargetKind};
 use burn::optim::{AdamConfig, GradientsParams};
@@ -18,127 +19,25 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use spdcam_core::dataset::{Columns, SampleBatch};
 use spdcam_core::spectral::Grid;
+pub use spdcam_infer::record::{Backend, Schedule, TrainOptions};
 use std::ops::Range;
 use std::time::Instant;
 
-/// Where the networks train.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum Backend {
-    /// burn's flex backend on the CPU (always available).
-    #[default]
-    Cpu,
-    /// burn's CUDA backend, GPU 0 (cargo feature `cuda`).
-    Cuda,
-    /// burn's wgpu backend, the default adapter (cargo feature `wgpu`).
-    Wgpu,
-}
-
-impl Backend {
-    /// The burn device with autodiff; an error when this build lacks the backend.
-    fn device(self) -> Result<Device> {
-        let device = match self {
-            Backend::Cpu => Device::flex(),
-            #[cfg(feature = "cuda")]
-            Backend::Cuda => Device::cuda(0),
-            #[cfg(feature = "wgpu")]
-            Backend::Wgpu => Device::wgpu(Default::default()),
-            #[allow(unreachable_patterns)]
-            other => {
-                return Err(LearnError::invalid(format!(
-                    "this build has no {other:?} backend; rebuild spdcam-learn with the cargo feature {}",
-                    format!("{other:?}").to_lowercase()
-                )))
-            }
-        };
-        Ok(device.autodiff())
-    }
-}
-
-/// The optimisation schedule.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Schedule {
-    /// The most epochs to run.
-    pub epochs: usize,
-    /// Samples per optimiser step.
-    pub batch: usize,
-    /// Adam's initial learning rate.
-    pub lr: f64,
-    /// Stop after this many epochs without a better validation loss (`None`: run all).
-    pub patience: Option<usize>,
-    /// Halve the learning rate after this many epochs without improvement (`None`: constant).
-    pub plateau: Option<usize>,
-}
-
-impl Schedule {
-    /// The thesis's set-up: 200 epochs, batch 64, learning rate 1e-3, constant, no early
-    /// stopping (the best validation epoch is still the one kept).
-    pub fn thesis() -> Schedule {
-        Schedule {
-            epochs: 200,
-            batch: 64,
-            lr: 1e-3,
-            patience: None,
-            plateau: None,
-        }
-    }
-
-    /// Our default, chosen by validation measurements (docs/learning-results.md): larger
-    /// batches run faster per epoch on a CPU, and halving the learning rate on plateaus
-    /// reaches a lower loss than a constant rate.
-    pub fn default_for(architecture: &Architecture) -> Schedule {
-        match architecture {
-            Architecture::Mlp(_) => Schedule {
-                epochs: 400,
-                batch: 128,
-                lr: 1e-3,
-                patience: Some(30),
-                plateau: Some(8),
-            },
-            _ => Schedule {
-                epochs: 300,
-                batch: 128,
-                lr: 2e-3,
-                patience: Some(25),
-                plateau: Some(6),
-            },
-        }
-    }
-
-    fn validate(&self) -> Result<()> {
-        if self.epochs == 0 || self.batch == 0 {
-            return Err(LearnError::invalid(format!(
-                "epochs ({}) and batch size ({}) must be at least 1",
-                self.epochs, self.batch
-            )));
-        }
-        if !(self.lr.is_finite() && self.lr > 0.0) {
-            return Err(LearnError::invalid(format!(
-                "the learning rate {} must be positive",
-                self.lr
-            )));
-        }
-        Ok(())
-    }
-}
-
-/// Everything a training run needs besides the data.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrainOptions {
-    /// The model.
-    pub architecture: Architecture,
-    /// PCA coefficients or channel weights.
-    pub target: TargetKind,
-    /// The grid the model estimates SPDs on (a sub-grid of the dataset's).
-    pub grid: Grid,
-    /// The optimisation schedule (ignored by `linear`).
-    pub schedule: Schedule,
-    /// Seed of the split, the initial weights, the shuffling and the dropout.
-    pub seed: u64,
-    /// The share of the data held out for validation when no validation set is given.
-    pub val_split: f64,
-    /// Where to train.
-    pub backend: Backend,
+/// The burn device of `backend`, with autodiff; an error when this build lacks the backend.
+fn device(backend: Backend) -> Result<Device> {
+    let device = match backend {
+        Backend::Cpu => Device::flex(),
+        #[cfg(feature = "cuda")]
+        Backend::Cuda => Device::cuda(0),
+        #[cfg(feature = "wgpu")]
+        Backend::Wgpu => Device::wgpu(Default::default()),
+        #[allow(unreachable_patterns)]
+        other => return Err(LearnError::invalid(format!(
+            "this build has no {other:?} backend; rebuild spdcam-learn with the cargo feature {}",
+            format!("{other:?}").to_lowercase()
+        ))),
+    };
+    Ok(device.autodiff())
 }
 
 /// A dataset in memory with what the model file records about it.
@@ -515,7 +414,7 @@ pub fn train_in_parts(
         fitted.target,
         fitted.targets,
         options.grid,
-        data,
+        data.columns.feature_names.clone(),
         record,
     )?;
     Ok(Trained { model, log })
@@ -674,7 +573,7 @@ fn fit_network(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<(Network, Vec<EpochRecord>, usize)> {
     keep_freed_memory();
-    let device = backend.device()?;
+    let device = device(backend)?;
     device.seed(seed);
     let architecture = init.architecture().clone();
     let f = init.inputs();
@@ -839,7 +738,7 @@ pub fn finetune(
         &spds,
         &grid,
         (options.val_split, options.seed),
-        |v| model.check_features(&v.columns.feature_names, &v.info.path),
+        |v| Ok(model.check_features(&v.columns.feature_names, &v.info.path)?),
     )?;
     let train_spds = take_rows(&spds, d, &train_idx);
     let (target, targets) = match (model.target(), options.refit_pca) {
@@ -919,7 +818,7 @@ pub fn finetune(
         fitted.target,
         fitted.targets,
         grid,
-        data,
+        data.columns.feature_names.clone(),
         record,
     )?;
     if let Some(template) = model.photo_chart() {

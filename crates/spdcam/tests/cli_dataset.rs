@@ -223,6 +223,7 @@ fn generated_features_equal_spdcam_render_of_their_spd() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[cfg(feature = "measured-data")]
 #[test]
 fn thesis_dev_set_imports_without_losing_a_number() {
     let root = std::env::var_os("SPDCAM_DATA")

@@ -1,5 +1,5 @@
-//! One sample file: a Parquet file with one row group, flat and wide, so that pandas,
-//! polars, DuckDB and Spark read it as it is.
+//! Writing one sample file: a Parquet file with one row group, flat and wide, so that
+//! pandas, polars, DuckDB and Spark read it as it is (`file_read` reads it back).
 
 use super::batch::{Columns, Precision, SampleBatch};
 use crate::error::{Error, Result};
@@ -7,13 +7,10 @@ use parquet::basic::{
     Compression as ParquetCompression, ConvertedType, Encoding, LogicalType, Repetition,
     Type as PhysicalType, ZstdLevel,
 };
-use parquet::column::reader::{ColumnReader, ColumnReaderImpl};
-use parquet::data_type::{ByteArray, DataType, DoubleType, FloatType, Int32Type, Int64Type};
+use parquet::data_type::{ByteArray, DoubleType, FloatType, Int32Type, Int64Type};
 use parquet::file::properties::{EnabledStatistics, WriterProperties};
-use parquet::file::reader::{FileReader, SerializedFileReader};
 use parquet::file::writer::{SerializedColumnWriter, SerializedFileWriter};
 use parquet::schema::types::{ColumnPath, Type};
-use std::path::Path;
 use std::sync::Arc;
 
 /// What each column holds, in file order.
@@ -96,20 +93,6 @@ impl FileFormat {
             Field::Spd(_) | Field::Weight(_) => float(self.values),
             Field::Attempts => PhysicalType::INT32,
         }
-    }
-}
-
-/// Whether a column of `field` may have `found` as its physical type: the float columns
-/// are read as FLOAT or DOUBLE whatever the manifest's precision (datasets written before
-/// SPDs were stored as FLOAT hold DOUBLE ones; both convert to `f64` exactly).
-fn accepts(field: Field, found: PhysicalType) -> bool {
-    match field {
-        Field::Sample => found == PhysicalType::INT64,
-        Field::Family => found == PhysicalType::BYTE_ARRAY,
-        Field::Feature(_) | Field::Spd(_) | Field::Weight(_) => {
-            matches!(found, PhysicalType::FLOAT | PhysicalType::DOUBLE)
-        }
-        Field::Attempts => found == PhysicalType::INT32,
     }
 }
 
@@ -269,150 +252,4 @@ fn write_floats(
                 .write_batch(doubles, None, None)
         }
     }
-}
-
-/// Opens a sample file and checks its columns against `columns`; returns the reader.
-fn open(path: &Path, columns: &Columns) -> Result<SerializedFileReader<std::fs::File>> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let bad = |msg: String| Error::parse(path.display().to_string(), msg);
-    let reader = SerializedFileReader::new(file)
-        .map_err(|e| bad(format!("not a readable Parquet file: {e}")))?;
-    let descr = reader.metadata().file_metadata().schema_descr_ptr();
-    let names = columns.column_names();
-    if descr.num_columns() != names.len() {
-        return Err(bad(format!(
-            "{} columns, the manifest describes {}",
-            descr.num_columns(),
-            names.len()
-        )));
-    }
-    for (i, (field, name)) in fields(columns).into_iter().zip(&names).enumerate() {
-        let c = descr.column(i);
-        if c.name() != name || !accepts(field, c.physical_type()) {
-            return Err(bad(format!(
-                "column {} is '{}' ({}), the manifest expects '{name}' ({})",
-                i + 1,
-                c.name(),
-                c.physical_type(),
-                FileFormat::for_columns(columns).physical_type(field)
-            )));
-        }
-        // Optional (nullable) columns are what pandas and pyarrow write; they are read as long
-        // as no value is missing.
-        if c.max_def_level() > 1 || c.max_rep_level() != 0 {
-            return Err(bad(format!("column '{name}' is not a flat column")));
-        }
-    }
-    Ok(reader)
-}
-
-/// The number of rows of a sample file whose columns match `columns`.
-pub(crate) fn row_count(path: &Path, columns: &Columns) -> Result<u64> {
-    Ok(open(path, columns)?.metadata().file_metadata().num_rows() as u64)
-}
-
-fn read_values<T: DataType>(
-    reader: &mut ColumnReaderImpl<T>,
-    rows: usize,
-    path: &Path,
-) -> Result<Vec<T::T>> {
-    let bad = |msg: String| Error::parse(path.display().to_string(), msg);
-    let mut values = Vec::with_capacity(rows);
-    let mut levels = Vec::with_capacity(rows);
-    let (records, _, _) = reader
-        .read_records(rows, Some(&mut levels), None, &mut values)
-        .map_err(|e| bad(e.to_string()))?;
-    if records != rows {
-        return Err(bad(format!(
-            "a column holds {records} rows where the row group has {rows}"
-        )));
-    }
-    if values.len() != rows {
-        return Err(bad(format!(
-            "a column has {} missing (null) values; every sample needs all its values",
-            rows - values.len().min(rows)
-        )));
-    }
-    Ok(values)
-}
-
-/// Reads a FLOAT or DOUBLE column as `f64`.
-fn read_floats(column: ColumnReader, rows: usize, path: &Path) -> Result<Vec<f64>> {
-    match column {
-        ColumnReader::FloatColumnReader(mut r) => Ok(read_values(&mut r, rows, path)?
-            .into_iter()
-            .map(f64::from)
-            .collect()),
-        ColumnReader::DoubleColumnReader(mut r) => read_values(&mut r, rows, path),
-        _ => Err(Error::parse(
-            path.display().to_string(),
-            "a feature, SPD or weight column is not FLOAT or DOUBLE",
-        )),
-    }
-}
-
-/// Reads a whole sample file whose columns must match `columns`.
-pub(crate) fn decode(path: &Path, columns: &Columns) -> Result<SampleBatch> {
-    let reader = open(path, columns)?;
-    let bad = |msg: String| Error::parse(path.display().to_string(), msg);
-    let mut batch = columns.batch();
-    for g in 0..reader.num_row_groups() {
-        let group = reader.get_row_group(g).map_err(|e| bad(e.to_string()))?;
-        let rows = group.metadata().num_rows() as usize;
-        let start = batch.len();
-        batch
-            .features
-            .resize((start + rows) * batch.feature_count, 0.0);
-        batch.spds.resize((start + rows) * batch.spd_len, 0.0);
-        batch
-            .weights
-            .resize((start + rows) * batch.weight_count, 0.0);
-        let scatter = |target: &mut Vec<f64>, stride: usize, j: usize, values: Vec<f64>| {
-            for (r, v) in values.into_iter().enumerate() {
-                target[(start + r) * stride + j] = v;
-            }
-        };
-        for (i, field) in fields(columns).into_iter().enumerate() {
-            let column = group.get_column_reader(i).map_err(|e| bad(e.to_string()))?;
-            match (field, column) {
-                (Field::Sample, ColumnReader::Int64ColumnReader(mut r)) => batch.samples.extend(
-                    read_values(&mut r, rows, path)?
-                        .into_iter()
-                        .map(|v| v as u64),
-                ),
-                (Field::Family, ColumnReader::ByteArrayColumnReader(mut r)) => {
-                    for v in read_values(&mut r, rows, path)? {
-                        let text = v
-                            .as_utf8()
-                            .map_err(|_| bad("a family name is not UTF-8".into()))?;
-                        batch.families.push(text.to_string());
-                    }
-                }
-                (Field::Feature(j), reader) => {
-                    let values = read_floats(reader, rows, path)?;
-                    scatter(&mut batch.features, batch.feature_count, j, values)
-                }
-                (Field::Spd(j), reader) => {
-                    let values = read_floats(reader, rows, path)?;
-                    scatter(&mut batch.spds, batch.spd_len, j, values)
-                }
-                (Field::Weight(j), reader) => {
-                    let values = read_floats(reader, rows, path)?;
-                    scatter(&mut batch.weights, batch.weight_count, j, values)
-                }
-                (Field::Attempts, ColumnReader::Int32ColumnReader(mut r)) => batch.attempts.extend(
-                    read_values(&mut r, rows, path)?
-                        .into_iter()
-                        .map(|v| v as u32),
-                ),
-                (field, _) => {
-                    return Err(bad(format!(
-                        "column {} ({field:?}) has an unexpected type",
-                        i + 1
-                    )))
-                }
-            }
-        }
-    }
-    Ok(batch)
 }
