@@ -225,20 +225,25 @@ mod tests {
 
     #[test]
     fn bisection_matches_the_scan_on_the_reference_cases() {
-        let reference: serde_json::Value = serde_json::from_str(include_str!(
-            "../../tests/reference/colorimetry.json"
-        ))
-        .unwrap();
+        let reference: serde_json::Value =
+            serde_json::from_str(include_str!("../../tests/reference/colorimetry.json")).unwrap();
         let cases = reference["cct_duv"]["cases"].as_array().unwrap();
         assert!(cases.len() >= 10);
         let table = planck_table();
         for case in cases {
-            let uv = [case["uv"][0].as_f64().unwrap(), case["uv"][1].as_f64().unwrap()];
+            let uv = [
+                case["uv"][0].as_f64().unwrap(),
+                case["uv"][1].as_f64().unwrap(),
+            ];
             let m = nearest_row(table, uv);
             assert_eq!(m, nearest_row_by_scan(table, uv), "{}", case["source"]);
             // colour-science's Ohno 2013 CCT lies between the neighbours of the row found.
             let cct = case["CCT"].as_f64().unwrap();
-            assert!(table[m - 1][0] <= cct && cct <= table[m + 1][0], "{}", case["source"]);
+            assert!(
+                table[m - 1][0] <= cct && cct <= table[m + 1][0],
+                "{}",
+                case["source"]
+            );
         }
     }
 
