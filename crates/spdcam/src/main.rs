@@ -18,6 +18,7 @@ mod plot_file;
 mod render;
 #[cfg(feature = "train")]
 mod ridge;
+mod serve;
 #[cfg(feature = "train")]
 mod sim2real_curve;
 #[cfg(feature = "train")]
@@ -68,6 +69,8 @@ enum Command {
     #[cfg(feature = "train")]
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
     Sim2real(experiment_sim2real::Sim2realArgs),
+    /// Serve a local web page where photos are dropped and their light is shown.
+    Serve(serve::ServeArgs),
 }
 
 /// Output piped into a program that stops reading (`spdcam … | head`) ends spdcam quietly,
@@ -106,6 +109,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),
         #[cfg(feature = "train")]
         Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
+        Command::Serve(args) => serve::run(args, &data_dir),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
