@@ -125,6 +125,7 @@ await test('a reference SPD is overlaid with GFC and RMSE equal to the CLI truth
 await test('dragging a corner re-runs the estimate with those corners', async () => {
   const before = await plottedSpd(page, expected.name);
   const handle = page.locator('#stage circle.handle[data-corner="0"]');
+  await handle.scrollIntoViewIfNeeded();
   const box = await handle.boundingBox();
   check(box, 'no corner handle');
   const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];

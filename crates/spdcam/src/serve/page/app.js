@@ -240,6 +240,7 @@ function renderStage() {
   stage.replaceChildren();
   if (!e) { html('p', { class: 'placeholder' }, stage, 'No photo yet.'); return; }
   const photo = e.result && e.result.photo;
+  if (e.error && !e.result) { html('p', { class: 'error' }, stage, e.error); return; }
   const img = html('img', { src: e.url, alt: e.name }, stage);
   const draw = (w, h) => {
     if (!photo) return;
