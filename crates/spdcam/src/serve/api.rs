@@ -114,7 +114,10 @@ impl Api {
     /// `GET /api/jobs/ID`: where the job is, and its result once finished.
     fn job(&self, id: &str) -> Answer {
         let Some(progress) = id.parse::<u64>().ok().and_then(|id| self.jobs.progress(id)) else {
-            return Answer::error(404, format!("no job '{id}' (finished jobs are kept a while)"));
+            return Answer::error(
+                404,
+                format!("no job '{id}' (finished jobs are kept a while)"),
+            );
         };
         let value = match progress {
             Progress::Queued { ahead } => serde_json::json!({ "state": "queued", "ahead": ahead }),
@@ -241,7 +244,11 @@ fn locus_json() -> Result<serde_json::Value> {
         let xyz = [observer.cmf(0)[i], observer.cmf(1)[i], observer.cmf(2)[i]];
         let sum: f64 = xyz.iter().sum();
         if sum > 0.0 {
-            spectral.push(serde_json::json!([wavelengths[i], xyz[0] / sum, xyz[1] / sum]));
+            spectral.push(serde_json::json!([
+                wavelengths[i],
+                xyz[0] / sum,
+                xyz[1] / sum
+            ]));
         }
     }
     let mut planckian = Vec::new();
@@ -280,8 +287,14 @@ mod tests {
             .iter()
             .find(|p| p[0].as_f64() == Some(520.0))
             .unwrap();
-        assert!((at520[1].as_f64().unwrap() - 0.0743).abs() < 5e-4, "{at520}");
-        assert!((at520[2].as_f64().unwrap() - 0.8338).abs() < 5e-4, "{at520}");
+        assert!(
+            (at520[1].as_f64().unwrap() - 0.0743).abs() < 5e-4,
+            "{at520}"
+        );
+        assert!(
+            (at520[2].as_f64().unwrap() - 0.8338).abs() < 5e-4,
+            "{at520}"
+        );
         // The Planckian radiator near 2856 K (illuminant A): x 0.4476, y 0.4074.
         let near_a = locus["planckian"]
             .as_array()
@@ -294,6 +307,9 @@ mod tests {
             .unwrap();
         let t = near_a[0].as_f64().unwrap();
         assert!((t - 2856.0).abs() < 80.0, "{near_a}");
-        assert!((near_a[1].as_f64().unwrap() - 0.4476).abs() < 0.006, "{near_a}");
+        assert!(
+            (near_a[1].as_f64().unwrap() - 0.4476).abs() < 0.006,
+            "{near_a}"
+        );
     }
 }

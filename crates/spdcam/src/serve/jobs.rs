@@ -201,6 +201,7 @@ impl Jobs {
     }
 
     /// Stops the workers (after their current job) and wakes every waiter.
+    #[cfg(test)]
     pub fn stop(&self) {
         self.lock().stopping = true;
         self.changed.notify_all();

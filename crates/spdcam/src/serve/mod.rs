@@ -53,7 +53,9 @@ pub struct Config {
 
 /// A running server.
 pub struct Server {
+    #[cfg(test)]
     http: Arc<tiny_http::Server>,
+    #[cfg(test)]
     jobs: Arc<Jobs>,
     threads: Vec<JoinHandle<()>>,
     addr: SocketAddr,
@@ -85,7 +87,9 @@ impl Server {
             }));
         }
         Ok(Server {
+            #[cfg(test)]
             http,
+            #[cfg(test)]
             jobs,
             threads,
             addr,
@@ -110,6 +114,7 @@ impl Server {
     }
 
     /// Stops serving and joins the threads.
+    #[cfg(test)]
     pub fn stop(self) {
         self.jobs.stop();
         for _ in 0..REQUEST_THREADS {

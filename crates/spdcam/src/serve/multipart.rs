@@ -123,11 +123,16 @@ mod tests {
             boundary("multipart/form-data; boundary=\"ab\"").unwrap(),
             "ab"
         );
-        assert!(boundary("application/json").unwrap_err().contains("multipart"));
+        assert!(boundary("application/json")
+            .unwrap_err()
+            .contains("multipart"));
         assert!(boundary("multipart/form-data").is_err());
         assert!(parse(b"no parts here", "b").is_err());
-        assert!(parse(b"--b\r\nContent-Disposition: form-data; name=\"x\"\r\n\r\nabc", "b")
-            .unwrap_err()
-            .contains("closing boundary"));
+        assert!(parse(
+            b"--b\r\nContent-Disposition: form-data; name=\"x\"\r\n\r\nabc",
+            "b"
+        )
+        .unwrap_err()
+        .contains("closing boundary"));
     }
 }

@@ -108,7 +108,8 @@ fn twenty_concurrent_uploads_are_all_answered_correctly() {
                 s.spawn(move || {
                     let name = format!("room-{i}.jpg");
                     let body = form(&[("photo", Some(name.as_str()), EXAMPLE)]);
-                    let (status, body) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+                    let (status, body) =
+                        request(addr, "POST", "/api/estimate", Some(body.as_slice()));
                     (status, json(&body))
                 })
             })
@@ -129,7 +130,12 @@ fn twenty_concurrent_uploads_are_all_answered_correctly() {
 fn the_answer_equals_the_library_estimate() {
     let server = start(16 << 20);
     let body = form(&[("photo", Some("sg-telelumen.jpg"), EXAMPLE)]);
-    let (status, got) = request(server.addr(), "POST", "/api/estimate", Some(body.as_slice()));
+    let (status, got) = request(
+        server.addr(),
+        "POST",
+        "/api/estimate",
+        Some(body.as_slice()),
+    );
     assert_eq!(status, 200);
     assert_eq!(json(&got), expected("sg-telelumen.jpg"));
     server.stop();
@@ -139,7 +145,12 @@ fn the_answer_equals_the_library_estimate() {
 fn an_upload_over_the_limit_is_refused_with_413() {
     let server = start(100 << 10);
     let body = form(&[("photo", Some("big.jpg"), EXAMPLE)]);
-    let (status, got) = request(server.addr(), "POST", "/api/estimate", Some(body.as_slice()));
+    let (status, got) = request(
+        server.addr(),
+        "POST",
+        "/api/estimate",
+        Some(body.as_slice()),
+    );
     assert_eq!(status, 413);
     let message = json(&got)["error"].as_str().unwrap().to_string();
     assert!(message.contains("limit"), "{message}");
@@ -161,7 +172,10 @@ fn bad_input_gets_a_clear_error_and_the_server_keeps_serving() {
         ),
         (form(&[("other", None, b"x")]), 400, "no field 'photo'"),
         (
-            form(&[("photo", Some("p.jpg"), EXAMPLE), ("corners", None, b"1,2,3")]),
+            form(&[
+                ("photo", Some("p.jpg"), EXAMPLE),
+                ("corners", None, b"1,2,3"),
+            ]),
             400,
             "eight numbers",
         ),
@@ -199,7 +213,10 @@ fn a_job_is_polled_until_its_estimate_is_done() {
         assert_eq!(status, 200);
         let got = json(&got);
         let state = got["state"].as_str().unwrap().to_string();
-        assert!(["queued", "running", "done"].contains(&state.as_str()), "{got}");
+        assert!(
+            ["queued", "running", "done"].contains(&state.as_str()),
+            "{got}"
+        );
         states.push(state);
         if got["state"] == "done" {
             break got["result"].clone();
