@@ -234,7 +234,7 @@ fn the_page_and_its_assets_are_embedded() {
     let server = start(16 << 20);
     for (path, needle) in [
         ("/", "<html"),
-        ("/app.js", "/api/jobs"),
+        ("/app.js", "api/jobs/"),
         ("/style.css", "{"),
     ] {
         let (status, body) = request(server.addr(), "GET", path, None);
