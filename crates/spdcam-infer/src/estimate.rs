@@ -16,6 +16,7 @@ use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
 use spdcam_core::metrics;
 use spdcam_core::photo::{self, AnalyseOptions, ChartTemplate, PhotoAnalysis};
+use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use std::path::{Path, PathBuf};
 
@@ -213,6 +214,9 @@ pub struct Estimate {
     pub spd: Vec<f64>,
     /// xy, CCT, Duv of the SPD.
     pub colorimetry: Colorimetry,
+    /// The lighting-quality metrics of the SPD (CRI, TM-30, α-opic, S/P, PPF, blue-light
+    /// hazard; `spdcam_core::quality`), computed on the SPD's grid only.
+    pub metrics: LightingMetrics,
     /// The score against a true SPD, when one was given.
     pub truth: Option<Score>,
     /// The analysis of the photo, for estimates from photos.
@@ -220,8 +224,8 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`, `truth`,
-    /// and for photos `photo` (chart, method, confidence, corners, homography, features and
+    /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`,
+    /// `metrics` (every [`LightingMetrics`] key), `truth`, and for photos `photo` (chart, method, confidence, corners, homography, features and
     /// `features_by_name`, every patch with its statistics and flags, warnings).
     pub fn to_json(&self) -> Result<serde_json::Value> {
         let mut v = serde_json::json!({
@@ -230,6 +234,7 @@ impl Estimate {
             "wavelength_nm": self.grid.wavelengths(),
             "spd": self.spd,
             "colorimetry": self.colorimetry,
+            "metrics": self.metrics,
             "truth": self.truth,
         });
         if let Some(a) = &self.photo {
@@ -282,6 +287,7 @@ pub fn estimate_features(
                 grid: *grid,
                 spd: set.item(i).to_vec(),
                 colorimetry: Colorimetry::of(set.item(i), grid)?,
+                metrics: LightingMetrics::from_samples(&grid.wavelengths(), set.item(i)),
                 truth: None,
                 photo: None,
             })
@@ -411,6 +417,7 @@ pub fn estimate_analysis(
         model: chosen.name.clone(),
         grid: *grid,
         colorimetry: Colorimetry::of(&spd, grid)?,
+        metrics: LightingMetrics::from_samples(&grid.wavelengths(), &spd),
         spd,
         truth: None,
         photo: Some(analysis),

@@ -12,6 +12,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
 use spdcam_core::metrics;
 use spdcam_core::photo::{self, PhotoAnalysis};
+use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_infer::estimate::{analyse_photos, chart_templates, estimate_analysis};
 use spdcam_infer::plot::spds_svg;
@@ -282,6 +283,7 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
         if detailed {
             println!("{}: {}", e.name, e.colorimetry.label());
             println!("  relative SPD: {}", spd_line(&e.spd, &e.grid));
+            println!("  {}", metrics_line(&e.metrics));
         }
         if let Some(s) = e.truth {
             println!(
@@ -293,6 +295,16 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     if estimates.iter().any(|e| e.photo.is_some()) {
         println!(
             "confidence: how sure the chart's detection is (0–1; below 0.8 check the --debug image)"
+        );
+    }
+    if detailed {
+        println!(
+            "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and gamut; \
+             M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: scotopic/photopic; \
+             PPF: µmol/s of 400–700 nm photons per klm; computed on the estimate's {}–{} nm only \
+             (`spdcam metrics` on a wider SPD, `--json` for every number)",
+            estimates[0].grid.start_nm,
+            estimates[0].grid.end_nm()
         );
     }
     if estimates.iter().any(|e| e.truth.is_some()) {
@@ -310,6 +322,21 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     if let Some(plot) = &args.plot {
         println!("plot → {}", plot.display());
     }
+}
+
+/// The main lighting-quality numbers on one line, `—` where undefined.
+fn metrics_line(m: &LightingMetrics) -> String {
+    let f = |v: Option<f64>, d: usize| v.map_or_else(|| "—".into(), |v| format!("{v:.d$}"));
+    format!(
+        "Ra {} (R9 {}), Rf {}, Rg {}, M-EDER {}, S/P {}, PPF {}",
+        f(m.cri_ra, 0),
+        f(m.cri_r.map(|r| r[8]), 0),
+        f(m.tm30_rf, 0),
+        f(m.tm30_rg, 0),
+        f(m.mel_der, 2),
+        f(m.sp_ratio, 2),
+        f(m.ppf_per_lux.map(|v| 1000.0 * v), 1),
+    )
 }
 
 /// The SPD every 25 nm, peak-normalised, on one terminal line: `400:0.12 425:0.40 …`.
