@@ -79,6 +79,9 @@ impl Api {
         let path = url.split('?').next().unwrap_or("");
         let get = *request.method() == Method::Get;
         let post = *request.method() == Method::Post;
+        if let Some(id) = path.strip_prefix("/api/jobs/").filter(|_| get) {
+            return self.job(id);
+        }
         match path {
             "/" | "/index.html" if get => {
                 Answer(200, "text/html; charset=utf-8", INDEX_HTML.into())
@@ -101,7 +104,6 @@ impl Api {
                 },
                 Err(answer) => answer,
             },
-            _ if path.starts_with("/api/jobs/") && get => self.job(&path["/api/jobs/".len()..]),
             "/" | "/index.html" | "/app.js" | "/style.css" | "/example.jpg" | "/api/locus"
             | "/api/estimate" | "/api/jobs" => Answer::error(
                 405,

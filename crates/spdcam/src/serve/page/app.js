@@ -410,10 +410,19 @@ function row(table, label, value, id) {
   return td;
 }
 
-/** A metrics object (possibly nested) as table rows. */
+/** Readable names of the lighting metrics' keys; other keys are shown as they are. */
+const METRIC_LABELS = {
+  cct_k: 'CCT (K)', duv: 'Duv', cri_ra: 'CRI Ra', tm30_rf: 'TM-30 Rf', tm30_rg: 'TM-30 Rg',
+  mel_der: 'melanopic DER', sp_ratio: 'S/P ratio', ppf_per_lux: 'PPF per lux (µmol s⁻¹ m⁻² lx⁻¹)',
+  blh_efficacy_w_per_lm: 'blue-light hazard efficacy (W/lm)', alpha_opic_der: 'α-opic DER',
+  alpha_opic_elr_mw_per_lm: 'α-opic ELR (mW/lm)', reasons: 'not given:',
+};
+
+/** A metrics object (possibly nested) as table rows; lists (per-sample values) are left out. */
 function metricRows(table, obj, prefix) {
   for (const [k, v] of Object.entries(obj)) {
-    const label = prefix ? `${prefix} ${k}` : k;
+    if (k === 'warnings') continue;
+    const label = prefix ? `${prefix} ${METRIC_LABELS[k] || k}` : METRIC_LABELS[k] || k;
     if (v && typeof v === 'object' && !Array.isArray(v)) metricRows(table, v, label);
     else if (typeof v === 'number') row(table, label, Math.abs(v) >= 100 ? v.toFixed(0) : v.toPrecision(4));
     else if (typeof v === 'string' || typeof v === 'boolean') row(table, label, String(v));
@@ -460,7 +469,7 @@ function renderSummary() {
     html('h2', {}, box, 'Lighting metrics');
     metricRows(html('table', { id: 'metrics' }, box), r.metrics, '');
   }
-  const warnings = (r.photo && r.photo.warnings) || [];
+  const warnings = ((r.photo && r.photo.warnings) || []).concat((r.metrics && r.metrics.warnings) || []);
   if (warnings.length) {
     html('h2', {}, box, 'Warnings');
     const ul = html('ul', { class: 'warnings', id: 'warnings' }, box);
