@@ -470,6 +470,39 @@ pub fn estimate_photo(
     estimate_analysis(models, analysis, name, grid)
 }
 
+/// Analyses a photo held in memory (an upload, never written to disk) named `name` in
+/// messages: decoded with the same limits as a file, the chart found (or placed by
+/// `options.corners`) among the charts [`chart_templates`] gives, and sampled.
+pub fn analyse_photo_bytes(
+    bytes: &[u8],
+    name: &str,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+) -> Result<PhotoAnalysis> {
+    let templates = chart_templates(models, options.chart.as_deref(), data_dir)?;
+    let decoded = photo::decode_photo(bytes, name)?;
+    let analyse = AnalyseOptions {
+        templates,
+        corners: options.corners.clone(),
+        debug: options.debug.clone(),
+    };
+    Ok(photo::analyse(&decoded, &analyse)?)
+}
+
+/// [`estimate_photo`] for a photo held in memory, labelled `name`.
+pub fn estimate_photo_bytes(
+    bytes: &[u8],
+    name: &str,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Estimate> {
+    let analysis = analyse_photo_bytes(bytes, name, models, options, data_dir)?;
+    estimate_analysis(models, analysis, name.to_string(), grid)
+}
+
 /// `colorchecker_sg96, colorchecker24`: the charts the set's models read.
 fn charts_of(models: &ModelSet) -> String {
     models
