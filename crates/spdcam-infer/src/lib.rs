@@ -38,6 +38,8 @@ pub mod shipped;
 pub mod target;
 
 pub use error::{InferError, Result};
-pub use estimate::{estimate_features, estimate_photo, Estimate, FeatureRows, PhotoOptions};
+pub use estimate::{
+    estimate_decoded, estimate_features, estimate_photo, Estimate, FeatureRows, PhotoOptions,
+};
 pub use model::Model;
 pub use shipped::ModelSet;
