@@ -34,6 +34,8 @@ __all__ = [
     "read_photo",
     "estimate",
     "estimate_features",
+    "Rendering",
+    "render",
     "__version__",
 ]
 
@@ -416,4 +418,61 @@ def estimate_features(
         xy=np.frombuffer(xy, dtype=np.float64).reshape(rows, 2),
         cct=np.frombuffer(cct, dtype=np.float64),
         duv=np.frombuffer(duv, dtype=np.float64),
+    )
+
+
+@dataclass(frozen=True)
+class Rendering:
+    """A chart rendered under a light by a simulated camera."""
+
+    #: The rendered chart, encoded sRGB 0–1: shape (height, width, 3), float32.
+    image: np.ndarray
+    #: The feature columns, ``p01_r, p01_g, …``.
+    feature_names: list[str]
+    #: The feature row (mean encoded sRGB 0–255 of each feature patch), as a model reads it.
+    features: np.ndarray
+
+    def to_uint8(self) -> np.ndarray:
+        """The image as 8-bit sRGB, as ``spdcam render`` writes it to PNG."""
+        return np.rint(np.clip(self.image, 0.0, 1.0) * 255.0).astype(np.uint8)
+
+
+def render(
+    spd: Any,
+    wavelengths: Optional[Sequence[float]] = None,
+    *,
+    camera: str = "nikon_d5100_npl",
+    chart: str = "colorchecker24",
+    patch_px: int = 24,
+    seed: int = 0,
+) -> Rendering:
+    """Renders a chart photographed under a light, as ``spdcam render`` with its default
+    camera settings: the same light and seed give the same image and features.
+
+    ``spd`` names a light (``"D65"``, ``"A"``, ``"cct:4000"``, ``"daylight:5000"``,
+    ``"planck:3000"``, a spectral CSV path), or is its values on ``wavelengths`` (nm), or a
+    ``colour.SpectralDistribution``. ``camera`` and ``chart`` are built-in names (``spdcam
+    list``) or CSV files.
+    """
+    if hasattr(spd, "wavelengths") and hasattr(spd, "values") and wavelengths is None:
+        wavelengths, spd = spd.wavelengths, spd.values
+    if isinstance(spd, (str, os.PathLike)):
+        if wavelengths is not None:
+            raise SpdcamError("wavelengths go with SPD values, not with a named light")
+        args: tuple = (os.fspath(spd), None, None)
+    else:
+        values = np.asarray(spd, dtype=np.float64).ravel()
+        if wavelengths is None:
+            raise SpdcamError("SPD values need their wavelengths (nm)")
+        wl = np.asarray(wavelengths, dtype=np.float64).ravel()
+        if wl.size != values.size:
+            raise SpdcamError(f"{wl.size} wavelengths for {values.size} SPD values")
+        args = ("light", wl.tolist(), values.tolist())
+    width, height, data, names, features = _native.render(
+        *args, camera=camera, chart=chart, patch_px=patch_px, seed=seed
+    )
+    return Rendering(
+        image=np.frombuffer(data, dtype=np.float32).reshape(height, width, 3),
+        feature_names=list(names),
+        features=np.asarray(features, dtype=np.float32),
     )

@@ -8,7 +8,12 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use spdcam_core::builtin::DataDir;
+use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::camera::sensor::Sensitivities;
+use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::chart::{Chart, Layout};
+use spdcam_core::light;
+use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
 use spdcam_core::photo::{decode_photo, load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_infer::estimate::estimate_decoded;
@@ -273,6 +278,72 @@ fn read_photo(py: Python<'_>, path: PathBuf) -> PyResult<(usize, usize, u32, Bou
     ))
 }
 
+/// What `render` returns: width, height, the image as native-endian `f32` bytes (encoded
+/// sRGB 0–1, interleaved RGB), the feature names, and the features (mean sRGB 0–255).
+type RenderResult<'py> = (usize, usize, Bound<'py, PyBytes>, Vec<String>, Vec<f32>);
+
+/// Renders `chart` photographed by `camera` (the command line's default settings) under a
+/// light: `spd` names one (D65, A, cct:T, daylight:T, planck:T, a spectral CSV) or, with
+/// `wavelengths`, is its values; `spdcam render` with the same light and seed gives the
+/// same image and features.
+#[pyfunction]
+#[pyo3(signature = (spd, wavelengths=None, values=None, camera="nikon_d5100_npl", chart="colorchecker24", patch_px=24, seed=0))]
+#[allow(clippy::too_many_arguments)]
+fn render<'py>(
+    py: Python<'py>,
+    spd: &str,
+    wavelengths: Option<Vec<f64>>,
+    values: Option<Vec<f64>>,
+    camera: &str,
+    chart: &str,
+    patch_px: usize,
+    seed: u64,
+) -> PyResult<RenderResult<'py>> {
+    let rendering = py
+        .allow_threads(|| -> spdcam_core::Result<_> {
+            let grid = Grid::SIMULATION;
+            let data_dir = DataDir::new(None);
+            let light = match (wavelengths, values) {
+                (Some(w), Some(v)) => {
+                    let set = SpectralSet::new(w, vec![spd.to_string()], vec![v])?;
+                    let (set, _) =
+                        set.resample(&grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
+                    set.item(0).to_vec()
+                }
+                _ => light::resolve_spd(spd, &data_dir, &grid)?.values,
+            };
+            let chart = Chart::resolve(chart, None, &data_dir, &grid)?;
+            let layout = Layout::grid(chart.layout.rows, chart.layout.cols, patch_px, 0, 0);
+            let chart = chart.with_layout(layout)?;
+            let (name, measured) = builtin::resolve_table(
+                camera,
+                "camera",
+                builtin::CAMERAS,
+                &data_dir,
+                &["cameras", "thesis"],
+            )?;
+            let sensitivities = Sensitivities::new(&name, &measured, &grid)?;
+            let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid)?;
+            let rendering = camera.render(&light, seed, false)?;
+            Ok((rendering, camera.chart().feature_names()))
+        })
+        .map_err(py_err)?;
+    let (rendering, names) = rendering;
+    let image = &rendering.image;
+    let bytes: Vec<u8> = (0..image.height)
+        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+        .flat_map(|(x, y)| image.pixel(x, y))
+        .flat_map(f32::to_ne_bytes)
+        .collect();
+    Ok((
+        image.width,
+        image.height,
+        PyBytes::new(py, &bytes),
+        names,
+        rendering.features,
+    ))
+}
+
 /// Seconds the library alone takes for `repeats` estimates from the photo file at `path`
 /// (no Python conversions): the baseline of `python/bench.py`.
 #[pyfunction]
@@ -325,6 +396,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(estimate_pixels, m)?)?;
     m.add_function(wrap_pyfunction!(estimate_rows, m)?)?;
     m.add_function(wrap_pyfunction!(read_photo, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(library_seconds_photo, m)?)?;
     m.add_function(wrap_pyfunction!(library_seconds_rows, m)?)?;
     Ok(())
