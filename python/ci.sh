@@ -15,7 +15,7 @@ pip=("$venv/bin/python" -m pip install --quiet --disable-pip-version-check)
 "${pip[@]}" pytest numpy colour-science nbclient nbformat ipykernel matplotlib pandas pyarrow
 "${pip[@]}" "$root/python"
 # The command line the tests compare with.
-cargo build --release --quiet -p spdcam --manifest-path "$root/Cargo.toml"
+cargo build --release --quiet --manifest-path "$root/Cargo.toml"
 export SPDCAM_BIN="$target/release/spdcam"
 cd "$root"
 "$venv/bin/python" -m pytest python/tests -q -p no:cacheprovider

@@ -25,7 +25,7 @@ if ! [ -f "$here/node_modules/playwright-core/package.json" ]; then
     (cd "$here" && npm ci --no-audit --no-fund)
 fi
 
-cargo build --release -p spdcam --manifest-path "$repo/Cargo.toml"
+cargo build --release --manifest-path "$repo/Cargo.toml"
 bin="$target/release/spdcam"
 mkdir -p "$artefacts"
 work="$(mktemp -d)"

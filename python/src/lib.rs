@@ -13,9 +13,9 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, Layout};
 use spdcam_core::light;
-use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
 use spdcam_core::photo::{decode_photo, load_photo, Photo};
 use spdcam_core::spectral::Grid;
+use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
 use spdcam_infer::estimate::estimate_decoded;
 use spdcam_infer::{
     estimate_features, estimate_photo, Estimate, FeatureRows, Model, ModelSet, PhotoOptions,
@@ -347,7 +347,12 @@ fn render<'py>(
 /// Seconds the library alone takes for `repeats` estimates from the photo file at `path`
 /// (no Python conversions): the baseline of `python/bench.py`.
 #[pyfunction]
-fn library_seconds_photo(py: Python<'_>, path: PathBuf, models: &Models, repeats: usize) -> PyResult<f64> {
+fn library_seconds_photo(
+    py: Python<'_>,
+    path: PathBuf,
+    models: &Models,
+    repeats: usize,
+) -> PyResult<f64> {
     let grid = Grid::parse("400-700:5").map_err(py_err)?;
     let options = PhotoOptions::default();
     py.allow_threads(|| {
