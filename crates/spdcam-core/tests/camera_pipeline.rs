@@ -1,5 +1,6 @@
 //! The whole virtual camera against independent expectations.
 
+#[cfg(feature = "measured-data")]
 mod shared_data;
 
 use spdcam_core::builtin::{self, DataDir};
@@ -74,6 +75,7 @@ fn d65_render_reproduces_the_chart_colours() {
     assert!(mean <= 2.0, "mean ΔE2000 {mean}");
 }
 
+#[cfg(feature = "measured-data")]
 #[test]
 fn d65_render_with_the_thesis_camera_and_sg() {
     let data = DataDir::new(Some(shared_data::data_dir()));

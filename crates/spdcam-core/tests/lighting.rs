@@ -1,5 +1,7 @@
 //! The lighting recipes against the thesis's rules and its luminaire, and their errors.
 
+#![cfg(feature = "measured-data")]
+
 mod shared_data;
 
 use spdcam_core::builtin::DataDir;

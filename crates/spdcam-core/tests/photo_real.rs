@@ -1,5 +1,7 @@
 //! Real photos of a ColorChecker 24 (shared data, `photos/`) and bad input.
 
+#![cfg(feature = "measured-data")]
+
 mod shared_data;
 
 use spdcam_core::chart::Chart;

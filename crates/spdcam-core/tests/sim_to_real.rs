@@ -8,6 +8,8 @@
 //! rendered, tells the two orders apart: only the chart's physical order
 //! (`colorchecker_sg96`) makes the real and the virtual ranks agree.
 
+#![cfg(feature = "measured-data")]
+
 mod shared_data;
 
 use spdcam_core::builtin::{self, DataDir};

@@ -8,6 +8,9 @@ pub enum LearnError {
     /// An error of the simulation library (datasets, spectra, files).
     #[error(transparent)]
     Core(#[from] spdcam_core::Error),
+    /// An error of the inference crate (model files, scalings, targets).
+    #[error(transparent)]
+    Infer(#[from] spdcam_infer::InferError),
     /// A setting or an input is out of range or inconsistent with another one.
     #[error("{0}")]
     Invalid(String),

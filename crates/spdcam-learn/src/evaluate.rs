@@ -8,6 +8,7 @@ use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 use spdcam_core::metrics::{compare, summarise, SpectralMetrics, Summary};
 use spdcam_core::spectral::Grid;
+use spdcam_infer::plot::{plot_error, spds_svg, svg};
 
 /// Summaries of the four metrics over a set.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -91,25 +92,6 @@ pub fn evaluate(model: &Model, set: &TrainingSet) -> Result<Evaluation> {
     })
 }
 
-fn plot_error(e: impl std::fmt::Display) -> LearnError {
-    LearnError::invalid(format!("drawing a plot: {e}"))
-}
-
-/// Draws into an SVG string of `size`.
-fn svg(
-    size: (u32, u32),
-    draw: impl FnOnce(DrawingArea<SVGBackend<'_>, plotters::coord::Shift>) -> Result<()>,
-) -> Result<String> {
-    let mut out = String::new();
-    {
-        let root = SVGBackend::with_string(&mut out, size).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_error)?;
-        draw(root.clone())?;
-        root.present().map_err(plot_error)?;
-    }
-    Ok(out)
-}
-
 /// Training and validation loss per epoch (log scale), the best epoch marked.
 pub fn loss_curve_svg(log: &[EpochRecord], best_epoch: usize) -> Result<String> {
     if log.is_empty() {
@@ -118,7 +100,7 @@ pub fn loss_curve_svg(log: &[EpochRecord], best_epoch: usize) -> Result<String> 
     let values = log.iter().flat_map(|r| [r.train_loss, r.val_loss]);
     let lo = values.clone().fold(f64::INFINITY, f64::min).max(1e-12);
     let hi = values.fold(0.0, f64::max).max(lo * 10.0);
-    svg((900, 520), |root| {
+    Ok(svg((900, 520), |root| {
         let mut chart = ChartBuilder::on(&root)
             .caption("Training loss (MSE of scaled targets)", ("sans-serif", 22))
             .margin(16)
@@ -172,48 +154,7 @@ pub fn loss_curve_svg(log: &[EpochRecord], best_epoch: usize) -> Result<String> 
             .draw()
             .map_err(plot_error)?;
         Ok(())
-    })
-}
-
-/// SPDs on `grid`, each a named series (`(name, values)`), max-normalised.
-pub fn spds_svg(title: &str, grid: &Grid, series: &[(String, Vec<f64>)]) -> Result<String> {
-    svg((900, 520), |root| {
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(56)
-            .build_cartesian_2d(grid.start_nm..grid.end_nm(), 0.0..1.05)
-            .map_err(plot_error)?;
-        chart
-            .configure_mesh()
-            .x_desc("wavelength (nm)")
-            .y_desc("relative power")
-            .draw()
-            .map_err(plot_error)?;
-        for (i, (name, values)) in series.iter().enumerate() {
-            let colour = Palette99::pick(i).to_rgba();
-            let points: Vec<(f64, f64)> = values
-                .iter()
-                .enumerate()
-                .map(|(k, v)| (grid.wavelength(k), *v))
-                .collect();
-            chart
-                .draw_series(LineSeries::new(points, colour.stroke_width(2)))
-                .map_err(plot_error)?
-                .label(name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
-        }
-        if series.len() <= 12 {
-            chart
-                .configure_series_labels()
-                .border_style(BLACK)
-                .background_style(WHITE.mix(0.8))
-                .draw()
-                .map_err(plot_error)?;
-        }
-        Ok(())
-    })
+    })?)
 }
 
 /// Best, median and worst estimates (by GFC) against the truth (thesis Fig. 6.6).
@@ -237,14 +178,18 @@ pub fn best_median_worst_svg(e: &Evaluation) -> Result<String> {
             e.estimates[i * d..(i + 1) * d].to_vec(),
         ));
     }
-    spds_svg("Best, median and worst estimates", &e.grid, &series)
+    Ok(spds_svg(
+        "Best, median and worst estimates",
+        &e.grid,
+        &series,
+    )?)
 }
 
 /// Mean absolute error per band (thesis Fig. 6.4).
 pub fn band_mae_svg(e: &Evaluation) -> Result<String> {
     let top = e.band_mae.iter().copied().fold(0.0, f64::max).max(1e-9) * 1.1;
     let grid = e.grid;
-    svg((900, 480), |root| {
+    Ok(svg((900, 480), |root| {
         let mut chart = ChartBuilder::on(&root)
             .caption("Mean absolute error per band", ("sans-serif", 22))
             .margin(16)
@@ -268,7 +213,7 @@ pub fn band_mae_svg(e: &Evaluation) -> Result<String> {
             .draw_series(LineSeries::new(points, BLUE.stroke_width(2)))
             .map_err(plot_error)?;
         Ok(())
-    })
+    })?)
 }
 
 /// Box plots of the four metrics (thesis Fig. 6.3): box from the first to the third
@@ -280,7 +225,7 @@ pub fn boxplots_svg(e: &Evaluation) -> Result<String> {
         ("SAM (rad)", e.per_sample.iter().map(|m| m.sam).collect()),
         ("SID", e.per_sample.iter().map(|m| m.sid).collect()),
     ];
-    svg((1000, 420), |root| {
+    Ok(svg((1000, 420), |root| {
         let panels = root.split_evenly((1, 4));
         for ((name, mut values), panel) in metrics.into_iter().zip(panels) {
             values.sort_by(f64::total_cmp);
@@ -334,5 +279,5 @@ pub fn boxplots_svg(e: &Evaluation) -> Result<String> {
                 .map_err(plot_error)?;
         }
         Ok(())
-    })
+    })?)
 }

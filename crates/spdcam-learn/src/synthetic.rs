@@ -4,7 +4,7 @@
 //! summed over wavelength, then a 1/2.2 gamma — so that learning has a real, non-linear
 //! inverse problem to solve.
 
-use crate::model::DataInfo;
+use crate::record::DataInfo;
 use crate::train::TrainingSet;
 use rand::{Rng, SeedableRng};
 use spdcam_core::dataset::{Columns, Precision, SampleBatch};

@@ -1,30 +1,23 @@
 //! `spdcam estimate`: the light's SPD from photos of a chart, or from chart features, with a
 //! trained model (by default the one shipped inside the program).
 //!
-//! Every source of features ends in [`estimate_rows`] (features → SPDs): a features CSV, or
-//! photos analysed by [`crate::photo_args`].
+//! The work is the library's (`spdcam_infer::estimate`): this module reads the options,
+//! reads truths, and prints and writes what the estimates say.
 
 use crate::photo_args::{self, PhotoArgs};
 use crate::plot_file::{plot_is_png, write_plot};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
-use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
 use spdcam_core::fsio;
 use spdcam_core::metrics;
-use spdcam_core::photo::PhotoAnalysis;
+use spdcam_core::photo::{self, PhotoAnalysis};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
-use spdcam_learn::evaluate::spds_svg;
-use spdcam_learn::model::Model;
+use spdcam_infer::estimate::{analyse_photos, chart_templates, estimate_analysis};
+use spdcam_infer::plot::spds_svg;
+use spdcam_infer::{estimate_features, Estimate, FeatureRows, Model, ModelSet};
 use std::path::{Path, PathBuf};
 
-/// The model used when `--model` is not given: a 1D CNN for the ColorChecker Digital SG,
-/// trained on virtual photos (see the README for the command that made it).
-const DEFAULT_MODEL: &[u8] = include_bytes!("../../../models/default.spdm");
-/// What `--model` shows for the shipped model.
-const DEFAULT_MODEL_NAME: &str = "the shipped default model";
-/// CCT is defined only this near the Planckian locus (|Duv| in CIE 1960 uv).
-const MAX_CCT_DUV: f64 = 0.05;
 /// Truth files found beside a photo: `<photo stem>` + this.
 const TRUTH_SUFFIX: &str = ".truth.csv";
 
@@ -35,7 +28,8 @@ pub struct EstimateArgs {
     /// one estimate each.
     #[arg(value_name = "PHOTO", required_unless_present = "features")]
     photos: Vec<PathBuf>,
-    /// The model file (.spdm); default: the model shipped inside spdcam.
+    /// The model file (.spdm); default: the models shipped inside spdcam, one per chart
+    /// (ColorChecker Digital SG, ColorChecker 24), chosen by the chart in the photo.
     #[arg(long)]
     model: Option<PathBuf>,
     /// Estimate from a features CSV instead of photos: a header naming the columns (p01_r,
@@ -61,150 +55,11 @@ pub struct EstimateArgs {
     photo: PhotoArgs,
 }
 
-/// Feature rows read from a CSV file: column names and row-major values.
-pub struct FeatureRows {
-    /// Column names from the header.
-    pub names: Vec<String>,
-    /// Values, row-major.
-    pub values: Vec<f64>,
-    /// Number of rows.
-    pub rows: usize,
-}
-
-/// Reads a features CSV (header + numeric rows).
-pub fn read_features(path: &Path) -> Result<FeatureRows> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty());
-    let Some((_, header)) = lines.next() else {
-        bail!("{}: the file is empty", path.display());
-    };
-    let names: Vec<String> = header
-        .split(',')
-        .map(|s| s.trim().trim_matches('"').to_string())
-        .collect();
-    let mut values = Vec::new();
-    let mut rows = 0;
-    for (i, line) in lines {
-        let cells: Vec<&str> = line.split(',').collect();
-        if cells.len() != names.len() {
-            bail!(
-                "{} line {}: {} values, the header names {} columns",
-                path.display(),
-                i + 1,
-                cells.len(),
-                names.len()
-            );
-        }
-        for (cell, name) in cells.iter().zip(&names) {
-            let v: f64 = cell.trim().parse().map_err(|_| {
-                anyhow::anyhow!(
-                    "{} line {}, column {name}: '{}' is not a number",
-                    path.display(),
-                    i + 1,
-                    cell.trim()
-                )
-            })?;
-            if !v.is_finite() {
-                bail!(
-                    "{} line {}, column {name}: {v} is not a finite number",
-                    path.display(),
-                    i + 1
-                );
-            }
-            values.push(v);
-        }
-        rows += 1;
-    }
-    if rows == 0 {
-        bail!("{}: no rows of features below the header", path.display());
-    }
-    Ok(FeatureRows {
-        names,
-        values,
-        rows,
-    })
-}
-
-/// SPD estimates for feature rows (checked against the model's columns), one set item per
-/// row named by `labels`, resampled to `grid`.
-pub fn estimate_rows(
-    model: &Model,
-    features: &FeatureRows,
-    labels: Vec<String>,
-    source: &str,
-    grid: &Grid,
-) -> Result<SpectralSet> {
-    model.check_features(&features.names, source)?;
-    let mg = model.grid();
-    if grid.start_nm < mg.start_nm - 1e-9 || grid.end_nm() > mg.end_nm() + 1e-9 {
-        bail!(
-            "--range {}: the model estimates {} nm only",
-            grid.label(),
-            mg.label()
-        );
-    }
-    let spds = model.estimate_rows(&features.values)?;
-    let values = spds.chunks_exact(mg.count).map(<[f64]>::to_vec).collect();
-    let set = SpectralSet::on_grid(&mg, labels, values)?;
-    if *grid == mg {
-        return Ok(set);
-    }
-    let (resampled, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
-    Ok(resampled)
-}
-
-/// CIE 1931 xy, and CCT and Duv where the chromaticity is near enough the Planckian locus.
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct Colorimetry {
-    /// CIE 1931 chromaticity.
-    pub xy: [f64; 2],
-    /// Correlated colour temperature (K); `None` farther than |Duv| 0.05 from the locus.
-    pub cct: Option<f64>,
-    /// Distance from the Planckian locus in CIE 1960 uv.
-    pub duv: Option<f64>,
-}
-
-impl Colorimetry {
-    /// The colorimetry of `spd` on `grid`.
-    pub fn of(spd: &[f64], grid: &Grid) -> Result<Colorimetry> {
-        let xy = Observer::cie1931(grid)?.spd_to_xy(spd);
-        let (cct, duv) = match uv_to_cct_duv(xy_to_uv1960(xy)) {
-            Ok((cct, duv)) if duv.abs() <= MAX_CCT_DUV => (Some(cct), Some(duv)),
-            _ => (None, None),
-        };
-        Ok(Colorimetry { xy, cct, duv })
-    }
-
-    /// `xy (0.3127, 0.3290), CCT 6504 K, Duv +0.0032`.
-    pub fn label(&self) -> String {
-        let mut s = format!("xy ({:.4}, {:.4})", self.xy[0], self.xy[1]);
-        match (self.cct, self.duv) {
-            (Some(cct), Some(duv)) => s.push_str(&format!(", CCT {cct:.0} K, Duv {duv:+.4}")),
-            _ => s.push_str(", no CCT (far from the Planckian locus)"),
-        }
-        s
-    }
-}
-
-/// An estimate compared with its truth.
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-struct Score {
-    gfc: f64,
-    rmse: f64,
-}
-
-/// The model `--model` names, or the shipped one; with its name for messages.
-fn load_model(path: Option<&Path>) -> Result<(Model, String)> {
+/// The model `--model` names, or the shipped ones.
+fn load_models(path: Option<&Path>) -> Result<ModelSet> {
     match path {
-        Some(p) => Ok((Model::load(p)?, p.display().to_string())),
-        None => Ok((
-            Model::from_bytes(DEFAULT_MODEL).context("the shipped default model is damaged")?,
-            DEFAULT_MODEL_NAME.to_string(),
-        )),
+        Some(p) => Ok(ModelSet::single(Model::load(p)?, p.display().to_string())),
+        None => Ok(ModelSet::shipped()?),
     }
 }
 
@@ -231,17 +86,25 @@ fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
+/// Reads a spectral CSV of true SPDs, resampled to `grid`.
+fn read_truths(path: &Path, grid: &Grid) -> Result<SpectralSet> {
+    let set = SpectralSet::read_csv(path)
+        .with_context(|| format!("reading the true SPDs {}", path.display()))?;
+    let (set, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
+    Ok(set)
+}
+
 /// The truth for each estimate: from `--truth` (one column for all, or one per estimate),
-/// else from `<stem>.truth.csv` beside each photo; resampled to `grid`.
-fn truths(args: &EstimateArgs, count: usize, grid: &Grid) -> Result<Vec<Option<Vec<f64>>>> {
-    let read = |path: &Path| -> Result<SpectralSet> {
-        let set = SpectralSet::read_csv(path)
-            .with_context(|| format!("reading the true SPDs {}", path.display()))?;
-        let (set, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
-        Ok(set)
-    };
-    if let Some(path) = &args.truth {
-        let set = read(path)?;
+/// else from `<stem>.truth.csv` beside each photo (`photos`, one per estimate); resampled
+/// to `grid`.
+fn truths(
+    truth: Option<&Path>,
+    photos: &[&Path],
+    count: usize,
+    grid: &Grid,
+) -> Result<Vec<Option<Vec<f64>>>> {
+    if let Some(path) = truth {
+        let set = read_truths(path, grid)?;
         return match set.len() {
             1 => Ok(vec![Some(set.item(0).to_vec()); count]),
             n if n == count => Ok((0..n).map(|i| Some(set.item(i).to_vec())).collect()),
@@ -251,10 +114,10 @@ fn truths(args: &EstimateArgs, count: usize, grid: &Grid) -> Result<Vec<Option<V
             ),
         };
     }
-    if args.photos.is_empty() {
+    if photos.is_empty() {
         return Ok(vec![None; count]);
     }
-    args.photos
+    photos
         .iter()
         .map(|photo| {
             let Some(stem) = photo.file_stem() else {
@@ -264,7 +127,7 @@ fn truths(args: &EstimateArgs, count: usize, grid: &Grid) -> Result<Vec<Option<V
             if !path.is_file() {
                 return Ok(None);
             }
-            let set = read(&path)?;
+            let set = read_truths(&path, grid)?;
             if set.len() != 1 {
                 bail!(
                     "{}: one true SPD expected, found {}",
@@ -275,6 +138,61 @@ fn truths(args: &EstimateArgs, count: usize, grid: &Grid) -> Result<Vec<Option<V
             Ok(Some(set.item(0).to_vec()))
         })
         .collect()
+}
+
+/// Estimates from the photos, one per photo that could be used; the photos that could not
+/// (no chart found, no model for its chart, unreadable) are reported on stderr and counted.
+fn estimate_from_photos(
+    args: &EstimateArgs,
+    models: &ModelSet,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<(Vec<Estimate>, Vec<PathBuf>, usize)> {
+    let options = args.photo.options()?;
+    let templates = chart_templates(models, options.chart.as_deref(), data_dir)?;
+    let results = analyse_photos(&args.photos, &options, templates)?;
+    let labels = photo_labels(&args.photos);
+    let mut analyses: Vec<(PathBuf, String, PhotoAnalysis)> = Vec::new();
+    let mut failed = 0;
+    for ((path, label), result) in args.photos.iter().zip(labels).zip(results) {
+        match result {
+            Ok(a) => {
+                for w in &a.warnings {
+                    eprintln!("warning: {}: {w}", a.source);
+                }
+                analyses.push((path.clone(), label, a));
+            }
+            Err(e) => {
+                eprintln!("error: cannot use photo {}: {e}", path.display());
+                failed += 1;
+            }
+        }
+    }
+    if let Some(out) = &args.photo.features_out {
+        let all: Vec<PhotoAnalysis> = analyses.iter().map(|(_, _, a)| a.clone()).collect();
+        if !all.is_empty() {
+            photo::write_features_csv(out, &all)?;
+            eprintln!("features → {}", out.display());
+        }
+    }
+    let mut estimates = Vec::with_capacity(analyses.len());
+    let mut paths = Vec::with_capacity(analyses.len());
+    for (path, label, analysis) in analyses {
+        if !args.photo.json {
+            println!("{}", photo_args::describe(&analysis));
+        }
+        match estimate_analysis(models, analysis, label, grid) {
+            Ok(e) => {
+                estimates.push(e);
+                paths.push(path);
+            }
+            Err(e) => {
+                eprintln!("error: no estimate for {}: {e}", path.display());
+                failed += 1;
+            }
+        }
+    }
+    Ok((estimates, paths, failed))
 }
 
 /// Runs `spdcam estimate`.
@@ -288,61 +206,38 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     if let Some(plot) = &args.plot {
         plot_is_png(plot)?;
     }
-    let (model, model_name) = load_model(args.model.as_deref())?;
+    let models = load_models(args.model.as_deref())?;
     let grid = Grid::parse(&args.range)?;
-    let (features, labels, analyses, source) = match &args.features {
+    let (mut estimates, photos, failed) = match &args.features {
         Some(path) => {
-            let f = read_features(path)?;
-            let labels = (1..=f.rows).map(|i| format!("estimate_{i}")).collect();
-            (f, labels, Vec::new(), path.display().to_string())
+            let rows = FeatureRows::read_csv(path)?;
+            let source = path.display().to_string();
+            (
+                estimate_features(&models, &rows, &source, &grid)?,
+                Vec::new(),
+                0,
+            )
         }
-        None => {
-            let templates = photo_args::templates(&args.photo, &model, data_dir)?;
-            let analyses = photo_args::analyse_photos(&args.photos, &args.photo, &templates)?;
-            photo_args::write_outputs(&analyses, &args.photo)?;
-            let f = photo_features(&analyses)?;
-            if !args.photo.json {
-                for a in &analyses {
-                    println!("{}", photo_args::describe(a));
-                }
-            }
-            if let Some(out) = &args.photo.features_out {
-                if model.check_features(&f.names, "").is_err() {
-                    println!(
-                        "features → {}; no estimate: {model_name} is for chart {}",
-                        out.display(),
-                        model.header().chart.as_deref().unwrap_or("unknown")
-                    );
-                    return Ok(());
-                }
-            }
-            let source = match args.photos.as_slice() {
-                [one] => one.display().to_string(),
-                _ => "the photos".into(),
-            };
-            (f, photo_labels(&args.photos), analyses, source)
-        }
+        None => estimate_from_photos(&args, &models, data_dir, &grid)?,
     };
-    let set = estimate_rows(&model, &features, labels, &source, &grid)?;
-    let truths = truths(&args, set.len(), &grid)?;
-    let mut scores = Vec::with_capacity(set.len());
-    let mut colorimetry = Vec::with_capacity(set.len());
-    for (i, truth) in truths.iter().enumerate() {
-        colorimetry.push(Colorimetry::of(set.item(i), &grid)?);
-        scores.push(
-            truth
-                .as_ref()
-                .map(|t| -> Result<Score> {
-                    let t = metrics::normalise_by_max(t);
-                    let e = metrics::normalise_by_max(set.item(i));
-                    Ok(Score {
-                        gfc: metrics::gfc(&t, &e)?,
-                        rmse: metrics::rmse(&t, &e)?,
-                    })
-                })
-                .transpose()?,
+    if estimates.is_empty() {
+        bail!(
+            "no estimate: none of the {} photo(s) could be used (see the errors above)",
+            failed
         );
     }
+    let photo_refs: Vec<&Path> = photos.iter().map(PathBuf::as_path).collect();
+    let truths = truths(args.truth.as_deref(), &photo_refs, estimates.len(), &grid)?;
+    for (e, truth) in estimates.iter_mut().zip(&truths) {
+        if let Some(t) = truth {
+            e.score_against(t)?;
+        }
+    }
+    let set = SpectralSet::on_grid(
+        &grid,
+        estimates.iter().map(|e| e.name.clone()).collect(),
+        estimates.iter().map(|e| e.spd.clone()).collect(),
+    )?;
     if let Some(out) = &args.output {
         set.write_csv(out)?;
     }
@@ -352,67 +247,69 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             .map(|i| (set.names()[i].clone(), set.item(i).to_vec()))
             .collect();
         let title = if set.len() == 1 {
-            format!("Estimated SPD: {}", colorimetry[0].label())
+            format!("Estimated SPD: {}", estimates[0].colorimetry.label())
         } else {
             format!("Estimated SPDs ({shown} of {})", set.len())
         };
         write_plot(plot, &spds_svg(&title, &grid, &series)?)?;
     }
     if args.photo.json {
-        let json = estimates_json(&set, &grid, &colorimetry, &scores, &analyses)?;
+        let json = estimates
+            .iter()
+            .map(Estimate::to_json)
+            .collect::<spdcam_infer::Result<Vec<_>>>()?;
         println!("{}", serde_json::to_string_pretty(&json)?);
-        return Ok(());
+    } else {
+        print_estimates(&estimates, &args);
     }
-    println!("{} estimate(s) with {model_name}", set.len());
-    let detailed = set.len() <= 20;
-    for i in 0..set.len() {
+    if failed > 0 {
+        bail!(
+            "{failed} of {} photo(s) gave no estimate (see the errors above)",
+            failed + estimates.len()
+        );
+    }
+    Ok(())
+}
+
+/// The estimates as text: colorimetry and the SPD every 25 nm (for up to 20), the score
+/// against the truth, what each number means, and where the files went.
+fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
+    let mut models: Vec<&str> = estimates.iter().map(|e| e.model.as_str()).collect();
+    models.dedup();
+    println!("{} estimate(s) with {}", estimates.len(), models.join(", "));
+    let detailed = estimates.len() <= 20;
+    for e in estimates {
         if detailed {
-            println!("{}: {}", set.names()[i], colorimetry[i].label());
-            println!("  relative SPD: {}", spd_line(set.item(i), &grid));
+            println!("{}: {}", e.name, e.colorimetry.label());
+            println!("  relative SPD: {}", spd_line(&e.spd, &e.grid));
         }
-        if let Some(s) = scores[i] {
+        if let Some(s) = e.truth {
             println!(
                 "  against the true SPD: GFC {:.4}, RMSE {:.4} (both peak-normalised)",
                 s.gfc, s.rmse
             );
         }
     }
+    if estimates.iter().any(|e| e.photo.is_some()) {
+        println!(
+            "confidence: how sure the chart's detection is (0–1; below 0.8 check the --debug image)"
+        );
+    }
+    if estimates.iter().any(|e| e.truth.is_some()) {
+        println!(
+            "GFC: goodness-of-fit of the spectral shape, 1 = identical (≥ 0.999 excellent, ≥ 0.99 good)"
+        );
+    }
     if let Some(out) = &args.output {
         println!(
             "SPD{} → {}",
-            if set.len() > 1 { "s" } else { "" },
+            if estimates.len() > 1 { "s" } else { "" },
             out.display()
         );
     }
     if let Some(plot) = &args.plot {
         println!("plot → {}", plot.display());
     }
-    Ok(())
-}
-
-/// The feature rows of analysed photos; all must come from the same chart.
-fn photo_features(analyses: &[PhotoAnalysis]) -> Result<FeatureRows> {
-    let first = &analyses[0];
-    if let Some(other) = analyses
-        .iter()
-        .find(|a| a.feature_names != first.feature_names)
-    {
-        bail!(
-            "{} shows chart {} and {} chart {}: estimate them in separate calls",
-            first.source,
-            first.chart,
-            other.source,
-            other.chart
-        );
-    }
-    Ok(FeatureRows {
-        names: first.feature_names.clone(),
-        values: analyses
-            .iter()
-            .flat_map(|a| a.features.iter().map(|&v| f64::from(v)))
-            .collect(),
-        rows: analyses.len(),
-    })
 }
 
 /// The SPD every 25 nm, peak-normalised, on one terminal line: `400:0.12 425:0.40 …`.
@@ -425,31 +322,4 @@ fn spd_line(spd: &[f64], grid: &Grid) -> String {
         .map(|(w, v)| format!("{w:.0}:{v:.2}"))
         .collect::<Vec<_>>()
         .join(" ")
-}
-
-/// Everything about the estimates as JSON: per estimate its name, SPD, colorimetry, score
-/// against the truth, and (from photos) the chart analysis.
-fn estimates_json(
-    set: &SpectralSet,
-    grid: &Grid,
-    colorimetry: &[Colorimetry],
-    scores: &[Option<Score>],
-    analyses: &[PhotoAnalysis],
-) -> Result<serde_json::Value> {
-    let items = (0..set.len())
-        .map(|i| {
-            let mut v = serde_json::json!({
-                "name": set.names()[i],
-                "wavelength_nm": grid.wavelengths(),
-                "spd": set.item(i),
-                "colorimetry": colorimetry[i],
-                "truth": scores[i],
-            });
-            if let Some(a) = analyses.get(i) {
-                v["photo"] = photo_args::analysis_json(a)?;
-            }
-            Ok(v)
-        })
-        .collect::<Result<Vec<_>>>()?;
-    Ok(serde_json::Value::Array(items))
 }

@@ -8,7 +8,6 @@
 //! of 1. Models predict PCA coefficients of the SPD (`--target weights`: the channel weights,
 //! as the thesis did for these sets).
 
-use crate::estimate::read_features;
 use crate::evaluate::metrics_table;
 use crate::train::{reporter, ModelKind, Preset, TargetArg};
 use anyhow::{bail, Context, Result};
@@ -17,9 +16,10 @@ use spdcam_core::dataset::{Columns, Precision, SampleBatch};
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::Channels;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_infer::FeatureRows;
 use spdcam_learn::evaluate::evaluate;
-use spdcam_learn::model::DataInfo;
 use spdcam_learn::pca::Components;
+use spdcam_learn::record::DataInfo;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{train, Schedule, TrainOptions, TrainingSet};
 use std::collections::BTreeMap;
@@ -169,8 +169,8 @@ fn channels(set: SetName, root: &Path) -> Result<Vec<Vec<f64>>> {
 /// One part (`train` or `val`) of a set, with SPDs made from its weights.
 fn load_part(set: SetName, part: &str, root: &Path, ch: &[Vec<f64>]) -> Result<TrainingSet> {
     let dir = root.join("virtual").join(format!("{}_{part}", set.dir()));
-    let features = read_features(&dir.join("features.csv"))?;
-    let weights = read_features(&dir.join("weights.csv"))?;
+    let features = FeatureRows::read_csv(&dir.join("features.csv"))?;
+    let weights = FeatureRows::read_csv(&dir.join("weights.csv"))?;
     if weights.rows != features.rows || weights.names.len() != ch.len() {
         bail!(
             "{}: {} feature rows, {} weight rows of {} channels (expected {})",

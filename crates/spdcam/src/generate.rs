@@ -28,7 +28,7 @@ pub struct GenerateArgs {
     /// Seed: sample i depends only on (seed, i).
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Output dataset directory (manifest.json + samples-NNNNN.parquet).
+    /// Output dataset directory (manifest.json + samples/part-NNNNN.parquet).
     #[arg(short, long)]
     output: PathBuf,
     /// Also write each rendered chart as images/sample-NNNNNNNN.png.

@@ -4,18 +4,26 @@ mod calibrate;
 mod coverage;
 mod dataset;
 mod estimate;
+#[cfg(feature = "train")]
 mod evaluate;
+#[cfg(feature = "train")]
 mod experiment;
+#[cfg(feature = "train")]
 mod experiment_sim2real;
+#[cfg(feature = "train")]
 mod finetune;
 mod generate;
 mod lamps;
 mod list;
+mod metrics;
 mod photo_args;
 mod plot_file;
 mod render;
+#[cfg(feature = "train")]
 mod ridge;
+#[cfg(feature = "train")]
 mod sim2real_curve;
+#[cfg(feature = "train")]
 mod train;
 mod validate_lamps;
 
@@ -45,18 +53,25 @@ enum Command {
     Dataset(dataset::DatasetArgs),
     /// List built-in cameras, charts, illuminants, lighting recipes and presets.
     List(list::ListArgs),
+    /// Lighting-quality metrics (CCT, CRI, TM-30, α-opic, S/P, PPF) of SPDs.
+    Metrics(metrics::MetricsArgs),
+    #[cfg(feature = "train")]
     /// Train a model (1D CNN, MLP or ridge baseline) on a dataset.
     Train(Box<train::TrainArgs>),
     /// Estimate the light's SPD from photos of a colour chart (or chart features).
     Estimate(Box<estimate::EstimateArgs>),
+    #[cfg(feature = "train")]
     /// Score a model on a dataset: metrics, per-band error, plots.
     Evaluate(evaluate::EvaluateArgs),
+    #[cfg(feature = "train")]
     /// Adapt a trained model to a small new dataset (transfer learning).
     Finetune(Box<finetune::FinetuneArgs>),
+    #[cfg(feature = "train")]
     /// Reproduce the thesis's experiments on its own datasets.
     Experiment(experiment::ExperimentArgs),
     /// Fit a real camera's in-camera rendering to a few of its chart photos with known light.
     Calibrate(Box<calibrate::CalibrateArgs>),
+    #[cfg(feature = "train")]
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
     Sim2real(experiment_sim2real::Sim2realArgs),
     /// How well lighting recipes cover measured SPDs, per lamp type.
@@ -80,17 +95,27 @@ fn main() -> ExitCode {
     exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     let data_dir = spdcam_core::builtin::DataDir::new(cli.data_dir);
+    if let Err(e) = data_dir.check() {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Render(args) => render::run(*args, &data_dir),
         Command::Generate(args) => generate::run(*args, &data_dir),
         Command::Dataset(args) => dataset::run(args, &data_dir),
         Command::List(args) => list::run(args, &data_dir),
+        Command::Metrics(args) => metrics::run(args, &data_dir),
+        #[cfg(feature = "train")]
         Command::Train(args) => train::run(*args, &data_dir),
         Command::Estimate(args) => estimate::run(*args, &data_dir),
+        #[cfg(feature = "train")]
         Command::Evaluate(args) => evaluate::run(args, &data_dir),
+        #[cfg(feature = "train")]
         Command::Finetune(args) => finetune::run(*args),
+        #[cfg(feature = "train")]
         Command::Experiment(args) => experiment::run(args, &data_dir),
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),
+        #[cfg(feature = "train")]
         Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
         Command::Coverage(args) => coverage::run(*args, &data_dir),
         Command::Lamps(args) => lamps::run(args, &data_dir),
@@ -98,8 +123,39 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The error and its causes joined by ": ", leaving out a cause the text already says (an
+/// I/O error is often both in a message and its source).
+fn error_text(error: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in error.chain() {
+        let message = cause.to_string();
+        if !text.contains(&message) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&message);
+        }
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_os_error_is_printed_once() {
+        // Issue 15: "Permission denied (os error 13): Permission denied (os error 13)".
+        let io = std::io::Error::from(std::io::ErrorKind::PermissionDenied);
+        let e = anyhow::Error::from(spdcam_core::Error::io("out.csv", io)).context("writing");
+        let text = error_text(&e);
+        assert_eq!(text.matches("denied").count(), 1, "{text}");
+        assert!(text.starts_with("writing: out.csv: "), "{text}");
     }
 }

@@ -1,5 +1,5 @@
-//! Writes a plot made as SVG to the file a user named: SVG as it is, PNG rasterised (text in
-//! the system's fonts).
+//! Writes a plot made as SVG to the file a user named: SVG as it is, PNG rasterised with its
+//! text in DejaVu Sans embedded in the program, so a PNG has its labels on any machine.
 
 use anyhow::{bail, Context, Result};
 use resvg::{tiny_skia, usvg};
@@ -39,7 +39,10 @@ pub fn write_plot(path: &Path, svg: &str) -> Result<()> {
 /// The SVG drawn on a white background, as PNG bytes.
 fn rasterise(svg: &str) -> Result<Vec<u8>> {
     let mut options = usvg::Options::default();
-    options.fontdb_mut().load_system_fonts();
+    let fonts = options.fontdb_mut();
+    fonts.load_font_data(dejavu::sans::regular().to_vec());
+    fonts.set_sans_serif_family("DejaVu Sans");
+    fonts.set_serif_family("DejaVu Sans");
     let tree = usvg::Tree::from_str(svg, &options).context("reading the plot's SVG")?;
     let size = tree.size();
     let width = (size.width() * PNG_SCALE).ceil() as u32;
@@ -74,5 +77,21 @@ mod tests {
         assert!(err.contains(".svg or .png"), "{err}");
         assert!(!dir.join("p.pdf").exists());
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// Dark pixels of `svg` rasterised.
+    fn ink(svg: &str) -> usize {
+        let png = rasterise(svg).unwrap();
+        let image = image::load_from_memory(&png).unwrap().to_luma8();
+        image.pixels().filter(|p| p.0[0] < 128).count()
+    }
+
+    #[test]
+    fn png_plots_carry_their_text() {
+        let text = r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="40"><text x="5" y="30" font-family="sans-serif" font-size="24">wavelength</text></svg>"#;
+        let blank = r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="40"></svg>"#;
+        assert_eq!(ink(blank), 0);
+        // "wavelength" at 24 px, doubled by PNG_SCALE, inks thousands of pixels.
+        assert!(ink(text) > 1000, "text drew {} dark pixels", ink(text));
     }
 }

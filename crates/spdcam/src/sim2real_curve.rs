@@ -11,7 +11,8 @@ use rand::SeedableRng;
 use spdcam_core::dataset::{Columns, Precision, SampleBatch};
 use spdcam_core::metrics;
 use spdcam_core::spectral::Grid;
-use spdcam_learn::model::{DataInfo, Model};
+use spdcam_learn::model::Model;
+use spdcam_learn::record::DataInfo;
 use spdcam_learn::train::{finetune, FinetuneOptions, Schedule, TrainingSet};
 use std::collections::BTreeMap;
 

@@ -8,9 +8,9 @@ use spdcam_core::fsio;
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::Grid;
 use spdcam_learn::evaluate::loss_curve_svg;
-use spdcam_learn::model::DataInfo;
 use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
 use spdcam_learn::pca::Components;
+use spdcam_learn::record::DataInfo;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{
     train, Backend, EpochRecord, Progress, Schedule, TrainOptions, TrainingSet,
@@ -203,17 +203,32 @@ pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
 }
 
 /// A progress reporter: a bar per run on a terminal (epoch, loss, validation loss and GFC),
-/// nothing when stderr is piped.
+/// one plain line per epoch when stderr is not a terminal.
 pub fn reporter(epochs: usize) -> (impl FnMut(Progress), Option<indicatif::ProgressBar>) {
-    let bar = crate::generate::progress_bar(epochs as u64, "epochs");
+    use std::io::IsTerminal;
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let style = indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{wide_bar}] epoch {pos}/{len}, ETA {eta} {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+        indicatif::ProgressBar::new(epochs as u64).with_style(style)
+    });
     let handle = bar.clone();
     let report = move |p: Progress| {
-        if let (Some(bar), Progress::Epoch(r)) = (&bar, p) {
-            bar.set_position(r.epoch as u64);
-            bar.set_message(format!(
-                "loss {:.3e}, val {:.3e}, val GFC {:.5}",
-                r.train_loss, r.val_loss, r.val_gfc
-            ));
+        let Progress::Epoch(r) = p else {
+            return;
+        };
+        let line = format!(
+            "loss {:.3e}, val loss {:.3e}, val GFC {:.5}, {:.1} s/epoch",
+            r.train_loss, r.val_loss, r.val_gfc, r.seconds
+        );
+        match &bar {
+            Some(bar) => {
+                bar.set_position(r.epoch as u64);
+                bar.set_message(line);
+            }
+            // Not a terminal (a log file, a batch job): one plain line per epoch.
+            None => eprintln!("epoch {}/{epochs}: {line}", r.epoch),
         }
     };
     (report, handle)
@@ -237,7 +252,10 @@ pub fn write_log(log: &[EpochRecord], best: usize, csv: &Path, svg: &Path) -> Re
 
 /// Runs `spdcam train`.
 pub fn run(args: TrainArgs, data_dir: &DataDir) -> Result<()> {
-    fsio::check_parent_dir(&args.output)?;
+    fsio::check_writable(&args.output)?;
+    for path in args.log.iter().chain(&args.plot) {
+        fsio::check_writable(path)?;
+    }
     let data = load_set(&args.data)?;
     let val = args.schedule.val.as_deref().map(load_set).transpose()?;
     let architecture = match (args.model, args.ridge) {

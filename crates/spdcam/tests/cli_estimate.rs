@@ -76,7 +76,11 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
         &s(&debug),
     ]);
     assert!(out.contains("colorchecker_sg140 detected"), "{out}");
-    assert!(out.contains("shipped default model"), "{out}");
+    assert!(out.contains("the shipped colorchecker_sg96 model"), "{out}");
+    assert!(
+        out.contains("GFC: goodness-of-fit"),
+        "the output explains GFC:\n{out}"
+    );
     // The truth file beside the photo is found and scored.
     let gfc = number_after(&out, "GFC");
     assert!(gfc > 0.9 && gfc <= 1.0, "GFC {gfc}:\n{out}");
@@ -117,28 +121,57 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
 }
 
 #[test]
-fn features_of_a_chart_no_model_knows_are_written_alone() {
+fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
     let dir = scratch("cc24");
     let photo = dir.join("cc24.jpg");
+    let truth = dir.join("truth.csv");
     ok(&[
         "render",
         "--spd",
-        "D65",
+        "A",
         "--scene",
         "1200x900",
         "-o",
         &s(&photo),
+        "--spd-out",
+        &s(&truth),
     ]);
-    let features = dir.join("f.csv");
+    // No options: the chart is detected and the ColorChecker 24 model chosen.
+    let csv = dir.join("spd.csv");
     let out = ok(&[
+        "estimate",
+        &s(&photo),
+        "--truth",
+        &s(&truth),
+        "-o",
+        &s(&csv),
+    ]);
+    assert!(out.contains("colorchecker24 detected"), "{out}");
+    assert!(out.contains("the shipped colorchecker24 model"), "{out}");
+    let gfc = number_after(&out, "GFC");
+    assert!(gfc > 0.99, "CIE A through the CC24 model: GFC {gfc}\n{out}");
+    assert!(std::fs::read_to_string(&csv)
+        .unwrap()
+        .starts_with("wavelength_nm,cc24.jpg\n"));
+
+    // Features are written for any chart; with a model for another chart there is no
+    // estimate, and the run says so and fails, leaving no SPD file.
+    let features = dir.join("f.csv");
+    let never = dir.join("never.csv");
+    let err = fails(&[
         "estimate",
         &s(&photo),
         "--chart",
         "colorchecker24",
+        "--model",
+        "../../models/colorchecker_sg96.spdm",
         "--features-out",
         &s(&features),
+        "-o",
+        &s(&never),
     ]);
-    assert!(out.contains("no estimate"), "{out}");
+    assert!(err.contains("no model for chart colorchecker24"), "{err}");
+    assert!(!never.exists(), "no SPD file without an estimate");
     let text = std::fs::read_to_string(&features).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -150,7 +183,7 @@ fn features_of_a_chart_no_model_knows_are_written_alone() {
         .split(',')
         .map(|v| v.parse().unwrap())
         .collect();
-    // Under D65 with white balance, patch 19 (white) is the lightest and near neutral.
+    // With white balance, patch 19 (white) is the lightest and near neutral.
     let white = &row[54..57];
     assert!(white.iter().all(|&v| v > 150.0), "{white:?}");
     assert!(
@@ -158,14 +191,10 @@ fn features_of_a_chart_no_model_knows_are_written_alone() {
             < 20.0
     );
 
-    // The shipped model looks for its own chart, the Digital SG: none here.
-    let csv = dir.join("never.csv");
-    let err = fails(&["estimate", &s(&photo), "-o", &s(&csv)]);
-    assert!(
-        err.contains("no chart found") && err.contains("colorchecker_sg140"),
-        "{err}"
-    );
-    assert!(!csv.exists(), "no partial output");
+    // Feature rows are matched to the model for their columns.
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", "--features", &s(&features), "--json"])).unwrap();
+    assert_eq!(json[0]["model"], "the shipped colorchecker24 model");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -211,9 +240,25 @@ fn bad_photos_give_clear_errors_and_no_output() {
     let err = fails(&["estimate", EXAMPLE, "--model", &s(&text)]);
     assert!(err.contains("not a spdcam model"), "{err}");
     assert!(!csv.exists(), "no partial output");
+
+    // One bad photo in a batch: the others are still estimated, the bad one is named, and
+    // the run fails.
+    let out = spdcam(&["estimate", EXAMPLE, &s(&text), "-o", &s(&csv)]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("notes.jpg") && stderr.contains("1 of 2 photo(s)"),
+        "{stderr}"
+    );
+    let written = std::fs::read_to_string(&csv).unwrap();
+    assert!(
+        written.starts_with("wavelength_nm,sg-telelumen.jpg\n"),
+        "{written}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
+#[cfg(feature = "measured-data")]
 /// The shared data directory (for the SG 96 reflectances and the Canon curves).
 fn data_dir() -> PathBuf {
     let root = std::env::var_os("SPDCAM_DATA")
@@ -223,6 +268,7 @@ fn data_dir() -> PathBuf {
     root
 }
 
+#[cfg(feature = "measured-data")]
 #[test]
 fn a_chart_image_from_render_is_estimated() {
     let dir = scratch("render");

@@ -1,6 +1,8 @@
 //! `spdcam train / estimate / evaluate / finetune` end to end on a small synthetic dataset
 //! brought in with `spdcam dataset import`.
 
+#![cfg(feature = "train")]
+
 use spdcam_learn::synthetic::gaussian_set;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -2,7 +2,7 @@
 //! (the default) or the channel weights of a luminaire (`--target weights`, the thesis's
 //! G/H experiments), whose channel spectra are fitted from the training data.
 
-use crate::error::{LearnError, Result};
+use crate::error::{InferError, Result};
 use crate::pca::{Components, Pca};
 use faer::{linalg::solvers::Solve, Mat, Side};
 use serde::{Deserialize, Serialize};
@@ -39,7 +39,7 @@ pub enum Target {
 }
 
 /// Divides by the maximum and clips negative values (an estimate is a relative SPD).
-pub(crate) fn normalise(spd: &mut [f64]) {
+pub fn normalise(spd: &mut [f64]) {
     let max = spd.iter().copied().fold(0.0, f64::max);
     for v in spd.iter_mut() {
         *v = if max > 0.0 { (*v / max).max(0.0) } else { 0.0 };
@@ -95,12 +95,12 @@ impl Target {
                     || d == 0
                     || c.spectra.iter().any(|s| s.len() != d)
                 {
-                    return Err(LearnError::invalid(
+                    return Err(InferError::invalid(
                         "the channel spectra do not match their names or grid",
                     ));
                 }
                 if c.spectra.iter().flatten().any(|v| !v.is_finite()) {
-                    return Err(LearnError::invalid(
+                    return Err(InferError::invalid(
                         "the channel spectra hold non-finite numbers",
                     ));
                 }
@@ -117,13 +117,13 @@ impl Channels {
     pub fn fit(names: Vec<String>, weights: &[f64], spds: &[f64], d: usize) -> Result<Channels> {
         let k = names.len();
         if k == 0 || d == 0 || weights.len() % k != 0 || spds.len() % d != 0 {
-            return Err(LearnError::invalid(
+            return Err(InferError::invalid(
                 "the weights and SPDs do not form rows for a channel fit",
             ));
         }
         let n = weights.len() / k;
         if spds.len() / d != n || n < k {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "a channel fit needs as many weight rows as SPD rows and at least {k}, got {n} and {}",
                 spds.len() / d
             )));
@@ -132,14 +132,14 @@ impl Channels {
         let mut gram = w.transpose() * &w;
         let trace: f64 = (0..k).map(|j| gram[(j, j)]).sum();
         if trace <= 0.0 {
-            return Err(LearnError::invalid("every channel weight is 0"));
+            return Err(InferError::invalid("every channel weight is 0"));
         }
         for j in 0..k {
             gram[(j, j)] += 1e-9 * trace / k as f64;
         }
         let llt = gram
             .llt(Side::Lower)
-            .map_err(|e| LearnError::Numerical(format!("channel fit: {e:?}")))?;
+            .map_err(|e| InferError::Numerical(format!("channel fit: {e:?}")))?;
         let mut scale = vec![1.0f64; n];
         let mut c = Mat::<f64>::zeros(k, d);
         for _ in 0..200 {

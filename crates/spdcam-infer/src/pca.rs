@@ -2,7 +2,7 @@
 //! are the first few PCA coefficients of the SPD, and an estimate is turned back into an SPD
 //! with the inverse transform.
 
-use crate::error::{LearnError, Result};
+use crate::error::{InferError, Result};
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
@@ -40,19 +40,19 @@ impl Pca {
     /// Fits the PCA of `data`: `rows` rows of `dim` values each, row-major.
     pub fn fit(data: &[f64], dim: usize, choice: Components) -> Result<Pca> {
         if dim == 0 || data.len() % dim != 0 {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "PCA: {} values do not form rows of {dim}",
                 data.len()
             )));
         }
         let rows = data.len() / dim;
         if rows < 2 {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "PCA needs at least 2 samples, got {rows}"
             )));
         }
         if let Some(v) = data.iter().find(|v| !v.is_finite()) {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "PCA: the data hold the non-finite value {v}"
             )));
         }
@@ -66,13 +66,13 @@ impl Pca {
         let centred = Mat::<f64>::from_fn(rows, dim, |i, j| data[i * dim + j] - mean[j]);
         let svd = centred
             .thin_svd()
-            .map_err(|e| LearnError::Numerical(format!("PCA: the SVD failed: {e:?}")))?;
+            .map_err(|e| InferError::Numerical(format!("PCA: the SVD failed: {e:?}")))?;
         let s = svd.S().column_vector();
         let v = svd.V();
         let squares: Vec<f64> = (0..s.nrows()).map(|i| s[i] * s[i]).collect();
         let total: f64 = squares.iter().sum();
         if total <= 0.0 {
-            return Err(LearnError::invalid(
+            return Err(InferError::invalid(
                 "PCA: all samples are identical; there is no variance to explain",
             ));
         }
@@ -80,7 +80,7 @@ impl Pca {
         let keep = match choice {
             Components::Count(k) => {
                 if k == 0 || k > ratios.len() {
-                    return Err(LearnError::invalid(format!(
+                    return Err(InferError::invalid(format!(
                         "PCA: {k} components asked for; between 1 and {} possible",
                         ratios.len()
                     )));
@@ -89,7 +89,7 @@ impl Pca {
             }
             Components::Variance(f) => {
                 if !(f > 0.0 && f <= 1.0) {
-                    return Err(LearnError::invalid(format!(
+                    return Err(InferError::invalid(format!(
                         "PCA: explained variance {f} must lie in (0, 1]"
                     )));
                 }
@@ -165,14 +165,14 @@ impl Pca {
     pub fn validate(&self) -> Result<()> {
         let dim = self.dim();
         if dim == 0 || self.components.is_empty() {
-            return Err(LearnError::invalid(
+            return Err(InferError::invalid(
                 "the PCA has no dimension or no component",
             ));
         }
         if self.components.iter().any(|c| c.len() != dim)
             || self.explained_ratio.len() != self.components.len()
         {
-            return Err(LearnError::invalid(
+            return Err(InferError::invalid(
                 "the PCA's components do not match its dimension",
             ));
         }
@@ -182,7 +182,7 @@ impl Pca {
             .chain(self.components.iter().flatten())
             .all(|v| v.is_finite());
         if !finite {
-            return Err(LearnError::invalid("the PCA holds non-finite numbers"));
+            return Err(InferError::invalid("the PCA holds non-finite numbers"));
         }
         Ok(())
     }

@@ -10,7 +10,7 @@
 //! - max pooling takes the largest value of each run of `pool` positions, per channel
 //!   (a trailing partial run is dropped, like Keras's `MaxPooling1D`).
 
-use crate::error::{LearnError, Result};
+use crate::error::{InferError, Result};
 use faer::{linalg::matmul::matmul, Accum, MatMut, MatRef, Par};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -53,7 +53,7 @@ impl CnnSpec {
     /// features; an error when the input is too short for the kernels.
     pub fn lengths(&self, inputs: usize) -> Result<[usize; 3]> {
         let too_short = || {
-            LearnError::invalid(format!(
+            InferError::invalid(format!(
                 "the 1D CNN needs at least {} input features, got {inputs}",
                 self.conv1_kernel + self.conv2_kernel + self.pool - 2
             ))
@@ -125,7 +125,7 @@ impl Architecture {
         outputs: usize,
     ) -> Result<Vec<(String, Vec<usize>)>> {
         if inputs == 0 || outputs == 0 {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "a network needs inputs and outputs, got {inputs} and {outputs}"
             )));
         }
@@ -157,7 +157,7 @@ impl Architecture {
 
     /// Checks the settings are usable.
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: String| Err(LearnError::invalid(m));
+        let bad = |m: String| Err(InferError::invalid(m));
         match self {
             Architecture::Cnn1d(s) => {
                 if [
@@ -260,7 +260,7 @@ impl Network {
         architecture.validate()?;
         let shapes = architecture.parameter_shapes(inputs, outputs)?;
         if shapes.len() != parameters.len() {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "the {} network needs {} parameter arrays, got {}",
                 architecture.name(),
                 shapes.len(),
@@ -269,19 +269,19 @@ impl Network {
         }
         for ((name, shape), p) in shapes.iter().zip(&parameters) {
             if &p.name != name || &p.shape != shape {
-                return Err(LearnError::invalid(format!(
+                return Err(InferError::invalid(format!(
                     "parameter {} {:?} found where {name} {shape:?} was expected",
                     p.name, p.shape
                 )));
             }
             if p.data.len() != shape.iter().product::<usize>() {
-                return Err(LearnError::invalid(format!(
+                return Err(InferError::invalid(format!(
                     "parameter {name} has {} values for shape {shape:?}",
                     p.data.len()
                 )));
             }
             if p.data.iter().any(|v| !v.is_finite()) {
-                return Err(LearnError::invalid(format!(
+                return Err(InferError::invalid(format!(
                     "parameter {name} holds non-finite values"
                 )));
             }
@@ -333,7 +333,7 @@ impl Network {
     /// networks, plain linear outputs for `linear`. Blocks of rows run in parallel.
     pub fn forward(&self, x: &[f32]) -> Result<Vec<f32>> {
         if x.len() % self.inputs != 0 {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "{} values do not form rows of {} features",
                 x.len(),
                 self.inputs

@@ -13,17 +13,15 @@
 //! Reading checks all of it, so a wrong, damaged or incompatible file is an error naming what
 //! is wrong, never a panic.
 
-use crate::error::{LearnError, Result};
+use crate::error::{InferError, Result};
 use crate::network::{Architecture, Network, Parameter};
+use crate::record::TrainingRecord;
 use crate::scale::{FeatureScaler, TargetScaler};
 use crate::target::Target;
-use crate::train::{TrainOptions, TrainingSet};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use spdcam_core::dataset::Dataset;
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::Grid;
-use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The first bytes of every model file.
@@ -32,66 +30,6 @@ pub const MAGIC: &[u8; 8] = b"SPDCAMMD";
 pub const FORMAT_VERSION: u32 = 1;
 /// The usual file extension.
 pub const EXTENSION: &str = "spdm";
-
-/// Where a training (or validation) set came from.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DataInfo {
-    /// The dataset directory as given on the command line (or a description).
-    pub path: String,
-    /// Number of samples.
-    pub samples: usize,
-    /// The chart the features were taken from, when known.
-    pub chart: Option<String>,
-    /// The camera, when known.
-    pub camera: Option<String>,
-    /// Samples per light family.
-    pub families: BTreeMap<String, u64>,
-    /// The dataset manifest's `origin` (generation settings, import source…).
-    pub origin: Option<serde_json::Value>,
-}
-
-impl DataInfo {
-    /// The description of an opened dataset directory, labelled `path`.
-    pub fn from_dataset(dataset: &Dataset, path: &str) -> DataInfo {
-        let manifest = dataset.manifest();
-        let generated = manifest.origin.generated();
-        DataInfo {
-            path: path.to_string(),
-            samples: manifest.samples as usize,
-            chart: generated.map(|g| g.chart.name.clone()),
-            camera: generated.map(|g| g.camera.name.clone()),
-            families: manifest.families.clone(),
-            origin: serde_json::to_value(&manifest.origin).ok(),
-        }
-    }
-}
-
-/// How a model was trained.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrainingRecord {
-    /// The training data.
-    pub data: DataInfo,
-    /// A separate validation set, when one was given.
-    pub validation: Option<DataInfo>,
-    /// Rows trained on.
-    pub train_samples: usize,
-    /// Rows validated on.
-    pub val_samples: usize,
-    /// The settings.
-    pub options: TrainOptions,
-    /// Epochs run (0 for `linear`).
-    pub epochs_run: usize,
-    /// The epoch whose weights were kept.
-    pub best_epoch: usize,
-    /// Validation loss (MSE of the scaled targets) of the kept weights.
-    pub val_loss: f64,
-    /// Mean validation GFC of the kept weights.
-    pub val_gfc: f64,
-    /// Wall-clock seconds of the whole run.
-    pub seconds: f64,
-    /// The training of the model this one was fine-tuned from.
-    pub finetuned_from: Option<Box<TrainingRecord>>,
-}
 
 /// Name and shape of one stored parameter array.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -177,14 +115,15 @@ impl<'a> Cursor<'a> {
 }
 
 impl Model {
-    /// Puts a model together after training.
-    pub(crate) fn assemble(
+    /// Puts a model together after training; the chart and camera are those of the
+    /// training data (`training.data`).
+    pub fn assemble(
         network: Network,
         feature_scaler: FeatureScaler,
         target: Target,
         target_scaler: TargetScaler,
         grid: Grid,
-        data: &TrainingSet,
+        feature_names: Vec<String>,
         training: TrainingRecord,
     ) -> Result<Model> {
         let header = ModelHeader {
@@ -192,9 +131,9 @@ impl Model {
             format_version: FORMAT_VERSION,
             spdcam_version: env!("CARGO_PKG_VERSION").into(),
             architecture: network.architecture().clone(),
-            feature_names: data.columns.feature_names.clone(),
-            chart: data.info.chart.clone(),
-            camera: data.info.camera.clone(),
+            feature_names,
+            chart: training.data.chart.clone(),
+            camera: training.data.camera.clone(),
             photo_chart: None,
             feature_scaler,
             target,
@@ -225,21 +164,21 @@ impl Model {
         let inputs = self.network.inputs();
         let outputs = self.network.outputs();
         if h.feature_names.len() != inputs || h.feature_scaler.width() != inputs {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "the model has {} feature names and {} feature scalings for a network of {inputs} inputs",
                 h.feature_names.len(),
                 h.feature_scaler.width()
             )));
         }
         if h.target.len() != outputs || h.target_scaler.width() != outputs {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "the model has {} targets and {} target scalings for a network of {outputs} outputs",
                 h.target.len(),
                 h.target_scaler.width()
             )));
         }
         if h.target.spd_len() != h.grid.count {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "the model's SPDs have {} values for a grid of {} ({})",
                 h.target.spd_len(),
                 h.grid.count,
@@ -338,7 +277,7 @@ impl Model {
             .as_deref()
             .map(|c| format!(" (chart {c})"))
             .unwrap_or_default();
-        Err(LearnError::invalid(format!(
+        Err(InferError::invalid(format!(
             "{source}: {} feature columns ({}) do not match the model's {} ({}){chart}; \
              the features must come from the chart the model was trained for",
             names.len(),
@@ -376,7 +315,7 @@ impl Model {
     /// The SPD estimate for one row of features.
     pub fn estimate(&self, features: &[f64]) -> Result<Vec<f64>> {
         if features.len() != self.network.inputs() {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "{} features given, the model reads {}",
                 features.len(),
                 self.network.inputs()
@@ -388,7 +327,7 @@ impl Model {
     /// The model as the bytes of a `.spdm` file.
     pub fn to_bytes(&self) -> Result<Vec<u8>> {
         let header = serde_json::to_vec(&self.header)
-            .map_err(|e| LearnError::invalid(format!("encoding the model header: {e}")))?;
+            .map_err(|e| InferError::invalid(format!("encoding the model header: {e}")))?;
         let blob_len: usize = self.network.parameter_count() * 4;
         let mut out = Vec::with_capacity(8 + 4 + 8 + header.len() + 8 + blob_len + 8);
         out.extend_from_slice(MAGIC);
@@ -414,16 +353,16 @@ impl Model {
 
     /// Reads a model file.
     pub fn load(path: &Path) -> Result<Model> {
-        let bytes = std::fs::read(path).map_err(|source| LearnError::Io {
+        let bytes = std::fs::read(path).map_err(|source| InferError::Io {
             path: path.to_path_buf(),
             source,
         })?;
         Model::from_bytes(&bytes).map_err(|e| match e {
-            LearnError::ModelFile { message, .. } => LearnError::ModelFile {
+            InferError::ModelFile { message, .. } => InferError::ModelFile {
                 path: path.to_path_buf(),
                 message,
             },
-            other => LearnError::ModelFile {
+            other => InferError::ModelFile {
                 path: path.to_path_buf(),
                 message: other.to_string(),
             },
@@ -432,7 +371,7 @@ impl Model {
 
     /// A model from the bytes of a `.spdm` file.
     pub fn from_bytes(bytes: &[u8]) -> Result<Model> {
-        let bad = |message: String| LearnError::ModelFile {
+        let bad = |message: String| InferError::ModelFile {
             path: "<bytes>".into(),
             message,
         };

@@ -2,7 +2,7 @@
 //! model: each feature row divided by its own maximum, then each feature min-max scaled;
 //! each target min-max scaled to [0, 1] so that a sigmoid output can reach it.
 
-use crate::error::{LearnError, Result};
+use crate::error::{InferError, Result};
 use serde::{Deserialize, Serialize};
 
 /// Per-feature minimum and maximum (after the per-sample maximum), fitted on training rows.
@@ -27,12 +27,12 @@ fn divide_by_max(row: &mut [f64]) {
 /// Checks stored per-column bounds: equal, non-zero lengths and finite numbers.
 fn validate_bounds(min: &[f64], max: &[f64], what: &str) -> Result<()> {
     if min.is_empty() || min.len() != max.len() {
-        return Err(LearnError::invalid(format!(
+        return Err(InferError::invalid(format!(
             "the {what} scaling has mismatched lengths"
         )));
     }
     if min.iter().chain(max).any(|v| !v.is_finite()) {
-        return Err(LearnError::invalid(format!(
+        return Err(InferError::invalid(format!(
             "the {what} scaling holds non-finite numbers"
         )));
     }
@@ -41,13 +41,13 @@ fn validate_bounds(min: &[f64], max: &[f64], what: &str) -> Result<()> {
 
 fn check_rows(data: &[f64], width: usize, what: &str) -> Result<usize> {
     if width == 0 || data.len() % width != 0 {
-        return Err(LearnError::invalid(format!(
+        return Err(InferError::invalid(format!(
             "{what}: {} values do not form rows of {width}",
             data.len()
         )));
     }
     if let Some(v) = data.iter().find(|v| !v.is_finite()) {
-        return Err(LearnError::invalid(format!(
+        return Err(InferError::invalid(format!(
             "{what}: the data hold the non-finite value {v}"
         )));
     }
@@ -71,7 +71,7 @@ impl FeatureScaler {
     pub fn fit(data: &[f64], width: usize, per_sample_max: bool) -> Result<FeatureScaler> {
         let rows = check_rows(data, width, "features")?;
         if rows == 0 {
-            return Err(LearnError::invalid(
+            return Err(InferError::invalid(
                 "features: no rows to fit the scaling on",
             ));
         }
@@ -143,7 +143,7 @@ impl TargetScaler {
     pub fn fit(data: &[f64], width: usize) -> Result<TargetScaler> {
         let rows = check_rows(data, width, "targets")?;
         if rows == 0 {
-            return Err(LearnError::invalid(
+            return Err(InferError::invalid(
                 "targets: no rows to fit the scaling on",
             ));
         }

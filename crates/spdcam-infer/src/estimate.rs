@@ -1,0 +1,448 @@
+//! From chart features, or from photos of a chart, to estimates of the light's SPD: the one
+//! path every front end (command line, Python, web app) calls.
+//!
+//! ```text
+//! photo ─► decode ─► detect chart ─► sample (spdcam-core::photo) ─┐
+//! features CSV ─► FeatureRows ──────────────────────────────────────┴─► model for the chart
+//!     (ModelSet) ─► SPD ─► Estimate (SPD, colorimetry, score against a truth, photo analysis)
+//! ```
+
+use crate::error::{InferError, Result};
+use crate::model::Model;
+use crate::shipped::ModelSet;
+use serde::Serialize;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::chart::Chart;
+use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
+use spdcam_core::metrics;
+use spdcam_core::photo::{self, AnalyseOptions, ChartTemplate, PhotoAnalysis};
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use std::path::{Path, PathBuf};
+
+/// CCT is defined only this near the Planckian locus (|Duv| in CIE 1960 uv).
+pub const MAX_CCT_DUV: f64 = 0.05;
+
+/// Feature rows: column names and row-major values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeatureRows {
+    /// Column names (`p01_r, p01_g, …`).
+    pub names: Vec<String>,
+    /// Values, row-major.
+    pub values: Vec<f64>,
+    /// Number of rows.
+    pub rows: usize,
+}
+
+impl FeatureRows {
+    /// Reads a features CSV: a header naming the columns, then one numeric row per estimate.
+    pub fn read_csv(path: &Path) -> Result<FeatureRows> {
+        let shown = path.display();
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .flexible(true)
+            .from_path(path)
+            .map_err(|e| InferError::invalid(format!("reading {shown}: {e}")))?;
+        let names: Vec<String> = reader
+            .headers()
+            .map_err(|e| InferError::invalid(format!("{shown}: {e}")))?
+            .iter()
+            .map(str::to_string)
+            .collect();
+        if names.iter().all(String::is_empty) {
+            return Err(InferError::invalid(format!("{shown}: the file is empty")));
+        }
+        let mut values = Vec::new();
+        let mut rows = 0;
+        for record in reader.records() {
+            let record = record.map_err(|e| InferError::invalid(format!("{shown}: {e}")))?;
+            let line = record.position().map_or(0, |p| p.line());
+            if record.iter().all(str::is_empty) {
+                continue;
+            }
+            if record.len() != names.len() {
+                return Err(InferError::invalid(format!(
+                    "{shown} line {line}: {} values, the header names {} columns",
+                    record.len(),
+                    names.len()
+                )));
+            }
+            for (cell, name) in record.iter().zip(&names) {
+                let v: f64 = cell.parse().map_err(|_| {
+                    InferError::invalid(format!(
+                        "{shown} line {line}, column {name}: '{cell}' is not a number"
+                    ))
+                })?;
+                if !v.is_finite() {
+                    return Err(InferError::invalid(format!(
+                        "{shown} line {line}, column {name}: {v} is not a finite number"
+                    )));
+                }
+                values.push(v);
+            }
+            rows += 1;
+        }
+        if rows == 0 {
+            return Err(InferError::invalid(format!(
+                "{shown}: no rows of features below the header"
+            )));
+        }
+        Ok(FeatureRows {
+            names,
+            values,
+            rows,
+        })
+    }
+
+    /// The rows of analysed photos that all show the same chart.
+    pub fn of_analyses(analyses: &[&PhotoAnalysis]) -> Result<FeatureRows> {
+        let Some(first) = analyses.first() else {
+            return Err(InferError::invalid("no photo analysed"));
+        };
+        if let Some(other) = analyses
+            .iter()
+            .find(|a| a.feature_names != first.feature_names)
+        {
+            return Err(InferError::invalid(format!(
+                "{} shows chart {} and {} chart {}",
+                first.source, first.chart, other.source, other.chart
+            )));
+        }
+        Ok(FeatureRows {
+            names: first.feature_names.clone(),
+            values: analyses
+                .iter()
+                .flat_map(|a| a.features.iter().map(|&v| f64::from(v)))
+                .collect(),
+            rows: analyses.len(),
+        })
+    }
+}
+
+/// SPD estimates for feature rows (checked against the model's columns), one set item per
+/// row named by `labels`, resampled to `grid` (within the model's grid).
+pub fn estimate_rows(
+    model: &Model,
+    features: &FeatureRows,
+    labels: Vec<String>,
+    source: &str,
+    grid: &Grid,
+) -> Result<SpectralSet> {
+    model.check_features(&features.names, source)?;
+    let mg = model.grid();
+    if grid.start_nm < mg.start_nm - 1e-9 || grid.end_nm() > mg.end_nm() + 1e-9 {
+        return Err(InferError::invalid(format!(
+            "the range {}: the model estimates {} nm only",
+            grid.label(),
+            mg.label()
+        )));
+    }
+    let spds = model.estimate_rows(&features.values)?;
+    let values = spds.chunks_exact(mg.count).map(<[f64]>::to_vec).collect();
+    let set = SpectralSet::on_grid(&mg, labels, values)?;
+    if *grid == mg {
+        return Ok(set);
+    }
+    let (resampled, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
+    Ok(resampled)
+}
+
+/// CIE 1931 xy, and CCT and Duv where the chromaticity is near enough the Planckian locus.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Colorimetry {
+    /// CIE 1931 chromaticity.
+    pub xy: [f64; 2],
+    /// Correlated colour temperature (K); `None` farther than |Duv| 0.05 from the locus.
+    pub cct: Option<f64>,
+    /// Distance from the Planckian locus in CIE 1960 uv.
+    pub duv: Option<f64>,
+}
+
+impl Colorimetry {
+    /// The colorimetry of `spd` on `grid` (CIE 1931 2° observer; CCT and Duv by Ohno 2014).
+    pub fn of(spd: &[f64], grid: &Grid) -> Result<Colorimetry> {
+        let xy = Observer::cie1931(grid)?.spd_to_xy(spd);
+        let (cct, duv) = match uv_to_cct_duv(xy_to_uv1960(xy)) {
+            Ok((cct, duv)) if duv.abs() <= MAX_CCT_DUV => (Some(cct), Some(duv)),
+            _ => (None, None),
+        };
+        Ok(Colorimetry { xy, cct, duv })
+    }
+
+    /// `xy (0.3127, 0.3290), CCT 6504 K, Duv +0.0032`.
+    pub fn label(&self) -> String {
+        let mut s = format!("xy ({:.4}, {:.4})", self.xy[0], self.xy[1]);
+        match (self.cct, self.duv) {
+            (Some(cct), Some(duv)) => s.push_str(&format!(", CCT {cct:.0} K, Duv {duv:+.4}")),
+            _ => s.push_str(", no CCT (far from the Planckian locus)"),
+        }
+        s
+    }
+}
+
+/// An estimate compared with its true SPD (both peak-normalised, thesis section 4.3).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Score {
+    /// Goodness-of-fit coefficient (1 = same shape).
+    pub gfc: f64,
+    /// Root-mean-square error.
+    pub rmse: f64,
+}
+
+impl Score {
+    /// The score of `estimate` against `truth` (same grid).
+    pub fn of(truth: &[f64], estimate: &[f64]) -> Result<Score> {
+        let t = metrics::normalise_by_max(truth);
+        let e = metrics::normalise_by_max(estimate);
+        Ok(Score {
+            gfc: metrics::gfc(&t, &e)?,
+            rmse: metrics::rmse(&t, &e)?,
+        })
+    }
+}
+
+/// One estimate of the light: its SPD, what it means, and where it came from.
+#[derive(Debug, Clone)]
+pub struct Estimate {
+    /// The photo's file name, or `estimate_N` for feature rows.
+    pub name: String,
+    /// The model that made it.
+    pub model: String,
+    /// The SPD's wavelengths (nm).
+    pub grid: Grid,
+    /// The relative SPD, peak 1.
+    pub spd: Vec<f64>,
+    /// xy, CCT, Duv of the SPD.
+    pub colorimetry: Colorimetry,
+    /// The score against a true SPD, when one was given.
+    pub truth: Option<Score>,
+    /// The analysis of the photo, for estimates from photos.
+    pub photo: Option<PhotoAnalysis>,
+}
+
+impl Estimate {
+    /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`, `truth`,
+    /// and for photos `photo` (chart, method, confidence, corners, homography, features and
+    /// `features_by_name`, every patch with its statistics and flags, warnings).
+    pub fn to_json(&self) -> Result<serde_json::Value> {
+        let mut v = serde_json::json!({
+            "name": self.name,
+            "model": self.model,
+            "wavelength_nm": self.grid.wavelengths(),
+            "spd": self.spd,
+            "colorimetry": self.colorimetry,
+            "truth": self.truth,
+        });
+        if let Some(a) = &self.photo {
+            v["photo"] = analysis_json(a)?;
+        }
+        Ok(v)
+    }
+
+    /// Compares the estimate with `truth` (on the estimate's grid) and keeps the score.
+    pub fn score_against(&mut self, truth: &[f64]) -> Result<()> {
+        self.truth = Some(Score::of(truth, &self.spd)?);
+        Ok(())
+    }
+}
+
+/// One photo analysis as JSON, with the features also keyed by column name.
+pub fn analysis_json(analysis: &PhotoAnalysis) -> Result<serde_json::Value> {
+    let mut v = serde_json::to_value(analysis)
+        .map_err(|e| InferError::invalid(format!("encoding the analysis: {e}")))?;
+    let named: serde_json::Map<String, serde_json::Value> = analysis
+        .feature_names
+        .iter()
+        .zip(&analysis.features)
+        .map(|(n, f)| (n.clone(), serde_json::json!(f)))
+        .collect();
+    if let Some(obj) = v.as_object_mut() {
+        obj.insert("features_by_name".into(), serde_json::Value::Object(named));
+    }
+    Ok(v)
+}
+
+/// Estimates for feature rows: each row through the model for its columns, labelled
+/// `estimate_1…`, on `grid`.
+pub fn estimate_features(
+    models: &ModelSet,
+    features: &FeatureRows,
+    source: &str,
+    grid: &Grid,
+) -> Result<Vec<Estimate>> {
+    let chosen = models.require(&features.names, source)?;
+    let labels: Vec<String> = (1..=features.rows)
+        .map(|i| format!("estimate_{i}"))
+        .collect();
+    let set = estimate_rows(&chosen.model, features, labels, source, grid)?;
+    (0..set.len())
+        .map(|i| {
+            Ok(Estimate {
+                name: set.names()[i].clone(),
+                model: chosen.name.clone(),
+                grid: *grid,
+                spd: set.item(i).to_vec(),
+                colorimetry: Colorimetry::of(set.item(i), grid)?,
+                truth: None,
+                photo: None,
+            })
+        })
+        .collect()
+}
+
+/// How photos are analysed: which charts to look for, and optional corners or debug image.
+#[derive(Debug, Clone, Default)]
+pub struct PhotoOptions {
+    /// Look only for this chart (a name or a reflectance CSV); default: every chart a model
+    /// of the set was trained for.
+    pub chart: Option<String>,
+    /// The chart's four outer corners in pixels, any order (one photo only).
+    pub corners: Option<Vec<[f64; 2]>>,
+    /// Where to write a debug image of each photo (see `spdcam_core::photo::debug_path`).
+    pub debug: Option<PathBuf>,
+}
+
+/// The charts to look for in photos. With `chart`: that chart as photos show it (from a
+/// model's file when a model was trained for it) and as `spdcam render` draws it. Without:
+/// every model's chart, the same two ways; when no model carries its chart's template, the
+/// ColorChecker 24 and, when the data directory holds it, the Digital SG.
+pub fn chart_templates(
+    models: &ModelSet,
+    chart: Option<&str>,
+    data_dir: &DataDir,
+) -> Result<Vec<ChartTemplate>> {
+    let grid = Grid::SIMULATION;
+    let names: Vec<String> = match chart {
+        Some(name) => vec![name.to_string()],
+        None => models
+            .models()
+            .iter()
+            .filter(|m| m.model.photo_chart().is_some())
+            .filter_map(|m| m.model.header().chart.clone())
+            .collect(),
+    };
+    if names.is_empty() {
+        let mut out = vec![ChartTemplate::from_chart(&Chart::colorchecker24(&grid)?)?];
+        if let Ok(sg) = Chart::resolve("colorchecker_sg140", None, data_dir, &grid) {
+            out.push(ChartTemplate::from_chart(&sg)?);
+        }
+        return Ok(out);
+    }
+    let mut out: Vec<ChartTemplate> = Vec::new();
+    let mut push = |t: ChartTemplate| {
+        if out.iter().all(|o| o.name != t.name) {
+            out.push(t);
+        }
+    };
+    for name in &names {
+        let physical = match models.for_chart(name).and_then(|m| m.model.photo_chart()) {
+            Some(t) => Some(t.clone()),
+            None => ChartTemplate::for_chart(name, data_dir, &grid),
+        };
+        physical.into_iter().for_each(&mut push);
+        if let Some(rendered) = Chart::resolve(name, None, data_dir, &grid)
+            .ok()
+            .and_then(|c| ChartTemplate::from_chart(&c).ok())
+        {
+            push(rendered);
+        }
+    }
+    if out.is_empty() {
+        // Name the reason: an unknown chart, or one with too few neutral patches.
+        let name = &names[0];
+        let chart = Chart::resolve(name, None, data_dir, &grid)?;
+        ChartTemplate::from_chart(&chart)?;
+        return Err(InferError::invalid(format!(
+            "chart '{name}' cannot be found in photos"
+        )));
+    }
+    Ok(out)
+}
+
+/// Analyses photos (in parallel) with `options` and the charts of `templates`; one result
+/// per photo, in order, so one bad photo does not cost the others.
+pub fn analyse_photos(
+    photos: &[PathBuf],
+    options: &PhotoOptions,
+    templates: Vec<ChartTemplate>,
+) -> Result<Vec<Result<PhotoAnalysis>>> {
+    if options.corners.is_some() && photos.len() > 1 {
+        return Err(InferError::invalid(format!(
+            "corners apply to one photo; {} were given",
+            photos.len()
+        )));
+    }
+    let analyse = AnalyseOptions {
+        templates,
+        corners: options.corners.clone(),
+        debug: options.debug.clone(),
+    };
+    Ok(photo::analyse_photos(photos, &analyse)
+        .into_iter()
+        .map(|r| r.map_err(InferError::from))
+        .collect())
+}
+
+/// The estimate for an analysed photo, with the model for its chart, labelled `name`.
+pub fn estimate_analysis(
+    models: &ModelSet,
+    analysis: PhotoAnalysis,
+    name: String,
+    grid: &Grid,
+) -> Result<Estimate> {
+    let rows = FeatureRows::of_analyses(&[&analysis])?;
+    let chosen = models.require(&rows.names, &analysis.source).map_err(|_| {
+        InferError::invalid(format!(
+            "{}: no model for chart {}; the models are for {}",
+            analysis.source,
+            analysis.chart,
+            charts_of(models)
+        ))
+    })?;
+    let set = estimate_rows(
+        &chosen.model,
+        &rows,
+        vec![name.clone()],
+        &analysis.source,
+        grid,
+    )?;
+    let spd = set.item(0).to_vec();
+    Ok(Estimate {
+        name,
+        model: chosen.name.clone(),
+        grid: *grid,
+        colorimetry: Colorimetry::of(&spd, grid)?,
+        spd,
+        truth: None,
+        photo: Some(analysis),
+    })
+}
+
+/// The estimate for one photo file: analysed with `options`, estimated with the model for
+/// the chart it shows, on `grid`.
+pub fn estimate_photo(
+    path: &Path,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Estimate> {
+    let templates = chart_templates(models, options.chart.as_deref(), data_dir)?;
+    let analysis = analyse_photos(&[path.to_path_buf()], options, templates)?
+        .pop()
+        .ok_or_else(|| InferError::invalid("no photo analysed"))??;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string());
+    estimate_analysis(models, analysis, name, grid)
+}
+
+/// `colorchecker_sg96, colorchecker24`: the charts the set's models read.
+fn charts_of(models: &ModelSet) -> String {
+    models
+        .models()
+        .iter()
+        .map(|m| m.model.header().chart.as_deref().unwrap_or("unknown"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}

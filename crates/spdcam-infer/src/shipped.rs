@@ -1,0 +1,137 @@
+//! The models shipped inside spdcam, one per chart people own, and the set of models an
+//! estimate chooses from: the model whose features a photo's chart gives.
+
+use crate::error::{InferError, Result};
+use crate::model::Model;
+
+/// The shipped models: chart name and `.spdm` bytes (`models/<chart>.spdm`, each made by the
+/// seeded commands in the README).
+const SHIPPED: &[(&str, &[u8])] = &[(
+    "colorchecker_sg96",
+    include_bytes!("../../../models/colorchecker_sg96.spdm"),
+)];
+
+/// A model with the name messages use for it.
+#[derive(Debug, Clone)]
+pub struct NamedModel {
+    /// `the shipped colorchecker24 model` or the model file's path.
+    pub name: String,
+    /// The model.
+    pub model: Model,
+}
+
+/// The models an estimate may use; each feature layout (chart) picks its own.
+#[derive(Debug, Clone)]
+pub struct ModelSet {
+    models: Vec<NamedModel>,
+}
+
+impl ModelSet {
+    /// The models shipped inside spdcam.
+    pub fn shipped() -> Result<ModelSet> {
+        let models = SHIPPED
+            .iter()
+            .map(|(chart, bytes)| {
+                let model = Model::from_bytes(bytes).map_err(|e| {
+                    InferError::invalid(format!("the shipped {chart} model is damaged: {e}"))
+                })?;
+                Ok(NamedModel {
+                    name: format!("the shipped {chart} model"),
+                    model,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(ModelSet { models })
+    }
+
+    /// One model, named `name` (e.g. its file's path).
+    pub fn single(model: Model, name: impl Into<String>) -> ModelSet {
+        ModelSet {
+            models: vec![NamedModel {
+                name: name.into(),
+                model,
+            }],
+        }
+    }
+
+    /// The models, in order.
+    pub fn models(&self) -> &[NamedModel] {
+        &self.models
+    }
+
+    /// The model that reads exactly these feature columns.
+    pub fn for_features(&self, names: &[String]) -> Option<&NamedModel> {
+        self.models
+            .iter()
+            .find(|m| m.model.feature_names() == names)
+    }
+
+    /// The model trained for the chart named `chart`.
+    pub fn for_chart(&self, chart: &str) -> Option<&NamedModel> {
+        self.models
+            .iter()
+            .find(|m| m.model.header().chart.as_deref() == Some(chart))
+    }
+
+    /// The model for feature columns `names` (from `source`), or an error that names the
+    /// charts and column counts the set's models read.
+    pub fn require(&self, names: &[String], source: &str) -> Result<&NamedModel> {
+        if let Some(m) = self.for_features(names) {
+            return Ok(m);
+        }
+        if let [only] = self.models.as_slice() {
+            only.model.check_features(names, source)?;
+        }
+        let known = self
+            .models
+            .iter()
+            .map(|m| {
+                format!(
+                    "{} ({} features)",
+                    m.model.header().chart.as_deref().unwrap_or("unknown chart"),
+                    m.model.feature_names().len()
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        Err(InferError::invalid(format!(
+            "{source}: no model reads these {} feature columns; the models are for {known}",
+            names.len()
+        )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shipped_models_load_and_each_names_its_chart() {
+        let set = ModelSet::shipped().unwrap();
+        assert_eq!(set.models().len(), SHIPPED.len());
+        for (chart, _) in SHIPPED {
+            let m = set.for_chart(chart).unwrap();
+            assert_eq!(m.model.header().chart.as_deref(), Some(*chart));
+            assert!(
+                m.model.photo_chart().is_some(),
+                "{chart}: no photo template"
+            );
+            let found = set.for_features(m.model.feature_names()).unwrap();
+            assert_eq!(found.name, m.name);
+        }
+    }
+
+    #[test]
+    fn unknown_features_name_the_known_charts() {
+        let set = ModelSet::shipped().unwrap();
+        let err = set
+            .require(&["a".to_string(), "b".to_string()], "f.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("f.csv") && err.contains("colorchecker24"),
+            "{err}"
+        );
+        assert!(err.contains("colorchecker_sg96 (288 features)"), "{err}");
+    }
+}

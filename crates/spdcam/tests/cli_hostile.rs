@@ -1,0 +1,283 @@
+//! Hostile and careless input on the command line (issue 15): every case gets a clear
+//! error at once — no abort, no minutes of work, no lost output, no silent overwrite.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn spdcam(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_spdcam"))
+        .args(args)
+        .env_remove("SPDCAM_DATA")
+        .output()
+        .expect("spdcam runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("spdcam-cli-hostile-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Runs spdcam, expects it to fail within a few seconds, and returns its stderr.
+fn fails_fast(args: &[&str]) -> String {
+    let started = Instant::now();
+    let out = spdcam(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "spdcam {args:?} succeeded");
+    assert_eq!(out.status.code(), Some(1), "spdcam {args:?} died: {stderr}");
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "spdcam {args:?} took {:?}",
+        started.elapsed()
+    );
+    assert!(stderr.lines().any(|l| l.starts_with("error: ")), "{stderr}");
+    stderr
+}
+
+#[test]
+fn sizes_from_options_are_capped_with_a_clear_error() {
+    // Issue 15, item 4: these aborted on allocation or ran for minutes with gigabytes.
+    let dir = scratch("caps");
+    let png = dir.join("c.png");
+    let jpg = dir.join("c.jpg");
+    for (args, limit) in [
+        (vec!["--patch-px", "100000"], "SPDCAM_MAX_RENDER_PIXELS"),
+        (vec!["--size", "200000x200000"], "SPDCAM_MAX_RENDER_PIXELS"),
+        (
+            vec!["--white-balance", "grey-edge:1:1e9"],
+            "SPDCAM_MAX_FILTER_SIGMA",
+        ),
+    ] {
+        let mut all = vec!["render", "--spd", "D65", "-o", s(&png)];
+        all.extend(args.iter().copied());
+        let e = fails_fast(&all);
+        assert!(e.contains(limit), "{args:?}: {e}");
+    }
+    let e = fails_fast(&[
+        "render",
+        "--spd",
+        "D65",
+        "--scene",
+        "100000x100000",
+        "-o",
+        s(&jpg),
+    ]);
+    assert!(e.contains("SPDCAM_MAX_RENDER_PIXELS"), "{e}");
+    let out = dir.join("d");
+    let e = fails_fast(&[
+        "generate",
+        "--lighting",
+        "gaussian:4",
+        "--count",
+        "1000000000000",
+        "-o",
+        s(&out),
+    ]);
+    assert!(e.contains("SPDCAM_MAX_SAMPLES"), "{e}");
+    let e = fails_fast(&[
+        "generate",
+        "--lighting",
+        "gaussian:4",
+        "--count",
+        "10",
+        "--spd-grid",
+        "380-780:0.00001",
+        "-o",
+        s(&out),
+    ]);
+    assert!(e.contains("SPDCAM_MAX_GRID_BANDS"), "{e}");
+    assert!(!out.exists() || std::fs::read_dir(&out).unwrap().count() == 0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_negative_exposure_is_named_not_mistaken_for_an_option() {
+    // Issue 15, item 13: `--exposure -1` was rejected by the argument parser.
+    let dir = scratch("exposure");
+    let e = fails_fast(&[
+        "render",
+        "--spd",
+        "D65",
+        "--exposure",
+        "-1",
+        "-o",
+        s(&dir.join("c.png")),
+    ]);
+    assert!(e.contains("--exposure -1") && e.contains("positive"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn help_names_the_files_generate_writes() {
+    let out = spdcam(&["generate", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    assert!(help.contains("samples/part-NNNNN.parquet"), "{help}");
+    assert!(!help.contains("samples-NNNNN"), "{help}");
+}
+
+#[test]
+fn dash_writes_to_standard_output() {
+    // Issue 15, item 13: `-o -` wrote a file named `-`.
+    let dir = scratch("stdout");
+    let out = Command::new(env!("CARGO_BIN_EXE_spdcam"))
+        .args(["render", "--spd", "D65", "--noise", "off", "-o", "-"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.stdout.starts_with(b"\x89PNG"), "stdout is the PNG");
+    let png = dir.join("c.png");
+    let features = Command::new(env!("CARGO_BIN_EXE_spdcam"))
+        .args([
+            "render",
+            "--spd",
+            "D65",
+            "--noise",
+            "off",
+            "-o",
+            s(&png),
+            "--features",
+            "-",
+        ])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&features.stdout);
+    assert!(text.starts_with("p01_r,p01_g,p01_b,"), "{text}");
+    assert!(!dir.join("-").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn train_refuses_an_unwritable_model_path_before_training() {
+    // Issue 15, item 6: `train -o DIR` failed only after training finished.
+    let dir = scratch("train-out");
+    let e = fails_fast(&[
+        "train",
+        "--model",
+        "mlp",
+        "--data",
+        s(&dir.join("no-such-data")),
+        "-o",
+        s(&dir),
+    ]);
+    assert!(e.contains("is a directory"), "{e}");
+    let e = fails_fast(&[
+        "train",
+        "--model",
+        "mlp",
+        "--data",
+        s(&dir.join("no-such-data")),
+        "-o",
+        s(&dir.join("missing/m.spdm")),
+    ]);
+    assert!(e.contains("does not exist"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn evaluate_refuses_to_overwrite_a_directory_of_user_files() {
+    // Issue 15, item 10: `evaluate -o` overwrote a user's files while export/split refuse.
+    let dir = scratch("evaluate-out");
+    std::fs::write(dir.join("samples.csv"), "my own file").unwrap();
+    let e = fails_fast(&[
+        "evaluate",
+        "--model",
+        s(&dir.join("m.spdm")),
+        "--data",
+        s(&dir),
+        "-o",
+        s(&dir),
+    ]);
+    assert!(e.contains("not empty") && e.contains("--force"), "{e}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("samples.csv")).unwrap(),
+        "my own file"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_damaged_dataset_fails_verification_and_a_failed_import_leaves_nothing() {
+    // Issue 15, items 7 and 9.
+    let dir = scratch("verify");
+    let data = dir.join("d");
+    let out = spdcam(&[
+        "generate",
+        "--lighting",
+        "gaussian:4",
+        "--count",
+        "20",
+        "--chunk-size",
+        "8",
+        "--fast",
+        "-o",
+        s(&data),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let ok = spdcam(&["dataset", "info", s(&data), "--verify"]);
+    let text = String::from_utf8_lossy(&ok.stdout);
+    assert!(
+        ok.status.success() && text.contains("verified: 3 files, 20 samples"),
+        "{text}"
+    );
+    let part = data.join("samples/part-00001.parquet");
+    let mut bytes = std::fs::read(&part).unwrap();
+    let at = bytes.len() / 2;
+    bytes[at] ^= 1;
+    std::fs::write(&part, bytes).unwrap();
+    let e = fails_fast(&["dataset", "info", s(&data), "--verify"]);
+    assert!(
+        e.contains("part-00001.parquet") && e.contains("checksum"),
+        "{e}"
+    );
+    let e = fails_fast(&[
+        "dataset",
+        "export",
+        s(&data),
+        "--csv",
+        "-o",
+        s(&dir.join("csv")),
+    ]);
+    assert!(e.contains("checksum"), "{e}");
+
+    std::fs::write(dir.join("f.csv"), "p01_r,p01_g,p01_b\n1,2,3\n").unwrap();
+    std::fs::write(dir.join("s.csv"), "400,500\n-1,1\n").unwrap();
+    let (f, spds, imported) = (dir.join("f.csv"), dir.join("s.csv"), dir.join("imported"));
+    let import = [
+        "dataset",
+        "import",
+        "--features",
+        s(&f),
+        "--spds",
+        s(&spds),
+        "-o",
+        s(&imported),
+    ];
+    let e = fails_fast(&import);
+    assert!(e.contains("negative"), "{e}");
+    assert!(!dir.join("imported").exists());
+    std::fs::write(dir.join("s.csv"), "400,500\n1,1\n").unwrap();
+    let again = spdcam(&import);
+    assert!(
+        again.status.success(),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
