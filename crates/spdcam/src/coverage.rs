@@ -93,15 +93,24 @@ pub fn run(args: CoverageArgs, data_dir: &DataDir) -> Result<()> {
             })
             .collect()
     });
-    let mut md = String::from("| lamp type | lamps |");
-    for (label, _) in &columns {
-        md += &format!(" {label} |");
+    let kinds: Vec<Option<LampType>> = LampType::ALL
+        .iter()
+        .filter(|t| library.types.contains(t))
+        .map(|&t| Some(t))
+        .chain([None])
+        .collect();
+    let members = |kind: Option<LampType>| -> Vec<usize> {
+        (0..library.names.len())
+            .filter(|&i| kind.is_none_or(|k| library.types[i] == k))
+            .collect()
+    };
+    let mut md = String::from("| recipe |");
+    for &kind in &kinds {
+        let label = kind.map_or("all", LampType::label);
+        md += &format!(" {label} ({}) |", members(kind).len());
     }
-    if fitted.is_some() {
-        md += " family model fitted |";
-    }
-    md += "\n|---|---:|";
-    md += &"---:|".repeat(columns.len() + usize::from(fitted.is_some()));
+    md += "\n|---|";
+    md += &"---:|".repeat(kinds.len());
     md.push('\n');
     let cell = |values: Vec<f64>| -> String {
         if values.is_empty() {
@@ -111,23 +120,20 @@ pub fn run(args: CoverageArgs, data_dir: &DataDir) -> Result<()> {
         let worst = values.iter().cloned().fold(1.0, f64::min);
         format!("{mean:.4} ({worst:.3})")
     };
-    let kinds: Vec<Option<LampType>> = LampType::ALL
-        .iter()
-        .filter(|t| library.types.contains(t))
-        .map(|&t| Some(t))
-        .chain([None])
-        .collect();
-    for kind in kinds {
-        let rows: Vec<usize> = (0..library.names.len())
-            .filter(|&i| kind.is_none_or(|k| library.types[i] == k))
-            .collect();
-        let label = kind.map_or("**all**", LampType::label);
-        md += &format!("| {label} | {} |", rows.len());
-        for (_, best) in &columns {
-            md += &format!(" {} |", cell(rows.iter().map(|&i| best[i]).collect()));
+    for (label, best) in &columns {
+        md += &format!("| {label} |");
+        for &kind in &kinds {
+            md += &format!(" {} |", cell(members(kind).iter().map(|&i| best[i]).collect()));
         }
-        if let Some(f) = &fitted {
-            md += &format!(" {} |", cell(rows.iter().filter_map(|&i| f[i]).collect()));
+        md.push('\n');
+    }
+    if let Some(f) = &fitted {
+        md += "| family model of the lamp's type, fitted |";
+        for &kind in &kinds {
+            md += &format!(
+                " {} |",
+                cell(members(kind).iter().filter_map(|&i| f[i]).collect())
+            );
         }
         md.push('\n');
     }

@@ -65,6 +65,14 @@ pub fn run(args: ListArgs, data_dir: &DataDir) -> Result<()> {
         for (form, what) in lighting::catalogue() {
             println!("  {form:<28} {what}");
         }
+        println!("lamp families (lamp:NAME), fitted to measured lamps:");
+        for family in lighting::LampFamily::ALL {
+            println!(
+                "  {:<28} {}",
+                format!("lamp:{}", family.name()),
+                family.describe()
+            );
+        }
     }
     if want(Topic::Presets) {
         println!("noise presets:");

@@ -65,7 +65,7 @@ pub fn catalogue() -> Vec<(&'static str, &'static str)> {
         ("phosphor", "phosphor-converted white LED: blue pump 440–460 nm + yellow-green and red phosphor bands, heights set for a CCT of 2700–6500 K and |Duv| ≤ 0.006"),
         ("fluorescent", "fluorescent-like lamp: mercury lines and tri-phosphor bands of random strength on a broad Planckian base"),
         ("lamp:FAMILY[:spread=S][:fits=FILE]", "real-lamp families fitted to measured lamps (`spdcam lamps fit`): phosphor-led, hybrid-led, mixed-led, fluorescent, hid, incandescent; each draw is a fitted lamp moved by a kernel step of the fitted parameters' spread (Scott's rule × S, default 1; 0 = the fitted lamps themselves); fits=FILE uses another fit"),
-        ("blend:RECIPE+RECIPE", "two sources at once (a window and a lamp): a·A + (1 − a)·B with A and B of equal luminance and a uniform on [0, 1), e.g. blend:daylight+lamp:phosphor-led"),
+        ("blend:RECIPE[+RECIPE]", "two sources at once (a window and a lamp): a·A + (1 − a)·B with A and B drawn from the two recipes (or twice from one), scaled to equal luminance, a uniform on [0, 1), e.g. blend:daylight+lamp:phosphor-led; a recipe may be a mix: (the blend then cannot sit inside a mix:)"),
         ("spds:FILE[:mix]", "measured SPDs from a spectral CSV: one at random, or with :mix a random mixture of two"),
         ("mix:RECIPE=P,RECIPE=P,…", "a mixture of recipes drawn with the given proportions, e.g. mix:telelumen:config1=0.5,daylight=0.3,planck=0.2"),
     ]
@@ -143,17 +143,10 @@ impl Lighting {
             "spds" => Family::Measured(MeasuredSpds::parse(rest, spec, data_dir, grid)?),
             "lamp" => Family::Lamp(parse_lamp(rest, spec, grid)?),
             "blend" => {
-                let (a, b) = rest.split_once('+').ok_or_else(|| {
-                    Error::invalid(format!(
-                        "'{spec}': a blend names two recipes joined by '+', e.g. blend:daylight+lamp:phosphor-led"
-                    ))
-                })?;
-                if [a, b]
-                    .iter()
-                    .any(|r| r.starts_with("mix:") || r.starts_with("blend:"))
-                {
+                let (a, b) = rest.split_once('+').unwrap_or((rest, rest));
+                if [a, b].iter().any(|r| r.starts_with("blend:")) {
                     return Err(Error::invalid(format!(
-                        "'{spec}': a blend joins two plain recipes, not mixtures or blends"
+                        "'{spec}': a blend cannot contain a blend"
                     )));
                 }
                 Family::Blend(Box::new(Blend {
