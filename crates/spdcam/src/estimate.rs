@@ -37,7 +37,8 @@ pub struct EstimateArgs {
     /// p01_g, …), one row per estimate; values on any scale (0–255 or 0–1).
     #[arg(long, value_name = "FILE.csv", conflicts_with = "photos")]
     features: Option<PathBuf>,
-    /// Spectral CSV to write: wavelength_nm, then one column per photo (or feature row).
+    /// Spectral CSV to write: wavelength_nm, then one column per photo (or feature row);
+    /// `-` writes it to standard output (and nothing else goes there).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Wavelength grid of the output, START-END[:STEP] in nm (within the model's grid).
@@ -87,12 +88,26 @@ fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
-/// Reads a spectral CSV of true SPDs, resampled to `grid`.
+/// Reads a spectral CSV of true SPDs, resampled to `grid`; a truth that is negative or
+/// holds no light on `grid` is refused (a GFC against it means nothing).
 fn read_truths(path: &Path, grid: &Grid) -> Result<SpectralSet> {
     let set = SpectralSet::read_csv(path)
+        .and_then(|s| s.require_non_negative("true SPD", 0.01))
         .with_context(|| format!("reading the true SPDs {}", path.display()))?;
     let (set, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
+    if let Some(i) = (0..set.len()).find(|&i| set.item(i).iter().all(|&v| v <= 0.0)) {
+        bail!(
+            "{}: the true SPD '{}' is zero everywhere on {grid}; a truth must hold light",
+            path.display(),
+            set.names()[i]
+        );
+    }
     Ok(set)
+}
+
+/// Whether the terminal report is left out: with `--json`, or with the SPDs on stdout.
+fn quiet(args: &EstimateArgs) -> bool {
+    args.photo.json || args.output.as_deref().is_some_and(fsio::is_stdout)
 }
 
 /// The truth for each estimate: from `--truth` (one column for all, or one per estimate),
@@ -179,7 +194,7 @@ fn estimate_from_photos(
     let mut estimates = Vec::with_capacity(analyses.len());
     let mut paths = Vec::with_capacity(analyses.len());
     for (path, label, analysis) in analyses {
-        if !args.photo.json {
+        if !quiet(args) {
             println!("{}", photo_args::describe(&analysis));
         }
         match estimate_analysis(models, analysis, label, grid) {
@@ -203,6 +218,9 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         .flatten()
     {
         fsio::check_parent_dir(path)?;
+    }
+    if args.photo.json && args.output.as_deref().is_some_and(fsio::is_stdout) {
+        bail!("--json and -o - both write to standard output; choose one");
     }
     if let Some(plot) = &args.plot {
         plot_is_png(plot)?;
@@ -240,7 +258,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         estimates.iter().map(|e| e.spd.clone()).collect(),
     )?;
     if let Some(out) = &args.output {
-        set.write_csv(out)?;
+        fsio::write_output(out, set.to_csv_string().as_bytes())?;
     }
     if let Some(plot) = &args.plot {
         let shown = set.len().min(20);
@@ -260,7 +278,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             .map(Estimate::to_json)
             .collect::<spdcam_infer::Result<Vec<_>>>()?;
         println!("{}", serde_json::to_string_pretty(&json)?);
-    } else {
+    } else if !quiet(&args) {
         print_estimates(&estimates, &args);
     }
     if failed > 0 {
