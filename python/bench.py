@@ -49,7 +49,7 @@ def main() -> None:
     features = spdcam.estimate(PHOTO, model=models).detection.features.astype(np.float64)
     rng = np.random.default_rng(1)
     rows = features * rng.uniform(0.5, 1.0, size=(ROWS, 1))
-    rows_rust = best_of(args.repeats, lambda: _native.library_seconds_rows(rows, ROWS, native, 1))
+    rows_rust = best_of(args.repeats, lambda: _native.library_seconds_rows(rows.tobytes(), ROWS, native, 1))
     rows_py = best_of(args.repeats, timed(lambda: spdcam.estimate_features(rows, model=models)))
 
     print(f"{'case':<22}{'Rust (ms)':>11}{'Python (ms)':>13}{'overhead':>10}")

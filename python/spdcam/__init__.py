@@ -300,7 +300,10 @@ def _estimate_one(
         name = source or "photo array"
         pixels = _pixels(photo, name)
         h, w, _ = pixels.shape
-        text = _native.estimate_pixels(pixels, w, h, name, models, chart, corners, range)
+        bits = 8 if pixels.dtype == np.uint8 else 16
+        text = _native.estimate_pixels(
+            pixels.tobytes(), w, h, bits, name, models, chart, corners, range
+        )
     elif isinstance(photo, (str, os.PathLike)):
         path = os.fspath(photo)
         if not os.path.isfile(path):
@@ -408,7 +411,7 @@ def estimate_features(
         if len(names) != cols:
             raise SpdcamError(f"{source}: {len(names)} names for {cols} feature columns")
     model_name, wl, spd, xy, cct, duv = _native.estimate_rows(
-        a, rows, _models(model), names, source, range
+        a.tobytes(), rows, _models(model), names, source, range
     )
     wavelengths = np.frombuffer(wl, dtype=np.float64)
     return Estimates(
