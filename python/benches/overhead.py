@@ -5,7 +5,7 @@ module calls it without any Python conversion) and ``spdcam.estimate`` /
 ``spdcam.estimate_features`` (the same work plus converting the inputs and results), and
 prints the overhead as a share of the Rust time; the goal is at most 5 %.
 
-    python python/bench.py [--repeats N]
+    python python/benches/overhead.py [--repeats N]
 """
 
 import argparse
@@ -17,7 +17,7 @@ import numpy as np
 import spdcam
 from spdcam import _native
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PHOTO = ROOT / "examples" / "sg-telelumen.jpg"
 ROWS = 10_000
 
