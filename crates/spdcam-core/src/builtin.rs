@@ -54,6 +54,42 @@ pub const TM30_CES99: BuiltinTable = BuiltinTable {
     csv: include_str!("../../../data/tm30_ces99.csv"),
 };
 
+/// The CIE 1964 10° supplementary standard observer x̄₁₀, ȳ₁₀, z̄₁₀ (360–830 nm, 1 nm), the
+/// observer of CIE 224:2017 / ANSI/IES TM-30.
+pub const CIE1964_10DEG_CMF: BuiltinTable = BuiltinTable {
+    name: "cie_1964_10deg_cmf",
+    description: "CIE 1964 10° standard observer colour-matching functions",
+    csv: include_str!("../../../data/cie_1964_10deg_cmf.csv"),
+};
+
+/// The 14 test colour samples of CIE 13.3-1995 (TCS01–TCS14, 360–830 nm, 5 nm).
+pub const CIE1995_TCS14: BuiltinTable = BuiltinTable {
+    name: "cie_1995_tcs14",
+    description: "CIE 13.3-1995 test colour samples TCS01–TCS14",
+    csv: include_str!("../../../data/cie_1995_tcs14.csv"),
+};
+
+/// The CIE 1951 scotopic spectral luminous efficiency V′(λ) (380–780 nm, 1 nm).
+pub const CIE1951_SCOTOPIC: BuiltinTable = BuiltinTable {
+    name: "cie_1951_scotopic",
+    description: "CIE 1951 scotopic luminous efficiency V′(λ)",
+    csv: include_str!("../../../data/cie_1951_scotopic.csv"),
+};
+
+/// The α-opic action spectra of CIE S 026:2018: sc, mc, lc, rh, mel (380–780 nm, 1 nm).
+pub const CIE_S026_ALPHA_OPIC: BuiltinTable = BuiltinTable {
+    name: "cie_s026_alpha_opic",
+    description: "CIE S 026:2018 α-opic action spectra (sc, mc, lc, rh, mel)",
+    csv: include_str!("../../../data/cie_s026_alpha_opic.csv"),
+};
+
+/// The blue-light hazard function B(λ) of ICNIRP 2013 / IEC 62471:2006 (300–700 nm, 1 nm).
+pub const BLUE_LIGHT_HAZARD: BuiltinTable = BuiltinTable {
+    name: "blue_light_hazard",
+    description: "ICNIRP / IEC 62471 blue-light hazard function B(λ)",
+    csv: include_str!("../../../data/blue_light_hazard.csv"),
+};
+
 /// Looks up a built-in table by name in `tables`.
 pub fn find<'a>(tables: &'a [BuiltinTable], name: &str) -> Option<&'a BuiltinTable> {
     tables.iter().find(|t| t.name.eq_ignore_ascii_case(name))
@@ -168,7 +204,7 @@ pub fn resolve_table(
     Err(Error::UnknownName {
         kind,
         name: spec.to_string(),
-        valid: format!("{}{hint}", valid.join(", ")),
+        valid: format!("{}{hint}", crate::error::brief_list(&valid)),
     })
 }
 
@@ -178,10 +214,26 @@ mod tests {
 
     #[test]
     fn every_builtin_table_parses() {
-        for t in CAMERAS.iter().chain([&COLORCHECKER24, &TM30_CES99]) {
+        let quality = [
+            &CIE1964_10DEG_CMF,
+            &CIE1995_TCS14,
+            &CIE1951_SCOTOPIC,
+            &CIE_S026_ALPHA_OPIC,
+            &BLUE_LIGHT_HAZARD,
+        ];
+        for t in CAMERAS
+            .iter()
+            .chain([&COLORCHECKER24, &TM30_CES99])
+            .chain(quality)
+        {
             let set = t.load().unwrap();
             assert!(!set.is_empty(), "{}", t.name);
         }
+        assert_eq!(CIE1995_TCS14.load().unwrap().len(), 14);
+        assert_eq!(
+            CIE_S026_ALPHA_OPIC.load().unwrap().names(),
+            ["sc", "mc", "lc", "rh", "mel"]
+        );
         assert_eq!(COLORCHECKER24.load().unwrap().len(), 24);
         assert_eq!(TM30_CES99.load().unwrap().len(), 99);
         for c in CAMERAS {

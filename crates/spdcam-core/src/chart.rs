@@ -3,8 +3,17 @@
 
 use crate::builtin::{self, DataDir};
 use crate::error::{Error, Result};
+use crate::limits;
 use crate::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use serde::{Deserialize, Serialize};
+
+/// Pixels spanned by `n` patches of `patch` px, `gap` px apart, with `border` px on each
+/// side; saturates instead of overflowing, so that [`limits::RENDER_PIXELS`] refuses it.
+fn span(n: usize, patch: usize, gap: usize, border: usize) -> usize {
+    n.saturating_mul(patch)
+        .saturating_add(n.saturating_sub(1).saturating_mul(gap))
+        .saturating_add(border.saturating_mul(2))
+}
 
 /// Where the patches lie on the rendered image: a `rows × cols` grid of square patches of
 /// `patch_px`, `gap_px` apart, its top-left corner at (`margin_x`, `margin_y`) of a
@@ -37,9 +46,14 @@ impl Layout {
             gap_px,
             margin_x: border_px,
             margin_y: border_px,
-            width: cols * patch_px + cols.saturating_sub(1) * gap_px + 2 * border_px,
-            height: rows * patch_px + rows.saturating_sub(1) * gap_px + 2 * border_px,
+            width: span(cols, patch_px, gap_px, border_px),
+            height: span(rows, patch_px, gap_px, border_px),
         }
+    }
+
+    /// Pixels of the whole canvas.
+    pub fn pixels(&self) -> u64 {
+        limits::product(&[self.width as u64, self.height as u64])
     }
 
     /// The largest grid with gaps of `gap_fraction` of a patch that fits a `width × height`
@@ -153,6 +167,9 @@ pub struct Chart {
 
 /// The thesis's patch size in pixels (m = 576 pixels per patch).
 pub const THESIS_PATCH_PX: usize = 24;
+/// The largest reflectance a chart patch may have: fluorescent patches exceed 1 a little;
+/// a file in percent has values up to about 100.
+const MAX_REFLECTANCE: f64 = 2.0;
 /// Reflectance of a chart's matte black body, shown in gaps and borders.
 pub const DEFAULT_BACKGROUND: f64 = 0.04;
 
@@ -187,6 +204,22 @@ impl Chart {
             return Err(Error::invalid(format!(
                 "chart '{name}' has {} reflectances, which do not fill a {rows}×{cols} layout",
                 reflectances.len()
+            )));
+        }
+        let peak = reflectances
+            .items()
+            .iter()
+            .zip(reflectances.names())
+            .flat_map(|(v, n)| v.iter().map(move |x| (*x, n)))
+            .fold(
+                (0.0f64, ""),
+                |a, (x, n)| if x > a.0 { (x, n.as_str()) } else { a },
+            );
+        if peak.0 > MAX_REFLECTANCE {
+            return Err(Error::invalid(format!(
+                "chart '{name}': patch '{}' reflects {} of the light; reflectances are \
+                 fractions 0–1 (a file in percent? divide it by 100)",
+                peak.1, peak.0
             )));
         }
         let (resampled, _) = reflectances
@@ -324,6 +357,13 @@ impl Chart {
         if layout.patch_px < 4 {
             return Err(Error::invalid("patches must be at least 4 px wide"));
         }
+        limits::RENDER_PIXELS.check(
+            layout.pixels(),
+            &format!(
+                "chart '{}' of {}×{} patches of {} px ({}×{} px)",
+                self.name, layout.rows, layout.cols, layout.patch_px, layout.width, layout.height
+            ),
+        )?;
         self.layout = layout;
         Ok(self)
     }
@@ -378,6 +418,34 @@ mod tests {
         let (_, y_end) = l.patch_origin(23);
         assert!(y_end + l.patch_px <= 1212);
         assert!(Layout::fit(4, 6, 10, 10, 0.0, 0.0).is_err());
+    }
+
+    #[test]
+    fn reflectances_in_percent_and_giant_layouts_are_refused() {
+        // Issue 15: a chart in percent was accepted; `--patch-px 100000` aborted.
+        let set = builtin::COLORCHECKER24.load().unwrap();
+        let percent = SpectralSet::new(
+            set.wavelengths().to_vec(),
+            set.names().to_vec(),
+            set.items()
+                .iter()
+                .map(|v| v.iter().map(|x| x * 100.0).collect())
+                .collect(),
+        )
+        .unwrap();
+        let e = Chart::from_reflectances("pct", &percent, 4, 6, &Grid::SIMULATION)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("percent"), "{e}");
+        let chart = Chart::colorchecker24(&Grid::SIMULATION).unwrap();
+        for layout in [
+            Layout::grid(4, 6, 100_000, 0, 0),
+            Layout::grid(4, 6, usize::MAX / 2, 7, 9),
+        ] {
+            let e = chart.clone().with_layout(layout).unwrap_err().to_string();
+            assert!(e.contains("SPDCAM_MAX_RENDER_PIXELS"), "{e}");
+        }
+        assert!(chart.with_layout(Layout::grid(4, 6, 200, 10, 10)).is_ok());
     }
 
     #[test]

@@ -56,5 +56,34 @@ impl Error {
     }
 }
 
+/// At most this many names are listed in one message.
+const LISTED_NAMES: usize = 10;
+
+/// Names for a one-line message: all of them joined by ", " when there are few, else the
+/// first [`LISTED_NAMES`] and how many there are (a file with 2000 columns must not make a
+/// 13 kB error line).
+pub fn brief_list<S: AsRef<str>>(names: &[S]) -> String {
+    let shown: Vec<&str> = names.iter().take(LISTED_NAMES).map(AsRef::as_ref).collect();
+    if names.len() <= LISTED_NAMES {
+        shown.join(", ")
+    } else {
+        format!("{}, … ({} in all)", shown.join(", "), names.len())
+    }
+}
+
 /// Result with the library's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_name_lists_are_cut() {
+        assert_eq!(brief_list(&["a", "b"]), "a, b");
+        let many: Vec<String> = (0..2000).map(|i| format!("column_{i}")).collect();
+        let text = brief_list(&many);
+        assert!(text.ends_with("column_9, … (2000 in all)"), "{text}");
+        assert!(text.len() < 200);
+    }
+}

@@ -19,6 +19,43 @@ pub fn check_parent_dir(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Checks, before long work, that a file can later be written at `path`: its directory
+/// exists, `path` is not a directory, and a file can be created beside it (the check file
+/// is removed at once). Catches an unwritable path before hours of training, not after.
+pub fn check_writable(path: &Path) -> Result<()> {
+    check_parent_dir(path)?;
+    if path.is_dir() {
+        return Err(Error::invalid(format!(
+            "cannot write {}: it is a directory; name a file",
+            path.display()
+        )));
+    }
+    let probe = temporary_path(path);
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(|e| Error::io(path, e))?;
+    std::fs::remove_file(&probe).map_err(|e| Error::io(&probe, e))
+}
+
+/// Whether `path` names standard output (`-`, as Unix tools read it).
+pub fn is_stdout(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// Writes `bytes` to standard output when `path` is `-`, else to the file atomically.
+pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
+    if is_stdout(path) {
+        let mut out = std::io::stdout().lock();
+        return out
+            .write_all(bytes)
+            .and_then(|()| out.flush())
+            .map_err(|e| Error::io("standard output", e));
+    }
+    write_atomic(path, bytes)
+}
+
 /// The temporary sibling a file is written to before it is renamed into place.
 fn temporary_path(path: &Path) -> PathBuf {
     let name = path
@@ -66,6 +103,23 @@ mod tests {
         let err = write_atomic(&target, b"x").unwrap_err().to_string();
         assert!(err.contains("does not exist"), "{err}");
         assert!(!target.exists());
+    }
+
+    #[test]
+    fn unwritable_targets_are_found_before_the_work() {
+        // Issue 15: `train -o DIR` failed only after training.
+        let dir = std::env::temp_dir().join(format!("spdcam-fsio-check-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let e = check_writable(&dir).unwrap_err().to_string();
+        assert!(e.contains("is a directory"), "{e}");
+        let e = check_writable(&dir.join("no/such/m.spdm"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("does not exist"), "{e}");
+        check_writable(&dir.join("m.spdm")).unwrap();
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+        assert!(is_stdout(Path::new("-")) && !is_stdout(Path::new("./-x")));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

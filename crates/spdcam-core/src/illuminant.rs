@@ -84,35 +84,65 @@ pub fn daylight(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
 }
 
 /// The CIE D-series SPD of daylight chromaticity `xy` on `grid` (CIE 015:2018):
-/// S = S0 + M1·S1 + M2·S2 with M = 0.0241 + 0.2562x − 0.7341y,
-/// M1 = (−1.3515 − 1.7703x + 5.9114y)/M, M2 = (0.0300 − 31.4424x + 30.0717y)/M, M1 and M2
-/// rounded to three decimals as CIE 015 prescribes (and colour-science does by default).
-/// The basis S0, S1, S2 (shipped at 5 nm, 300–830 nm) is resampled to `grid` by linear
-/// interpolation, the interpolation CIE 015 recommends for it, and is zero outside
-/// 300–830 nm. The result is normalised to 100 at 560 nm.
+/// `DaylightBasis::on_grid(grid)?.spd(xy)`; see [`DaylightBasis`].
 pub fn daylight_from_xy(xy: [f64; 2], grid: &Grid) -> Result<Vec<f64>> {
-    let [x, y] = xy;
-    let m = 0.0241 + 0.2562 * x - 0.7341 * y;
-    if !(x.is_finite() && y.is_finite()) || m.abs() < 1e-6 {
-        return Err(Error::invalid(format!(
-            "chromaticity ({x}, {y}) has no CIE daylight spectrum (M = {m})"
-        )));
+    DaylightBasis::on_grid(grid)?.spd(xy)
+}
+
+/// The CIE daylight basis S0, S1, S2 on a working grid, for computing many D-series SPDs on
+/// one grid (e.g. the reference illuminants of colour rendering) without resampling the basis
+/// each time.
+///
+/// The basis (shipped at 5 nm, 300–830 nm) is resampled to the grid by linear interpolation,
+/// the interpolation CIE 015 recommends for it, and is zero outside 300–830 nm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DaylightBasis {
+    basis: [Vec<f64>; 3],
+    /// S0, S1, S2 at 560 nm, where the SPDs are normalised to 100.
+    at_560: [f64; 3],
+}
+
+impl DaylightBasis {
+    /// The basis on `grid`.
+    pub fn on_grid(grid: &Grid) -> Result<DaylightBasis> {
+        let native = daylight_basis();
+        let i560 = native
+            .wavelengths()
+            .iter()
+            .position(|&w| w == 560.0)
+            .expect("the shipped daylight basis has a 560 nm row");
+        let (set, _) = native.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
+        Ok(DaylightBasis {
+            basis: [0, 1, 2].map(|i| set.item(i).to_vec()),
+            at_560: [0, 1, 2].map(|i| native.item(i)[i560]),
+        })
     }
-    let round3 = |v: f64| (v * 1000.0).round() / 1000.0;
-    let m1 = round3((-1.3515 - 1.7703 * x + 5.9114 * y) / m);
-    let m2 = round3((0.0300 - 31.4424 * x + 30.0717 * y) / m);
-    let native = daylight_basis();
-    let combine = |s: &SpectralSet, i: usize| s.item(0)[i] + m1 * s.item(1)[i] + m2 * s.item(2)[i];
-    let i560 = native
-        .wavelengths()
-        .iter()
-        .position(|&w| w == 560.0)
-        .expect("the shipped daylight basis has a 560 nm row");
-    let scale = 100.0 / combine(native, i560);
-    let (basis, _) = native.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
-    Ok((0..grid.count)
-        .map(|i| scale * combine(&basis, i))
-        .collect())
+
+    /// The D-series SPD of daylight chromaticity `xy` (CIE 015:2018):
+    /// S = S0 + M1·S1 + M2·S2 with M = 0.0241 + 0.2562x − 0.7341y,
+    /// M1 = (−1.3515 − 1.7703x + 5.9114y)/M, M2 = (0.0300 − 31.4424x + 30.0717y)/M, M1 and M2
+    /// rounded to three decimals as CIE 015 prescribes (and colour-science does by default),
+    /// normalised to 100 at 560 nm.
+    pub fn spd(&self, xy: [f64; 2]) -> Result<Vec<f64>> {
+        let [x, y] = xy;
+        let m = 0.0241 + 0.2562 * x - 0.7341 * y;
+        if !(x.is_finite() && y.is_finite()) || m.abs() < 1e-6 {
+            return Err(Error::invalid(format!(
+                "chromaticity ({x}, {y}) has no CIE daylight spectrum (M = {m})"
+            )));
+        }
+        let round3 = |v: f64| (v * 1000.0).round() / 1000.0;
+        let m1 = round3((-1.3515 - 1.7703 * x + 5.9114 * y) / m);
+        let m2 = round3((0.0300 - 31.4424 * x + 30.0717 * y) / m);
+        let [s0, s1, s2] = &self.basis;
+        let scale = 100.0 / (self.at_560[0] + m1 * self.at_560[1] + m2 * self.at_560[2]);
+        Ok(s0
+            .iter()
+            .zip(s1)
+            .zip(s2)
+            .map(|((a, b), c)| scale * (a + m1 * b + m2 * c))
+            .collect())
+    }
 }
 
 /// The CIE daylight basis S0, S1, S2 (300–830 nm, 5 nm), parsed once.

@@ -66,7 +66,7 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
         Some(c) => set.position(c).ok_or_else(|| {
             Error::invalid(format!(
                 "{file} has no column '{c}'; it has {}",
-                set.names().join(", ")
+                crate::error::brief_list(set.names())
             ))
         })?,
         None if set.len() == 1 => 0,
@@ -74,7 +74,7 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
             return Err(Error::invalid(format!(
                 "{file} holds {} SPDs ({}); pick one as {file}:COLUMN",
                 set.len(),
-                set.names().join(", ")
+                crate::error::brief_list(set.names())
             )))
         }
     };

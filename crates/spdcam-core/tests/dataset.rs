@@ -10,8 +10,8 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::{
-    self, Dataset, ExportOptions, GenerateOptions, Generator, ImportOptions, Origin, Pipeline,
-    Shard,
+    self, Dataset, ExportOptions, FileFormat, GenerateOptions, Generator, ImportOptions, Origin,
+    Pipeline, Shard,
 };
 use spdcam_core::lighting::Lighting;
 use spdcam_core::seed;
@@ -241,6 +241,14 @@ fn interrupted_run_resumes_to_the_same_files() {
         })
     }));
     assert!(interrupted.is_err());
+    // The interrupted run's plan holds the directory's lock until it is dropped.
+    let e = Generator::new(&cam, &light, options(64, 5))
+        .unwrap()
+        .prepare(&dir, false)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("in use"), "{e}");
+    drop(plan);
     assert!(!dir.join("manifest.json").exists());
     assert!(Dataset::open(&dir).is_err());
     std::fs::write(dir.join(".samples-00003.parquet.999.partial"), b"PAR1 junk").unwrap();
@@ -560,4 +568,131 @@ fn import_of_thesis_weights_makes_the_thesis_spds() {
         "{err}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn samples_bytes(dir: &Path) -> usize {
+    files(&dir.join("samples")).values().map(Vec::len).sum()
+}
+
+#[test]
+fn generated_sets_are_compressed_float32_and_old_float64_files_still_read() {
+    let (cam, light) = (camera(CameraConfig::default()), lighting());
+    let generator = Generator::new(
+        &cam,
+        &light,
+        GenerateOptions {
+            pipeline: Pipeline::Fast,
+            chunk_size: 500,
+            ..GenerateOptions::new(2000, 4)
+        },
+    )
+    .unwrap();
+    let exact = generator.samples(0..2000, None, &|_| {}).unwrap();
+    let dir = scratch("float32");
+    generator
+        .run(&generator.prepare(&dir, false).unwrap(), &|_| {})
+        .unwrap();
+    let stored = Dataset::open(&dir).unwrap().load().unwrap();
+    // Features are computed in f32 and kept exactly; SPDs and weights are rounded to f32.
+    assert_eq!(stored.features, exact.features);
+    assert_eq!(stored.samples, exact.samples);
+    assert_eq!(stored.families, exact.families);
+    let relative = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| {
+                if *y == 0.0 {
+                    x.abs()
+                } else {
+                    (x / y - 1.0).abs()
+                }
+            })
+            .fold(0.0f64, f64::max)
+    };
+    let spd_error = relative(&stored.spds, &exact.spds);
+    let weight_error = relative(&stored.weights, &exact.weights);
+    assert!(spd_error > 0.0, "SPDs are stored as FLOAT");
+    // Half an f32 ulp: 2⁻²⁴ ≈ 6e-8, some 65,000 times below one step of 8-bit features.
+    assert!(
+        spd_error <= 6e-8 && weight_error <= 6e-8,
+        "{spd_error} {weight_error}"
+    );
+    for (a, b) in stored.spds.iter().zip(&exact.spds) {
+        assert_eq!(*a, f64::from(*b as f32));
+    }
+    // What that rounding does to the features the stored SPDs render: far below one level.
+    let (mut raw, mut features) = (Vec::new(), Vec::new());
+    let mut feature_shift = 0.0f64;
+    for i in 0..stored.len() {
+        features.clear();
+        cam.features_fast(
+            &cam.light(stored.spd_of(i)).unwrap(),
+            &mut raw,
+            &mut features,
+        );
+        for (a, b) in features.iter().zip(exact.features_of(i)) {
+            feature_shift = feature_shift.max((f64::from(*a) - b).abs());
+        }
+    }
+    assert!(feature_shift < 1e-3, "{feature_shift} of an 8-bit level");
+    let compressed = samples_bytes(&dir);
+
+    // The first datasets' files (uncompressed, SPDs and weights as DOUBLE) read as written.
+    let old = scratch("float64");
+    dataset::merge(&[Dataset::open(&dir).unwrap()], &old, false, &|_| {}).unwrap();
+    let columns = generator.columns();
+    let legacy = FileFormat::uncompressed_float64_values(columns);
+    let mut first = 0;
+    for entry in &Dataset::open(&old).unwrap().manifest().files {
+        let mut batch = columns.batch();
+        for i in first..first + entry.rows as usize {
+            batch.push(exact.row(i)).unwrap();
+        }
+        first += entry.rows as usize;
+        let bytes = dataset::encode_parquet_as(columns, &batch, &legacy).unwrap();
+        std::fs::write(old.join(&entry.name), bytes).unwrap();
+    }
+    let uncompressed = samples_bytes(&old);
+    assert_eq!(Dataset::open(&old).unwrap().load().unwrap(), exact);
+    println!(
+        "2,000 fast samples: {compressed} bytes zstd + float32, {uncompressed} bytes \
+         uncompressed + float64 values ({:.2}×); SPD relative error {spd_error:.1e}, \
+         features of the stored SPDs within {feature_shift:.1e} of an 8-bit level",
+        uncompressed as f64 / compressed as f64
+    );
+    // Lossless: float32 mantissas are close to random, so about half the bytes go.
+    assert!(
+        compressed * 5 < uncompressed * 3,
+        "{compressed} vs {uncompressed}"
+    );
+    for d in [&dir, &old] {
+        std::fs::remove_dir_all(d).unwrap();
+    }
+}
+
+/// A dataset spdcam generated, read and written back by pandas (pyarrow): one file snappy
+/// (pandas' default), one gzip, columns nullable (`tools/export_pandas_dataset.py`).
+#[test]
+fn files_written_by_pandas_read_back() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/pandas-dataset");
+    let data = Dataset::open(&dir).unwrap();
+    let read = data.load().unwrap();
+    let (cam, light) = (camera(CameraConfig::default()), lighting());
+    let generator = Generator::new(
+        &cam,
+        &light,
+        GenerateOptions {
+            pipeline: Pipeline::Fast,
+            chunk_size: 6,
+            spd_grid: Grid::parse("400-700:50").unwrap(),
+            ..GenerateOptions::new(12, 5)
+        },
+    )
+    .unwrap();
+    assert_eq!(data.columns(), generator.columns());
+    let mut expected = generator.samples(0..12, None, &|_| {}).unwrap();
+    for v in expected.spds.iter_mut().chain(expected.weights.iter_mut()) {
+        *v = f64::from(*v as f32);
+    }
+    assert_eq!(read, expected);
 }

@@ -14,8 +14,10 @@ use serde::Serialize;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
+use spdcam_core::feature_check;
 use spdcam_core::metrics;
 use spdcam_core::photo::{self, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis};
+use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use std::path::{Path, PathBuf};
 
@@ -36,12 +38,17 @@ pub struct FeatureRows {
 impl FeatureRows {
     /// Reads a features CSV: a header naming the columns, then one numeric row per estimate.
     pub fn read_csv(path: &Path) -> Result<FeatureRows> {
-        let shown = path.display();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| InferError::invalid(format!("reading {}: {e}", path.display())))?;
+        FeatureRows::from_csv_str(&text, &path.display().to_string())
+    }
+
+    /// Parses features CSV text (see [`FeatureRows::read_csv`]); `shown` names it in errors.
+    pub fn from_csv_str(text: &str, shown: &str) -> Result<FeatureRows> {
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .flexible(true)
-            .from_path(path)
-            .map_err(|e| InferError::invalid(format!("reading {shown}: {e}")))?;
+            .from_reader(text.as_bytes());
         let names: Vec<String> = reader
             .headers()
             .map_err(|e| InferError::invalid(format!("{shown}: {e}")))?
@@ -154,6 +161,7 @@ pub fn estimate_rows(
     grid: &Grid,
 ) -> Result<SpectralSet> {
     model.check_features(&features.names, source)?;
+    check_rows(features, source)?;
     let mg = model.grid();
     if grid.start_nm < mg.start_nm - 1e-9 || grid.end_nm() > mg.end_nm() + 1e-9 {
         return Err(InferError::invalid(format!(
@@ -170,6 +178,25 @@ pub fn estimate_rows(
     }
     let (resampled, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
     Ok(resampled)
+}
+
+/// Refuses rows that say nothing about the light (values outside the encoding's range, a
+/// black chart, a chart without colour; see [`feature_check`]), naming the row when there
+/// are several. Rows on 0–1 are told from rows on 0–255 by their largest value.
+fn check_rows(features: &FeatureRows, source: &str) -> Result<()> {
+    let width = features.names.len().max(1);
+    for (i, row) in features.values.chunks(width).enumerate() {
+        let scale = if row.iter().any(|&v| v > 1.0) { 255.0 } else { 1.0 };
+        feature_check::check_feature_row(row, &features.names, scale).map_err(|e| {
+            let at = if features.rows > 1 {
+                format!(" row {}", i + 1)
+            } else {
+                String::new()
+            };
+            InferError::invalid(format!("{source}{at}: {e}"))
+        })?;
+    }
+    Ok(())
 }
 
 /// CIE 1931 xy, and CCT and Duv where the chromaticity is near enough the Planckian locus.
@@ -239,6 +266,9 @@ pub struct Estimate {
     pub spd: Vec<f64>,
     /// xy, CCT, Duv of the SPD.
     pub colorimetry: Colorimetry,
+    /// The lighting-quality metrics of the SPD (CRI, TM-30, α-opic, S/P, PPF, blue-light
+    /// hazard; `spdcam_core::quality`), computed on the SPD's grid only.
+    pub metrics: LightingMetrics,
     /// The score against a true SPD, when one was given.
     pub truth: Option<Score>,
     /// The analysis of the photo, for estimates from photos.
@@ -246,8 +276,8 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`, `truth`,
-    /// and for photos `photo` (chart, method, confidence, corners, homography, features and
+    /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`,
+    /// `metrics` (every [`LightingMetrics`] key), `truth`, and for photos `photo` (chart, method, confidence, corners, homography, features and
     /// `features_by_name`, every patch with its statistics and flags, warnings).
     pub fn to_json(&self) -> Result<serde_json::Value> {
         let mut v = serde_json::json!({
@@ -256,6 +286,7 @@ impl Estimate {
             "wavelength_nm": self.grid.wavelengths(),
             "spd": self.spd,
             "colorimetry": self.colorimetry,
+            "metrics": self.metrics,
             "truth": self.truth,
         });
         if let Some(a) = &self.photo {
@@ -308,6 +339,7 @@ pub fn estimate_features(
                 grid: *grid,
                 spd: set.item(i).to_vec(),
                 colorimetry: Colorimetry::of(set.item(i), grid)?,
+                metrics: LightingMetrics::from_samples(&grid.wavelengths(), set.item(i)),
                 truth: None,
                 photo: None,
             })
@@ -437,6 +469,7 @@ pub fn estimate_analysis(
         model: chosen.name.clone(),
         grid: *grid,
         colorimetry: Colorimetry::of(&spd, grid)?,
+        metrics: LightingMetrics::from_samples(&grid.wavelengths(), &spd),
         spd,
         truth: None,
         photo: Some(analysis),
@@ -463,6 +496,35 @@ pub fn estimate_photo(
     estimate_analysis(models, analysis, name, grid)
 }
 
+/// Analyses a decoded photo: the chart found (or placed by `options.corners`) among the
+/// charts [`chart_templates`] gives, and sampled.
+pub fn analyse_decoded(
+    photo: &Photo,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+) -> Result<PhotoAnalysis> {
+    let analyse = AnalyseOptions {
+        templates: chart_templates(models, options.chart.as_deref(), data_dir)?,
+        corners: options.corners.clone(),
+        debug: options.debug.clone(),
+    };
+    Ok(photo::analyse(photo, &analyse)?)
+}
+
+/// Analyses a photo held in memory (an upload, never written to disk) named `name` in
+/// messages, decoded with the same limits as a file.
+pub fn analyse_photo_bytes(
+    bytes: &[u8],
+    name: &str,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+) -> Result<PhotoAnalysis> {
+    let decoded = photo::decode_photo(bytes, name)?;
+    analyse_decoded(&decoded, models, options, data_dir)
+}
+
 /// The estimate for a photo already decoded (from bytes or a pixel array, e.g. in Python),
 /// analysed with `options` and estimated with the model for its chart, labelled with the
 /// photo's source.
@@ -473,13 +535,21 @@ pub fn estimate_decoded(
     data_dir: &DataDir,
     grid: &Grid,
 ) -> Result<Estimate> {
-    let analyse = AnalyseOptions {
-        templates: chart_templates(models, options.chart.as_deref(), data_dir)?,
-        corners: options.corners.clone(),
-        debug: options.debug.clone(),
-    };
-    let analysis = photo::analyse(photo, &analyse)?;
+    let analysis = analyse_decoded(photo, models, options, data_dir)?;
     estimate_analysis(models, analysis, photo.source.clone(), grid)
+}
+
+/// [`estimate_photo`] for a photo held in memory, labelled `name`.
+pub fn estimate_photo_bytes(
+    bytes: &[u8],
+    name: &str,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Estimate> {
+    let analysis = analyse_photo_bytes(bytes, name, models, options, data_dir)?;
+    estimate_analysis(models, analysis, name.to_string(), grid)
 }
 
 /// `colorchecker_sg96, colorchecker24`: the charts the set's models read.

@@ -39,7 +39,8 @@ pub mod target;
 
 pub use error::{InferError, Result};
 pub use estimate::{
-    estimate_decoded, estimate_features, estimate_photo, Estimate, FeatureRows, PhotoOptions,
+    analyse_photo_bytes, estimate_decoded, estimate_features, estimate_photo,
+    estimate_photo_bytes, Estimate, FeatureRows, PhotoOptions,
 };
 pub use model::Model;
 pub use shipped::ModelSet;

@@ -8,8 +8,9 @@
 
 use crate::error::{LearnError, Result};
 use crate::network::{Architecture, CnnSpec, Network, Parameter};
-use burn::module::{Module, Param};
+use burn::module::{Module, Param, ParamId};
 use burn::nn::Linear;
+use burn::optim::GradientsParams;
 use burn::tensor::activation::{relu, sigmoid};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::Rng;
@@ -107,6 +108,43 @@ impl BurnNet {
             .map(|(i, l)| if i < last { l.no_grad() } else { l })
             .collect();
         self
+    }
+
+    /// A copy of the network whose parameters are new leaves of the autodiff graph (same
+    /// values, same parameter ids): a step on it builds its own graph, which burn keeps
+    /// under its own lock, so copies run forward and backward passes on separate threads at
+    /// once. Their gradients are keyed by the original parameter ids.
+    pub(crate) fn replica(&self) -> BurnNet {
+        let detached = |p: &Param<Tensor<2>>| Param::initialized(p.id, p.val().detach());
+        let layers = self
+            .layers
+            .iter()
+            .map(|l| Linear {
+                weight: detached(&l.weight),
+                bias: l
+                    .bias
+                    .as_ref()
+                    .map(|b| Param::initialized(b.id, b.val().detach())),
+            })
+            .collect();
+        BurnNet { layers }
+    }
+
+    /// The sum of the gradients of several parts of one batch (computed on replicas).
+    pub(crate) fn sum_gradients(&self, parts: Vec<GradientsParams>) -> GradientsParams {
+        let mut parts = parts.into_iter();
+        let Some(mut total) = parts.next() else {
+            return GradientsParams::new();
+        };
+        for mut part in parts {
+            for layer in &self.layers {
+                add_gradient::<2>(&mut total, &mut part, layer.weight.id);
+                if let Some(b) = &layer.bias {
+                    add_gradient::<1>(&mut total, &mut part, b.id);
+                }
+            }
+        }
+        total
     }
 
     /// The outputs (after the sigmoid) for a prepared batch, with the dropout masks of
@@ -208,6 +246,21 @@ pub(crate) fn dropout_masks(
             Tensor::from_data(TensorData::new(mask, [rows, w]), device)
         })
         .collect())
+}
+
+/// Adds `part`'s gradient of parameter `id` to `total`'s (frozen parameters have none).
+fn add_gradient<const D: usize>(
+    total: &mut GradientsParams,
+    part: &mut GradientsParams,
+    id: ParamId,
+) {
+    if let Some(g) = part.remove::<D>(id) {
+        let sum = match total.remove::<D>(id) {
+            Some(t) => t + g,
+            None => g,
+        };
+        total.register(id, sum);
+    }
 }
 
 fn to_vec(data: TensorData) -> Result<Vec<f32>> {

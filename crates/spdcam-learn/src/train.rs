@@ -15,10 +15,12 @@ use burn::tensor::{Device, Tensor, TensorData};
 use faer::{linalg::solvers::Solve, Mat, Side};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use spdcam_core::dataset::{Columns, SampleBatch};
 use spdcam_core::spectral::Grid;
 pub use spdcam_infer::record::{Backend, Schedule, TrainOptions};
+use std::ops::Range;
 use std::time::Instant;
 
 /// The burn device of `backend`, with autodiff; an error when this build lacks the backend.
@@ -280,12 +282,31 @@ fn split_indices(n: usize, val_split: f64, seed: u64) -> Result<(Vec<usize>, Vec
     Ok((train, val))
 }
 
+/// Parts each training batch is split into: each part's gradient is computed on its own
+/// thread (in its own autodiff graph) and the parts' gradients are summed, so that one step
+/// keeps two cores busy (data parallelism within the batch). A fixed number rather than the
+/// thread count, so that the sums, and so the trained weights, are the same on any machine.
+pub const BATCH_PARTS: usize = 2;
+
 /// Trains a model on `data`, validating on `validation` or, without one, on a seeded
-/// `val_split` share of `data`.
+/// `val_split` share of `data`. Each batch is computed in [`BATCH_PARTS`] parallel parts.
 pub fn train(
     data: &TrainingSet,
     validation: Option<&TrainingSet>,
     options: &TrainOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Trained> {
+    train_in_parts(data, validation, options, BATCH_PARTS, progress)
+}
+
+/// [`train`] with each batch computed in `parts` parallel parts (1: one graph on one
+/// thread, the loop before data parallelism; the learning benchmark compares the two).
+/// The same gradient up to rounding, whatever `parts`.
+pub fn train_in_parts(
+    data: &TrainingSet,
+    validation: Option<&TrainingSet>,
+    options: &TrainOptions,
+    parts: usize,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Trained> {
     let started = Instant::now();
@@ -367,7 +388,7 @@ pub fn train(
                 &options.schedule,
                 options.seed,
                 false,
-                options.backend,
+                (options.backend, parts),
                 progress,
             )?
         }
@@ -483,7 +504,62 @@ fn keep_freed_memory() {
     }
 }
 
+/// `rows` cut into at most `parts` contiguous, nearly equal, non-empty ranges.
+fn part_ranges(rows: usize, parts: usize) -> Vec<Range<usize>> {
+    let parts = parts.clamp(1, rows.max(1));
+    (0..parts)
+        .map(|p| rows * p / parts..rows * (p + 1) / parts)
+        .filter(|r| !r.is_empty())
+        .collect()
+}
+
+/// One optimiser step's gradient on rows `xb`/`yb` (`rows` of them) of `net`, computed in
+/// `parts` parts on parallel threads, each on a replica of `net` with its own autodiff graph;
+/// the parts' losses are scaled so that they add up to the batch's mean squared error.
+/// Returns the summed gradients and that loss.
+#[allow(clippy::too_many_arguments)]
+fn batch_gradient(
+    net: &BurnNet,
+    architecture: &Architecture,
+    (xb, yb): (&[f32], &[f32]),
+    (rows, f, k): (usize, usize, usize),
+    masks: Vec<Tensor<2>>,
+    parts: usize,
+    device: &Device,
+) -> Result<(GradientsParams, f64)> {
+    let ranges = part_ranges(rows, parts);
+    let replicas: Vec<BurnNet> = (1..ranges.len()).map(|_| net.replica()).collect();
+    let scale = 1.0 / (rows * k) as f32;
+    let part = |p: usize| -> Result<(GradientsParams, f64)> {
+        let model = if p == 0 { net } else { &replicas[p - 1] };
+        let r = ranges[p].clone();
+        let n = r.len();
+        let input = prepare(architecture, &xb[r.start * f..r.end * f], n, f, device)?;
+        let target = Tensor::<2>::from_data(
+            TensorData::new(yb[r.start * k..r.end * k].to_vec(), [n, k]),
+            device,
+        );
+        let masks = masks
+            .iter()
+            .map(|m| m.clone().narrow(0, r.start, n))
+            .collect();
+        let output = model.forward(architecture, input, masks)?;
+        let loss = (output - target).square().sum().mul_scalar(scale);
+        let grads = loss.backward();
+        let value = f64::from(loss.into_scalar::<f32>());
+        Ok((GradientsParams::from_grads(grads, model), value))
+    };
+    let results = (0..ranges.len())
+        .into_par_iter()
+        .map(part)
+        .collect::<Result<Vec<_>>>()?;
+    let loss = results.iter().map(|(_, l)| l).sum();
+    let grads = net.sum_gradients(results.into_iter().map(|(g, _)| g).collect());
+    Ok((grads, loss))
+}
+
 /// The gradient loop: returns the best-validation network, the log and the best epoch.
+/// Each batch is computed in `parts` parallel parts (see [`batch_gradient`]).
 #[allow(clippy::too_many_arguments)]
 fn fit_network(
     init: Network,
@@ -493,7 +569,7 @@ fn fit_network(
     schedule: &Schedule,
     seed: u64,
     freeze_features: bool,
-    backend: Backend,
+    (backend, parts): (Backend, usize),
     progress: &mut dyn FnMut(Progress),
 ) -> Result<(Network, Vec<EpochRecord>, usize)> {
     keep_freed_memory();
@@ -530,14 +606,17 @@ fn fit_network(
                 yb.extend_from_slice(&train.y[i * k..(i + 1) * k]);
             }
             let rows = chunk.len();
-            let input = prepare(&architecture, &xb, rows, f, &device)?;
-            let target = Tensor::<2>::from_data(TensorData::new(yb.clone(), [rows, k]), &device);
             let masks = dropout_masks(&architecture, rows, f, &mut rng, &device)?;
-            let output = net.forward(&architecture, input, masks)?;
-            let loss = (output - target).square().mean();
-            let grads = loss.backward();
-            loss_sum += f64::from(loss.into_scalar::<f32>()) * rows as f64;
-            let grads = GradientsParams::from_grads(grads, &net);
+            let (grads, loss) = batch_gradient(
+                &net,
+                &architecture,
+                (&xb, &yb),
+                (rows, f, k),
+                masks,
+                parts,
+                &device,
+            )?;
+            loss_sum += loss * rows as f64;
             net = optimizer.step(lr, net, grads);
             progress(Progress::Step {
                 epoch,
@@ -709,7 +788,7 @@ pub fn finetune(
         &options.schedule,
         options.seed,
         options.freeze_features,
-        options.backend,
+        (options.backend, BATCH_PARTS),
         progress,
     )?;
     let outputs = network.forward(&val_rows.x)?;
@@ -746,4 +825,73 @@ pub fn finetune(
         tuned.set_photo_chart(template.clone())?;
     }
     Ok(Trained { model: tuned, log })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::network::{Architecture, CnnSpec};
+    use crate::pca::Components;
+    use crate::synthetic::gaussian_set;
+
+    #[test]
+    fn part_ranges_tile_the_batch() {
+        assert_eq!(part_ranges(7, 2), vec![0..3, 3..7]);
+        assert_eq!(part_ranges(64, 2), vec![0..32, 32..64]);
+        assert_eq!(part_ranges(1, 2), vec![0..1]);
+        assert_eq!(part_ranges(5, 1), vec![0..5]);
+    }
+
+    #[test]
+    fn batch_parts_give_the_one_graph_weights() {
+        let data = gaussian_set(300, 24, 3, 4);
+        let options = TrainOptions {
+            architecture: Architecture::Cnn1d(CnnSpec::thesis()),
+            target: TargetKind::Pca(Components::default()),
+            grid: Grid::ESTIMATION,
+            schedule: Schedule {
+                epochs: 1,
+                batch: 37,
+                ..Schedule::thesis()
+            },
+            seed: 5,
+            val_split: 0.2,
+            backend: Backend::Cpu,
+        };
+        let one = train_in_parts(&data, None, &options, 1, &mut |_| {}).unwrap();
+        let two = train_in_parts(&data, None, &options, 2, &mut |_| {}).unwrap();
+        let three = train_in_parts(&data, None, &options, 3, &mut |_| {}).unwrap();
+        let (a, b, c) = (
+            one.model.network(),
+            two.model.network(),
+            three.model.network(),
+        );
+        let mut largest = 0.0f32;
+        let mut moved = 0.0f32;
+        let init = Network::init(a.architecture().clone(), a.inputs(), a.outputs(), 5).unwrap();
+        for (((pa, pb), pc), p0) in a
+            .parameters()
+            .iter()
+            .zip(b.parameters())
+            .zip(c.parameters())
+            .zip(init.parameters())
+        {
+            for (((x, y), z), w) in pa.data.iter().zip(&pb.data).zip(&pc.data).zip(&p0.data) {
+                largest = largest.max((x - y).abs()).max((x - z).abs());
+                moved = moved.max((x - w).abs());
+            }
+        }
+        // Training moved the weights; splitting the batches changed them by rounding only.
+        assert!(moved > 1e-3, "{moved}");
+        assert!(
+            largest < 1e-4 * moved.max(1.0),
+            "{largest} vs moved {moved}"
+        );
+        for (x, y) in one.log.iter().zip(&two.log) {
+            assert!(
+                (x.train_loss - y.train_loss).abs() < 1e-5 * x.train_loss,
+                "{x:?} {y:?}"
+            );
+        }
+    }
 }

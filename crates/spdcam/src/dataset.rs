@@ -130,6 +130,14 @@ struct InfoArgs {
     /// Also plot 20 SPDs spread over the dataset into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
+    /// Read every sample file and check it against the manifest (SHA-256, columns, finite
+    /// values, row and family counts); exits non-zero when anything is wrong.
+    #[arg(long)]
+    verify: bool,
+    /// After rewriting sample files on purpose (e.g. with pandas, same columns): re-read
+    /// them and record their new row counts and checksums in the manifest.
+    #[arg(long, conflicts_with = "verify")]
+    update_checksums: bool,
 }
 
 /// Runs `spdcam dataset …`.
@@ -381,8 +389,49 @@ fn print_info(dir: &Path, m: &Manifest) {
 }
 
 fn info(args: InfoArgs) -> Result<()> {
+    if args.update_checksums {
+        let m = Dataset::update_checksums(&args.dataset)?;
+        println!(
+            "recorded {} files ({} samples) with their checksums in {}",
+            m.files.len(),
+            m.samples,
+            args.dataset.join(dataset::MANIFEST_FILE).display()
+        );
+    }
     let dataset = Dataset::open(&args.dataset)?;
     print_info(&args.dataset, dataset.manifest());
+    if args.verify {
+        let bar = progress_bar(dataset.len(), "rows");
+        let report = dataset.verify(&|n| {
+            if let Some(b) = &bar {
+                b.inc(n)
+            }
+        });
+        if let Some(b) = bar {
+            b.finish_and_clear();
+        }
+        for problem in &report.problems {
+            eprintln!("  problem:  {problem}");
+        }
+        let unchecked = match report.without_checksum {
+            0 => String::new(),
+            n => format!(" ({n} without a checksum in the manifest: contents not proven)"),
+        };
+        if !report.problems.is_empty() {
+            bail!(
+                "{} does not match its manifest: {} of {} sample files read correctly; problems: {}",
+                args.dataset.display(),
+                report.files_ok,
+                dataset.manifest().files.len(),
+                report.problems.len()
+            );
+        }
+        println!(
+            "  verified: {} files, {} samples match the manifest{unchecked}",
+            report.files_ok,
+            dataset.len()
+        );
+    }
     if let Some(path) = &args.plot {
         fsio::check_parent_dir(path)?;
         let n = dataset.len();

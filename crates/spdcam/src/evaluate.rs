@@ -1,7 +1,7 @@
 //! `spdcam evaluate`: score a model on a dataset and write a report directory.
 
 use crate::train::load_set;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::{Camera, CameraConfig};
@@ -26,9 +26,33 @@ pub struct EvaluateArgs {
     /// The dataset to score on.
     #[arg(long, value_name = "DIR")]
     data: PathBuf,
-    /// The report directory (created if missing).
+    /// The report directory (created if missing; a directory holding files is refused
+    /// unless --force).
     #[arg(short, long, value_name = "REPORT")]
     output: PathBuf,
+    /// Write the report into a directory that holds files, replacing the report's files.
+    #[arg(long)]
+    force: bool,
+}
+
+/// Refuses a report directory that holds files unless `force`, as `dataset export` does:
+/// a report must not overwrite a user's files by surprise.
+fn check_report_dir(dir: &Path, force: bool) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("report {} exists and is not a directory", dir.display());
+    }
+    let holds_files = dir.is_dir()
+        && std::fs::read_dir(dir)
+            .with_context(|| format!("reading {}", dir.display()))?
+            .next()
+            .is_some();
+    if holds_files && !force {
+        bail!(
+            "report directory {} is not empty; use --force to replace the report's files in it, or choose another directory",
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 /// The Markdown table of the four metrics.
@@ -171,6 +195,7 @@ fn worst_case_image(model: &Model, e: &Evaluation, data_dir: &DataDir) -> Result
 
 /// Runs `spdcam evaluate`.
 pub fn run(args: EvaluateArgs, data_dir: &DataDir) -> Result<()> {
+    check_report_dir(&args.output, args.force)?;
     let model = Model::load(&args.model)?;
     let set = load_set(&args.data)?;
     let e = evaluate(&model, &set)?;

@@ -36,7 +36,7 @@ pub struct FinetuneArgs {
 
 /// Runs `spdcam finetune`.
 pub fn run(args: FinetuneArgs) -> Result<()> {
-    fsio::check_parent_dir(&args.output)?;
+    fsio::check_writable(&args.output)?;
     let model = Model::load(&args.model)?;
     let data = load_set(&args.data)?;
     let val = args.schedule.val.as_deref().map(load_set).transpose()?;

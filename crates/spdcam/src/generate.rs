@@ -28,7 +28,7 @@ pub struct GenerateArgs {
     /// Seed: sample i depends only on (seed, i).
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Output dataset directory (manifest.json + samples-NNNNN.parquet).
+    /// Output dataset directory (manifest.json + samples/part-NNNNN.parquet).
     #[arg(short, long)]
     output: PathBuf,
     /// Also write each rendered chart as images/sample-NNNNNNNN.png.
@@ -62,6 +62,9 @@ pub struct GenerateArgs {
     /// comma-separated list of names or files.
     #[arg(long, value_name = "DIR|LIST")]
     cameras: Option<String>,
+    /// A validation split (`spdcam lamps split`): its held-out cameras are left out of the pool.
+    #[arg(long, value_name = "SPLIT.json")]
+    camera_split: Option<PathBuf>,
     /// Perturbed copies of each camera in the pool (shift ±5 nm, gain ±10 %).
     #[arg(long, default_value_t = 3)]
     camera_variants: usize,
@@ -109,8 +112,8 @@ fn randomisation(
     grid: &Grid,
 ) -> Result<Option<Randomisation>> {
     if args.randomise.is_empty() {
-        if args.cameras.is_some() {
-            bail!("--cameras needs --randomise camera");
+        if args.cameras.is_some() || args.camera_split.is_some() {
+            bail!("--cameras and --camera-split need --randomise camera");
         }
         return Ok(None);
     }
@@ -136,6 +139,16 @@ fn randomisation(
             for name in spec.split(',').map(str::trim).filter(|n| !n.is_empty()) {
                 sens.push(crate::calibrate::sensitivities(name, data_dir, grid)?);
             }
+        }
+    }
+    if let Some(path) = &args.camera_split {
+        let split = spdcam_core::lighting::ValidationSplit::read(path)?;
+        sens.retain(|s| split.allows_training_camera(&s.name));
+        if sens.is_empty() {
+            bail!(
+                "every camera of the pool is held out by {}",
+                path.display()
+            );
         }
     }
     let variants = if groups.contains(&"camera") {

@@ -1,6 +1,7 @@
 //! spdcam: what light is in the room, from a photo of a colour chart.
 
 mod calibrate;
+mod coverage;
 mod dataset;
 mod estimate;
 #[cfg(feature = "train")]
@@ -12,16 +13,20 @@ mod experiment_sim2real;
 #[cfg(feature = "train")]
 mod finetune;
 mod generate;
+mod lamps;
 mod list;
+mod metrics;
 mod photo_args;
 mod plot_file;
 mod render;
 #[cfg(feature = "train")]
 mod ridge;
+mod serve;
 #[cfg(feature = "train")]
 mod sim2real_curve;
 #[cfg(feature = "train")]
 mod train;
+mod validate_lamps;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -49,6 +54,8 @@ enum Command {
     Dataset(dataset::DatasetArgs),
     /// List built-in cameras, charts, illuminants, lighting recipes and presets.
     List(list::ListArgs),
+    /// Lighting-quality metrics (CCT, CRI, TM-30, α-opic, S/P, PPF) of SPDs.
+    Metrics(metrics::MetricsArgs),
     #[cfg(feature = "train")]
     /// Train a model (1D CNN, MLP or ridge baseline) on a dataset.
     Train(Box<train::TrainArgs>),
@@ -68,6 +75,12 @@ enum Command {
     #[cfg(feature = "train")]
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
     Sim2real(experiment_sim2real::Sim2realArgs),
+    /// Serve a local web page where photos are dropped and their light is shown.
+    Serve(serve::ServeArgs),
+    /// How well lighting recipes cover measured SPDs, per lamp type.
+    Coverage(Box<coverage::CoverageArgs>),
+    /// Real lamps: the validation split, the lamp-family fits, the validation protocol.
+    Lamps(lamps::LampsArgs),
 }
 
 /// Output piped into a program that stops reading (`spdcam … | head`) ends spdcam quietly,
@@ -94,6 +107,7 @@ fn main() -> ExitCode {
         Command::Generate(args) => generate::run(*args, &data_dir),
         Command::Dataset(args) => dataset::run(args, &data_dir),
         Command::List(args) => list::run(args, &data_dir),
+        Command::Metrics(args) => metrics::run(args, &data_dir),
         #[cfg(feature = "train")]
         Command::Train(args) => train::run(*args, &data_dir),
         Command::Estimate(args) => estimate::run(*args, &data_dir),
@@ -106,12 +120,46 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),
         #[cfg(feature = "train")]
         Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
+        Command::Serve(args) => serve::run(args, &data_dir),
+        Command::Coverage(args) => coverage::run(*args, &data_dir),
+        Command::Lamps(args) => lamps::run(args, &data_dir),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The error and its causes joined by ": ", leaving out a cause the text already says (an
+/// I/O error is often both in a message and its source).
+fn error_text(error: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in error.chain() {
+        let message = cause.to_string();
+        if !text.contains(&message) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&message);
+        }
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_os_error_is_printed_once() {
+        // Issue 15: "Permission denied (os error 13): Permission denied (os error 13)".
+        let io = std::io::Error::from(std::io::ErrorKind::PermissionDenied);
+        let e = anyhow::Error::from(spdcam_core::Error::io("out.csv", io)).context("writing");
+        let text = error_text(&e);
+        assert_eq!(text.matches("denied").count(), 1, "{text}");
+        assert!(text.starts_with("writing: out.csv: "), "{text}");
     }
 }

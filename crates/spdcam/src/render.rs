@@ -45,8 +45,8 @@ pub struct CameraArgs {
     /// Sensor: a Bayer pattern (rggb, bggr, grbg, gbrg) or `three` for three sensors.
     #[arg(long, default_value = "rggb")]
     pub sensor: String,
-    /// Brightest raw value as a fraction of full scale.
-    #[arg(long, default_value_t = 1.0)]
+    /// Brightest raw value as a fraction of full scale (> 0; above 1 clips).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub exposure: f64,
     /// Noise preset: thesis, phone, or off.
     #[arg(long, default_value = "thesis")]
@@ -93,6 +93,12 @@ fn parse_pair(text: &str, what: &str) -> Result<(usize, usize)> {
 impl CameraArgs {
     /// The camera settings these options describe.
     pub fn config(&self) -> Result<CameraConfig> {
+        if !(self.exposure.is_finite() && self.exposure > 0.0) {
+            bail!(
+                "--exposure {} is not a positive fraction of full scale (e.g. 0.8, or 1.5 to clip)",
+                self.exposure
+            );
+        }
         let mode = if self.sensor.eq_ignore_ascii_case("three") {
             SensorMode::ThreeSensor
         } else {
@@ -201,10 +207,11 @@ pub struct RenderArgs {
     /// Which draw of --lighting (the sample index of a generated dataset).
     #[arg(long, value_name = "INDEX", requires = "lighting")]
     draw: Option<u64>,
-    /// Output PNG (JPEG with --scene).
+    /// Output PNG (JPEG with --scene); `-` writes it to standard output.
     #[arg(short, long)]
     output: PathBuf,
-    /// Also write the feature row (mean sRGB 0–255 of each patch) as CSV.
+    /// Also write the feature row (mean sRGB 0–255 of each patch) as CSV; `-` for standard
+    /// output.
     #[arg(long, value_name = "FILE.csv")]
     features: Option<PathBuf>,
     /// Also write every intermediate stage as an image into this directory.
@@ -230,12 +237,17 @@ pub struct RenderArgs {
 pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
     let grid = Grid::SIMULATION;
     for path in std::iter::once(&args.output).chain(&args.features) {
-        fsio::check_parent_dir(path)?;
+        if !fsio::is_stdout(path) {
+            fsio::check_parent_dir(path)?;
+        }
+    }
+    if fsio::is_stdout(&args.output) && args.features.as_deref().is_some_and(fsio::is_stdout) {
+        bail!("only one of -o and --features can go to standard output");
     }
     if let Some(dir) = &args.stages {
-        if !dir.is_dir() {
-            bail!("stages directory {} does not exist", dir.display());
-        }
+        // Made here, before the render, so a bad place fails at once.
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot make the stages directory {}", dir.display()))?;
     }
     if let Some(path) = &args.spd_out {
         fsio::check_parent_dir(path)?;
@@ -245,12 +257,16 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         .as_deref()
         .map(|s| parse_pair(s, "scene"))
         .transpose()?;
+    if let Some((w, h)) = scene {
+        scene::check_scene_size(w, h)?;
+    }
     let extension = args
         .output
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
     match (&scene, extension.as_deref()) {
         (Some(_), Some("jpg" | "jpeg")) | (None, Some("png")) => {}
+        _ if fsio::is_stdout(&args.output) => {}
         (Some(_), _) => bail!("a scene is written as JPEG: name the output FILE.jpg"),
         (None, _) => bail!("the chart is written as PNG: name the output FILE.png"),
     }
@@ -294,10 +310,15 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         let names = camera.chart().feature_names();
         let values: Vec<String> = rendering.features.iter().map(|v| format!("{v}")).collect();
         let text = format!("{}\n{}\n", names.join(","), values.join(","));
-        fsio::write_atomic(path, text.as_bytes())?;
-        println!("features: {}", path.display());
+        fsio::write_output(path, text.as_bytes())?;
+        if !fsio::is_stdout(path) {
+            println!("features: {}", path.display());
+        }
     }
-    imageio::write_png(&args.output, &rendering.image, depth)?;
+    fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
+    if fsio::is_stdout(&args.output) {
+        return Ok(());
+    }
     let l = &camera.chart().layout;
     println!(
         "rendered {} under {} with {} ({}×{} px, {}-bit sRGB): {}",
@@ -340,7 +361,10 @@ fn render_scene(
         args.seed,
         &options,
     )?;
-    fsio::write_atomic(&args.output, &shot.jpeg)?;
+    fsio::write_output(&args.output, &shot.jpeg)?;
+    if fsio::is_stdout(&args.output) {
+        return Ok(());
+    }
     let corners: Vec<String> = shot
         .corners
         .iter()

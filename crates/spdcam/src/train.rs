@@ -252,7 +252,10 @@ pub fn write_log(log: &[EpochRecord], best: usize, csv: &Path, svg: &Path) -> Re
 
 /// Runs `spdcam train`.
 pub fn run(args: TrainArgs, data_dir: &DataDir) -> Result<()> {
-    fsio::check_parent_dir(&args.output)?;
+    fsio::check_writable(&args.output)?;
+    for path in args.log.iter().chain(&args.plot) {
+        fsio::check_writable(path)?;
+    }
     let data = load_set(&args.data)?;
     let val = args.schedule.val.as_deref().map(load_set).transpose()?;
     let architecture = match (args.model, args.ridge) {

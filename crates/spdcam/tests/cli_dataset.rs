@@ -117,6 +117,59 @@ fn generate_is_reproducible_and_shards_merge_into_one_run() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The local scale-out recipe (`tools/generate_shards.sh`, docs/scale-out.md): N shard
+/// processes running at once, then `dataset merge`, give the files of one run.
+#[cfg(unix)]
+#[test]
+fn shards_as_parallel_processes_merge_into_one_run() {
+    let dir = scratch("processes");
+    let common = [
+        "--lighting",
+        "mix:daylight=0.5,phosphor=0.3,planck=0.2",
+        "--count",
+        "1000",
+        "--fast",
+        "--seed",
+        "9",
+        "--chunk-size",
+        "64",
+    ];
+    let single = dir.join("single");
+    let mut args = vec!["generate", "-o", s(&single)];
+    args.extend_from_slice(&common);
+    ok(&args);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../tools/generate_shards.sh"
+    );
+    let out = Command::new("sh")
+        .arg(script)
+        .arg("5")
+        .arg(dir.join("sharded"))
+        .args(common)
+        .env("SPDCAM", env!("CARGO_BIN_EXE_spdcam"))
+        .env_remove("SPDCAM_DATA")
+        .output()
+        .expect("sh runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let whole = files(&single);
+    assert_eq!(
+        whole.keys().filter(|p| p.starts_with("samples")).count(),
+        16,
+        "1000 samples in files of 64"
+    );
+    for k in 0..5 {
+        let shard = files(&dir.join("sharded").join(format!("shard-{k}")));
+        assert!(shard.len() < whole.len(), "shard {k} holds a part");
+    }
+    assert_eq!(whole, files(&dir.join("sharded").join("merged")));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn generated_features_equal_spdcam_render_of_their_spd() {
     let dir = scratch("render");

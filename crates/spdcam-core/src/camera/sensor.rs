@@ -30,7 +30,7 @@ impl Sensitivities {
             return Err(Error::invalid(format!(
                 "camera '{name}' has {} sensitivity columns ({}); expected three: r,g,b",
                 measured.len(),
-                measured.names().join(",")
+                crate::error::brief_list(measured.names())
             )));
         }
         let measured = measured

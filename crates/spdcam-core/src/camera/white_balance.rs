@@ -2,6 +2,7 @@
 //! divide it out with per-channel gains (green keeps gain 1).
 
 use crate::error::{Error, Result};
+use crate::limits;
 use crate::raster::RgbImage;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -91,10 +92,13 @@ impl WhiteBalance {
             "grey-world" | "gray-world" => WhiteBalance::GreyWorld,
             "white-patch" | "max-rgb" => WhiteBalance::WhitePatch,
             "shades-of-grey" | "shades-of-gray" => WhiteBalance::ShadesOfGrey { p: number(6.0)? },
-            "grey-edge" | "gray-edge" => WhiteBalance::GreyEdge {
-                p: number(6.0)?,
-                sigma: number(1.0)?,
-            },
+            "grey-edge" | "gray-edge" => {
+                let p = number(6.0)?;
+                let sigma = number(1.0)?;
+                limits::FILTER_SIGMA_PX
+                    .check_f64(sigma, &format!("white balance '{text}': sigma"))?;
+                WhiteBalance::GreyEdge { p, sigma }
+            }
             _ => {
                 return Err(Error::UnknownName {
                     kind: "white balance",
@@ -403,5 +407,11 @@ mod tests {
         );
         assert!(WhiteBalance::parse("magic").is_err());
         assert!(WhiteBalance::parse("shades-of-grey:-1").is_err());
+        // Issue 15: `grey-edge:1:1e9` ran for minutes with gigabytes.
+        let e = WhiteBalance::parse("grey-edge:1:1e9")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("SPDCAM_MAX_FILTER_SIGMA"), "{e}");
+        assert!(WhiteBalance::parse("grey-edge:1:2").is_ok());
     }
 }

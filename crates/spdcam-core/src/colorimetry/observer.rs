@@ -48,6 +48,23 @@ impl Observer {
         })
     }
 
+    /// The CIE 1964 10° supplementary standard observer on `grid` (CIE 015:2018; the 1 nm table
+    /// of 360–830 nm shipped as `data/cie_1964_10deg_cmf.csv`), resampled as
+    /// [`Observer::cie1931`] does. CIE 224:2017 and ANSI/IES TM-30 compute colour fidelity with it.
+    pub fn cie1964_10deg(grid: &Grid) -> Result<Observer> {
+        static TABLE: OnceLock<SpectralSet> = OnceLock::new();
+        let native = TABLE.get_or_init(|| {
+            crate::builtin::CIE1964_10DEG_CMF
+                .load()
+                .expect("the shipped CIE 1964 CMF table parses")
+        });
+        let (set, _) = native.resample(grid, Interpolation::Sprague1880, Extrapolation::Zero)?;
+        Ok(Observer {
+            grid: *grid,
+            cmf: [0, 1, 2].map(|i| set.item(i).to_vec()),
+        })
+    }
+
     /// The grid the CMFs are sampled on.
     pub fn grid(&self) -> &Grid {
         &self.grid
@@ -179,6 +196,18 @@ mod tests {
         }
         let grey = obs.reflectance_to_xyz(&vec![0.18; 81], &illum);
         assert!((grey[1] - 0.18).abs() < 1e-15);
+    }
+
+    #[test]
+    fn ten_degree_observer_is_the_cie_1964_table() {
+        // CIE 015:2018 Table 2: ȳ₁₀(555 nm) = 0.999110, x̄₁₀(600 nm) = 1.123990, and ȳ₁₀
+        // peaks at 1 (557 nm).
+        let obs = Observer::cie1964_10deg(&Grid::new(360.0, 830.0, 1.0).unwrap()).unwrap();
+        assert_eq!(obs.cmf(1)[555 - 360], 0.99911);
+        assert_eq!(obs.cmf(0)[600 - 360], 1.12399);
+        assert_eq!(obs.cmf(1)[557 - 360], 1.0);
+        let peak = obs.cmf(1).iter().cloned().fold(0.0, f64::max);
+        assert!((peak - 1.0).abs() < 1e-6, "{peak}");
     }
 
     #[test]

@@ -119,7 +119,7 @@ pub fn import_csv(
     columns
         .validate()
         .map_err(|e| Error::parse(features.display().to_string(), e.to_string()))?;
-    prepare_output(out, overwrite)?;
+    let output = prepare_output(out, overwrite)?;
     let mut writer = DatasetWriter::new(out, columns.clone(), options.chunk_size)?;
     let mut feature_rows = feature_reader.records();
     let mut spd_rows = spd_reader.records();
@@ -176,10 +176,24 @@ pub fn import_csv(
                 second.as_slice()
             }
             None => {
-                map.apply(&second, &mut spd)?;
+                let line = s.position().map_or(0, |p| p.line());
+                let light = physical_spd(&second, &wavelengths).map_err(|e| {
+                    Error::parse(spds.display().to_string(), format!("line {line}: {e}"))
+                })?;
+                map.apply(&light, &mut spd)?;
                 &[]
             }
         };
+        if spd.iter().all(|&v| v == 0.0) {
+            let line = s.position().map_or(0, |p| p.line());
+            return Err(Error::parse(
+                spds.display().to_string(),
+                format!(
+                    "line {line}: the SPD is zero everywhere on {}",
+                    options.spd_grid
+                ),
+            ));
+        }
         writer.push(SampleRow {
             sample,
             family: &options.family,
@@ -197,8 +211,10 @@ pub fn import_csv(
         source_wavelengths: wavelengths,
         resampling: map.report().cloned(),
     });
+    let manifest = writer.finish(origin)?;
+    output.finish();
     Ok(ImportReport {
-        manifest: writer.finish(origin)?,
+        manifest,
         largest_feature,
     })
 }
@@ -221,16 +237,52 @@ fn wavelength_columns(header: &[String], path: &Path) -> Result<Vec<f64>> {
                 })
         })
         .collect::<Result<_>>()?;
+    let bad = |msg: String| Error::parse(path.display().to_string(), format!("line 1: {msg}"));
     if let Some(w) = wavelengths.windows(2).find(|w| w[1] <= w[0]) {
-        return Err(Error::parse(
-            path.display().to_string(),
-            format!(
-                "line 1: wavelength {} nm follows {} nm; they must increase",
-                w[1], w[0]
-            ),
-        ));
+        return Err(bad(format!(
+            "wavelength {} nm follows {} nm; they must increase",
+            w[1], w[0]
+        )));
+    }
+    if wavelengths.len() < 2 {
+        return Err(bad(format!(
+            "{} wavelength column; an SPD needs at least two",
+            wavelengths.len()
+        )));
+    }
+    let (lo, hi) = (wavelengths[0], wavelengths[wavelengths.len() - 1]);
+    if hi < MIN_WAVELENGTH_NM {
+        return Err(bad(format!(
+            "wavelengths {lo}–{hi} are not in nm (micrometres? 0.38 µm is 380 nm); \
+             the header must name wavelengths in nm"
+        )));
     }
     Ok(wavelengths)
+}
+
+/// Below this, a header's wavelengths are not nanometres of visible light (a file in µm
+/// has 0.38–0.78).
+const MIN_WAVELENGTH_NM: f64 = 100.0;
+
+/// The SPD of one row, as `render --spd` accepts one: negative values beyond 1 % of the
+/// peak are refused (small ones, measurement noise, become zero), and so is an SPD that is
+/// zero everywhere.
+fn physical_spd(values: &[f64], wavelengths: &[f64]) -> Result<Vec<f64>> {
+    let peak = values.iter().cloned().fold(0.0f64, f64::max);
+    if let Some((i, v)) = values
+        .iter()
+        .enumerate()
+        .find(|(_, v)| **v < -0.01 * peak.max(f64::MIN_POSITIVE))
+    {
+        return Err(Error::invalid(format!(
+            "the SPD is negative ({v}) at {} nm; light cannot be negative",
+            wavelengths[i]
+        )));
+    }
+    if peak <= 0.0 {
+        return Err(Error::invalid("the SPD is zero everywhere"));
+    }
+    Ok(values.iter().map(|v| v.max(0.0)).collect())
 }
 
 /// For a weights file: the lighting's grid (where the SPDs are made) and its weight names,
@@ -341,7 +393,7 @@ pub fn export_csv(
     let columns = dataset.columns();
     let grid = options.spd_grid.unwrap_or(columns.spd_grid);
     let map = SpdMap::new(&columns.spd_grid.wavelengths(), &grid)?;
-    prepare_output(out, overwrite)?;
+    let output = prepare_output(out, overwrite)?;
     let mut written = Vec::new();
 
     let path = out.join("features.csv");
@@ -393,5 +445,6 @@ pub fn export_csv(
         Ok(())
     })?;
     written.push(path);
+    output.finish();
     Ok(written)
 }

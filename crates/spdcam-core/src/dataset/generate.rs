@@ -3,27 +3,31 @@
 //! run resumes.
 
 use super::batch::{Columns, Counts, Precision, SampleBatch, SampleRow};
-use super::file;
+use super::lock::DirLock;
 use super::manifest::{
     CameraInfo, ChartInfo, FileEntry, GenerateSettings, LightingInfo, Manifest, Origin, Pipeline,
     Shard,
 };
 use super::randomise::Randomisation;
+use super::reader::read_sample_file;
 use super::spd_map::SpdMap;
 use super::writer::{
-    create_dir, is_empty_dir, prepare_output, remove_partials, sample_file_name, write_sample_file,
-    IMAGES_DIR, RUN_FILE, SAMPLES_DIR,
+    clear_output, create_dir, ensure_dir, is_empty_dir, remove_partials, sample_file_name,
+    write_sample_file, IMAGES_DIR, RUN_FILE, RUN_PARTS, SAMPLES_DIR,
 };
 use super::DEFAULT_CHUNK_SIZE;
 use crate::camera::{Camera, RenderBuffers};
 use crate::error::{Error, Result};
 use crate::lighting::Lighting;
 use crate::spectral::Grid;
-use crate::{fsio, imageio, seed};
+use crate::{fsio, imageio, limits, seed};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::io::Write;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
 /// Samples one worker renders between progress reports.
 const BLOCK: u64 = 64;
@@ -72,18 +76,21 @@ pub struct Generator<'a> {
     randomisation: Option<&'a Randomisation>,
 }
 
-/// The work of one run in one directory: which files are already there.
+/// The work of one run in one directory: which files are already there. Holds the
+/// directory's lock until the run has finished or the plan is dropped.
 #[derive(Debug, Clone)]
 pub struct Plan {
     dir: PathBuf,
     chunks: Vec<PlannedChunk>,
+    lock: Arc<Mutex<Option<DirLock>>>,
 }
 
 #[derive(Debug, Clone)]
 struct PlannedChunk {
     index: u64,
     samples: Range<u64>,
-    done: bool,
+    /// The file an earlier run finished, checked against its recorded checksum.
+    done: Option<FileEntry>,
 }
 
 impl Plan {
@@ -99,7 +106,7 @@ impl Plan {
     pub fn done(&self) -> u64 {
         self.chunks
             .iter()
-            .filter(|c| c.done)
+            .filter(|c| c.done.is_some())
             .map(|c| c.samples.end - c.samples.start)
             .sum()
     }
@@ -154,6 +161,19 @@ impl<'a> Generator<'a> {
             weight_names: lighting.weight_names().unwrap_or_default(),
         };
         columns.validate()?;
+        limits::SAMPLES.check(
+            options.count,
+            &format!("a run of {} samples", options.count),
+        )?;
+        let row_values =
+            (columns.feature_count() + columns.spd_len() + columns.weight_count()) as u64 + 3;
+        limits::CHUNK_BYTES.check(
+            limits::product(&[options.chunk_size, row_values, 8]),
+            &format!(
+                "sample files of {} samples of {row_values} values",
+                options.chunk_size
+            ),
+        )?;
         let spd_map = SpdMap::new(&sim.wavelengths(), &g)?;
         Ok(Generator {
             camera,
@@ -388,13 +408,16 @@ impl<'a> Generator<'a> {
         }
     }
 
-    /// Prepares `dir` for this run and finds the files an earlier run of the same command
-    /// finished. A directory holding anything else is refused unless `overwrite`, which
-    /// starts afresh.
+    /// Locks `dir` for this run, prepares it and finds the files an earlier run of the same
+    /// command finished: those whose bytes match the checksum that run recorded (in its
+    /// manifest, or in the journal an interrupted run leaves). A directory holding anything
+    /// else is refused unless `overwrite`, which starts afresh; a directory another run is
+    /// writing is refused.
     pub fn prepare(&self, dir: &Path, overwrite: bool) -> Result<Plan> {
         let record = self.record();
-        let resuming = dir.is_dir()
-            && !is_empty_dir(dir)?
+        ensure_dir(dir)?;
+        let lock = DirLock::acquire(dir)?;
+        let resuming = !is_empty_dir(dir)?
             && !overwrite
             && match Self::existing_run(dir) {
                 Some(previous) if previous == record => true,
@@ -410,8 +433,9 @@ impl<'a> Generator<'a> {
                 None => false,
             };
         if !resuming {
-            prepare_output(dir, overwrite)?;
+            clear_output(dir, overwrite)?;
         }
+        let finished = finished_parts(dir);
         remove_partials(dir)?;
         let mut text = serde_json::to_string_pretty(&record)
             .map_err(|e| Error::invalid(format!("run record: {e}")))?;
@@ -429,10 +453,14 @@ impl<'a> Generator<'a> {
             .chunk_range()
             .map(|index| {
                 let samples = self.chunk_samples(index);
-                let path = dir.join(sample_file_name(index));
-                let done = path.is_file()
-                    && file::row_count(&path, &self.columns).ok()
-                        == Some(samples.end - samples.start);
+                let name = sample_file_name(index);
+                let done = finished
+                    .get(&name)
+                    .filter(|e| e.rows == samples.end - samples.start && e.sha256.is_some())
+                    .filter(|e| {
+                        std::fs::read(dir.join(&name)).is_ok_and(|b| e.verify(&b, dir).is_ok())
+                    })
+                    .cloned();
                 PlannedChunk {
                     index,
                     samples,
@@ -443,52 +471,48 @@ impl<'a> Generator<'a> {
         Ok(Plan {
             dir: dir.to_path_buf(),
             chunks,
+            lock: Arc::new(Mutex::new(Some(lock))),
         })
     }
 
     /// Renders the files `plan` still lacks, then writes the manifest. `progress` is told how
-    /// many new samples were finished. Each file is encoded and written on a second thread
-    /// while the next one renders; at most one finished file waits in between, so memory
-    /// stays flat whatever the count.
+    /// many new samples were finished. Files are rendered, encoded and written in parallel,
+    /// each by the thread that picks it up, the samples of one file spread over threads that
+    /// would otherwise idle; so both rendering and compression use every core, and memory
+    /// holds about one file per thread whatever the count.
     pub fn run(&self, plan: &Plan, progress: &(dyn Fn(u64) + Sync)) -> Result<Manifest> {
         let dir = plan.dir.as_path();
         let images = self.options.images.then(|| dir.join(IMAGES_DIR));
-        let mut counts = Counts::default();
-        let mut files = Vec::with_capacity(plan.chunks.len());
-        std::thread::scope(|scope| {
-            let (sender, receiver) = std::sync::mpsc::sync_channel::<(String, SampleBatch)>(1);
-            let writer = scope.spawn(move || -> Result<()> {
-                for (name, batch) in receiver {
-                    write_sample_file(dir, name, &self.columns, &batch)?;
-                }
-                Ok(())
-            });
-            let rendered = (|| -> Result<()> {
-                for chunk in &plan.chunks {
-                    let name = sample_file_name(chunk.index);
-                    let batch = if chunk.done {
-                        file::decode(&dir.join(&name), &self.columns)?
-                    } else {
-                        self.samples(chunk.samples.clone(), images.as_deref(), progress)?
-                    };
-                    counts.add(&batch);
-                    files.push(FileEntry {
-                        name: name.clone(),
-                        rows: batch.len() as u64,
-                    });
-                    // A closed channel means the writer failed; its error is returned below.
-                    if !chunk.done && sender.send((name, batch)).is_err() {
-                        break;
+        // Resumed runs append to the journal from several threads; one line at a time.
+        let journal = std::sync::Mutex::new(());
+        let written = plan
+            .chunks
+            .par_iter()
+            .with_max_len(1)
+            .map(|chunk| -> Result<(FileEntry, Counts)> {
+                let (entry, batch) = match &chunk.done {
+                    Some(entry) => (entry.clone(), read_sample_file(dir, entry, &self.columns)?),
+                    None => {
+                        let name = sample_file_name(chunk.index);
+                        let batch =
+                            self.samples(chunk.samples.clone(), images.as_deref(), progress)?;
+                        let entry = write_sample_file(dir, name, &self.columns, &batch)?;
+                        let _line = journal.lock().unwrap_or_else(|e| e.into_inner());
+                        append_to_journal(dir, &entry)?;
+                        (entry, batch)
                     }
-                }
-                Ok(())
-            })();
-            drop(sender);
-            let written = writer
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-            rendered.and(written)
-        })?;
+                };
+                let mut counts = Counts::default();
+                counts.add(&batch);
+                Ok((entry, counts))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut counts = Counts::default();
+        let mut files = Vec::with_capacity(written.len());
+        for (entry, c) in written {
+            counts.merge(c);
+            files.push(entry);
+        }
         let manifest = Manifest::new(
             self.columns.clone(),
             counts,
@@ -496,10 +520,56 @@ impl<'a> Generator<'a> {
             Origin::Generated(Box::new(self.settings())),
         );
         manifest.write(dir)?;
-        let run_file = dir.join(RUN_FILE);
-        std::fs::remove_file(&run_file).map_err(|e| Error::io(&run_file, e))?;
+        for name in [RUN_FILE, RUN_PARTS] {
+            let path = dir.join(name);
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(Error::io(&path, e))
+                }
+                _ => {}
+            }
+        }
+        if let Ok(mut lock) = plan.lock.lock() {
+            lock.take();
+        }
         Ok(manifest)
     }
+}
+
+/// Records a finished sample file in the run's journal, so that a resumed run trusts it
+/// only while its bytes match.
+fn append_to_journal(dir: &Path, entry: &FileEntry) -> Result<()> {
+    let path = dir.join(RUN_PARTS);
+    let line =
+        serde_json::to_string(entry).map_err(|e| Error::invalid(format!("run journal: {e}")))?;
+    let mut file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .map_err(|e| Error::io(&path, e))?;
+    writeln!(file, "{line}")
+        .and_then(|()| file.sync_data())
+        .map_err(|e| Error::io(&path, e))
+}
+
+/// The sample files an earlier run of this directory finished, with their checksums: from
+/// its manifest, and from the journal of an interrupted run (a torn last line is skipped).
+fn finished_parts(dir: &Path) -> HashMap<String, FileEntry> {
+    let mut parts: HashMap<String, FileEntry> = Manifest::read(dir)
+        .map(|m| m.files)
+        .unwrap_or_default()
+        .into_iter()
+        .map(|e| (e.name.clone(), e))
+        .collect();
+    if let Ok(text) = std::fs::read_to_string(dir.join(RUN_PARTS)) {
+        for entry in text
+            .lines()
+            .filter_map(|l| serde_json::from_str::<FileEntry>(l).ok())
+        {
+            parts.insert(entry.name.clone(), entry);
+        }
+    }
+    parts
 }
 
 /// The names of the top-level settings in which two runs differ.

@@ -49,6 +49,44 @@ pub struct Manifest {
 pub struct FileEntry {
     pub name: String,
     pub rows: u64,
+    /// SHA-256 of the file's bytes, lower-case hex (what `sha256sum` prints); absent in
+    /// datasets written before checksums were kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sha256: Option<String>,
+}
+
+impl FileEntry {
+    /// The entry of a file of `rows` rows whose content is `bytes`.
+    pub fn of_bytes(name: String, rows: u64, bytes: &[u8]) -> FileEntry {
+        FileEntry {
+            name,
+            rows,
+            sha256: Some(sha256_hex(bytes)),
+        }
+    }
+
+    /// Checks `bytes`, the content of this file, against the checksum (when there is one).
+    pub fn verify(&self, bytes: &[u8], dir: &Path) -> Result<()> {
+        match &self.sha256 {
+            Some(expected) if *expected != sha256_hex(bytes) => Err(Error::invalid(format!(
+                "{}: the file does not match its checksum in the manifest: it was damaged or \
+                 changed after spdcam wrote it (if you rewrote it on purpose, run `spdcam \
+                 dataset info {} --update-checksums`)",
+                dir.join(&self.name).display(),
+                dir.display()
+            ))),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// SHA-256 (FIPS 180-4) of `bytes` as lower-case hex.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }
 
 /// Where a dataset's samples came from.

@@ -153,7 +153,7 @@ pub fn merge(
             },
         ),
     };
-    prepare_output(out, overwrite)?;
+    let output = prepare_output(out, overwrite)?;
     let mut writer = DatasetWriter::new(out, columns, chunk_size)?;
     for dataset in ordered {
         for batch in dataset.batches() {
@@ -164,5 +164,7 @@ pub fn merge(
             progress(batch.len() as u64);
         }
     }
-    writer.finish(origin)
+    let manifest = writer.finish(origin)?;
+    output.finish();
+    Ok(manifest)
 }

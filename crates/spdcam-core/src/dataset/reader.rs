@@ -1,10 +1,58 @@
 //! Reading a dataset directory: its manifest and its samples, one file at a time or all.
 
-use super::batch::{Columns, SampleBatch};
-use super::file;
-use super::manifest::Manifest;
+use super::batch::{Columns, Counts, SampleBatch};
+use super::file_read;
+use super::lock::DirLock;
+use super::manifest::{FileEntry, Manifest};
 use crate::error::{Error, Result};
+use crate::limits;
 use std::path::{Path, PathBuf};
+
+/// Reads sample file `entry` of the dataset in `dir`: its bytes (size checked against
+/// [`limits::CHUNK_BYTES`]), checked against the manifest's checksum, then decoded.
+pub(crate) fn read_sample_file(
+    dir: &Path,
+    entry: &FileEntry,
+    columns: &Columns,
+) -> Result<SampleBatch> {
+    let path = dir.join(&entry.name);
+    let source = path.display().to_string();
+    let size = std::fs::metadata(&path)
+        .map_err(|e| Error::io(&path, e))?
+        .len();
+    limits::CHUNK_BYTES.check(size, &source)?;
+    let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+    entry.verify(&bytes, dir)?;
+    let batch = file_read::decode(bytes.into(), columns, &source)?;
+    if batch.len() as u64 != entry.rows {
+        return Err(Error::invalid(format!(
+            "{source}: {} rows, the manifest says {}",
+            batch.len(),
+            entry.rows
+        )));
+    }
+    Ok(batch)
+}
+
+/// Whether `name` is a relative path that stays inside the dataset directory.
+fn inside(name: &str) -> bool {
+    let path = Path::new(name);
+    !name.is_empty()
+        && path
+            .components()
+            .all(|c| matches!(c, std::path::Component::Normal(_)))
+}
+
+/// What [`Dataset::verify`] found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Verification {
+    /// Files read and found as the manifest describes them.
+    pub files_ok: usize,
+    /// Of those, files the manifest has no checksum for (older datasets).
+    pub without_checksum: usize,
+    /// What is wrong, one line each, naming the file.
+    pub problems: Vec<String>,
+}
 
 /// An opened dataset directory.
 #[derive(Debug, Clone)]
@@ -23,6 +71,13 @@ impl Dataset {
                 "{}: the manifest counts {} samples but its files hold {listed}",
                 dir.display(),
                 manifest.samples
+            )));
+        }
+        if let Some(f) = manifest.files.iter().find(|f| !inside(&f.name)) {
+            return Err(Error::invalid(format!(
+                "{}: the manifest lists sample file '{}', which is not a path inside the dataset",
+                dir.display(),
+                f.name
             )));
         }
         if let Some(f) = manifest.files.iter().find(|f| !dir.join(&f.name).is_file()) {
@@ -63,20 +118,75 @@ impl Dataset {
         self.manifest.samples == 0
     }
 
-    /// Reads sample file `k` of the manifest.
+    /// Reads sample file `k` of the manifest, checking its checksum.
     pub fn read_file(&self, k: usize) -> Result<SampleBatch> {
-        let entry = &self.manifest.files[k];
-        let path = self.dir.join(&entry.name);
-        let batch = file::decode(&path, self.columns())?;
-        if batch.len() as u64 != entry.rows {
-            return Err(Error::invalid(format!(
-                "{}: {} rows, the manifest says {}",
-                path.display(),
-                batch.len(),
-                entry.rows
-            )));
+        read_sample_file(&self.dir, &self.manifest.files[k], self.columns())
+    }
+
+    /// Reads every sample file and checks it against the manifest: checksum, columns,
+    /// finite values, row counts, and the manifest's totals of samples, attempts and
+    /// families. Unlike reading, it goes on after a bad file and lists every problem.
+    pub fn verify(&self, progress: &dyn Fn(u64)) -> Verification {
+        let mut report = Verification::default();
+        let mut counts = Counts::default();
+        for (k, entry) in self.manifest.files.iter().enumerate() {
+            match self.read_file(k) {
+                Ok(batch) => {
+                    report.files_ok += 1;
+                    report.without_checksum += usize::from(entry.sha256.is_none());
+                    counts.add(&batch);
+                    progress(batch.len() as u64);
+                }
+                Err(e) => report.problems.push(e.to_string()),
+            }
         }
-        Ok(batch)
+        if report.problems.is_empty() {
+            let m = &self.manifest;
+            if (counts.samples, counts.attempts) != (m.samples, m.attempts) {
+                report.problems.push(format!(
+                    "{}: the files hold {} samples from {} attempts, the manifest says {} from {}",
+                    self.dir.display(),
+                    counts.samples,
+                    counts.attempts,
+                    m.samples,
+                    m.attempts
+                ));
+            }
+            if counts.families != m.families {
+                report.problems.push(format!(
+                    "{}: the files' family counts differ from the manifest's",
+                    self.dir.display()
+                ));
+            }
+        }
+        report
+    }
+
+    /// Re-reads every sample file after they were rewritten on purpose (e.g. filtered or
+    /// re-encoded with pandas, same columns), and rewrites the manifest with their row
+    /// counts, checksums and totals. Takes the directory's lock.
+    pub fn update_checksums(dir: &Path) -> Result<Manifest> {
+        let _lock = DirLock::acquire(dir)?;
+        let mut manifest = Manifest::read(dir)?;
+        let mut counts = Counts::default();
+        for entry in &mut manifest.files {
+            let path = dir.join(&entry.name);
+            let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+            let batch = file_read::decode(
+                bytes.clone().into(),
+                &manifest.columns,
+                &path.display().to_string(),
+            )?;
+            counts.add(&batch);
+            *entry = FileEntry::of_bytes(entry.name.clone(), batch.len() as u64, &bytes);
+        }
+        manifest.samples = counts.samples;
+        manifest.attempts = counts.attempts;
+        manifest.valid_ratio =
+            (counts.attempts > 0).then(|| counts.samples as f64 / counts.attempts as f64);
+        manifest.families = counts.families;
+        manifest.write(dir)?;
+        Ok(manifest)
     }
 
     /// The samples file by file, in row order; one file is in memory at a time.

@@ -2,7 +2,7 @@
 
 use super::manifest::{Manifest, Origin};
 use super::reader::Dataset;
-use super::writer::{prepare_output, DatasetWriter, SPLIT_PARTS};
+use super::writer::{clear_output, ensure_dir, prepare_output, DatasetWriter, SPLIT_PARTS};
 use super::DEFAULT_CHUNK_SIZE;
 use crate::error::{Error, Result};
 use crate::seed;
@@ -50,10 +50,11 @@ pub fn split(
     progress: &dyn Fn(u64),
 ) -> Result<[Manifest; 3]> {
     let parts = assign_parts(input.len(), fractions, seed)?;
-    prepare_output(out, overwrite)?;
+    let output = prepare_output(out, overwrite)?;
     let dirs = SPLIT_PARTS.map(|p| out.join(p));
     for dir in &dirs {
-        prepare_output(dir, overwrite)?;
+        ensure_dir(dir)?;
+        clear_output(dir, overwrite)?;
     }
     let mut writers = Vec::with_capacity(3);
     for dir in &dirs {
@@ -82,5 +83,6 @@ pub fn split(
             source: Box::new(input.manifest().origin.clone()),
         })?);
     }
+    output.finish();
     Ok(manifests.try_into().expect("one manifest per part"))
 }

@@ -2,13 +2,17 @@
 
 use super::batch::{Columns, Counts, SampleBatch, SampleRow};
 use super::file;
+use super::lock::{DirLock, LOCK_FILE};
 use super::manifest::{FileEntry, Manifest, Origin, MANIFEST_FILE};
 use crate::error::{Error, Result};
 use crate::fsio;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The record of an unfinished `spdcam generate` run, removed when its manifest is written.
 pub(crate) const RUN_FILE: &str = ".spdcam-run.json";
+/// The journal of the sample files an unfinished run wrote (one JSON entry a line, with
+/// checksums), removed with the run record.
+pub(crate) const RUN_PARTS: &str = ".spdcam-run-parts.jsonl";
 /// Where `--images` puts the rendered charts.
 pub(crate) const IMAGES_DIR: &str = "images";
 /// Where the sample files are: a folder of Parquet files and nothing else, which pandas,
@@ -34,16 +38,14 @@ pub(crate) fn write_sample_file(
 ) -> Result<FileEntry> {
     let bytes = file::encode_parquet(columns, batch)?;
     fsio::write_atomic(&dir.join(&name), &bytes)?;
-    Ok(FileEntry {
-        name,
-        rows: batch.len() as u64,
-    })
+    Ok(FileEntry::of_bytes(name, batch.len() as u64, &bytes))
 }
 
 /// Whether spdcam writes a file of this name into a dataset or export directory.
 fn is_ours(name: &str) -> bool {
     name == MANIFEST_FILE
         || name == RUN_FILE
+        || name == RUN_PARTS
         || EXPORT_FILES.contains(&name)
         || (name.starts_with("part-") && name.ends_with(".parquet"))
         || (name.starts_with("sample-") && name.ends_with(".png"))
@@ -92,19 +94,20 @@ pub(crate) fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))
 }
 
+/// Whether `dir` holds nothing (its lock file aside).
 pub(crate) fn is_empty_dir(dir: &Path) -> Result<bool> {
-    Ok(std::fs::read_dir(dir)
-        .map_err(|e| Error::io(dir, e))?
-        .next()
-        .is_none())
+    for entry in std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))? {
+        let entry = entry.map_err(|e| Error::io(dir, e))?;
+        if entry.file_name() != LOCK_FILE {
+            return Ok(false);
+        }
+    }
+    Ok(true)
 }
 
-/// Makes `dir` ready for new output: creates it, or, when it holds files, refuses unless
-/// `overwrite`, which removes what spdcam wrote there before.
-pub(crate) fn prepare_output(dir: &Path, overwrite: bool) -> Result<()> {
-    if !dir.exists() {
-        return create_dir(dir);
-    }
+/// Makes the existing directory `dir` ready for new output: when it holds files, refuses
+/// unless `overwrite`, which removes what spdcam wrote there before.
+pub(crate) fn clear_output(dir: &Path, overwrite: bool) -> Result<()> {
     if !dir.is_dir() {
         return Err(Error::invalid(format!(
             "output {} exists and is not a directory",
@@ -121,6 +124,65 @@ pub(crate) fn prepare_output(dir: &Path, overwrite: bool) -> Result<()> {
         )));
     }
     remove_ours(dir)
+}
+
+/// Creates `dir` (and its parents) unless it exists; says whether it did.
+pub(crate) fn ensure_dir(dir: &Path) -> Result<bool> {
+    if dir.exists() {
+        if !dir.is_dir() {
+            return Err(Error::invalid(format!(
+                "output {} exists and is not a directory",
+                dir.display()
+            )));
+        }
+        return Ok(false);
+    }
+    create_dir(dir)?;
+    Ok(true)
+}
+
+/// An output directory being written: locked against other writers, and, should the
+/// writing fail, left as it was found: what spdcam wrote is removed, and the directory too
+/// when this run created it.
+#[must_use = "call finish() once the output is complete"]
+pub(crate) struct Output {
+    dir: PathBuf,
+    lock: Option<DirLock>,
+    created: bool,
+    complete: bool,
+}
+
+impl Output {
+    /// The output is complete: keep it, release the lock.
+    pub(crate) fn finish(mut self) {
+        self.complete = true;
+    }
+}
+
+impl Drop for Output {
+    fn drop(&mut self) {
+        if !self.complete {
+            let _ = remove_ours(&self.dir);
+        }
+        drop(self.lock.take());
+        if !self.complete && self.created && is_empty_dir(&self.dir).unwrap_or(false) {
+            let _ = std::fs::remove_dir(&self.dir);
+        }
+    }
+}
+
+/// Makes `dir` ready for new output and locks it: creates it, or, when it holds files,
+/// refuses unless `overwrite`, which removes what spdcam wrote there before.
+pub(crate) fn prepare_output(dir: &Path, overwrite: bool) -> Result<Output> {
+    let created = ensure_dir(dir)?;
+    let lock = DirLock::acquire(dir)?;
+    clear_output(dir, overwrite)?;
+    Ok(Output {
+        dir: dir.to_path_buf(),
+        lock: Some(lock),
+        created,
+        complete: false,
+    })
 }
 
 /// Writes rows into a dataset directory, `chunk_size` rows per sample file, then the manifest.

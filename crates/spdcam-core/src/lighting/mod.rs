@@ -2,17 +2,27 @@
 //! `daylight`, `mix:…`), each drawn at random but reproducibly: draw `i` of a recipe depends
 //! only on (seed, i). Every SPD is on the simulation grid and normalised by its maximum.
 
+pub mod bands;
 mod channels;
+pub mod coverage;
+pub mod fit;
+pub mod lamp_families;
+pub mod lamp_library;
 mod luminaire;
 mod measured;
 mod parametric;
+pub mod validation_split;
 
 pub use channels::{Channels, WeightRule};
+pub use lamp_families::{LampDraws, LampFamily, LampFits};
+pub use lamp_library::{LampLibrary, LampType};
 pub use luminaire::{Luminaire, PowerBudget, TELELUMEN_BUDGET, TELELUMEN_FILE};
 pub use measured::MeasuredSpds;
 pub use parametric::{daylight, fluorescent, planck, CctRange, PhosphorLeds};
+pub use validation_split::ValidationSplit;
 
 use crate::builtin::DataDir;
+use crate::colorimetry::Observer;
 use crate::error::{Error, Result};
 use crate::illuminant::{DAYLIGHT_CCT_MAX_K, DAYLIGHT_CCT_MIN_K};
 use crate::seed;
@@ -54,6 +64,8 @@ pub fn catalogue() -> Vec<(&'static str, &'static str)> {
         ("planck[:MIN-MAX]", "Planckian radiator at a CCT uniform in mired, default 1500-10000 K"),
         ("phosphor", "phosphor-converted white LED: blue pump 440–460 nm + yellow-green and red phosphor bands, heights set for a CCT of 2700–6500 K and |Duv| ≤ 0.006"),
         ("fluorescent", "fluorescent-like lamp: mercury lines and tri-phosphor bands of random strength on a broad Planckian base"),
+        ("lamp:FAMILY[:spread=S][:fits=FILE]", "real-lamp families fitted to measured lamps (`spdcam lamps fit`): phosphor-led, hybrid-led, mixed-led, fluorescent, hid, incandescent; each draw is a fitted lamp moved by a kernel step of the fitted parameters' spread (Scott's rule × S, default 1; 0 = the fitted lamps themselves); fits=FILE uses another fit"),
+        ("blend:RECIPE+RECIPE", "two sources at once (a window and a lamp): a·A + (1 − a)·B with A and B of equal luminance and a uniform on [0, 1), e.g. blend:daylight+lamp:phosphor-led"),
         ("spds:FILE[:mix]", "measured SPDs from a spectral CSV: one at random, or with :mix a random mixture of two"),
         ("mix:RECIPE=P,RECIPE=P,…", "a mixture of recipes drawn with the given proportions, e.g. mix:telelumen:config1=0.5,daylight=0.3,planck=0.2"),
     ]
@@ -68,7 +80,17 @@ enum Family {
     Phosphor(PhosphorLeds),
     Fluorescent,
     Measured(MeasuredSpds),
+    Lamp(LampDraws),
+    Blend(Box<Blend>),
     Mix(Vec<(Lighting, f64)>),
+}
+
+/// Two recipes lighting the scene at once.
+#[derive(Debug, Clone, PartialEq)]
+struct Blend {
+    first: Lighting,
+    second: Lighting,
+    observer: Observer,
 }
 
 impl Lighting {
@@ -119,6 +141,24 @@ impl Lighting {
             "phosphor" => Family::Phosphor(PhosphorLeds::new(grid)?),
             "fluorescent" => Family::Fluorescent,
             "spds" => Family::Measured(MeasuredSpds::parse(rest, spec, data_dir, grid)?),
+            "lamp" => Family::Lamp(parse_lamp(rest, spec, grid)?),
+            "blend" => {
+                let (a, b) = rest.split_once('+').ok_or_else(|| {
+                    Error::invalid(format!(
+                        "'{spec}': a blend names two recipes joined by '+', e.g. blend:daylight+lamp:phosphor-led"
+                    ))
+                })?;
+                if [a, b].iter().any(|r| r.starts_with("mix:") || r.starts_with("blend:")) {
+                    return Err(Error::invalid(format!(
+                        "'{spec}': a blend joins two plain recipes, not mixtures or blends"
+                    )));
+                }
+                Family::Blend(Box::new(Blend {
+                    first: Lighting::parse(a, data_dir, grid)?,
+                    second: Lighting::parse(b, data_dir, grid)?,
+                    observer: Observer::cie1931(grid)?,
+                }))
+            }
             "mix" => Family::Mix(parse_mix(rest, spec, data_dir, grid)?),
             _ => {
                 let forms: Vec<&str> = catalogue().iter().map(|(form, _)| *form).collect();
@@ -144,6 +184,14 @@ impl Lighting {
     /// The recipe as given.
     pub fn spec(&self) -> &str {
         &self.spec
+    }
+
+    /// The members of a `mix:` recipe with their shares; `None` for other recipes.
+    pub fn mix_members(&self) -> Option<Vec<(&Lighting, f64)>> {
+        match &self.family {
+            Family::Mix(members) => Some(members.iter().map(|(m, p)| (m, *p)).collect()),
+            _ => None,
+        }
     }
 
     /// The channels whose weights make the light, for the Gaussian and LED families.
@@ -204,6 +252,16 @@ impl Lighting {
             }
             Family::Fluorescent => "fluorescent-like line spectra on a broad base".to_string(),
             Family::Measured(m) => m.describe(),
+            Family::Lamp(d) => format!(
+                "{} ({} fitted lamps)",
+                d.family().describe(),
+                d.lamp_count()
+            ),
+            Family::Blend(b) => format!(
+                "blend of equal-luminance {} and {}, share uniform",
+                b.first.describe(),
+                b.second.describe()
+            ),
             Family::Mix(members) => {
                 let parts: Vec<String> = members
                     .iter()
@@ -253,6 +311,27 @@ impl Lighting {
             Family::Phosphor(leds) => simple("phosphor", leds.draw(rng)?),
             Family::Fluorescent => simple("fluorescent", fluorescent(&self.grid, rng)?),
             Family::Measured(set) => simple("spds", set.draw(rng)),
+            Family::Lamp(draws) => simple(draws.family().name(), draws.draw(rng)),
+            Family::Blend(b) => {
+                let first = b.first.draw_with(rng)?;
+                let second = b.second.draw_with(rng)?;
+                let share = rng.random::<f64>();
+                let luminance = |s: &[f64]| b.observer.spd_to_xyz(s)[1].max(1e-12);
+                let (ya, yb) = (luminance(&first.spd), luminance(&second.spd));
+                let mut spd: Vec<f64> = first
+                    .spd
+                    .iter()
+                    .zip(&second.spd)
+                    .map(|(x, y)| share * x / ya + (1.0 - share) * y / yb)
+                    .collect();
+                channels::normalise_by_max(&mut spd);
+                LightDraw {
+                    spd,
+                    family: "blend".to_string(),
+                    weights: None,
+                    attempts: first.attempts + second.attempts,
+                }
+            }
             Family::Mix(members) => self.draw_member(members, rng)?,
         })
     }
@@ -281,6 +360,46 @@ impl Lighting {
         }
         Ok(draw)
     }
+}
+
+/// Parses `FAMILY[:spread=S][:fits=FILE]` of a `lamp:` recipe.
+fn parse_lamp(rest: &str, spec: &str, grid: &Grid) -> Result<LampDraws> {
+    let mut parts = rest.split(':');
+    let name = parts.next().unwrap_or_default();
+    let family = LampFamily::parse(name).ok_or_else(|| Error::UnknownName {
+        kind: "lamp family",
+        name: name.to_string(),
+        valid: LampFamily::ALL
+            .iter()
+            .map(|f| f.name())
+            .collect::<Vec<_>>()
+            .join(", "),
+    })?;
+    let mut spread = 1.0;
+    let mut fits = None;
+    for option in parts {
+        match option.split_once('=') {
+            Some(("spread", v)) => {
+                spread = v.parse().map_err(|_| {
+                    Error::invalid(format!("'{spec}': spread '{v}' is not a number"))
+                })?
+            }
+            Some(("fits", path)) => {
+                let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+                fits = Some(LampFits::from_json(&text, path)?);
+            }
+            _ => {
+                return Err(Error::invalid(format!(
+                    "'{spec}': unknown option '{option}' (spread=S, fits=FILE)"
+                )))
+            }
+        }
+    }
+    let fits = match fits {
+        Some(f) => f,
+        None => LampFits::shipped()?,
+    };
+    LampDraws::new(&fits, family, grid, spread)
 }
 
 fn parse_mix(

@@ -114,7 +114,7 @@ fn assemble(
         .iter()
         .flat_map(|&p| patches[p].rgb)
         .collect();
-    let mut warnings = Vec::new();
+    let mut warnings = photo.warnings.clone();
     let clipped: Vec<usize> = template
         .feature_patches
         .iter()
@@ -175,17 +175,54 @@ fn list(items: &[usize]) -> String {
 }
 
 /// Analyses several photos in parallel; one result per photo, in order. With several
-/// photos the debug image of each goes to [`debug_path`].
+/// photos the debug image of each goes to its own file, see [`debug_paths`].
 pub fn analyse_photos(paths: &[PathBuf], options: &AnalyseOptions) -> Vec<Result<PhotoAnalysis>> {
-    let count = paths.len();
+    let debug = options.debug.as_ref().map(|d| debug_paths(d, paths));
     paths
         .par_iter()
-        .map(|path| {
+        .enumerate()
+        .map(|(i, path)| {
             let mut own = options.clone();
-            own.debug = options.debug.as_ref().map(|d| debug_path(d, path, count));
+            own.debug = debug.as_ref().map(|d| d[i].clone());
             analyse_photo(path, &own)
         })
         .collect()
+}
+
+/// The debug image of each of `photos`, all different: [`debug_path`], and where two photos
+/// share a file stem (`d1/p.jpg`, `d2/p.jpg`), their directories' names join the stem
+/// (`dbg-d1-p.png`, `dbg-d2-p.png`), then their position in the list.
+pub fn debug_paths(base: &Path, photos: &[PathBuf]) -> Vec<PathBuf> {
+    let count = photos.len();
+    let mut paths: Vec<PathBuf> = photos.iter().map(|p| debug_path(base, p, count)).collect();
+    let duplicated =
+        |paths: &[PathBuf], i: usize| paths.iter().filter(|p| **p == paths[i]).count() > 1;
+    let clashing: Vec<usize> = (0..count).filter(|&i| duplicated(&paths, i)).collect();
+    for &i in &clashing {
+        let parent = photos[i]
+            .parent()
+            .and_then(Path::file_name)
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let stem = photos[i]
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        paths[i] = debug_path(base, Path::new(&format!("{parent}-{stem}")), count);
+    }
+    let clashing: Vec<usize> = (0..count).filter(|&i| duplicated(&paths, i)).collect();
+    for &i in &clashing {
+        let stem = paths[i]
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let ext = paths[i]
+            .extension()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        paths[i] = paths[i].with_file_name(format!("{stem}-{}.{ext}", i + 1));
+    }
+    paths
 }
 
 /// The debug image of `photo` when `count` photos share the base name `base`:
@@ -236,4 +273,32 @@ pub fn features_csv(analyses: &[PhotoAnalysis]) -> Result<String> {
 /// Writes [`features_csv`] to `path` atomically.
 pub fn write_features_csv(path: &Path, analyses: &[PhotoAnalysis]) -> Result<()> {
     fsio::write_atomic(path, features_csv(analyses)?.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn debug_images_of_photos_with_one_name_do_not_overwrite_each_other() {
+        // Issue 15: `--debug dbg.png` with `d1/p.jpg` and `d2/p.jpg` wrote one `dbg-p.png`.
+        let photos: Vec<PathBuf> = ["d1/p.jpg", "d2/p.jpg", "d2/q.jpg", "x/d1/p.png", "d1/p.png"]
+            .iter()
+            .map(PathBuf::from)
+            .collect();
+        let paths = debug_paths(Path::new("out/dbg.png"), &photos);
+        let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+        assert_eq!(
+            names,
+            [
+                "out/dbg-d1-p-1.png",
+                "out/dbg-d2-p.png",
+                "out/dbg-q.png",
+                "out/dbg-d1-p-4.png",
+                "out/dbg-d1-p-5.png"
+            ]
+        );
+        let one = debug_paths(Path::new("dbg.png"), &photos[..1]);
+        assert_eq!(one, [PathBuf::from("dbg.png")]);
+    }
 }

@@ -14,6 +14,10 @@ use nalgebra::Matrix3;
 
 /// Longer side (px) of the pyramid level searched first.
 pub const DETECTION_SIZE: usize = 1000;
+/// Most pixels of the finest pyramid level searched: a full-resolution level of a large
+/// photo takes 24 bytes a pixel (3.6 GB at 150 Mpx) and a minute of search. At 8 Mpx a
+/// chart a tenth of the photo's width is still 300 px wide, 25 px a patch of the SG.
+const MAX_SEARCH_PIXELS: usize = 8_000_000;
 /// Fewest blobs a lattice needs before it is placed on a template.
 const MIN_LATTICE: usize = 6;
 
@@ -91,7 +95,8 @@ pub fn detect_at(
     if templates.is_empty() {
         return Err(Error::invalid("no chart template to look for"));
     }
-    let mut factor = Level::factor_for(photo.width, photo.height, size.max(1));
+    let finest = finest_factor(photo.width, photo.height);
+    let mut factor = Level::factor_for(photo.width, photo.height, size.max(1)).max(finest);
     let mut trace = SearchTrace::default();
     loop {
         let level = Level::new(photo, factor);
@@ -121,12 +126,19 @@ pub fn detect_at(
                 ));
             }
         }
-        // Small charts may need a finer level.
-        if factor <= 1 {
+        // Small charts may need a finer level, down to the finest one searched.
+        if factor <= finest {
             return Ok((None, trace));
         }
-        factor /= 2;
+        factor = (factor / 2).max(finest);
     }
+}
+
+/// The smallest reduction factor the search goes down to: the level that keeps at most
+/// [`MAX_SEARCH_PIXELS`] (full resolution for photos up to that size).
+fn finest_factor(width: usize, height: usize) -> usize {
+    let pixels = width as f64 * height as f64;
+    (pixels / MAX_SEARCH_PIXELS as f64).sqrt().ceil().max(1.0) as usize
 }
 
 /// The best placement on one level, and the level's blobs.
@@ -368,4 +380,25 @@ pub fn from_corners(
         homography: map.to_rows(),
         confidence,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_finest_level_searched_stays_small() {
+        // Issue 15: a 30000×30000 photo without a chart aborted in the full-resolution
+        // level; at 150 Mpx the search took 4.6 GB and a minute.
+        assert_eq!(finest_factor(4000, 2000), 1);
+        assert_eq!(finest_factor(15_000, 10_000), 5);
+        for (w, h) in [(15_000, 10_000), (30_000, 30_000), (12_345, 678)] {
+            let f = finest_factor(w, h);
+            assert!(
+                (w / f) * (h / f) <= MAX_SEARCH_PIXELS,
+                "{w}×{h}: factor {f}"
+            );
+            assert!(f == 1 || (w / (f - 1)) * (h / (f - 1)) > MAX_SEARCH_PIXELS);
+        }
+    }
 }

@@ -2,14 +2,18 @@
 //! compact buffer of encoded sRGB values (8 or 16 bits per channel, as the file had).
 
 use crate::error::{Error, Result};
-use image::{DynamicImage, ImageDecoder, ImageReader};
-use std::io::{BufRead, Cursor, Seek};
+use crate::limits;
+use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader};
+use std::io::Cursor;
 use std::path::Path;
 
 /// Smallest width and height of a photo that can show a chart.
 pub const MIN_PHOTO_SIDE: usize = 16;
-/// Largest memory the decoder may allocate (a 50-megapixel 16-bit RGBA photo needs 400 MB).
+/// Largest memory the decoder may allocate (a 50-megapixel 16-bit RGBA photo needs 400 MB),
+/// and the largest photo file read; a safety net below [`limits::IMAGE_PIXELS`].
 const MAX_DECODE_BYTES: u64 = 1 << 30;
+/// Bytes of a 16-bit RGB pixel, the widest a photo is kept in.
+const RGB16_BYTES: u64 = 6;
 
 /// The pixels of a photo, interleaved RGB, as the file stored them.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,6 +32,8 @@ pub struct Photo {
     pub width: usize,
     /// Height in pixels.
     pub height: usize,
+    /// What the decoder noticed but could decode past, e.g. a truncated file.
+    pub warnings: Vec<String>,
     pixels: Pixels,
 }
 
@@ -64,19 +70,24 @@ impl Photo {
             source: source.to_string(),
             width,
             height,
+            warnings: Vec::new(),
             pixels,
         })
     }
 
     /// A photo from a decoded image (any colour type; alpha is dropped, grey becomes RGB).
+    /// RGBA is turned into RGB in place, so that a large photo is not held twice.
     pub fn from_image(source: &str, image: DynamicImage) -> Result<Photo> {
         let (w, h) = (image.width() as usize, image.height() as usize);
         match image {
             DynamicImage::ImageRgb8(b) => Photo::from_rgb8(source, w, h, b.into_raw()),
             DynamicImage::ImageRgb16(b) => Photo::from_rgb16(source, w, h, b.into_raw()),
+            DynamicImage::ImageRgba8(b) => Photo::from_rgb8(source, w, h, drop_alpha(b.into_raw())),
+            DynamicImage::ImageRgba16(b) => {
+                Photo::from_rgb16(source, w, h, drop_alpha(b.into_raw()))
+            }
             DynamicImage::ImageLuma16(_)
             | DynamicImage::ImageLumaA16(_)
-            | DynamicImage::ImageRgba16(_)
             | DynamicImage::ImageRgb32F(_)
             | DynamicImage::ImageRgba32F(_) => {
                 Photo::from_rgb16(source, w, h, image.to_rgb16().into_raw())
@@ -155,44 +166,136 @@ impl Photo {
     }
 }
 
+/// Interleaved RGBA values as interleaved RGB, in the same buffer.
+fn drop_alpha<T: Copy>(mut rgba: Vec<T>) -> Vec<T> {
+    let pixels = rgba.len() / 4;
+    for i in 0..pixels {
+        for c in 0..3 {
+            rgba[3 * i + c] = rgba[4 * i + c];
+        }
+    }
+    rgba.truncate(3 * pixels);
+    rgba.shrink_to_fit();
+    rgba
+}
+
 /// Reads a photo file (JPEG, PNG 8/16-bit, TIFF; format from the content), applying its
 /// EXIF orientation.
 pub fn load_photo(path: &Path) -> Result<Photo> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    decode(std::io::BufReader::new(file), &path.display().to_string())
+    let size = std::fs::metadata(path)
+        .map_err(|e| Error::io(path, e))?
+        .len();
+    let source = path.display().to_string();
+    if size > MAX_DECODE_BYTES {
+        return Err(Error::Image {
+            context: source,
+            message: format!(
+                "the file is {size} bytes, more than any photo up to the pixel limit holds"
+            ),
+        });
+    }
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    decode_photo(&bytes, &source)
 }
 
-/// Decodes a photo held in memory; `source` names it in messages.
+/// Decodes a photo held in memory; `source` names it in messages. The pixel count is read
+/// from the header and checked against [`limits::IMAGE_PIXELS`] before any pixel is
+/// decoded; a JPEG that ends before its end-of-image marker decodes with a warning.
 pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
-    decode(Cursor::new(bytes), source)
-}
-
-fn decode<R: BufRead + Seek>(reader: R, source: &str) -> Result<Photo> {
     let image_error = |message: String| Error::Image {
         context: source.to_string(),
         message,
     };
-    let mut reader = ImageReader::new(reader)
+    let mut reader = ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| image_error(format!("cannot read: {e}")))?;
-    if reader.format().is_none() {
+    let Some(format) = reader.format() else {
         return Err(image_error(
             "not an image in a supported format (JPEG, PNG, TIFF)".into(),
         ));
-    }
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(MAX_DECODE_BYTES);
-    reader.limits(limits);
+    };
+    let max_pixels = limits::IMAGE_PIXELS.value();
+    let mut decode_limits = image::Limits::default();
+    decode_limits.max_alloc = Some(MAX_DECODE_BYTES);
+    reader.limits(decode_limits);
     let mut decoder = reader
         .into_decoder()
         .map_err(|e| image_error(format!("cannot decode: {e}")))?;
+    let (w, h) = decoder.dimensions();
+    let pixels = limits::product(&[w.into(), h.into()]);
+    // Pixels wider than 16-bit RGB (alpha, floats) count as as many 16-bit RGB pixels as
+    // their bytes fill, so that the limit bounds the decoded bytes too.
+    let weighted = decoder.total_bytes().div_ceil(RGB16_BYTES);
+    let context = if weighted > pixels {
+        format!(
+            "{source} ({w}×{h} px of {:?}, counted as 16-bit RGB pixels)",
+            decoder.color_type()
+        )
+    } else {
+        format!("{source} ({w}×{h} px)")
+    };
+    limits::IMAGE_PIXELS.check_against(pixels.max(weighted), max_pixels, &context)?;
     let orientation = decoder
         .orientation()
         .unwrap_or(image::metadata::Orientation::NoTransforms);
     let mut image = DynamicImage::from_decoder(decoder)
         .map_err(|e| image_error(format!("cannot decode (damaged or truncated?): {e}")))?;
     image.apply_orientation(orientation);
-    Photo::from_image(source, image)
+    let mut photo = Photo::from_image(source, image)?;
+    if format == ImageFormat::Jpeg && jpeg_is_truncated(bytes) {
+        photo.warnings.push(
+            "the JPEG file is truncated (it ends before its end-of-image marker); the \
+             missing part of the picture is filled in by the decoder"
+                .to_string(),
+        );
+    }
+    Ok(photo)
+}
+
+/// Whether a JPEG stream ends before its end-of-image marker (ITU-T T.81, B.1.1): walks
+/// the marker segments, skipping each segment by its length and the entropy-coded data
+/// after each start-of-scan, and reports whether the data ran out before EOI (`FF D9`).
+pub fn jpeg_is_truncated(bytes: &[u8]) -> bool {
+    if !bytes.starts_with(&[0xFF, 0xD8]) {
+        return false;
+    }
+    let mut i = 2;
+    loop {
+        // A marker: one or more 0xFF fill bytes, then its code.
+        while i < bytes.len() && bytes[i] == 0xFF {
+            i += 1;
+        }
+        let Some(&code) = bytes.get(i) else {
+            return true;
+        };
+        i += 1;
+        match code {
+            0xD9 => return false,
+            0x01 | 0xD0..=0xD7 => continue,
+            _ => {}
+        }
+        let Some(len) = bytes
+            .get(i..i + 2)
+            .map(|b| u16::from_be_bytes([b[0], b[1]]))
+        else {
+            return true;
+        };
+        i += len as usize;
+        if i > bytes.len() {
+            return true;
+        }
+        if code == 0xDA {
+            // Entropy-coded data: ends at the first 0xFF not followed by 0x00 (stuffing) or
+            // a restart marker.
+            loop {
+                match bytes.get(i..i + 2) {
+                    None => return true,
+                    Some([0xFF, next]) if *next != 0x00 && !(0xD0..=0xD7).contains(next) => break,
+                    _ => i += 1,
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -215,6 +318,123 @@ mod tests {
         let values = p.rgb16().unwrap();
         assert_eq!(&values[3 * (2 * 20 + 3)..][..3], &[3000, 6000, 65535]);
         assert!(p.rgb8().is_none());
+    }
+
+    fn jpeg_of(width: u32, height: u32) -> Vec<u8> {
+        let img = image::ImageBuffer::<image::Rgb<u8>, _>::from_fn(width, height, |x, y| {
+            image::Rgb([(x * 7) as u8, (y * 5) as u8, ((x + y) * 3) as u8])
+        });
+        let mut bytes = Vec::new();
+        DynamicImage::ImageRgb8(img)
+            .write_to(&mut Cursor::new(&mut bytes), ImageFormat::Jpeg)
+            .unwrap();
+        bytes
+    }
+
+    #[test]
+    fn truncated_jpegs_decode_with_a_warning() {
+        // Issue 15: JPEGs cut at 90 % and 99 % decoded without a word.
+        let bytes = jpeg_of(64, 48);
+        assert!(!jpeg_is_truncated(&bytes));
+        assert!(decode_photo(&bytes, "whole.jpg")
+            .unwrap()
+            .warnings
+            .is_empty());
+        for percent in [50, 90, 99] {
+            let cut = &bytes[..bytes.len() * percent / 100];
+            assert!(jpeg_is_truncated(cut), "{percent} %");
+            if let Ok(photo) = decode_photo(cut, "cut.jpg") {
+                assert!(
+                    photo.warnings.iter().any(|w| w.contains("truncated")),
+                    "{percent} %: {:?}",
+                    photo.warnings
+                );
+            }
+        }
+        // Data after the end-of-image marker (as some phones append) is not truncation.
+        let mut trailing = bytes.clone();
+        trailing.extend_from_slice(b"extra data");
+        assert!(!jpeg_is_truncated(&trailing));
+    }
+
+    /// A PNG declaring `width × height` RGB pixels whose image data is one empty zlib
+    /// stream: a few dozen bytes that ask for gigabytes.
+    fn png_bomb(width: u32, height: u32) -> Vec<u8> {
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        let mut chunk = |kind: &[u8], body: &[u8]| {
+            let mut typed = kind.to_vec();
+            typed.extend_from_slice(body);
+            png.extend_from_slice(&(body.len() as u32).to_be_bytes());
+            png.extend_from_slice(&typed);
+            png.extend_from_slice(&crc32(&typed).to_be_bytes());
+        };
+        let mut header = Vec::new();
+        header.extend_from_slice(&width.to_be_bytes());
+        header.extend_from_slice(&height.to_be_bytes());
+        header.extend_from_slice(&[8, 2, 0, 0, 0]);
+        chunk(b"IHDR", &header);
+        // zlib header, one final stored block of no bytes, Adler-32 of nothing (RFC 1950/1951).
+        chunk(
+            b"IDAT",
+            &[0x78, 0x01, 0x01, 0x00, 0x00, 0xFF, 0xFF, 0, 0, 0, 1],
+        );
+        chunk(b"IEND", &[]);
+        png
+    }
+
+    /// CRC-32 (ISO 3309, as PNG uses), bit by bit.
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut crc = 0xFFFF_FFFFu32;
+        for &b in bytes {
+            crc ^= b as u32;
+            for _ in 0..8 {
+                crc = if crc & 1 != 0 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    }
+
+    #[test]
+    fn decompression_bombs_are_refused_from_the_header() {
+        // Issue 15: a PNG declaring 20000×20000 took 12.5 GB; 30000×30000 aborted.
+        for (w, h) in [(20_000, 20_000), (30_000, 30_000), (200_000, 1000)] {
+            let e = decode_photo(&png_bomb(w, h), "bomb.png")
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("bomb.png") && e.contains("SPDCAM_MAX_IMAGE_PIXELS"),
+                "{w}×{h}: {e}"
+            );
+        }
+        // Under the limit, the same header reaches the decoder, which finds no image data.
+        let e = decode_photo(&png_bomb(100, 100), "small.png").unwrap_err();
+        assert!(!e.to_string().contains("SPDCAM_MAX_IMAGE_PIXELS"), "{e}");
+    }
+
+    #[test]
+    fn alpha_is_dropped_in_place_keeping_the_colours() {
+        let img = image::ImageBuffer::<image::Rgba<u16>, _>::from_fn(17, 16, |x, y| {
+            image::Rgba([x as u16 * 100, y as u16 * 200, 7, 123])
+        });
+        let mut bytes = Vec::new();
+        DynamicImage::ImageRgba16(img)
+            .write_to(&mut Cursor::new(&mut bytes), ImageFormat::Png)
+            .unwrap();
+        let p = decode_photo(&bytes, "alpha.png").unwrap();
+        assert_eq!(p.bit_depth(), 16);
+        let v = p.pixel(16, 15);
+        let expect = [1600.0, 3000.0, 7.0].map(|x: f32| x / 65535.0);
+        for c in 0..3 {
+            assert!((v[c] - expect[c]).abs() < 1e-7, "{v:?}");
+        }
+        assert_eq!(
+            drop_alpha(vec![1u8, 2, 3, 4, 5, 6, 7, 8]),
+            [1, 2, 3, 5, 6, 7]
+        );
     }
 
     #[test]

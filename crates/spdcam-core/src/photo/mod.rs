@@ -24,8 +24,8 @@ pub mod scene;
 mod segment;
 
 pub use batch::{
-    analyse, analyse_photo, analyse_photos, debug_path, features_csv, write_features_csv,
-    AnalyseOptions, PhotoAnalysis,
+    analyse, analyse_photo, analyse_photos, debug_path, debug_paths, features_csv,
+    write_features_csv, AnalyseOptions, PhotoAnalysis,
 };
 pub use detect::{detect, detect_at, detect_traced, from_corners, SearchTrace, DETECTION_SIZE};
 pub use geometry::{sort_corners, Homography};

@@ -8,6 +8,7 @@ use super::ChartTemplate;
 use crate::chart::Layout;
 use crate::colorimetry::{srgb_decode, srgb_encode};
 use crate::error::{Error, Result};
+use crate::limits;
 use crate::raster::RgbImage;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
@@ -79,6 +80,20 @@ pub struct ScenePhoto {
     pub vignetting_at_features: Vec<f64>,
 }
 
+/// Checks that a scene of `width × height` px is large enough to show a chart and within
+/// [`limits::RENDER_PIXELS`].
+pub fn check_scene_size(width: usize, height: usize) -> Result<()> {
+    if width < 64 || height < 64 {
+        return Err(Error::invalid(format!(
+            "a scene of {width}×{height} px is too small; give at least 64×64"
+        )));
+    }
+    limits::RENDER_PIXELS.check(
+        limits::product(&[width as u64, height as u64]),
+        &format!("a scene of {width}×{height} px"),
+    )
+}
+
 /// Places `chart` (encoded sRGB on 0…1, rendered with `layout`) into scene `seed`.
 pub fn photograph(
     chart: &RgbImage,
@@ -89,11 +104,7 @@ pub fn photograph(
     options: &SceneOptions,
 ) -> Result<ScenePhoto> {
     let (w, h) = (options.width, options.height);
-    if w < 64 || h < 64 {
-        return Err(Error::invalid(format!(
-            "a scene of {w}×{h} px is too small; give at least 64×64"
-        )));
-    }
+    check_scene_size(w, h)?;
     if !(options.width_share.0 > 0.0
         && options.width_share.0 <= options.width_share.1
         && options.width_share.1 < 1.0)

@@ -1,10 +1,15 @@
 //! Regular wavelength grids.
 
 use crate::error::{Error, Result};
+use crate::limits;
 use serde::{Deserialize, Serialize};
 
 /// A regular wavelength grid: `count` samples from `start_nm` in steps of `step_nm`.
+///
+/// A grid read from a file (a manifest, a model) is checked as one built with
+/// [`Grid::new`]: finite, a positive step, 1 to [`limits::GRID_BANDS`] samples.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "GridFields")]
 pub struct Grid {
     pub start_nm: f64,
     pub step_nm: f64,
@@ -34,6 +39,10 @@ impl Grid {
             )));
         }
         let steps = (end - start) / step;
+        limits::GRID_BANDS.check_f64(
+            steps.round() + 1.0,
+            &format!("wavelength range {start}-{end} nm at {step} nm"),
+        )?;
         if (steps - steps.round()).abs() > 1e-6 {
             return Err(Error::invalid(format!(
                 "wavelength range {start}-{end} nm is not a whole number of {step} nm steps"
@@ -43,6 +52,22 @@ impl Grid {
             start_nm: start,
             step_nm: step,
             count: steps.round() as usize + 1,
+        })
+    }
+
+    /// A grid of `count` samples from `start_nm` in steps of `step_nm`, checked.
+    pub fn from_parts(start_nm: f64, step_nm: f64, count: usize) -> Result<Grid> {
+        let what = format!("wavelength grid of {count} samples from {start_nm} nm at {step_nm} nm");
+        if !(start_nm.is_finite() && step_nm.is_finite()) || step_nm <= 0.0 || count == 0 {
+            return Err(Error::invalid(format!(
+                "{what} is not a valid grid (need a finite start, a step > 0 and a sample)"
+            )));
+        }
+        limits::GRID_BANDS.check(count as u64, &what)?;
+        Ok(Grid {
+            start_nm,
+            step_nm,
+            count,
         })
     }
 
@@ -98,6 +123,22 @@ impl Grid {
     }
 }
 
+/// The fields of a [`Grid`] as a file stores them, checked by [`Grid::from_parts`].
+#[derive(Deserialize)]
+struct GridFields {
+    start_nm: f64,
+    step_nm: f64,
+    count: usize,
+}
+
+impl TryFrom<GridFields> for Grid {
+    type Error = Error;
+
+    fn try_from(f: GridFields) -> Result<Grid> {
+        Grid::from_parts(f.start_nm, f.step_nm, f.count)
+    }
+}
+
 impl std::fmt::Display for Grid {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
@@ -131,6 +172,31 @@ mod tests {
         assert!(Grid::parse("700-400").is_err());
         assert!(Grid::parse("400-703:5").is_err());
         assert!(Grid::parse("abc").is_err());
+    }
+
+    #[test]
+    fn grids_past_the_band_limit_are_refused() {
+        // Issue 15: `--range 400-700:0.0000001` and `--spd-grid 380-780:0.00001` ran for
+        // minutes and took gigabytes.
+        for text in ["400-700:0.0000001", "380-780:0.00001", "0-1e300:1"] {
+            let e = Grid::parse(text).unwrap_err().to_string();
+            assert!(e.contains("SPDCAM_MAX_GRID_BANDS"), "{text}: {e}");
+        }
+        assert_eq!(Grid::parse("380-780:0.1").unwrap().count, 4001);
+    }
+
+    #[test]
+    fn grids_read_from_files_are_checked() {
+        let ok: Grid = serde_json::from_str(r#"{"start_nm":400,"step_nm":5,"count":61}"#).unwrap();
+        assert_eq!(ok, Grid::ESTIMATION);
+        for bad in [
+            r#"{"start_nm":400,"step_nm":5,"count":1000000000000}"#,
+            r#"{"start_nm":400,"step_nm":0,"count":61}"#,
+            r#"{"start_nm":400,"step_nm":-5,"count":61}"#,
+            r#"{"start_nm":400,"step_nm":5,"count":0}"#,
+        ] {
+            assert!(serde_json::from_str::<Grid>(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -89,6 +89,14 @@ impl SpectralSet {
         extrapolation: Extrapolation,
     ) -> Result<(SpectralSet, ResampleReport)> {
         let x = self.wavelengths();
+        if x.len() < 2 {
+            return Err(Error::invalid(format!(
+                "cannot resample spectra given at {} wavelength only ({} nm): interpolation \
+                 needs at least two",
+                x.len(),
+                x[0]
+            )));
+        }
         let regular = self.grid();
         let method = match interpolation {
             Interpolation::Auto if regular.is_some() && x.len() >= 6 => Interpolation::Sprague1880,
@@ -241,6 +249,19 @@ mod tests {
             .resample(&grid, Interpolation::Auto, Extrapolation::Zero)
             .unwrap();
         assert_eq!(rep.method, Interpolation::Linear);
+    }
+
+    #[test]
+    fn a_single_wavelength_is_an_error_not_a_panic() {
+        // Issue 15: one wavelength row underflowed `len - 2` in `interval`.
+        let set = SpectralSet::new(vec![550.0], vec!["one".into()], vec![vec![1.0]]).unwrap();
+        for method in [Interpolation::Auto, Interpolation::Linear] {
+            let e = set
+                .resample(&Grid::SIMULATION, method, Extrapolation::Zero)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("550 nm") && e.contains("at least two"), "{e}");
+        }
     }
 
     #[test]

@@ -3,6 +3,7 @@
 use crate::error::{Error, Result};
 use crate::fsio;
 use crate::spectral::Grid;
+use std::collections::HashSet;
 use std::path::Path;
 
 /// A set of named spectra (SPDs, reflectances or sensitivities) sampled at common wavelengths.
@@ -60,10 +61,9 @@ impl SpectralSet {
                 )));
             }
         }
-        for (i, n) in names.iter().enumerate() {
-            if names[..i].contains(n) {
-                return Err(Error::invalid(format!("spectrum name '{n}' appears twice")));
-            }
+        let mut seen = HashSet::with_capacity(names.len());
+        if let Some(n) = names.iter().find(|n| !seen.insert(n.as_str())) {
+            return Err(Error::invalid(format!("spectrum name '{n}' appears twice")));
         }
         Ok(SpectralSet {
             wavelengths,
@@ -400,6 +400,17 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("'z'"));
+    }
+
+    #[test]
+    fn duplicate_names_are_found_among_many() {
+        let names = |n: usize| (0..n).map(|i| format!("s{i}")).collect::<Vec<String>>();
+        let values = |n: usize| vec![vec![1.0]; n];
+        assert!(SpectralSet::new(vec![500.0], names(50_000), values(50_000)).is_ok());
+        let mut twice = names(50_000);
+        twice[49_999] = "s17".into();
+        let e = SpectralSet::new(vec![500.0], twice, values(50_000)).unwrap_err();
+        assert!(e.to_string().contains("'s17' appears twice"), "{e}");
     }
 
     #[test]

@@ -1,0 +1,183 @@
+//! Resource limits on what a file or an option may ask for, in one place.
+//!
+//! Every size a user can type or a file can declare (image pixels, rendered pixels,
+//! wavelength bands, sample counts, chunk sizes, filter widths) is checked against one of
+//! these limits before anything is allocated, so that no input makes spdcam allocate more
+//! than about 1 GiB or run for hours by mistake. Each limit can be raised for one run with
+//! its environment variable; the error says which one and to what value.
+
+use crate::error::{Error, Result};
+
+/// A ceiling on one kind of size, raisable with an environment variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limit {
+    /// What is limited, for messages (e.g. "image pixels").
+    pub what: &'static str,
+    /// The environment variable that raises (or lowers) the limit.
+    pub env: &'static str,
+    /// The limit when the environment variable is not set.
+    pub default: u64,
+}
+
+/// Pixels of a photo, read from the file's header before it is decoded (pixels wider than
+/// 16-bit RGB count as several). 120 Mpx covers medium-format cameras (102 Mpx); a 16-bit
+/// photo of that size takes 720 MB decoded, an 8-bit one 360 MB.
+pub const IMAGE_PIXELS: Limit = Limit {
+    what: "image pixels",
+    env: "SPDCAM_MAX_IMAGE_PIXELS",
+    default: 120_000_000,
+};
+
+/// Pixels of a rendered chart or scene (`render --patch-px/--size/--scene`, `generate`):
+/// the full camera pipeline holds about 40 bytes per pixel.
+pub const RENDER_PIXELS: Limit = Limit {
+    what: "rendered pixels",
+    env: "SPDCAM_MAX_RENDER_PIXELS",
+    default: 25_000_000,
+};
+
+/// Bands of a wavelength grid (`--range`, `--spd-grid`): 4001 is 380–780 nm at 0.1 nm.
+pub const GRID_BANDS: Limit = Limit {
+    what: "wavelength bands",
+    env: "SPDCAM_MAX_GRID_BANDS",
+    default: 4001,
+};
+
+/// Samples of one `generate` run (all shards together).
+pub const SAMPLES: Limit = Limit {
+    what: "samples of one run",
+    env: "SPDCAM_MAX_SAMPLES",
+    default: 1_000_000_000,
+};
+
+/// Bytes of the values of one sample file held in memory while it is written.
+pub const CHUNK_BYTES: Limit = Limit {
+    what: "bytes of one sample file",
+    env: "SPDCAM_MAX_CHUNK_BYTES",
+    default: 256 << 20,
+};
+
+/// Width in pixels of a smoothing filter (`grey-edge:p:sigma`): the Gaussian spans
+/// ±3σ, so its cost per pixel grows with σ.
+pub const FILTER_SIGMA_PX: Limit = Limit {
+    what: "filter sigma in pixels",
+    env: "SPDCAM_MAX_FILTER_SIGMA",
+    default: 100,
+};
+
+impl Limit {
+    /// The limit in force: the environment variable's value when it is set to a whole
+    /// number, else [`Limit::default`].
+    pub fn value(&self) -> u64 {
+        std::env::var(self.env)
+            .ok()
+            .and_then(|v| v.trim().replace('_', "").parse::<u64>().ok())
+            .unwrap_or(self.default)
+    }
+
+    /// Checks that `requested` stays within the limit; the error names `context`, the
+    /// request, the limit and the environment variable that raises it.
+    pub fn check(&self, requested: u64, context: &str) -> Result<()> {
+        self.check_against(requested, self.value(), context)
+    }
+
+    /// As [`Limit::check`] for a real-valued request (rounded up).
+    pub fn check_f64(&self, requested: f64, context: &str) -> Result<()> {
+        let limit = self.value();
+        if requested.is_nan() || requested > limit as f64 {
+            let text = if requested.fract() == 0.0 && requested < u64::MAX as f64 {
+                group_digits(requested as u64)
+            } else {
+                format!("{requested}")
+            };
+            return Err(self.error(&text, limit, requested.ceil(), context));
+        }
+        Ok(())
+    }
+
+    /// [`Limit::check`] against an explicit `limit`.
+    pub fn check_against(&self, requested: u64, limit: u64, context: &str) -> Result<()> {
+        if requested > limit {
+            return Err(self.error(&group_digits(requested), limit, requested as f64, context));
+        }
+        Ok(())
+    }
+
+    fn error(&self, requested: &str, limit: u64, raise_to: f64, context: &str) -> Error {
+        let raise = if raise_to.is_finite() && raise_to < u64::MAX as f64 {
+            format!("{}={}", self.env, raise_to as u64)
+        } else {
+            format!("{}=N", self.env)
+        };
+        Error::invalid(format!(
+            "{context}: {requested} {} exceed the limit of {} (set {raise} to allow it, if the \
+             machine has the memory and time)",
+            self.what,
+            group_digits(limit)
+        ))
+    }
+}
+
+/// `1234567` as `1,234,567`.
+fn group_digits(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// `a × b` (and more factors) without overflow: `u64::MAX` when the product overflows, which
+/// every limit refuses.
+pub fn product(factors: &[u64]) -> u64 {
+    factors
+        .iter()
+        .try_fold(1u64, |acc, &f| acc.checked_mul(f))
+        .unwrap_or(u64::MAX)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn error_names_the_limit_and_how_to_raise_it() {
+        let e = IMAGE_PIXELS
+            .check_against(400_000_000, 120_000_000, "bomb.png (20000×20000)")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bomb.png"), "{e}");
+        assert!(e.contains("400,000,000 image pixels"), "{e}");
+        assert!(e.contains("120,000,000"), "{e}");
+        assert!(e.contains("SPDCAM_MAX_IMAGE_PIXELS=400000000"), "{e}");
+        assert!(IMAGE_PIXELS
+            .check_against(120_000_000, 120_000_000, "ok")
+            .is_ok());
+    }
+
+    #[test]
+    fn real_valued_requests_and_overflowing_products_are_refused() {
+        assert!(FILTER_SIGMA_PX.check_f64(1e9, "grey-edge").is_err());
+        assert!(FILTER_SIGMA_PX.check_f64(f64::NAN, "grey-edge").is_err());
+        assert!(FILTER_SIGMA_PX.check_f64(2.0, "grey-edge").is_ok());
+        assert_eq!(product(&[200_000, 200_000]), 40_000_000_000);
+        assert_eq!(product(&[u64::MAX, 2]), u64::MAX);
+        assert!(RENDER_PIXELS
+            .check(product(&[u64::MAX, 2]), "render")
+            .unwrap_err()
+            .to_string()
+            .contains("SPDCAM_MAX_RENDER_PIXELS=N"));
+    }
+
+    #[test]
+    fn digits_are_grouped() {
+        assert_eq!(group_digits(0), "0");
+        assert_eq!(group_digits(999), "999");
+        assert_eq!(group_digits(1000), "1,000");
+        assert_eq!(group_digits(1_234_567), "1,234,567");
+    }
+}

@@ -1,0 +1,37 @@
+//! Uniform chromaticity scales of light colours: CIE 1960 UCS (u, v) and CIE 1976 UCS (u′, v′).
+
+/// CIE 1960 UCS (u, v) of tristimulus values: u = 4X/(X+15Y+3Z), v = 6Y/(X+15Y+3Z)
+/// (CIE 015:2018 §8.1; the space of CCT, Duv and the CIE 13.3 adaptation). Black gives NaN.
+pub fn xyz_to_uv1960(xyz: [f64; 3]) -> [f64; 2] {
+    let d = xyz[0] + 15.0 * xyz[1] + 3.0 * xyz[2];
+    [4.0 * xyz[0] / d, 6.0 * xyz[1] / d]
+}
+
+/// CIE 1976 UCS (u′, v′) of tristimulus values: u′ = 4X/(X+15Y+3Z), v′ = 9Y/(X+15Y+3Z)
+/// (CIE 015:2018 §8.1), i.e. u′ = u and v′ = 1.5 v. Black gives NaN.
+pub fn xyz_to_uv1976(xyz: [f64; 3]) -> [f64; 2] {
+    let d = xyz[0] + 15.0 * xyz[1] + 3.0 * xyz[2];
+    [4.0 * xyz[0] / d, 9.0 * xyz[1] / d]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::colorimetry::{xy_to_uv1960, xy_to_xyz};
+
+    #[test]
+    fn equal_energy_white_and_agreement_with_xy_route() {
+        // Illuminant E: u = 4/19, v = 6/19, v′ = 9/19 (CIE 015:2018).
+        let e = xyz_to_uv1960([1.0, 1.0, 1.0]);
+        assert!((e[0] - 4.0 / 19.0).abs() < 1e-15 && (e[1] - 6.0 / 19.0).abs() < 1e-15);
+        let e76 = xyz_to_uv1976([1.0, 1.0, 1.0]);
+        assert!((e76[0] - 4.0 / 19.0).abs() < 1e-15 && (e76[1] - 9.0 / 19.0).abs() < 1e-15);
+        // D65 (x, y) = (0.31271, 0.32902): u′ = 0.19783, v′ = 0.46833 (CIE 015:2018 Table 11).
+        let xyz = xy_to_xyz([0.31271, 0.32902], 1.0);
+        let d65 = xyz_to_uv1976(xyz);
+        assert!((d65[0] - 0.19783).abs() < 1e-5 && (d65[1] - 0.46833).abs() < 1e-5);
+        let via_xy = xy_to_uv1960([0.31271, 0.32902]);
+        let direct = xyz_to_uv1960(xyz);
+        assert!((via_xy[0] - direct[0]).abs() < 1e-15 && (via_xy[1] - direct[1]).abs() < 1e-15);
+    }
+}
