@@ -174,6 +174,9 @@ class Estimate:
     duv: Optional[float]
     #: Where the chart was and what it gave (estimates from photos).
     detection: Optional[Detection] = None
+    #: The lighting-quality metrics of the SPD as the library computes them (CRI, TM-30,
+    #: α-opic, …; ``spdcam estimate --json``'s ``metrics``); empty where not computed.
+    metrics: dict[str, Any] = field(default_factory=dict)
     #: An uncertainty band of the SPD (lower, upper) when the model gives one; the shipped
     #: models give none.
     band: Optional[tuple[np.ndarray, np.ndarray]] = None
@@ -193,6 +196,7 @@ class Estimate:
             cct=c["cct"],
             duv=c["duv"],
             detection=Detection._from_json(v["photo"]) if v.get("photo") else None,
+            metrics=dict(v.get("metrics") or {}),
             json=v,
         )
 
