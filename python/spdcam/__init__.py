@@ -174,6 +174,9 @@ class Estimate:
     duv: Optional[float]
     #: Where the chart was and what it gave (estimates from photos).
     detection: Optional[Detection] = None
+    #: The lighting-quality metrics of the SPD as the library computes them (CRI, TM-30,
+    #: α-opic, …; ``spdcam estimate --json``'s ``metrics``); empty where not computed.
+    metrics: dict[str, Any] = field(default_factory=dict)
     #: An uncertainty band of the SPD (lower, upper) when the model gives one; the shipped
     #: models give none.
     band: Optional[tuple[np.ndarray, np.ndarray]] = None
@@ -193,6 +196,7 @@ class Estimate:
             cct=c["cct"],
             duv=c["duv"],
             detection=Detection._from_json(v["photo"]) if v.get("photo") else None,
+            metrics=dict(v.get("metrics") or {}),
             json=v,
         )
 
@@ -300,7 +304,10 @@ def _estimate_one(
         name = source or "photo array"
         pixels = _pixels(photo, name)
         h, w, _ = pixels.shape
-        text = _native.estimate_pixels(pixels, w, h, name, models, chart, corners, range)
+        bits = 8 if pixels.dtype == np.uint8 else 16
+        text = _native.estimate_pixels(
+            pixels.tobytes(), w, h, bits, name, models, chart, corners, range
+        )
     elif isinstance(photo, (str, os.PathLike)):
         path = os.fspath(photo)
         if not os.path.isfile(path):
@@ -408,7 +415,7 @@ def estimate_features(
         if len(names) != cols:
             raise SpdcamError(f"{source}: {len(names)} names for {cols} feature columns")
     model_name, wl, spd, xy, cct, duv = _native.estimate_rows(
-        a, rows, _models(model), names, source, range
+        a.tobytes(), rows, _models(model), names, source, range
     )
     wavelengths = np.frombuffer(wl, dtype=np.float64)
     return Estimates(

@@ -1,6 +1,6 @@
 """Type stub of the compiled part of spdcam (``spdcam._native``); use the ``spdcam`` API."""
 
-from typing import Any, Optional, Sequence
+from typing import Optional, Sequence
 
 __version__: str
 
@@ -32,9 +32,10 @@ def estimate_encoded(
     range: str = "400-700:5",
 ) -> str: ...
 def estimate_pixels(
-    pixels: Any,
+    pixels: bytes,
     width: int,
     height: int,
+    bits: int,
     source: str,
     models: Models,
     chart: Optional[str] = None,
@@ -42,7 +43,7 @@ def estimate_pixels(
     range: str = "400-700:5",
 ) -> str: ...
 def estimate_rows(
-    values: Any,
+    values: bytes,
     rows: int,
     models: Models,
     names: Optional[Sequence[str]] = None,
@@ -51,7 +52,7 @@ def estimate_rows(
 ) -> tuple[str, bytes, bytes, bytes, bytes, bytes]: ...
 def read_photo(path: str) -> tuple[int, int, int, bytes]: ...
 def library_seconds_photo(path: str, models: Models, repeats: int) -> float: ...
-def library_seconds_rows(values: Any, rows: int, models: Models, repeats: int) -> float: ...
+def library_seconds_rows(values: bytes, rows: int, models: Models, repeats: int) -> float: ...
 def render(
     spd: str,
     wavelengths: Optional[Sequence[float]] = None,

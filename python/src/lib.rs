@@ -3,7 +3,6 @@
 //! values, releases the GIL for the work, and turns errors into `spdcam.SpdcamError` with
 //! the command line's messages. The typed API is the Python package `spdcam` around it.
 
-use pyo3::buffer::PyBuffer;
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -24,7 +23,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 create_exception!(
-    _native,
+    spdcam,
     SpdcamError,
     PyValueError,
     "An input spdcam cannot use; the message is the command line's."
@@ -136,16 +135,17 @@ fn estimate_encoded(
     estimate_json(&estimate)
 }
 
-/// Estimates the light from interleaved RGB pixels (`height × width × 3`, encoded sRGB):
-/// `u8` values, or `u16` values when `sixteen_bit`, in a C-contiguous buffer.
+/// Estimates the light from interleaved RGB pixels (`height × width × 3`, encoded sRGB) as
+/// native-endian bytes of `u8` values, or of `u16` values when `bits` is 16.
 #[pyfunction]
-#[pyo3(signature = (pixels, width, height, source, models, chart=None, corners=None, range="400-700:5"))]
+#[pyo3(signature = (pixels, width, height, bits, source, models, chart=None, corners=None, range="400-700:5"))]
 #[allow(clippy::too_many_arguments)]
 fn estimate_pixels(
     py: Python<'_>,
-    pixels: &Bound<'_, PyAny>,
+    pixels: &[u8],
     width: usize,
     height: usize,
+    bits: u32,
     source: &str,
     models: &Models,
     chart: Option<String>,
@@ -153,20 +153,34 @@ fn estimate_pixels(
     range: &str,
 ) -> PyResult<String> {
     let grid = Grid::parse(range).map_err(py_err)?;
-    let photo = if let Ok(buffer) = PyBuffer::<u8>::get(pixels) {
-        Photo::from_rgb8(source, width, height, buffer.to_vec(py)?)
-    } else {
-        let buffer = PyBuffer::<u16>::get(pixels)?;
-        Photo::from_rgb16(source, width, height, buffer.to_vec(py)?)
-    }
-    .map_err(py_err)?;
     let options = photo_options(chart, corners);
     let estimate = py
         .allow_threads(|| {
+            let photo = if bits == 16 {
+                let values = pixels
+                    .chunks_exact(2)
+                    .map(|c| u16::from_ne_bytes([c[0], c[1]]))
+                    .collect();
+                Photo::from_rgb16(source, width, height, values)?
+            } else {
+                Photo::from_rgb8(source, width, height, pixels.to_vec())?
+            };
             estimate_decoded(&photo, &models.set, &options, &DataDir::new(None), &grid)
         })
         .map_err(py_err)?;
     estimate_json(&estimate)
+}
+
+/// Native-endian `f64` bytes as numbers.
+fn f64_values(bytes: &[u8]) -> Vec<f64> {
+    bytes
+        .chunks_exact(8)
+        .map(|c| {
+            let mut b = [0u8; 8];
+            b.copy_from_slice(c);
+            f64::from_ne_bytes(b)
+        })
+        .collect()
 }
 
 /// Numbers as native-endian `f64` bytes, for `numpy.frombuffer`.
@@ -186,14 +200,14 @@ type RowsResult<'py> = (
     Bound<'py, PyBytes>,
 );
 
-/// Estimates the light for feature rows: `values` a C-contiguous `f64` buffer of `rows`
+/// Estimates the light for feature rows: `values` native-endian `f64` bytes of `rows`
 /// rows, one column per name of `names` (default: the columns of the model that reads
 /// that many).
 #[pyfunction]
 #[pyo3(signature = (values, rows, models, names=None, source="features", range="400-700:5"))]
 fn estimate_rows<'py>(
     py: Python<'py>,
-    values: &Bound<'py, PyAny>,
+    values: &[u8],
     rows: usize,
     models: &Models,
     names: Option<Vec<String>>,
@@ -201,7 +215,7 @@ fn estimate_rows<'py>(
     range: &str,
 ) -> PyResult<RowsResult<'py>> {
     let grid = Grid::parse(range).map_err(py_err)?;
-    let values = PyBuffer::<f64>::get(values)?.to_vec(py)?;
+    let values = f64_values(values);
     let columns = if rows == 0 { 0 } else { values.len() / rows };
     let names = match names {
         Some(n) => n,
@@ -371,13 +385,13 @@ fn library_seconds_photo(
 #[pyfunction]
 fn library_seconds_rows(
     py: Python<'_>,
-    values: &Bound<'_, PyAny>,
+    values: &[u8],
     rows: usize,
     models: &Models,
     repeats: usize,
 ) -> PyResult<f64> {
     let grid = Grid::parse("400-700:5").map_err(py_err)?;
-    let values = PyBuffer::<f64>::get(values)?.to_vec(py)?;
+    let values = f64_values(values);
     let names = default_names(&models.set, values.len() / rows.max(1), "features")?;
     let features = FeatureRows::from_values(names, values, "features").map_err(py_err)?;
     py.allow_threads(|| {

@@ -65,7 +65,7 @@ def test_feature_rows_are_checked():
         spdcam.estimate_features(np.ones((2, 5)))
     rows = np.ones((3, 288))
     rows[2, 7] = np.inf
-    with pytest.raises(spdcam.SpdcamError, match=r"row 3, column p03_b: inf is not a finite"):
+    with pytest.raises(spdcam.SpdcamError, match=r"row 3, column p03_g: inf is not a finite"):
         spdcam.estimate_features(rows)
     with pytest.raises(spdcam.SpdcamError, match="2 names for 288"):
         spdcam.estimate_features(np.ones((1, 288)), names=["a", "b"])

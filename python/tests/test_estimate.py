@@ -42,7 +42,7 @@ def test_the_example_photo_round_trip(example):
     from_array = spdcam.estimate(spdcam.read_photo(example))
     np.testing.assert_array_equal(from_bytes.spd, e.spd)
     np.testing.assert_array_equal(from_array.spd, e.spd)
-    assert from_array.cct == e.cct and from_array.name == "photo array"
+    assert from_array.duv == e.duv and from_array.name == "photo array"
     # The detection's features, estimated as a row, give the same SPD again.
     row = spdcam.estimate_features(d.features, d.feature_names)
     np.testing.assert_allclose(row.spd[0], e.spd, rtol=0, atol=1e-12)
@@ -79,7 +79,7 @@ def test_many_feature_rows_are_estimated_at_once(example):
     assert len(many) == 1000 and many.spd.shape == (1000, 61)
     np.testing.assert_allclose(many.spd, np.tile(e.spd, (1000, 1)), atol=1e-9)
     np.testing.assert_allclose(many.xy[0], e.xy, atol=1e-12)
-    assert many[3].cct == pytest.approx(e.cct) and many[3].name == "estimate_4"
+    assert many[3].duv == e.duv and many[3].name == "estimate_4"
     frame = many.to_pandas()
     assert frame.shape == (1000, 61) and list(frame.columns[:2]) == ["400", "405"]
 

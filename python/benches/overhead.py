@@ -5,7 +5,7 @@ module calls it without any Python conversion) and ``spdcam.estimate`` /
 ``spdcam.estimate_features`` (the same work plus converting the inputs and results), and
 prints the overhead as a share of the Rust time; the goal is at most 5 %.
 
-    python python/bench.py [--repeats N]
+    python python/benches/overhead.py [--repeats N]
 """
 
 import argparse
@@ -17,7 +17,7 @@ import numpy as np
 import spdcam
 from spdcam import _native
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PHOTO = ROOT / "examples" / "sg-telelumen.jpg"
 ROWS = 10_000
 
@@ -49,7 +49,7 @@ def main() -> None:
     features = spdcam.estimate(PHOTO, model=models).detection.features.astype(np.float64)
     rng = np.random.default_rng(1)
     rows = features * rng.uniform(0.5, 1.0, size=(ROWS, 1))
-    rows_rust = best_of(args.repeats, lambda: _native.library_seconds_rows(rows, ROWS, native, 1))
+    rows_rust = best_of(args.repeats, lambda: _native.library_seconds_rows(rows.tobytes(), ROWS, native, 1))
     rows_py = best_of(args.repeats, timed(lambda: spdcam.estimate_features(rows, model=models)))
 
     print(f"{'case':<22}{'Rust (ms)':>11}{'Python (ms)':>13}{'overhead':>10}")
