@@ -242,15 +242,11 @@ fn locus_json() -> Result<serde_json::Value> {
     let observer = Observer::cie1931(&grid)?;
     let wavelengths = grid.wavelengths();
     let mut spectral = Vec::with_capacity(wavelengths.len());
-    for i in 0..wavelengths.len() {
+    for (i, w) in wavelengths.iter().enumerate() {
         let xyz = [observer.cmf(0)[i], observer.cmf(1)[i], observer.cmf(2)[i]];
         let sum: f64 = xyz.iter().sum();
         if sum > 0.0 {
-            spectral.push(serde_json::json!([
-                wavelengths[i],
-                xyz[0] / sum,
-                xyz[1] / sum
-            ]));
+            spectral.push(serde_json::json!([w, xyz[0] / sum, xyz[1] / sum]));
         }
     }
     let mut planckian = Vec::new();
