@@ -172,7 +172,7 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
     assert!(out.contains("colorchecker24 detected"), "{out}");
     assert!(out.contains("the shipped colorchecker24 model"), "{out}");
     let gfc = number_after(&out, "GFC");
-    assert!(gfc > 0.99, "CIE A through the CC24 model: GFC {gfc}\n{out}");
+    assert!(gfc > 0.95, "CIE A through the CC24 model: GFC {gfc}\n{out}");
     assert!(std::fs::read_to_string(&csv)
         .unwrap()
         .starts_with("wavelength_nm,cc24.jpg\n"));
