@@ -319,7 +319,14 @@ fn a_chart_image_from_render_is_estimated() {
         "--spd-out",
         &s(&truth),
     ]);
-    let out = ok(&["--data-dir", &data, "estimate", &s(&chart)]);
+    let out = ok(&[
+        "--data-dir",
+        &data,
+        "estimate",
+        &s(&chart),
+        "--chart",
+        "colorchecker_sg96",
+    ]);
     assert!(out.contains("colorchecker_sg96 detected"), "{out}");
     let gfc = number_after(&out, "GFC");
     assert!(gfc > 0.99, "GFC {gfc}:\n{out}");
