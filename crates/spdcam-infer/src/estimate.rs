@@ -378,7 +378,6 @@ pub fn chart_templates(
         None => models
             .models()
             .iter()
-            .filter(|m| m.model.photo_chart().is_some())
             .filter_map(|m| m.model.header().chart.clone())
             .collect(),
     };
