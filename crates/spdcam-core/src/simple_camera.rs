@@ -196,9 +196,7 @@ impl SimpleCamera {
         Ok(linear
             .iter()
             .flat_map(|v| {
-                (0..3).map(move |c| {
-                    (255.0 * srgb_encode((v[c] * scale).clamp(0.0, 1.0))).round()
-                })
+                (0..3).map(move |c| (255.0 * srgb_encode((v[c] * scale).clamp(0.0, 1.0))).round())
             })
             .collect())
     }

@@ -123,7 +123,10 @@ pub fn run(args: CoverageArgs, data_dir: &DataDir) -> Result<()> {
     for (label, best) in &columns {
         md += &format!("| {label} |");
         for &kind in &kinds {
-            md += &format!(" {} |", cell(members(kind).iter().map(|&i| best[i]).collect()));
+            md += &format!(
+                " {} |",
+                cell(members(kind).iter().map(|&i| best[i]).collect())
+            );
         }
         md.push('\n');
     }

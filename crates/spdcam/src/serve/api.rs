@@ -240,17 +240,12 @@ fn label(filename: Option<&str>) -> String {
 fn locus_json() -> Result<serde_json::Value> {
     let grid = Grid::parse("380-780:5")?;
     let observer = Observer::cie1931(&grid)?;
-    let wavelengths = grid.wavelengths();
-    let mut spectral = Vec::with_capacity(wavelengths.len());
-    for i in 0..wavelengths.len() {
-        let xyz = [observer.cmf(0)[i], observer.cmf(1)[i], observer.cmf(2)[i]];
-        let sum: f64 = xyz.iter().sum();
+    let (xbar, ybar, zbar) = (observer.cmf(0), observer.cmf(1), observer.cmf(2));
+    let mut spectral = Vec::new();
+    for (i, nm) in grid.wavelengths().into_iter().enumerate() {
+        let sum = xbar[i] + ybar[i] + zbar[i];
         if sum > 0.0 {
-            spectral.push(serde_json::json!([
-                wavelengths[i],
-                xyz[0] / sum,
-                xyz[1] / sum
-            ]));
+            spectral.push(serde_json::json!([nm, xbar[i] / sum, ybar[i] / sum]));
         }
     }
     let mut planckian = Vec::new();
