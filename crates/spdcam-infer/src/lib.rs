@@ -35,6 +35,7 @@ pub mod plot;
 pub mod record;
 pub mod scale;
 pub mod shipped;
+pub mod stream;
 pub mod target;
 
 pub use error::{InferError, Result};

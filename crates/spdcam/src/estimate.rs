@@ -15,8 +15,14 @@ use spdcam_core::photo::{self, PhotoAnalysis};
 use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_infer::estimate::{analyse_photos, chart_templates, estimate_analysis};
+use spdcam_infer::estimate::{Colorimetry, Score};
 use spdcam_infer::plot::spds_svg;
-use spdcam_infer::{estimate_features, Estimate, FeatureRows, Model, ModelSet};
+use spdcam_infer::stream::{
+    estimate_block, long_header, long_rows, row_name, FeatureStream, GridMap, Layout,
+    WIDE_LAYOUT_MAX_ROWS,
+};
+use spdcam_infer::{Estimate, Model, ModelSet};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Truth files found beside a photo: `<photo stem>` + this.
@@ -37,10 +43,16 @@ pub struct EstimateArgs {
     /// p01_g, …), one row per estimate; values on any scale (0–255 or 0–1).
     #[arg(long, value_name = "FILE.csv", conflicts_with = "photos")]
     features: Option<PathBuf>,
-    /// Spectral CSV to write: wavelength_nm, then one column per photo (or feature row);
-    /// `-` writes it to standard output (and nothing else goes there).
+    /// CSV of the SPDs to write, laid out as --layout says; `-` writes it to standard output
+    /// (and nothing else goes there).
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Layout of the --output CSV: `wide` (spectral CSV: wavelength_nm, then one column per
+    /// estimate) or `long` (one row per estimate: name, then one column per wavelength,
+    /// written as the rows are estimated, in bounded memory). Default: wide up to 256
+    /// estimates, long above.
+    #[arg(long, value_enum, value_name = "wide|long")]
+    layout: Option<LayoutArg>,
     /// Wavelength grid of the output, START-END[:STEP] in nm (within the model's grid).
     #[arg(long, default_value = "400-700:5", value_name = "START-END[:STEP]")]
     range: String,
@@ -55,6 +67,13 @@ pub struct EstimateArgs {
     truth: Option<PathBuf>,
     #[command(flatten)]
     photo: PhotoArgs,
+}
+
+/// `--layout`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum LayoutArg {
+    Wide,
+    Long,
 }
 
 /// The model `--model` names, or the shipped ones.
@@ -227,18 +246,13 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     }
     let models = load_models(args.model.as_deref())?;
     let grid = Grid::parse(&args.range)?;
-    let (mut estimates, photos, failed) = match &args.features {
-        Some(path) => {
-            let rows = FeatureRows::read_csv(path)?;
-            let source = path.display().to_string();
-            (
-                estimate_features(&models, &rows, &source, &grid)?,
-                Vec::new(),
-                0,
-            )
-        }
-        None => estimate_from_photos(&args, &models, data_dir, &grid)?,
-    };
+    if let Some(path) = &args.features {
+        return run_features(&args, path, &models, &grid);
+    }
+    if args.layout == Some(LayoutArg::Long) && args.output.is_some() {
+        bail!("--layout long is for --features; estimates of photos are written wide");
+    }
+    let (mut estimates, photos, failed) = estimate_from_photos(&args, &models, data_dir, &grid)?;
     if estimates.is_empty() {
         bail!(
             "no estimate: none of the {} photo(s) could be used (see the errors above)",
@@ -290,13 +304,251 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     Ok(())
 }
 
+/// Estimates printed in full (colorimetry, SPD, score) when there are no more than these.
+const DETAILED_MAX: usize = 20;
+
+/// What `estimate --features` keeps while it streams: the first estimates (to print and
+/// plot), the scores against the truths, and the count.
+struct FeatureRun {
+    model: String,
+    grid: Grid,
+    truths: Option<SpectralSet>,
+    /// The first [`DETAILED_MAX`] estimates, without colorimetry until printed.
+    first: Vec<(String, Vec<f64>, Option<Score>)>,
+    rows: usize,
+    /// (sum of GFC, sum of RMSE) over the scored estimates.
+    score_sums: (f64, f64),
+    /// Every SPD while the output may still be laid out wide (row-major).
+    wide: Option<Vec<f64>>,
+    layout: Option<Layout>,
+    json_started: bool,
+}
+
+impl FeatureRun {
+    /// The truth of row `row`: the only one, or the row's own.
+    fn truth(&self, row: usize) -> Result<Option<&[f64]>> {
+        let Some(set) = &self.truths else {
+            return Ok(None);
+        };
+        match set.len() {
+            1 => Ok(Some(set.item(0))),
+            n if row < n => Ok(Some(set.item(row))),
+            n => bail!("{n} true SPDs for more estimates; give one, or one per estimate"),
+        }
+    }
+
+    /// One full estimate (colorimetry and lighting metrics computed: they are asked for).
+    fn estimate(&self, name: String, spd: Vec<f64>, truth: Option<Score>) -> Result<Estimate> {
+        Ok(Estimate {
+            colorimetry: Colorimetry::of(&spd, &self.grid)?,
+            metrics: LightingMetrics::from_samples(&self.grid.wavelengths(), &spd),
+            name,
+            model: self.model.clone(),
+            grid: self.grid,
+            spd,
+            truth,
+            photo: None,
+        })
+    }
+
+    /// Takes the SPDs of the rows from `first_row` on: scores, keeps, prints JSON, writes.
+    fn add(
+        &mut self,
+        first_row: usize,
+        spds: Vec<f64>,
+        json: bool,
+        out: &mut Option<&mut dyn Write>,
+    ) -> Result<()> {
+        let width = self.grid.count;
+        let scores: Vec<Option<Score>> = spds
+            .chunks_exact(width)
+            .enumerate()
+            .map(|(k, spd)| match self.truth(first_row + k)? {
+                Some(t) => Ok(Some(Score::of(t, spd)?)),
+                None => Ok(None),
+            })
+            .collect::<Result<_>>()?;
+        for s in scores.iter().flatten() {
+            self.score_sums.0 += s.gfc;
+            self.score_sums.1 += s.rmse;
+        }
+        for (k, spd) in spds.chunks_exact(width).enumerate() {
+            if self.first.len() < DETAILED_MAX {
+                self.first
+                    .push((row_name(first_row + k), spd.to_vec(), scores[k]));
+            }
+        }
+        if json {
+            let mut text = String::new();
+            for (k, spd) in spds.chunks_exact(width).enumerate() {
+                let e = self.estimate(row_name(first_row + k), spd.to_vec(), scores[k])?;
+                text.push_str(if self.json_started { ",\n" } else { "[\n" });
+                self.json_started = true;
+                text.push_str(&serde_json::to_string_pretty(&e.to_json()?)?);
+            }
+            std::io::stdout().lock().write_all(text.as_bytes())?;
+        }
+        self.rows += spds.len() / width;
+        if let Some(out) = out {
+            if let Some(wide) = &mut self.wide {
+                wide.extend_from_slice(&spds);
+                if self.layout.is_none() && self.rows > WIDE_LAYOUT_MAX_ROWS {
+                    self.layout = Some(Layout::Long);
+                    let held = std::mem::take(wide);
+                    self.wide = None;
+                    out.write_all(long_header(&self.grid).as_bytes())?;
+                    out.write_all(&long_rows(&held, width, 0))?;
+                }
+            } else {
+                if first_row == 0 {
+                    out.write_all(long_header(&self.grid).as_bytes())?;
+                }
+                out.write_all(&long_rows(&spds, width, first_row))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the estimates held for the wide layout.
+    fn finish(&mut self, out: &mut Option<&mut dyn Write>) -> Result<()> {
+        if let (Some(out), Some(wide)) = (out, self.wide.take()) {
+            let width = self.grid.count;
+            let set = SpectralSet::on_grid(
+                &self.grid,
+                (0..self.rows).map(row_name).collect(),
+                wide.chunks_exact(width).map(<[f64]>::to_vec).collect(),
+            )?;
+            out.write_all(set.to_csv_string().as_bytes())?;
+        }
+        Ok(())
+    }
+}
+
+/// `estimate --features`: the rows of the features CSV streamed through the model for their
+/// columns a block at a time, the SPDs written as they come (long layout), so that time is
+/// linear in the rows and memory bounded whatever their number. Colorimetry (xy, CCT, Duv)
+/// and the lighting metrics are computed only for what is printed: the estimates shown in
+/// full (up to 20), the plot's title, and every estimate of `--json`.
+fn run_features(args: &EstimateArgs, path: &Path, models: &ModelSet, grid: &Grid) -> Result<()> {
+    let mut stream = FeatureStream::open(path)?;
+    let source = path.display().to_string();
+    let chosen = models.require(stream.names(), &source)?;
+    let map = GridMap::new(&chosen.model.grid(), grid)?;
+    let mut run = FeatureRun {
+        model: chosen.name.clone(),
+        grid: *grid,
+        truths: args
+            .truth
+            .as_deref()
+            .map(|t| read_truths(t, grid))
+            .transpose()?,
+        first: Vec::new(),
+        rows: 0,
+        score_sums: (0.0, 0.0),
+        wide: (args.layout != Some(LayoutArg::Long)).then(Vec::new),
+        layout: args.layout.map(|l| match l {
+            LayoutArg::Wide => Layout::Wide,
+            LayoutArg::Long => Layout::Long,
+        }),
+        json_started: false,
+    };
+    let mut estimate_all = |out: &mut Option<&mut dyn Write>| -> Result<()> {
+        let mut rows = 0;
+        while let Some(block) = stream.next_block(rows)? {
+            let spds = estimate_block(&chosen.model, &block, stream.names(), &source, &map)?;
+            rows += block.rows;
+            run.add(block.first_row, spds, args.photo.json, out)?;
+        }
+        if rows == 0 {
+            bail!("{source}: no rows of features below the header");
+        }
+        run.finish(out)
+    };
+    match &args.output {
+        None => estimate_all(&mut None)?,
+        Some(out) if fsio::is_stdout(out) => {
+            let mut lock = std::io::BufWriter::new(std::io::stdout().lock());
+            estimate_all(&mut Some(&mut lock as &mut dyn Write))?;
+            lock.flush()?;
+        }
+        Some(out) => {
+            let mut failure = None;
+            let written = fsio::write_atomic_with(out, |w| {
+                estimate_all(&mut Some(w as &mut dyn Write)).map_err(|e| {
+                    failure = Some(e);
+                    std::io::Error::other("no estimates written")
+                })
+            });
+            if let Some(e) = failure {
+                return Err(e);
+            }
+            written?;
+        }
+    }
+    if run.json_started {
+        println!("\n]");
+    }
+    let detailed = run.rows <= DETAILED_MAX;
+    if let Some(plot) = &args.plot {
+        let series: Vec<(String, Vec<f64>)> = run
+            .first
+            .iter()
+            .map(|(n, spd, _)| (n.clone(), spd.clone()))
+            .collect();
+        let title = if run.rows == 1 {
+            let (name, spd, _) = &run.first[0];
+            let e = run.estimate(name.clone(), spd.clone(), None)?;
+            format!("Estimated SPD: {}", e.colorimetry.label())
+        } else {
+            format!("Estimated SPDs ({} of {})", series.len(), run.rows)
+        };
+        write_plot(plot, &spds_svg(&title, grid, &series)?)?;
+    }
+    if quiet(args) {
+        return Ok(());
+    }
+    let shown = if detailed {
+        let first = std::mem::take(&mut run.first);
+        first
+            .into_iter()
+            .map(|(name, spd, score)| run.estimate(name, spd, score))
+            .collect::<Result<Vec<_>>>()?
+    } else {
+        Vec::new()
+    };
+    if detailed {
+        print_estimates(&shown, args);
+        return Ok(());
+    }
+    println!("{} estimates with {}", run.rows, run.model);
+    if run.truths.is_some() {
+        println!(
+            "against the true SPDs: mean GFC {:.4}, mean RMSE {:.4} (both peak-normalised)",
+            run.score_sums.0 / run.rows as f64,
+            run.score_sums.1 / run.rows as f64
+        );
+    }
+    if let Some(out) = &args.output {
+        let layout = if run.layout == Some(Layout::Wide) {
+            "wide"
+        } else {
+            "long"
+        };
+        println!("SPDs ({layout} layout) → {}", out.display());
+    }
+    if let Some(plot) = &args.plot {
+        println!("plot → {}", plot.display());
+    }
+    Ok(())
+}
+
 /// The estimates as text: colorimetry and the SPD every 25 nm (for up to 20), the score
 /// against the truth, what each number means, and where the files went.
 fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     let mut models: Vec<&str> = estimates.iter().map(|e| e.model.as_str()).collect();
     models.dedup();
     println!("{} estimate(s) with {}", estimates.len(), models.join(", "));
-    let detailed = estimates.len() <= 20;
+    let detailed = estimates.len() <= DETAILED_MAX;
     for e in estimates {
         if detailed {
             println!("{}: {}", e.name, e.colorimetry.label());

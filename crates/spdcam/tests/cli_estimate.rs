@@ -334,3 +334,96 @@ fn a_chart_image_from_render_is_estimated() {
     assert!((5800.0..7200.0).contains(&cct), "CCT {cct}:\n{out}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Cells of a CSV file, line by line.
+fn csv_cells(path: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect()
+}
+
+/// Many feature rows: streamed, laid out long above 256 rows (or as asked), the same
+/// numbers as the wide layout, in row order; colorimetry only for what is printed.
+#[test]
+fn many_feature_rows_stream_to_the_long_layout() {
+    let dir = scratch("long");
+    let one = dir.join("one.csv");
+    ok(&["estimate", EXAMPLE, "--features-out", &s(&one)]);
+    let text = std::fs::read_to_string(&one).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let row: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let many = dir.join("many.csv");
+    let mut body = format!("{header}\n");
+    for r in 0..300 {
+        let scaled: Vec<String> = row
+            .iter()
+            .map(|v| format!("{:.3}", v * (0.8 + 0.001 * r as f64)))
+            .collect();
+        body.push_str(&scaled.join(","));
+        body.push_str(if r == 150 { "\r\n\n" } else { "\n" });
+    }
+    std::fs::write(&many, body).unwrap();
+
+    let (long, wide) = (dir.join("long.csv"), dir.join("wide.csv"));
+    let out = ok(&["estimate", "--features", &s(&many), "-o", &s(&long)]);
+    assert!(out.starts_with("300 estimates with"), "{out}");
+    assert!(
+        !out.contains("CCT"),
+        "no colorimetry for rows not printed: {out}"
+    );
+    assert!(out.contains("long layout"), "{out}");
+    ok(&[
+        "estimate",
+        "--features",
+        &s(&many),
+        "-o",
+        &s(&wide),
+        "--layout",
+        "wide",
+    ]);
+    let (long, wide) = (csv_cells(&long), csv_cells(&wide));
+    assert_eq!(long.len(), 301);
+    assert_eq!(long[0][0], "name");
+    assert_eq!((long[0][1].as_str(), long[0][61].as_str()), ("400", "700"));
+    assert_eq!(wide.len(), 62);
+    assert_eq!(wide[0].len(), 301);
+    for r in 0..300 {
+        assert_eq!(long[r + 1][0], format!("estimate_{}", r + 1));
+        assert_eq!(wide[0][r + 1], long[r + 1][0]);
+        for k in 0..61 {
+            assert_eq!(long[r + 1][k + 1], wide[k + 1][r + 1], "row {r}, band {k}");
+        }
+    }
+
+    // A few rows: wide by default, printed in full; --layout long writes them long.
+    let few = dir.join("few.csv");
+    let text = std::fs::read_to_string(&many).unwrap();
+    std::fs::write(&few, text.lines().take(4).collect::<Vec<_>>().join("\n")).unwrap();
+    let small = dir.join("small.csv");
+    let out = ok(&["estimate", "--features", &s(&few), "-o", &s(&small)]);
+    assert_eq!(out.matches("CCT").count(), 3, "{out}");
+    assert!(std::fs::read_to_string(&small)
+        .unwrap()
+        .starts_with("wavelength_nm,estimate_1,estimate_2,estimate_3\n"));
+    ok(&[
+        "estimate",
+        "--features",
+        &s(&few),
+        "-o",
+        &s(&small),
+        "--layout",
+        "long",
+    ]);
+    assert_eq!(csv_cells(&small).len(), 4);
+    let err = fails(&["estimate", EXAMPLE, "-o", &s(&small), "--layout", "long"]);
+    assert!(err.contains("--layout long is for --features"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,492 @@
+//! Feature rows in, SPD estimates out, a block of rows at a time: estimating any number of
+//! rows in bounded memory, in time linear in the rows, on every core.
+//!
+//! ```text
+//! features CSV ─► FeatureStream (blocks of lines parsed in parallel) ─► Model::estimate_rows
+//!     ─► GridMap (model grid → output grid) ─► long CSV rows (formatted in parallel) ─► file
+//! ```
+
+use crate::error::{InferError, Result};
+use crate::model::Model;
+use rayon::prelude::*;
+use spdcam_core::feature_check;
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use std::io::{Read, Write};
+use std::path::Path;
+
+/// Bytes of the features file read and parsed at a time.
+const BLOCK_BYTES: usize = 8 << 20;
+/// Lines one parallel task parses.
+const LINES_PER_TASK: usize = 512;
+
+/// The rows of a features CSV (a header naming the columns, then one numeric row per
+/// estimate), read a block at a time. Lines are split and parsed in parallel; a line with a
+/// quoted field goes through the CSV parser. Blank lines are skipped.
+pub struct FeatureStream {
+    input: Box<dyn Read + Send>,
+    source: String,
+    names: Vec<String>,
+    /// Bytes read but not yet parsed (the start of an unfinished line).
+    pending: Vec<u8>,
+    /// The line number of the first pending byte.
+    line: usize,
+    finished: bool,
+}
+
+/// One block of feature rows and where they were in the file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeatureBlock {
+    /// Values, row-major, in the file's column order.
+    pub values: Vec<f64>,
+    /// Number of rows.
+    pub rows: usize,
+    /// The number (0-based) of the block's first row among all rows of the file.
+    pub first_row: usize,
+}
+
+impl FeatureStream {
+    /// Opens a features CSV and reads its header.
+    pub fn open(path: &Path) -> Result<FeatureStream> {
+        let file = std::fs::File::open(path)
+            .map_err(|e| InferError::invalid(format!("reading {}: {e}", path.display())))?;
+        FeatureStream::new(Box::new(file), &path.display().to_string())
+    }
+
+    /// A stream over `input`, named `source` in errors; reads the header.
+    pub fn new(input: Box<dyn Read + Send>, source: &str) -> Result<FeatureStream> {
+        let mut stream = FeatureStream {
+            input,
+            source: source.to_string(),
+            names: Vec::new(),
+            pending: Vec::new(),
+            line: 1,
+            finished: false,
+        };
+        let header = loop {
+            if let Some(end) = stream.pending.iter().position(|&b| b == b'\n') {
+                let header: Vec<u8> = stream.pending.drain(..=end).collect();
+                break header;
+            }
+            if stream.finished {
+                break std::mem::take(&mut stream.pending);
+            }
+            stream.fill()?;
+        };
+        stream.line = 2;
+        let names = parse_quoted(&header).map_err(|e| stream.error(1, e))?;
+        if names.iter().all(String::is_empty) {
+            return Err(InferError::invalid(format!(
+                "{}: the file is empty",
+                stream.source
+            )));
+        }
+        stream.names = names;
+        Ok(stream)
+    }
+
+    /// The column names of the header.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Reads up to [`BLOCK_BYTES`] more bytes into `pending`.
+    fn fill(&mut self) -> Result<()> {
+        let start = self.pending.len();
+        self.pending.resize(start + BLOCK_BYTES, 0);
+        let mut filled = start;
+        while filled < self.pending.len() {
+            match self.input.read(&mut self.pending[filled..]) {
+                Ok(0) => {
+                    self.finished = true;
+                    break;
+                }
+                Ok(n) => filled += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(InferError::invalid(format!("reading {}: {e}", self.source))),
+            }
+        }
+        self.pending.truncate(filled);
+        Ok(())
+    }
+
+    fn error(&self, line: usize, message: String) -> InferError {
+        InferError::invalid(format!("{} line {line}: {message}", self.source))
+    }
+
+    /// The next block of rows (`first_row` counts the rows before it), or `None` after the
+    /// last. Errors name the line and column of a bad value.
+    pub fn next_block(&mut self, first_row: usize) -> Result<Option<FeatureBlock>> {
+        loop {
+            if self.pending.is_empty() && self.finished {
+                return Ok(None);
+            }
+            let cut = if self.finished {
+                self.pending.len()
+            } else {
+                self.fill()?;
+                match self.pending.iter().rposition(|&b| b == b'\n') {
+                    Some(end) => end + 1,
+                    None if self.finished => self.pending.len(),
+                    // One line longer than a block: read on.
+                    None => continue,
+                }
+            };
+            let text: Vec<u8> = self.pending.drain(..cut).collect();
+            let first_line = self.line;
+            let lines: Vec<&[u8]> = text
+                .strip_suffix(b"\n")
+                .unwrap_or(&text)
+                .split(|&b| b == b'\n')
+                .collect();
+            self.line += lines.len();
+            let (names, source) = (&self.names, &self.source);
+            let width = names.len();
+            let parsed = lines
+                .par_chunks(LINES_PER_TASK)
+                .enumerate()
+                .map(|(task, chunk)| {
+                    let mut values = Vec::with_capacity(chunk.len() * width);
+                    for (k, line) in chunk.iter().enumerate() {
+                        let number = first_line + task * LINES_PER_TASK + k;
+                        parse_row(line, names, &mut values).map_err(|e| {
+                            InferError::invalid(format!("{source} line {number}: {e}"))
+                        })?;
+                    }
+                    Ok(values)
+                })
+                .collect::<Result<Vec<Vec<f64>>>>()?;
+            let values: Vec<f64> = parsed.concat();
+            let rows = values.len() / width.max(1);
+            if rows > 0 {
+                return Ok(Some(FeatureBlock {
+                    values,
+                    rows,
+                    first_row,
+                }));
+            }
+        }
+    }
+}
+
+/// Fields of one CSV line, through the CSV parser (quotes, escaped quotes), trimmed.
+fn parse_quoted(line: &[u8]) -> std::result::Result<Vec<String>, String> {
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .from_reader(line);
+    let mut record = csv::StringRecord::new();
+    match reader.read_record(&mut record) {
+        Ok(_) => Ok(record.iter().map(str::to_string).collect()),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Appends the values of one line to `out`; a blank line (or one of empty fields) adds none.
+fn parse_row(line: &[u8], names: &[String], out: &mut Vec<f64>) -> std::result::Result<(), String> {
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    let fields: Vec<String>;
+    let cells: Vec<&str> = if line.contains(&b'"') {
+        fields = parse_quoted(line)?;
+        fields.iter().map(String::as_str).collect()
+    } else {
+        let text = std::str::from_utf8(line).map_err(|_| "the line is not UTF-8".to_string())?;
+        text.split(',').map(str::trim).collect()
+    };
+    if cells.iter().all(|c| c.is_empty()) {
+        return Ok(());
+    }
+    if cells.len() != names.len() {
+        return Err(format!(
+            "{} values, the header names {} columns",
+            cells.len(),
+            names.len()
+        ));
+    }
+    for (cell, name) in cells.iter().zip(names) {
+        let v: f64 = cell
+            .parse()
+            .map_err(|_| format!("column {name}: '{cell}' is not a number"))?;
+        if !v.is_finite() {
+            return Err(format!("column {name}: {v} is not a finite number"));
+        }
+        out.push(v);
+    }
+    Ok(())
+}
+
+/// SPDs of the model's grid taken to another grid (within it) by the interpolation
+/// [`SpectralSet::resample`] uses, precomputed as a matrix: resampling is linear in the
+/// values, so row `j` of the matrix is the resampled unit spectrum `eⱼ`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridMap {
+    from: usize,
+    to: usize,
+    /// `None` when the grids are the same.
+    matrix: Option<Vec<f64>>,
+}
+
+impl GridMap {
+    /// The map from the model's grid `from` to `to`, which must lie within it.
+    pub fn new(from: &Grid, to: &Grid) -> Result<GridMap> {
+        if to.start_nm < from.start_nm - 1e-9 || to.end_nm() > from.end_nm() + 1e-9 {
+            return Err(InferError::invalid(format!(
+                "the range {}: the model estimates {} nm only",
+                to.label(),
+                from.label()
+            )));
+        }
+        if from == to {
+            return Ok(GridMap {
+                from: from.count,
+                to: to.count,
+                matrix: None,
+            });
+        }
+        let units: Vec<Vec<f64>> = (0..from.count)
+            .map(|j| {
+                (0..from.count)
+                    .map(|i| f64::from(u8::from(i == j)))
+                    .collect()
+            })
+            .collect();
+        let names = (0..from.count).map(|j| format!("e{j}")).collect();
+        let set = SpectralSet::on_grid(from, names, units)?;
+        let (resampled, _) = set.resample(to, Interpolation::Auto, Extrapolation::HoldEdge)?;
+        let matrix = (0..from.count)
+            .flat_map(|j| resampled.item(j).to_vec())
+            .collect();
+        Ok(GridMap {
+            from: from.count,
+            to: to.count,
+            matrix: Some(matrix),
+        })
+    }
+
+    /// Rows of SPDs on the model's grid (row-major) on the output grid.
+    pub fn apply(&self, spds: Vec<f64>) -> Vec<f64> {
+        let Some(m) = &self.matrix else {
+            return spds;
+        };
+        let mut out = vec![0.0; spds.len() / self.from * self.to];
+        out.par_chunks_mut(self.to)
+            .zip(spds.par_chunks(self.from))
+            .for_each(|(o, s)| {
+                for (j, &v) in s.iter().enumerate() {
+                    for (o, &w) in o.iter_mut().zip(&m[j * self.to..(j + 1) * self.to]) {
+                        *o += v * w;
+                    }
+                }
+            });
+        out
+    }
+}
+
+/// The SPDs of a block of feature rows (in the model's column order, named `names`) on
+/// `map`'s grid. Rows that say nothing about the light are refused first, as
+/// [`crate::estimate::estimate_features`] refuses them, naming the row (1-based in the file).
+pub fn estimate_block(
+    model: &Model,
+    block: &FeatureBlock,
+    names: &[String],
+    source: &str,
+    map: &GridMap,
+) -> Result<Vec<f64>> {
+    let width = names.len().max(1);
+    block
+        .values
+        .par_chunks(width)
+        .enumerate()
+        .try_for_each(|(i, row)| {
+            // Rows on 0–1 are told from rows on 0–255 by their largest value.
+            let scale = if row.iter().any(|&v| v > 1.0) {
+                255.0
+            } else {
+                1.0
+            };
+            feature_check::check_feature_row(row, names, scale).map_err(|e| {
+                InferError::invalid(format!("{source} row {}: {e}", block.first_row + i + 1))
+            })
+        })?;
+    Ok(map.apply(model.estimate_rows(&block.values)?))
+}
+
+/// The name of feature row `row` (0-based): `estimate_1`, `estimate_2`, ….
+pub fn row_name(row: usize) -> String {
+    format!("estimate_{}", row + 1)
+}
+
+/// How many SPDs one estimate file lays out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layout {
+    /// `wavelength_nm` then one column per estimate (the spectral CSV of colour-science):
+    /// every estimate is held until the end.
+    Wide,
+    /// One row per estimate: `name`, then one column per wavelength; written as it comes.
+    Long,
+}
+
+/// Estimates up to this many rows are laid out wide unless told otherwise; more, long.
+pub const WIDE_LAYOUT_MAX_ROWS: usize = 256;
+
+/// The header of the long layout: `name,400,405,…`.
+pub fn long_header(grid: &Grid) -> String {
+    let mut line = String::from("name");
+    for w in grid.wavelengths() {
+        line.push(',');
+        line.push_str(&format!("{w}"));
+    }
+    line.push('\n');
+    line
+}
+
+/// Rows of the long layout for SPDs (row-major on a grid of `width` values) whose first is
+/// row `first_row`, formatted in parallel: `estimate_N,v1,v2,…` (shortest round-trip
+/// decimals, −0 as 0, as the wide layout writes them).
+pub fn long_rows(spds: &[f64], width: usize, first_row: usize) -> Vec<u8> {
+    let chunks: Vec<Vec<u8>> = spds
+        .par_chunks(width * LINES_PER_TASK)
+        .enumerate()
+        .map(|(task, chunk)| {
+            let mut out = Vec::with_capacity(chunk.len() * 20);
+            for (k, spd) in chunk.chunks_exact(width).enumerate() {
+                let _ = write!(out, "{}", row_name(first_row + task * LINES_PER_TASK + k));
+                for &v in spd {
+                    // −0 as 0, as the wide layout writes it.
+                    let _ = if v == 0.0 {
+                        write!(out, ",0")
+                    } else {
+                        write!(out, ",{v}")
+                    };
+                }
+                out.push(b'\n');
+            }
+            out
+        })
+        .collect();
+    chunks.concat()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stream(text: &str) -> FeatureStream {
+        FeatureStream::new(
+            Box::new(std::io::Cursor::new(text.as_bytes().to_vec())),
+            "f.csv",
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn blocks_hold_every_row_and_errors_name_the_line() {
+        let mut text = String::from("a,\"b\", c\r\n");
+        for i in 0..3000 {
+            if i % 700 == 0 {
+                text.push('\n');
+            }
+            text.push_str(&format!("{i}, {}.5,\"{}\"\r\n", i * 2, -(i as i64)));
+        }
+        let mut s = stream(&text);
+        assert_eq!(s.names(), ["a", "b", "c"]);
+        let block = s.next_block(0).unwrap().unwrap();
+        assert_eq!(block.rows, 3000);
+        assert_eq!(&block.values[3 * 2999..], [2999.0, 5998.5, -2999.0]);
+        assert!(s.next_block(3000).unwrap().is_none());
+
+        let e = stream("a,b\n1,2\n3,x\n")
+            .next_block(0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("f.csv line 3: column b: 'x' is not a number"),
+            "{e}"
+        );
+        let e = stream("a,b\n1,2\n\n3\n")
+            .next_block(0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("line 4: 1 values, the header names 2 columns"),
+            "{e}"
+        );
+        let e = stream("a,b\n1,inf\n")
+            .next_block(0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not a finite number"), "{e}");
+        assert!(FeatureStream::new(Box::new(std::io::empty()), "e.csv").is_err());
+    }
+
+    #[test]
+    fn rows_longer_than_a_read_and_many_blocks_come_whole() {
+        let width = 40_000;
+        let names: Vec<String> = (0..width).map(|j| format!("c{j}")).collect();
+        let mut text = names.join(",") + "\n";
+        for r in 0..300 {
+            let row: Vec<String> = (0..width)
+                .map(|j| format!("{}", (r * 7 + j) % 1000))
+                .collect();
+            text.push_str(&row.join(","));
+            text.push('\n');
+        }
+        let mut s = stream(&text);
+        let mut rows = 0;
+        let mut blocks = 0;
+        while let Some(b) = s.next_block(rows).unwrap() {
+            assert_eq!(b.first_row, rows);
+            assert_eq!(b.values[0], ((rows * 7) % 1000) as f64);
+            rows += b.rows;
+            blocks += 1;
+        }
+        assert_eq!(rows, 300);
+        assert!(blocks > 1, "{blocks}");
+    }
+
+    #[test]
+    fn grid_map_is_the_set_resampling() {
+        let from = Grid::ESTIMATION;
+        let to = Grid::parse("401-698:3").unwrap();
+        let map = GridMap::new(&from, &to).unwrap();
+        let spds: Vec<Vec<f64>> = (0..5)
+            .map(|r| {
+                (0..from.count)
+                    .map(|i| ((i * (r + 3)) as f64 * 0.1).sin().abs() + 0.1)
+                    .collect()
+            })
+            .collect();
+        let names = (0..5).map(|r| format!("s{r}")).collect();
+        let set = SpectralSet::on_grid(&from, names, spds.clone()).unwrap();
+        let (expected, _) = set
+            .resample(&to, Interpolation::Auto, Extrapolation::HoldEdge)
+            .unwrap();
+        let got = map.apply(spds.concat());
+        for r in 0..5 {
+            for (a, b) in got[r * to.count..(r + 1) * to.count]
+                .iter()
+                .zip(expected.item(r))
+            {
+                assert!((a - b).abs() < 1e-12, "{a} {b}");
+            }
+        }
+        assert_eq!(
+            GridMap::new(&from, &from).unwrap().apply(vec![1.0; 61]),
+            vec![1.0; 61]
+        );
+        assert!(GridMap::new(&from, &Grid::parse("380-700:5").unwrap()).is_err());
+    }
+
+    #[test]
+    fn long_rows_are_named_and_exact() {
+        let text = String::from_utf8(long_rows(&[0.1, 1.0 / 3.0, 2.0, -0.0], 2, 9)).unwrap();
+        assert_eq!(
+            text,
+            "estimate_10,0.1,0.3333333333333333\nestimate_11,2,0\n"
+        );
+        assert_eq!(
+            long_header(&Grid::parse("400-410:5").unwrap()),
+            "name,400,405,410\n"
+        );
+    }
+}

@@ -1,0 +1,140 @@
+//! Speed of `spdcam estimate --features` (issue 16: linear in the rows, 1,000,000 rows → SPDs
+//! in ≤ 10 s, memory bounded). Feature rows of the ColorChecker Digital SG (288 columns, two
+//! decimals, as `--features-out` writes them) through the shipped model:
+//!
+//! - the command itself on 1,000,000 rows (100,000 with `--quick`), long layout written to a
+//!   file, with its peak memory (Linux);
+//! - against the previous path in the same run, on 20,000 rows in the process: the whole file
+//!   read into memory, every estimate with its colorimetry (xy, CCT, Duv), one wide CSV —
+//!   beside the streamed path (blocks parsed in parallel, estimated, written as long rows).
+//!
+//! `cargo bench -p spdcam --bench estimate [-- --quick]`.
+
+use spdcam_core::spectral::{Grid, SpectralSet};
+use spdcam_infer::stream::{estimate_block, long_header, long_rows, FeatureStream, GridMap};
+use spdcam_infer::{estimate_features, FeatureRows, ModelSet};
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+/// Writes `rows` feature rows for the model's columns: values 20–235 with two decimals.
+fn write_features(path: &Path, names: &[String], rows: usize) {
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path).expect("features file"));
+    writeln!(out, "{}", names.join(",")).expect("write");
+    let mut line = String::new();
+    for r in 0..rows {
+        line.clear();
+        for j in 0..names.len() {
+            let phase = (r as f64 * 0.618_034 + j as f64 * 0.381_966).fract();
+            let channel = [1.0, 0.9, 0.75][j % 3];
+            if j > 0 {
+                line.push(',');
+            }
+            line.push_str(&format!("{:.2}", 20.0 + 215.0 * phase * channel));
+        }
+        writeln!(out, "{line}").expect("write");
+    }
+    out.flush().expect("flush");
+}
+
+/// Peak resident memory of finished child processes (Linux), in MB.
+fn children_peak_mb() -> Option<f64> {
+    #[cfg(target_os = "linux")]
+    {
+        let mut usage = std::mem::MaybeUninit::<libc::rusage>::uninit();
+        // SAFETY: getrusage fills the struct it is given.
+        if unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, usage.as_mut_ptr()) } == 0 {
+            // SAFETY: filled by the successful call above.
+            return Some(unsafe { usage.assume_init() }.ru_maxrss as f64 / 1024.0);
+        }
+    }
+    None
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let big = if quick { 100_000 } else { 1_000_000 };
+    let dir = std::env::temp_dir().join(format!("spdcam-bench-estimate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    let models = ModelSet::shipped().expect("shipped models");
+    let model = models
+        .models()
+        .iter()
+        .find(|m| m.model.feature_names().len() == 288)
+        .expect("the shipped ColorChecker SG model");
+    let names = model.model.feature_names().to_vec();
+    let grid = Grid::ESTIMATION;
+
+    // The previous path against the streamed one, in the process, on the same rows.
+    let small = 20_000;
+    let features = dir.join("small.csv");
+    write_features(&features, &names, small);
+    let t = Instant::now();
+    let rows = FeatureRows::read_csv(&features).expect("features");
+    let estimates = estimate_features(&models, &rows, "bench", &grid).expect("estimates");
+    let set = SpectralSet::on_grid(
+        &grid,
+        estimates.iter().map(|e| e.name.clone()).collect(),
+        estimates.iter().map(|e| e.spd.clone()).collect(),
+    )
+    .expect("set");
+    std::fs::write(dir.join("wide.csv"), set.to_csv_string()).expect("write");
+    let previous = t.elapsed().as_secs_f64();
+    drop((rows, estimates, set));
+    let t = Instant::now();
+    let mut stream = FeatureStream::open(&features).expect("stream");
+    let map = GridMap::new(&model.model.grid(), &grid).expect("grid map");
+    let mut out =
+        std::io::BufWriter::new(std::fs::File::create(dir.join("long.csv")).expect("out"));
+    out.write_all(long_header(&grid).as_bytes()).expect("write");
+    let mut done = 0;
+    while let Some(block) = stream.next_block(done).expect("block") {
+        let spds = estimate_block(&model.model, &block, &names, "bench", &map).expect("estimates");
+        out.write_all(&long_rows(&spds, grid.count, done))
+            .expect("write");
+        done += block.rows;
+    }
+    out.flush().expect("flush");
+    let streamed = t.elapsed().as_secs_f64();
+    println!(
+        "{small} rows in the process: streamed {:.3} s ({:.1} µs a row); previous path (all in \
+         memory, colorimetry of every row, wide CSV): {previous:.3} s → {:.2}×",
+        streamed,
+        streamed / small as f64 * 1e6,
+        previous / streamed
+    );
+
+    // The command on many rows.
+    let features = dir.join("big.csv");
+    write_features(&features, &names, big);
+    let size = std::fs::metadata(&features).map(|m| m.len()).unwrap_or(0);
+    let output = dir.join("spds.csv");
+    let t = Instant::now();
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_spdcam"))
+        .args(["estimate", "--features"])
+        .arg(&features)
+        .arg("-o")
+        .arg(&output)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("spdcam runs");
+    let seconds = t.elapsed().as_secs_f64();
+    assert!(status.success(), "spdcam estimate failed");
+    let written = std::fs::metadata(&output).map(|m| m.len()).unwrap_or(0);
+    let memory = children_peak_mb()
+        .map(|mb| format!(", peak memory {mb:.0} MB"))
+        .unwrap_or_default();
+    let label = if big == 1_000_000 {
+        "1,000,000".to_string()
+    } else {
+        big.to_string()
+    };
+    println!(
+        "{label} rows, spdcam estimate --features ({:.0} MB in) -o ({:.0} MB out, long): \
+         {seconds:.2} s ({:.1} µs a row; target ≤ 10 s for 1,000,000){memory}",
+        size as f64 / 1e6,
+        written as f64 / 1e6,
+        seconds / big as f64 * 1e6
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
