@@ -160,7 +160,11 @@ pub fn estimate_rows(
 fn check_rows(features: &FeatureRows, source: &str) -> Result<()> {
     let width = features.names.len().max(1);
     for (i, row) in features.values.chunks(width).enumerate() {
-        let scale = if row.iter().any(|&v| v > 1.0) { 255.0 } else { 1.0 };
+        let scale = if row.iter().any(|&v| v > 1.0) {
+            255.0
+        } else {
+            1.0
+        };
         feature_check::check_feature_row(row, &features.names, scale).map_err(|e| {
             let at = if features.rows > 1 {
                 format!(" row {}", i + 1)

@@ -116,8 +116,10 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
         let average = average_spd(&truth, &fit_lamps);
         md += &format!(
             "### `{}` ({chart_name})\n\n",
-            path.file_name()
-                .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into())
+            path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into()
+            )
         );
         md += "| lamp type | lamps (val / test) | average SPD (val) | (a) randomised in-camera (val) | (b) simple camera (val) | average SPD (test) | (a) test | (b) test |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
         let mut cells: Vec<[LampScores; 3]> = Vec::new();
@@ -296,7 +298,10 @@ fn score(
 ) -> Result<LampScores> {
     let estimates = model.estimate_rows(&photos.features)?;
     let d = model.grid().count;
-    debug_assert_eq!(photos.features.len() / photos.width, ids.len() * shots as usize);
+    debug_assert_eq!(
+        photos.features.len() / photos.width,
+        ids.len() * shots as usize
+    );
     Ok(ids
         .iter()
         .enumerate()
@@ -334,7 +339,10 @@ fn real_scores(args: &ValidateArgs, model: &Model, data_dir: &DataDir) -> Result
     let sets = [
         load(&["telelumen_canon5d4_dev"])?,
         load(&["hue_canon5d4_train", "hue_canon5d4_val"])?,
-        load(&["telelumen_galaxy_tab_s7_train", "telelumen_galaxy_tab_s7_val"])?,
+        load(&[
+            "telelumen_galaxy_tab_s7_train",
+            "telelumen_galaxy_tab_s7_val",
+        ])?,
     ];
     let grid = model.grid();
     let mut out = [0.0; 3];

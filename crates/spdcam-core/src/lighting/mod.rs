@@ -148,7 +148,10 @@ impl Lighting {
                         "'{spec}': a blend names two recipes joined by '+', e.g. blend:daylight+lamp:phosphor-led"
                     ))
                 })?;
-                if [a, b].iter().any(|r| r.starts_with("mix:") || r.starts_with("blend:")) {
+                if [a, b]
+                    .iter()
+                    .any(|r| r.starts_with("mix:") || r.starts_with("blend:"))
+                {
                     return Err(Error::invalid(format!(
                         "'{spec}': a blend joins two plain recipes, not mixtures or blends"
                     )));
