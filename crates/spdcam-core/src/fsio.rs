@@ -1,6 +1,7 @@
 //! Writing files so that an interrupted or failed run never leaves a half-written one.
 
 use crate::error::{Error, Result};
+use crate::limits;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -17,6 +18,15 @@ pub fn check_parent_dir(path: &Path) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Reads a whole text file whose size is within [`limits::TEXT_FILE_BYTES`].
+pub fn read_text(path: &Path) -> Result<String> {
+    let size = std::fs::metadata(path)
+        .map_err(|e| Error::io(path, e))?
+        .len();
+    limits::TEXT_FILE_BYTES.check(size, &path.display().to_string())?;
+    std::fs::read_to_string(path).map_err(|e| Error::io(path, e))
 }
 
 /// Checks, before long work, that a file can later be written at `path`: its directory

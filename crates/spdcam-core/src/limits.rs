@@ -57,6 +57,13 @@ pub const CHUNK_BYTES: Limit = Limit {
     default: 256 << 20,
 };
 
+/// Bytes of a text file read whole (spectral CSV, manifest): far above any real one.
+pub const TEXT_FILE_BYTES: Limit = Limit {
+    what: "bytes of a text file",
+    env: "SPDCAM_MAX_TEXT_FILE_BYTES",
+    default: 256 << 20,
+};
+
 /// Width in pixels of a smoothing filter (`grey-edge:p:sigma`): the Gaussian spans
 /// ±3σ, so its cost per pixel grows with σ.
 pub const FILTER_SIGMA_PX: Limit = Limit {

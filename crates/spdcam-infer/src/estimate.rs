@@ -38,17 +38,21 @@ pub struct FeatureRows {
 impl FeatureRows {
     /// Reads a features CSV: a header naming the columns, then one numeric row per estimate.
     pub fn read_csv(path: &Path) -> Result<FeatureRows> {
-        let text = std::fs::read_to_string(path)
+        let file = std::fs::File::open(path)
             .map_err(|e| InferError::invalid(format!("reading {}: {e}", path.display())))?;
-        FeatureRows::from_csv_str(&text, &path.display().to_string())
+        FeatureRows::from_reader(std::io::BufReader::new(file), &path.display().to_string())
     }
 
     /// Parses features CSV text (see [`FeatureRows::read_csv`]); `shown` names it in errors.
     pub fn from_csv_str(text: &str, shown: &str) -> Result<FeatureRows> {
+        FeatureRows::from_reader(text.as_bytes(), shown)
+    }
+
+    fn from_reader(input: impl std::io::Read, shown: &str) -> Result<FeatureRows> {
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .flexible(true)
-            .from_reader(text.as_bytes());
+            .from_reader(input);
         let names: Vec<String> = reader
             .headers()
             .map_err(|e| InferError::invalid(format!("{shown}: {e}")))?

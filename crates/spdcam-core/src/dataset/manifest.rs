@@ -268,7 +268,7 @@ impl Manifest {
                 dir.display()
             )));
         }
-        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let text = fsio::read_text(&path)?;
         let source = path.display().to_string();
         let value: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| Error::parse(&source, format!("not valid JSON: {e}")))?;

@@ -160,7 +160,7 @@ impl SpectralSet {
 
     /// Reads a spectral CSV file.
     pub fn read_csv(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = fsio::read_text(path)?;
         SpectralSet::from_csv_str(&text, &path.display().to_string())
     }
 
