@@ -13,8 +13,8 @@
 
 use crate::camera::sensor::Sensitivities;
 use crate::chart::Chart;
-use crate::colorimetry::{srgb_encode, xyz_to_linear_srgb};
 use crate::colorimetry::Observer;
+use crate::colorimetry::{srgb_encode, xyz_to_linear_srgb};
 use crate::error::{Error, Result};
 use crate::illuminant::StandardIlluminant;
 use crate::spectral::Grid;
@@ -188,13 +188,18 @@ impl SimpleCamera {
             .sum::<f64>()
             / linear.len() as f64;
         if !(luminance > 0.0 && luminance.is_finite()) {
-            return Err(Error::invalid("the light gives the simple camera no signal"));
+            return Err(Error::invalid(
+                "the light gives the simple camera no signal",
+            ));
         }
         let scale = shot.exposure_target / luminance;
         Ok(linear
             .iter()
             .flat_map(|v| {
-                (0..3).map(move |c| (255.0 * srgb_encode((v[c] * scale).clamp(0.0, 1.0)) as f64).round())
+                (0..3).map(move |c| {
+                    let encoded: f64 = srgb_encode((v[c] * scale).clamp(0.0, 1.0));
+                    (255.0 * encoded).round()
+                })
             })
             .collect())
     }
@@ -258,7 +263,11 @@ mod tests {
         };
         let warm = cam.photograph(&a, &shot).unwrap();
         // Patch 22 (neutral 5): red well above blue under illuminant A without balance.
-        assert!(warm[3 * 21] > warm[3 * 21 + 2] + 20.0, "{:?}", &warm[63..66]);
+        assert!(
+            warm[3 * 21] > warm[3 * 21 + 2] + 20.0,
+            "{:?}",
+            &warm[63..66]
+        );
         shot.adaptation = 1.0;
         let balanced = cam.photograph(&a, &shot).unwrap();
         assert!((balanced[3 * 21] - balanced[3 * 21 + 2]).abs() < warm[3 * 21] - warm[3 * 21 + 2]);
@@ -267,7 +276,9 @@ mod tests {
             let s = Shot::draw(&mut rng);
             assert!((0.6..=1.0).contains(&s.adaptation) && (0.0..=0.05).contains(&s.flare));
             let f = cam.photograph(&a, &s).unwrap();
-            assert!(f.iter().all(|v| (0.0..=255.0).contains(v) && v.fract() == 0.0));
+            assert!(f
+                .iter()
+                .all(|v| (0.0..=255.0).contains(v) && v.fract() == 0.0));
         }
         assert!(cam.photograph(&[1.0; 3], &shot).is_err());
     }

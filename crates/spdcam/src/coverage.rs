@@ -75,7 +75,10 @@ pub fn run(args: CoverageArgs, data_dir: &DataDir) -> Result<()> {
         } else {
             format!("`{spec}`")
         };
-        columns.push((label, best_gfc(&lighting, args.seed, args.draws, &library.spds)?));
+        columns.push((
+            label,
+            best_gfc(&lighting, args.seed, args.draws, &library.spds)?,
+        ));
         eprintln!("{spec}: done");
     }
     let fitted: Option<Vec<Option<f64>>> = (!args.no_fit).then(|| {
@@ -120,7 +123,10 @@ pub fn run(args: CoverageArgs, data_dir: &DataDir) -> Result<()> {
     for (label, best) in &columns {
         md += &format!("| {label} |");
         for &kind in &kinds {
-            md += &format!(" {} |", cell(members(kind).iter().map(|&i| best[i]).collect()));
+            md += &format!(
+                " {} |",
+                cell(members(kind).iter().map(|&i| best[i]).collect())
+            );
         }
         md.push('\n');
     }

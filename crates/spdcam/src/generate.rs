@@ -145,10 +145,7 @@ fn randomisation(
         let split = spdcam_core::lighting::ValidationSplit::read(path)?;
         sens.retain(|s| split.allows_training_camera(&s.name));
         if sens.is_empty() {
-            bail!(
-                "every camera of the pool is held out by {}",
-                path.display()
-            );
+            bail!("every camera of the pool is held out by {}", path.display());
         }
     }
     let variants = if groups.contains(&"camera") {

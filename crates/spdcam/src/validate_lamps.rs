@@ -121,11 +121,7 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
         model.check_features(&chart.feature_names(), &chart_name)?;
         let truth = on_grid(&library, &model.grid())?;
         let average = average_spd(&truth, &fit_lamps);
-        md += &format!(
-            "### `{}` ({chart_name})\n\n",
-            path.file_name()
-                .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into())
-        );
+        md += &format!("### `{}` ({chart_name})\n\n", file_name(path));
         md += "| lamp type | lamps (val / test) | average SPD (val) | (a) randomised in-camera (val) | (b) simple camera (val) | average SPD (test) | (a) test | (b) test |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
         let mut cells: Vec<[LampScores; 3]> = Vec::new();
         for (k, ids) in lamps.iter().enumerate() {
@@ -186,7 +182,7 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
         for (path, scores) in &real_rows {
             md += &format!(
                 "| `{}` | {:.4} | {:.4} | {:.4} |\n",
-                path.display(),
+                file_name(path),
                 scores[0],
                 scores[1],
                 scores[2]
@@ -209,6 +205,12 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");
     Ok(())
+}
+
+/// A model's file name, for the tables (directories differ between machines).
+fn file_name(path: &std::path::Path) -> String {
+    path.file_name()
+        .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into())
 }
 
 /// Every lamp of the library on `grid` (linear interpolation), normalised by its maximum.
@@ -303,7 +305,10 @@ fn score(
 ) -> Result<LampScores> {
     let estimates = model.estimate_rows(&photos.features)?;
     let d = model.grid().count;
-    debug_assert_eq!(photos.features.len() / photos.width, ids.len() * shots as usize);
+    debug_assert_eq!(
+        photos.features.len() / photos.width,
+        ids.len() * shots as usize
+    );
     Ok(ids
         .iter()
         .enumerate()
@@ -341,7 +346,10 @@ fn real_scores(args: &ValidateArgs, model: &Model, data_dir: &DataDir) -> Result
     let sets = [
         load(&["telelumen_canon5d4_dev"])?,
         load(&["hue_canon5d4_train", "hue_canon5d4_val"])?,
-        load(&["telelumen_galaxy_tab_s7_train", "telelumen_galaxy_tab_s7_val"])?,
+        load(&[
+            "telelumen_galaxy_tab_s7_train",
+            "telelumen_galaxy_tab_s7_val",
+        ])?,
     ];
     let grid = model.grid();
     let mut out = [0.0; 3];

@@ -47,7 +47,10 @@ fn row<'a>(table: &'a str, label: &str) -> Vec<&'a str> {
         .lines()
         .find(|l| l.trim_start_matches("| ").starts_with(label))
         .unwrap_or_else(|| panic!("no row {label} in\n{table}"));
-    line.split('|').map(str::trim).filter(|c| !c.is_empty()).collect()
+    line.split('|')
+        .map(str::trim)
+        .filter(|c| !c.is_empty())
+        .collect()
 }
 
 /// The mean of a `mean (worst)` cell.
@@ -65,7 +68,11 @@ fn write_lamps(dir: &Path) -> (PathBuf, PathBuf) {
     for k in 0..81 {
         let nm = 380.0 + 5.0 * k as f64;
         let line = (-((nm - 530.0) / 4.0).powi(2)).exp();
-        csv += &format!("{nm},{},{},{line}\n", planck(nm, 3000.0), planck(nm, 2700.0));
+        csv += &format!(
+            "{nm},{},{},{line}\n",
+            planck(nm, 3000.0),
+            planck(nm, 2700.0)
+        );
     }
     let spds = dir.join("lamps.csv");
     std::fs::write(&spds, csv).unwrap();
@@ -145,12 +152,7 @@ fn lamp_recipes_are_listed_and_bad_ones_named() {
         err.contains("lamp family 'candle'") && err.contains("phosphor-led"),
         "{err}"
     );
-    let err = fails(&[
-        "coverage",
-        &s(&spds),
-        "--lighting",
-        "lamp:hid:spread=wide",
-    ]);
+    let err = fails(&["coverage", &s(&spds), "--lighting", "lamp:hid:spread=wide"]);
     assert!(err.contains("spread 'wide'"), "{err}");
     // A lamp family and a blend with daylight draw (the built-in fits need no data).
     let out = ok(&[

@@ -6,7 +6,7 @@
 use crate::illuminant::planck_radiance;
 
 /// hc in eV·nm: photon energy E = [`HC_EV_NM`] / λ.
-pub const HC_EV_NM: f64 = 1239.841_984;
+pub const HC_EV_NM: f64 = 1_239.841_984;
 
 /// One emission shape.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,9 +45,10 @@ impl Shape {
                 let d = HC_EV_NM / nm - HC_EV_NM / peak_nm;
                 (-d * d / (2.0 * sigma_ev * sigma_ev)).exp()
             }
-            Shape::Line { centre_nm, sigma_nm } => {
-                (-(nm - centre_nm).powi(2) / (2.0 * sigma_nm * sigma_nm)).exp()
-            }
+            Shape::Line {
+                centre_nm,
+                sigma_nm,
+            } => (-(nm - centre_nm).powi(2) / (2.0 * sigma_nm * sigma_nm)).exp(),
             Shape::Filament { cct_k, tilt, curve } => {
                 let x = (nm - 580.0) / 200.0;
                 planck_radiance(nm, cct_k) * (tilt * x + curve * x * x).exp()

@@ -65,7 +65,13 @@ mod tests {
         let lighting = Lighting::parse("planck:2000-3000", &DataDir::new(None), &grid).unwrap();
         let member = lighting.draw(9, 3).unwrap().spd;
         let line: Vec<f64> = (0..grid.count)
-            .map(|k| if grid.wavelength(k) == 450.0 { 1.0 } else { 0.0 })
+            .map(|k| {
+                if grid.wavelength(k) == 450.0 {
+                    1.0
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let dark = vec![0.0; grid.count];
         let best = best_gfc(&lighting, 9, 50, &[member, line, dark]).unwrap();

@@ -155,7 +155,10 @@ mod tests {
         let a = DMatrix::from_row_slice(4, 3, &[1., 0., 1., 0., 1., -1., 1., 1., 0., 1., 2., 0.]);
         let b = DVector::from_row_slice(&[2., 3., 5., 8.]);
         let x = nnls(&a, &b);
-        assert!((x[0] - 2.0).abs() < 1e-10 && (x[1] - 3.0).abs() < 1e-10, "{x}");
+        assert!(
+            (x[0] - 2.0).abs() < 1e-10 && (x[1] - 3.0).abs() < 1e-10,
+            "{x}"
+        );
         assert!(x[2].abs() < 1e-10, "{x}");
         // The unconstrained optimum of min ‖x − (1, −1)‖ clips at zero.
         let id = DMatrix::identity(2, 2);

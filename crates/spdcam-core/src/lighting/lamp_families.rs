@@ -40,7 +40,7 @@ const FLUORESCENT_LINES: [f64; 13] = [
 /// Lines of high-intensity discharge lamps (nm): Hg, Na, Tl, In, Li.
 const DISCHARGE_LINES: [f64; 12] = [
     404.66, 435.83, 546.07, 578.0, // Hg
-    589.3, 568.8, 615.4, 498.3, // Na (D doublet as one)
+    589.3, 568.8, 615.4, 498.3,  // Na (D doublet as one)
     535.05, // Tl
     410.18, 451.13, // In
     670.78, // Li
@@ -470,7 +470,7 @@ pub fn fit_lamp(family: LampFamily, name: &str, spd: &[f64], grid: &Grid) -> Res
         .copied()
         .collect();
     let max = model.iter().cloned().fold(0.0, f64::max);
-    if !(max > 0.0) {
+    if max.is_nan() || max <= 0.0 {
         return Err(Error::invalid(format!(
             "lamp '{name}': the {} model fits it with zero light",
             family.name()
@@ -558,12 +558,15 @@ impl LampDraws {
     /// Draws for `family` from `fits`, on `grid`, with the kernel bandwidths multiplied by
     /// `spread` (1 = Scott's rule; 0 = the fitted lamps themselves).
     pub fn new(fits: &LampFits, family: LampFamily, grid: &Grid, spread: f64) -> Result<Self> {
-        let fit = fits.family(family).filter(|f| !f.lamps.is_empty()).ok_or_else(|| {
-            Error::invalid(format!(
-                "no lamps are fitted to the {} family; run `spdcam lamps fit`",
-                family.name()
-            ))
-        })?;
+        let fit = fits
+            .family(family)
+            .filter(|f| !f.lamps.is_empty())
+            .ok_or_else(|| {
+                Error::invalid(format!(
+                    "no lamps are fitted to the {} family; run `spdcam lamps fit`",
+                    family.name()
+                ))
+            })?;
         if !(spread.is_finite() && (0.0..=10.0).contains(&spread)) {
             return Err(Error::invalid(format!(
                 "lamp:{}: spread {spread} is outside 0–10",
@@ -639,8 +642,8 @@ impl LampDraws {
             .zip(&self.theta_kernel)
             .map(|(&v, k)| {
                 let x = if k.scale == Scale::Log { v.ln() } else { v };
-                let moved =
-                    (x + self.spread * k.bandwidth * normal()).clamp(k.lower.min(x), k.upper.max(x));
+                let moved = (x + self.spread * k.bandwidth * normal())
+                    .clamp(k.lower.min(x), k.upper.max(x));
                 if k.scale == Scale::Log {
                     moved.exp()
                 } else {
@@ -698,15 +701,17 @@ mod tests {
                 vec![455.0, 11.0, 530.0, 17.0, 590.0, 9.0, 632.0, 10.0],
                 vec![0.5, 0.9, 0.4, 0.7],
             ),
-            (
-                LampFamily::Incandescent,
-                vec![2900.0, 0.4, -0.3],
-                vec![1.0],
-            ),
+            (LampFamily::Incandescent, vec![2900.0, 0.4, -0.3], vec![1.0]),
             (
                 LampFamily::Fluorescent,
                 vec![0.0, 2.5, 450.0, 0.2, 490.0, 0.25, 600.0, 0.12],
-                [vec![0.2, 0.5, 0.9, 0.2], vec![0.1, 0.6, 0.1, 0.1], vec![0.05, 1.0, 0.2, 0.1, 0.05], vec![0.1, 0.1, 0.2]].concat(),
+                [
+                    vec![0.2, 0.5, 0.9, 0.2],
+                    vec![0.1, 0.6, 0.1, 0.1],
+                    vec![0.05, 1.0, 0.2, 0.1, 0.05],
+                    vec![0.1, 0.1, 0.2],
+                ]
+                .concat(),
             ),
         ];
         let wl = grid().wavelengths();
@@ -770,7 +775,10 @@ mod tests {
         // The pump varies (the fitted pumps span 440–460 nm) but stays in their range
         // widened by one bandwidth (10 · 3^(−0.1) ≈ 8 nm).
         assert!(peaks.iter().any(|&p| p != peaks[0]));
-        assert!(peaks.iter().all(|&p| (430.0..=470.0).contains(&p)), "{peaks:?}");
+        assert!(
+            peaks.iter().all(|&p| (430.0..=470.0).contains(&p)),
+            "{peaks:?}"
+        );
         // A family without fitted lamps is an error that says what to run.
         let err = LampDraws::new(&fits, LampFamily::Hid, &grid(), 1.0).unwrap_err();
         assert!(err.to_string().contains("spdcam lamps fit"));

@@ -243,6 +243,9 @@ mod tests {
             product_key("LED Phosphor Blue Pump (07)"),
             "LED Phosphor Blue Pump (07)"
         );
-        assert_eq!(product_key("MHC100UMP3K - Metal Halide"), "MHC100UMP3K - Metal Halide");
+        assert_eq!(
+            product_key("MHC100UMP3K - Metal Halide"),
+            "MHC100UMP3K - Metal Halide"
+        );
     }
 }

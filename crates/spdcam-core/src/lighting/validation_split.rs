@@ -111,8 +111,8 @@ impl ValidationSplit {
         }
         let mut keys: Vec<&str> = models.keys().copied().collect();
         keys.shuffle(&mut rng);
-        let held = ((keys.len() as f64 * HELD_OUT_CAMERA_SHARE).round() as usize)
-            .clamp(1, keys.len() - 1);
+        let held =
+            ((keys.len() as f64 * HELD_OUT_CAMERA_SHARE).round() as usize).clamp(1, keys.len() - 1);
         let mut held_out: Vec<String> = keys[..held]
             .iter()
             .flat_map(|k| models[k].iter().map(|c| c.to_string()))
@@ -137,10 +137,7 @@ impl ValidationSplit {
             ),
             seed,
             lamps,
-            cameras: CameraSplit {
-                training,
-                held_out,
-            },
+            cameras: CameraSplit { training, held_out },
         })
     }
 
