@@ -209,8 +209,10 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
 
 /// A model's file name, for the tables (directories differ between machines).
 fn file_name(path: &std::path::Path) -> String {
-    path.file_name()
-        .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into())
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    )
 }
 
 /// Every lamp of the library on `grid` (linear interpolation), normalised by its maximum.
