@@ -14,8 +14,10 @@ use serde::Serialize;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
+use spdcam_core::feature_check;
 use spdcam_core::metrics;
-use spdcam_core::photo::{self, AnalyseOptions, ChartTemplate, PhotoAnalysis};
+use spdcam_core::photo::{self, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis};
+use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use std::path::{Path, PathBuf};
 
@@ -36,12 +38,17 @@ pub struct FeatureRows {
 impl FeatureRows {
     /// Reads a features CSV: a header naming the columns, then one numeric row per estimate.
     pub fn read_csv(path: &Path) -> Result<FeatureRows> {
-        let shown = path.display();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| InferError::invalid(format!("reading {}: {e}", path.display())))?;
+        FeatureRows::from_csv_str(&text, &path.display().to_string())
+    }
+
+    /// Parses features CSV text (see [`FeatureRows::read_csv`]); `shown` names it in errors.
+    pub fn from_csv_str(text: &str, shown: &str) -> Result<FeatureRows> {
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .flexible(true)
-            .from_path(path)
-            .map_err(|e| InferError::invalid(format!("reading {shown}: {e}")))?;
+            .from_reader(text.as_bytes());
         let names: Vec<String> = reader
             .headers()
             .map_err(|e| InferError::invalid(format!("{shown}: {e}")))?
@@ -93,6 +100,32 @@ impl FeatureRows {
         })
     }
 
+    /// Rows from values in memory (row-major, one column per name; e.g. a numpy array),
+    /// checked like a CSV's: whole rows, at least one, every value finite. `source` names
+    /// them in messages.
+    pub fn from_values(names: Vec<String>, values: Vec<f64>, source: &str) -> Result<FeatureRows> {
+        let columns = names.len();
+        if columns == 0 || values.is_empty() || values.len() % columns != 0 {
+            return Err(InferError::invalid(format!(
+                "{source}: {} values do not make rows of {columns} features",
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(InferError::invalid(format!(
+                "{source} row {}, column {}: {} is not a finite number",
+                i / columns + 1,
+                names[i % columns],
+                values[i]
+            )));
+        }
+        Ok(FeatureRows {
+            rows: values.len() / columns,
+            names,
+            values,
+        })
+    }
+
     /// The rows of analysed photos that all show the same chart.
     pub fn of_analyses(analyses: &[&PhotoAnalysis]) -> Result<FeatureRows> {
         let Some(first) = analyses.first() else {
@@ -128,6 +161,7 @@ pub fn estimate_rows(
     grid: &Grid,
 ) -> Result<SpectralSet> {
     model.check_features(&features.names, source)?;
+    check_rows(features, source)?;
     let mg = model.grid();
     if grid.start_nm < mg.start_nm - 1e-9 || grid.end_nm() > mg.end_nm() + 1e-9 {
         return Err(InferError::invalid(format!(
@@ -144,6 +178,29 @@ pub fn estimate_rows(
     }
     let (resampled, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
     Ok(resampled)
+}
+
+/// Refuses rows that say nothing about the light (values outside the encoding's range, a
+/// black chart, a chart without colour; see [`feature_check`]), naming the row when there
+/// are several. Rows on 0–1 are told from rows on 0–255 by their largest value.
+fn check_rows(features: &FeatureRows, source: &str) -> Result<()> {
+    let width = features.names.len().max(1);
+    for (i, row) in features.values.chunks(width).enumerate() {
+        let scale = if row.iter().any(|&v| v > 1.0) {
+            255.0
+        } else {
+            1.0
+        };
+        feature_check::check_feature_row(row, &features.names, scale).map_err(|e| {
+            let at = if features.rows > 1 {
+                format!(" row {}", i + 1)
+            } else {
+                String::new()
+            };
+            InferError::invalid(format!("{source}{at}: {e}"))
+        })?;
+    }
+    Ok(())
 }
 
 /// CIE 1931 xy, and CCT and Duv where the chromaticity is near enough the Planckian locus.
@@ -213,6 +270,9 @@ pub struct Estimate {
     pub spd: Vec<f64>,
     /// xy, CCT, Duv of the SPD.
     pub colorimetry: Colorimetry,
+    /// The lighting-quality metrics of the SPD (CRI, TM-30, α-opic, S/P, PPF, blue-light
+    /// hazard; `spdcam_core::quality`), computed on the SPD's grid only.
+    pub metrics: LightingMetrics,
     /// The score against a true SPD, when one was given.
     pub truth: Option<Score>,
     /// The analysis of the photo, for estimates from photos.
@@ -220,8 +280,8 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`, `truth`,
-    /// and for photos `photo` (chart, method, confidence, corners, homography, features and
+    /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`,
+    /// `metrics` (every [`LightingMetrics`] key), `truth`, and for photos `photo` (chart, method, confidence, corners, homography, features and
     /// `features_by_name`, every patch with its statistics and flags, warnings).
     pub fn to_json(&self) -> Result<serde_json::Value> {
         let mut v = serde_json::json!({
@@ -230,6 +290,7 @@ impl Estimate {
             "wavelength_nm": self.grid.wavelengths(),
             "spd": self.spd,
             "colorimetry": self.colorimetry,
+            "metrics": self.metrics,
             "truth": self.truth,
         });
         if let Some(a) = &self.photo {
@@ -282,6 +343,7 @@ pub fn estimate_features(
                 grid: *grid,
                 spd: set.item(i).to_vec(),
                 colorimetry: Colorimetry::of(set.item(i), grid)?,
+                metrics: LightingMetrics::from_samples(&grid.wavelengths(), set.item(i)),
                 truth: None,
                 photo: None,
             })
@@ -411,6 +473,7 @@ pub fn estimate_analysis(
         model: chosen.name.clone(),
         grid: *grid,
         colorimetry: Colorimetry::of(&spd, grid)?,
+        metrics: LightingMetrics::from_samples(&grid.wavelengths(), &spd),
         spd,
         truth: None,
         photo: Some(analysis),
@@ -437,6 +500,62 @@ pub fn estimate_photo(
     estimate_analysis(models, analysis, name, grid)
 }
 
+/// Analyses a decoded photo: the chart found (or placed by `options.corners`) among the
+/// charts [`chart_templates`] gives, and sampled.
+pub fn analyse_decoded(
+    photo: &Photo,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+) -> Result<PhotoAnalysis> {
+    let analyse = AnalyseOptions {
+        templates: chart_templates(models, options.chart.as_deref(), data_dir)?,
+        corners: options.corners.clone(),
+        debug: options.debug.clone(),
+    };
+    Ok(photo::analyse(photo, &analyse)?)
+}
+
+/// Analyses a photo held in memory (an upload, never written to disk) named `name` in
+/// messages, decoded with the same limits as a file.
+pub fn analyse_photo_bytes(
+    bytes: &[u8],
+    name: &str,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+) -> Result<PhotoAnalysis> {
+    let decoded = photo::decode_photo(bytes, name)?;
+    analyse_decoded(&decoded, models, options, data_dir)
+}
+
+/// The estimate for a photo already decoded (from bytes or a pixel array, e.g. in Python),
+/// analysed with `options` and estimated with the model for its chart, labelled with the
+/// photo's source.
+pub fn estimate_decoded(
+    photo: &Photo,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Estimate> {
+    let analysis = analyse_decoded(photo, models, options, data_dir)?;
+    estimate_analysis(models, analysis, photo.source.clone(), grid)
+}
+
+/// [`estimate_photo`] for a photo held in memory, labelled `name`.
+pub fn estimate_photo_bytes(
+    bytes: &[u8],
+    name: &str,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Estimate> {
+    let analysis = analyse_photo_bytes(bytes, name, models, options, data_dir)?;
+    estimate_analysis(models, analysis, name.to_string(), grid)
+}
+
 /// `colorchecker_sg96, colorchecker24`: the charts the set's models read.
 fn charts_of(models: &ModelSet) -> String {
     models
@@ -445,4 +564,63 @@ fn charts_of(models: &ModelSet) -> String {
         .map(|m| m.model.header().chart.as_deref().unwrap_or("unknown"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn example_photo() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/sg-telelumen.jpg")
+    }
+
+    #[test]
+    fn a_decoded_photo_gives_the_same_estimate_as_its_file() {
+        let models = ModelSet::shipped().unwrap();
+        let grid = Grid::parse("400-700:5").unwrap();
+        let options = PhotoOptions::default();
+        let data_dir = DataDir::new(None);
+        let path = example_photo();
+        let from_file = estimate_photo(&path, &models, &options, &data_dir, &grid).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let photo = photo::decode_photo(&bytes, "in memory").unwrap();
+        let decoded = estimate_decoded(&photo, &models, &options, &data_dir, &grid).unwrap();
+        assert_eq!(decoded.name, "in memory");
+        assert_eq!(decoded.spd, from_file.spd);
+        assert_eq!(decoded.colorimetry, from_file.colorimetry);
+    }
+
+    #[test]
+    fn rows_from_values_are_checked_like_a_csv() {
+        let names = vec!["a".to_string(), "b".to_string()];
+        let rows = FeatureRows::from_values(names.clone(), vec![1.0, 2.0, 3.0, 4.0], "x").unwrap();
+        assert_eq!(rows.rows, 2);
+        let err = FeatureRows::from_values(names.clone(), vec![1.0, 2.0, 3.0], "x").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "x: 3 values do not make rows of 2 features"
+        );
+        let err = FeatureRows::from_values(names, vec![1.0, 2.0, 3.0, f64::NAN], "x").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "x row 2, column b: NaN is not a finite number"
+        );
+    }
+
+    #[test]
+    fn a_photo_without_a_chart_names_itself() {
+        let models = ModelSet::shipped().unwrap();
+        let grid = Grid::parse("400-700:5").unwrap();
+        let photo = Photo::from_rgb8("grey.png", 200, 150, vec![128; 200 * 150 * 3]).unwrap();
+        let err = estimate_decoded(
+            &photo,
+            &models,
+            &PhotoOptions::default(),
+            &DataDir::new(None),
+            &grid,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("grey.png"), "{err}");
+    }
 }

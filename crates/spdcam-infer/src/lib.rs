@@ -38,6 +38,9 @@ pub mod shipped;
 pub mod target;
 
 pub use error::{InferError, Result};
-pub use estimate::{estimate_features, estimate_photo, Estimate, FeatureRows, PhotoOptions};
+pub use estimate::{
+    analyse_photo_bytes, estimate_decoded, estimate_features, estimate_photo, estimate_photo_bytes,
+    Estimate, FeatureRows, PhotoOptions,
+};
 pub use model::Model;
 pub use shipped::ModelSet;

@@ -384,7 +384,12 @@ impl Model {
         let mut c = Cursor { bytes, at: 8 };
         let truncated = || bad("the file is truncated".into());
         let version = c.u32().ok_or_else(truncated)?;
-        if version == 0 || version > FORMAT_VERSION {
+        if version == 0 {
+            return Err(bad(
+                "model format version 0, which no spdcam writes: the file is damaged".into(),
+            ));
+        }
+        if version > FORMAT_VERSION {
             return Err(bad(format!(
                 "model format version {version}; this spdcam reads versions 1 to {FORMAT_VERSION} \
                  (a newer spdcam wrote it?)"

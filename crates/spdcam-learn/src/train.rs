@@ -32,10 +32,12 @@ fn device(backend: Backend) -> Result<Device> {
         #[cfg(feature = "wgpu")]
         Backend::Wgpu => Device::wgpu(Default::default()),
         #[allow(unreachable_patterns)]
-        other => return Err(LearnError::invalid(format!(
+        other => {
+            return Err(LearnError::invalid(format!(
             "this build has no {other:?} backend; rebuild spdcam-learn with the cargo feature {}",
             format!("{other:?}").to_lowercase()
-        ))),
+        )))
+        }
     };
     Ok(device.autodiff())
 }

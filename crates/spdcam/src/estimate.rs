@@ -12,6 +12,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
 use spdcam_core::metrics;
 use spdcam_core::photo::{self, PhotoAnalysis};
+use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_infer::estimate::{analyse_photos, chart_templates, estimate_analysis};
 use spdcam_infer::plot::spds_svg;
@@ -36,7 +37,8 @@ pub struct EstimateArgs {
     /// p01_g, …), one row per estimate; values on any scale (0–255 or 0–1).
     #[arg(long, value_name = "FILE.csv", conflicts_with = "photos")]
     features: Option<PathBuf>,
-    /// Spectral CSV to write: wavelength_nm, then one column per photo (or feature row).
+    /// Spectral CSV to write: wavelength_nm, then one column per photo (or feature row);
+    /// `-` writes it to standard output (and nothing else goes there).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Wavelength grid of the output, START-END[:STEP] in nm (within the model's grid).
@@ -86,12 +88,26 @@ fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
-/// Reads a spectral CSV of true SPDs, resampled to `grid`.
+/// Reads a spectral CSV of true SPDs, resampled to `grid`; a truth that is negative or
+/// holds no light on `grid` is refused (a GFC against it means nothing).
 fn read_truths(path: &Path, grid: &Grid) -> Result<SpectralSet> {
     let set = SpectralSet::read_csv(path)
+        .and_then(|s| s.require_non_negative("true SPD", 0.01))
         .with_context(|| format!("reading the true SPDs {}", path.display()))?;
     let (set, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
+    if let Some(i) = (0..set.len()).find(|&i| set.item(i).iter().all(|&v| v <= 0.0)) {
+        bail!(
+            "{}: the true SPD '{}' is zero everywhere on {grid}; a truth must hold light",
+            path.display(),
+            set.names()[i]
+        );
+    }
     Ok(set)
+}
+
+/// Whether the terminal report is left out: with `--json`, or with the SPDs on stdout.
+fn quiet(args: &EstimateArgs) -> bool {
+    args.photo.json || args.output.as_deref().is_some_and(fsio::is_stdout)
 }
 
 /// The truth for each estimate: from `--truth` (one column for all, or one per estimate),
@@ -178,7 +194,7 @@ fn estimate_from_photos(
     let mut estimates = Vec::with_capacity(analyses.len());
     let mut paths = Vec::with_capacity(analyses.len());
     for (path, label, analysis) in analyses {
-        if !args.photo.json {
+        if !quiet(args) {
             println!("{}", photo_args::describe(&analysis));
         }
         match estimate_analysis(models, analysis, label, grid) {
@@ -202,6 +218,9 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         .flatten()
     {
         fsio::check_parent_dir(path)?;
+    }
+    if args.photo.json && args.output.as_deref().is_some_and(fsio::is_stdout) {
+        bail!("--json and -o - both write to standard output; choose one");
     }
     if let Some(plot) = &args.plot {
         plot_is_png(plot)?;
@@ -239,7 +258,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         estimates.iter().map(|e| e.spd.clone()).collect(),
     )?;
     if let Some(out) = &args.output {
-        set.write_csv(out)?;
+        fsio::write_output(out, set.to_csv_string().as_bytes())?;
     }
     if let Some(plot) = &args.plot {
         let shown = set.len().min(20);
@@ -259,7 +278,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             .map(Estimate::to_json)
             .collect::<spdcam_infer::Result<Vec<_>>>()?;
         println!("{}", serde_json::to_string_pretty(&json)?);
-    } else {
+    } else if !quiet(&args) {
         print_estimates(&estimates, &args);
     }
     if failed > 0 {
@@ -282,6 +301,7 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
         if detailed {
             println!("{}: {}", e.name, e.colorimetry.label());
             println!("  relative SPD: {}", spd_line(&e.spd, &e.grid));
+            println!("  {}", metrics_line(&e.metrics));
         }
         if let Some(s) = e.truth {
             println!(
@@ -293,6 +313,16 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     if estimates.iter().any(|e| e.photo.is_some()) {
         println!(
             "confidence: how sure the chart's detection is (0–1; below 0.8 check the --debug image)"
+        );
+    }
+    if detailed {
+        println!(
+            "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and gamut; \
+             M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: scotopic/photopic; \
+             PPF: µmol/s of 400–700 nm photons per klm; computed on the estimate's {}–{} nm only \
+             (`spdcam metrics` on a wider SPD, `--json` for every number)",
+            estimates[0].grid.start_nm,
+            estimates[0].grid.end_nm()
         );
     }
     if estimates.iter().any(|e| e.truth.is_some()) {
@@ -310,6 +340,21 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     if let Some(plot) = &args.plot {
         println!("plot → {}", plot.display());
     }
+}
+
+/// The main lighting-quality numbers on one line, `—` where undefined.
+fn metrics_line(m: &LightingMetrics) -> String {
+    let f = |v: Option<f64>, d: usize| v.map_or_else(|| "—".into(), |v| format!("{v:.d$}"));
+    format!(
+        "Ra {} (R9 {}), Rf {}, Rg {}, M-EDER {}, S/P {}, PPF {}",
+        f(m.cri_ra, 0),
+        f(m.cri_r.map(|r| r[8]), 0),
+        f(m.tm30_rf, 0),
+        f(m.tm30_rg, 0),
+        f(m.mel_der, 2),
+        f(m.sp_ratio, 2),
+        f(m.ppf_per_lux.map(|v| 1000.0 * v), 1),
+    )
 }
 
 /// The SPD every 25 nm, peak-normalised, on one terminal line: `400:0.12 425:0.40 …`.

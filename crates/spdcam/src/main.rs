@@ -21,6 +21,7 @@ mod plot_file;
 mod render;
 #[cfg(feature = "train")]
 mod ridge;
+mod serve;
 #[cfg(feature = "train")]
 mod sim2real_curve;
 #[cfg(feature = "train")]
@@ -74,6 +75,8 @@ enum Command {
     #[cfg(feature = "train")]
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
     Sim2real(experiment_sim2real::Sim2realArgs),
+    /// Serve a local web page where photos are dropped and their light is shown.
+    Serve(serve::ServeArgs),
     /// How well lighting recipes cover measured SPDs, per lamp type.
     Coverage(Box<coverage::CoverageArgs>),
     /// Real lamps: the validation split, the lamp-family fits, the validation protocol.
@@ -117,6 +120,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),
         #[cfg(feature = "train")]
         Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
+        Command::Serve(args) => serve::run(args, &data_dir),
         Command::Coverage(args) => coverage::run(*args, &data_dir),
         Command::Lamps(args) => lamps::run(args, &data_dir),
     };

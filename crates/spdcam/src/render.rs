@@ -245,9 +245,9 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         bail!("only one of -o and --features can go to standard output");
     }
     if let Some(dir) = &args.stages {
-        if !dir.is_dir() {
-            bail!("stages directory {} does not exist", dir.display());
-        }
+        // Made here, before the render, so a bad place fails at once.
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot make the stages directory {}", dir.display()))?;
     }
     if let Some(path) = &args.spd_out {
         fsio::check_parent_dir(path)?;

@@ -22,7 +22,7 @@ use spdcam_core::lighting::{LampLibrary, LampType, ValidationSplit};
 use spdcam_core::simple_camera::{Shot, SimpleCamera};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_core::{metrics, seed};
-use spdcam_infer::model::Model;
+use spdcam_infer::Model;
 use std::path::PathBuf;
 
 /// Options of `spdcam lamps validate`.

@@ -159,6 +159,7 @@ fn dash_writes_to_standard_output() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[cfg(feature = "train")]
 #[test]
 fn train_refuses_an_unwritable_model_path_before_training() {
     // Issue 15, item 6: `train -o DIR` failed only after training finished.
@@ -186,6 +187,7 @@ fn train_refuses_an_unwritable_model_path_before_training() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[cfg(feature = "train")]
 #[test]
 fn evaluate_refuses_to_overwrite_a_directory_of_user_files() {
     // Issue 15, item 10: `evaluate -o` overwrote a user's files while export/split refuse.
@@ -278,6 +280,131 @@ fn a_damaged_dataset_fails_verification_and_a_failed_import_leaves_nothing() {
         again.status.success(),
         "{}",
         String::from_utf8_lossy(&again.stderr)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The example photo committed with the repository (a ColorChecker Digital SG).
+fn example_photo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/sg-telelumen.jpg")
+}
+
+#[test]
+fn nonsense_features_and_truths_get_no_spd() {
+    // Issue 15, item 5: all-zero features printed "CCT 6744 K", negative features were
+    // accepted, a greyscale photo got an SPD, an all-zero truth printed GFC 0.0000.
+    let dir = scratch("nonsense");
+    let features = dir.join("f.csv");
+    let out = spdcam(&[
+        "estimate",
+        s(&example_photo()),
+        "--features-out",
+        s(&features),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&features).unwrap();
+    let (header, row) = text.trim().split_once('\n').unwrap();
+    let values: Vec<f64> = row.split(',').map(|v| v.parse().unwrap()).collect();
+    let write = |name: &str, values: &[f64]| {
+        let path = dir.join(name);
+        let cells: Vec<String> = values.iter().map(|v| v.to_string()).collect();
+        std::fs::write(&path, format!("{header}\n{}\n", cells.join(","))).unwrap();
+        path
+    };
+    let zero = write("zero.csv", &vec![0.0; values.len()]);
+    let e = fails_fast(&["estimate", "--features", s(&zero)]);
+    assert!(e.contains("black") && !e.contains("CCT"), "{e}");
+    let mut negative = values.clone();
+    negative[4] = -3.0;
+    let e = fails_fast(&["estimate", "--features", s(&write("neg.csv", &negative))]);
+    assert!(e.contains("p02_g") && e.contains("-3"), "{e}");
+    let grey: Vec<f64> = values
+        .chunks(3)
+        .flat_map(|p| {
+            let mean = p.iter().sum::<f64>() / 3.0;
+            [mean; 3]
+        })
+        .collect();
+    let e = fails_fast(&["estimate", "--features", s(&write("grey.csv", &grey))]);
+    assert!(e.contains("greyscale"), "{e}");
+
+    let truth = dir.join("zero-truth.csv");
+    std::fs::write(&truth, "wavelength_nm,t\n380,0\n780,0\n").unwrap();
+    let e = fails_fast(&["estimate", "--features", s(&features), "--truth", s(&truth)]);
+    assert!(e.contains("zero everywhere"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_greyscale_photo_gets_no_spd() {
+    let dir = scratch("greyscale");
+    let grey = dir.join("grey.png");
+    image::open(example_photo())
+        .unwrap()
+        .grayscale()
+        .save(&grey)
+        .unwrap();
+    let e = fails_fast(&["estimate", s(&grey)]);
+    assert!(e.contains("grey.png"), "{e}");
+    assert!(e.contains("greyscale") || e.contains("no chart"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_truncated_jpeg_is_estimated_with_a_warning() {
+    // Issue 15, item 11: JPEGs cut at 90 % and 99 % decoded without a word.
+    let dir = scratch("truncated");
+    let bytes = std::fs::read(example_photo()).unwrap();
+    let cut = dir.join("cut.jpg");
+    std::fs::write(&cut, &bytes[..bytes.len() * 99 / 100]).unwrap();
+    let out = spdcam(&["estimate", s(&cut)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("cut.jpg") && stderr.contains("truncated"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn estimates_go_to_standard_output_with_dash() {
+    let dir = scratch("estimate-stdout");
+    let out = Command::new(env!("CARGO_BIN_EXE_spdcam"))
+        .args(["estimate", s(&example_photo()), "-o", "-"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.starts_with("wavelength_nm,sg-telelumen.jpg\n400,"),
+        "{text}"
+    );
+    assert_eq!(text.lines().count(), 62, "the CSV and nothing else: {text}");
+    assert!(!dir.join("-").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_version_0_model_is_called_damaged_not_newer() {
+    let dir = scratch("model-v0");
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/colorchecker_sg96.spdm");
+    let mut bytes = std::fs::read(shipped).unwrap();
+    bytes[8..12].copy_from_slice(&0u32.to_le_bytes());
+    let model = dir.join("v0.spdm");
+    std::fs::write(&model, bytes).unwrap();
+    let e = fails_fast(&["estimate", s(&example_photo()), "--model", s(&model)]);
+    assert!(
+        e.contains("version 0") && e.contains("damaged") && !e.contains("newer"),
+        "{e}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -235,6 +235,7 @@ impl NormalStream {
     fn new(seed: u64) -> NormalStream {
         let mut words = (1..).map(|k| crate::seed::derive(seed, k));
         let mut state = [[0u32; LANES]; 4];
+        #[allow(clippy::needless_range_loop)] // one lane's four words per step
         for lane in 0..LANES {
             let (a, b) = (words.next().unwrap_or(1), words.next().unwrap_or(2));
             state[0][lane] = a as u32;
@@ -275,6 +276,7 @@ impl NormalStream {
 /// with his w = −ln(1 − x²) taken as −ln(4u(1 − u)) (no cancellation near u = 0 or 1).
 /// Both branches are evaluated and one selected, so the function vectorises.
 #[inline(always)]
+#[allow(clippy::excessive_precision)] // the published coefficients, as printed
 fn inverse_normal_cdf(u: f32) -> f32 {
     let w = -ln(4.0 * u * (1.0 - u));
     let x = 2.0 * u - 1.0;
@@ -313,6 +315,7 @@ fn inverse_normal_cdf(u: f32) -> f32 {
 /// Natural logarithm of a positive normal `x`, by Cephes's `logf` (S. Moshier 1984):
 /// x = m·2ᵉ with m in [√½, √2), ln(m) by a degree-9 polynomial in m − 1; within 5e-7.
 #[inline(always)]
+#[allow(clippy::excessive_precision)] // the published coefficients, as printed
 fn ln(x: f32) -> f32 {
     let bits = x.to_bits();
     let mut e = ((bits >> 23) & 0xff) as i32 - 127;

@@ -114,7 +114,7 @@ fn assemble(
         .iter()
         .flat_map(|&p| patches[p].rgb)
         .collect();
-    let mut warnings = Vec::new();
+    let mut warnings = photo.warnings.clone();
     let clipped: Vec<usize> = template
         .feature_patches
         .iter()

@@ -96,6 +96,23 @@ impl Photo {
         }
     }
 
+    /// The stored values, interleaved RGB row by row, when they have 8 bits per channel
+    /// (e.g. to hand the decoded photo to another program).
+    pub fn rgb8(&self) -> Option<&[u8]> {
+        match &self.pixels {
+            Pixels::Rgb8(d) => Some(d),
+            Pixels::Rgb16(_) => None,
+        }
+    }
+
+    /// The stored values, interleaved RGB row by row, when they have 16 bits per channel.
+    pub fn rgb16(&self) -> Option<&[u16]> {
+        match &self.pixels {
+            Pixels::Rgb8(_) => None,
+            Pixels::Rgb16(d) => Some(d),
+        }
+    }
+
     /// Bits per channel of the stored values (8 or 16).
     pub fn bit_depth(&self) -> u32 {
         match self.pixels {
@@ -226,10 +243,11 @@ pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
     image.apply_orientation(orientation);
     let mut photo = Photo::from_image(source, image)?;
     if format == ImageFormat::Jpeg && jpeg_is_truncated(bytes) {
-        photo.warnings.push(format!(
-            "{source}: the JPEG file is truncated (it ends before its end-of-image marker); \
-             the missing part of the picture is filled in by the decoder"
-        ));
+        photo.warnings.push(
+            "the JPEG file is truncated (it ends before its end-of-image marker); the \
+             missing part of the picture is filled in by the decoder"
+                .to_string(),
+        );
     }
     Ok(photo)
 }
@@ -297,6 +315,9 @@ mod tests {
         assert_eq!((p.width, p.height, p.bit_depth()), (20, 18, 16));
         let v = p.pixel(3, 2);
         assert!((v[0] - 3000.0 / 65535.0).abs() < 1e-6 && (v[2] - 1.0).abs() < 1e-6);
+        let values = p.rgb16().unwrap();
+        assert_eq!(&values[3 * (2 * 20 + 3)..][..3], &[3000, 6000, 65535]);
+        assert!(p.rgb8().is_none());
     }
 
     fn jpeg_of(width: u32, height: u32) -> Vec<u8> {

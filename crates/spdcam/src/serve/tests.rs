@@ -1,0 +1,248 @@
+//! The server in-process on a free loopback port, spoken to over plain HTTP/1.1 sockets.
+
+use super::{shipped_engine, Config, Server};
+use spdcam_core::builtin::DataDir;
+use spdcam_core::spectral::Grid;
+use spdcam_infer::{estimate_photo_bytes, ModelSet, PhotoOptions};
+use std::io::{Read, Write};
+use std::net::{SocketAddr, TcpStream};
+use std::time::Duration;
+
+const EXAMPLE: &[u8] = include_bytes!("../../../../examples/sg-telelumen.jpg");
+const BOUNDARY: &str = "spdcam-test-boundary-7f3a";
+
+fn start(max_upload_bytes: usize) -> Server {
+    Server::start(
+        Config {
+            addr: "127.0.0.1:0".parse().unwrap(),
+            max_upload_bytes,
+            workers: 2,
+        },
+        shipped_engine(&DataDir::new(None)).unwrap(),
+    )
+    .unwrap()
+}
+
+/// A multipart body with `fields` (name, file name, content).
+fn form(fields: &[(&str, Option<&str>, &[u8])]) -> Vec<u8> {
+    let mut body = Vec::new();
+    for (name, filename, data) in fields {
+        body.extend_from_slice(format!("--{BOUNDARY}\r\n").as_bytes());
+        match filename {
+            Some(f) => body.extend_from_slice(
+                format!("Content-Disposition: form-data; name=\"{name}\"; filename=\"{f}\"\r\nContent-Type: application/octet-stream\r\n\r\n").as_bytes(),
+            ),
+            None => body.extend_from_slice(
+                format!("Content-Disposition: form-data; name=\"{name}\"\r\n\r\n").as_bytes(),
+            ),
+        }
+        body.extend_from_slice(data);
+        body.extend_from_slice(b"\r\n");
+    }
+    body.extend_from_slice(format!("--{BOUNDARY}--\r\n").as_bytes());
+    body
+}
+
+/// Sends one request and gives the status and the body.
+fn request(addr: SocketAddr, method: &str, path: &str, body: Option<&[u8]>) -> (u16, Vec<u8>) {
+    let mut stream = TcpStream::connect(addr).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(120)))
+        .unwrap();
+    let mut head = format!("{method} {path} HTTP/1.1\r\nHost: test\r\nConnection: close\r\n");
+    if let Some(b) = body {
+        head.push_str(&format!(
+            "Content-Type: multipart/form-data; boundary={BOUNDARY}\r\nContent-Length: {}\r\n",
+            b.len()
+        ));
+    }
+    head.push_str("\r\n");
+    stream.write_all(head.as_bytes()).unwrap();
+    if let Some(b) = body {
+        stream.write_all(b).unwrap();
+    }
+    let mut answer = Vec::new();
+    stream.read_to_end(&mut answer).unwrap();
+    parse_answer(&answer)
+}
+
+fn parse_answer(answer: &[u8]) -> (u16, Vec<u8>) {
+    let split = answer
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .expect("an HTTP answer");
+    let head = String::from_utf8_lossy(&answer[..split]);
+    let status = head.split(' ').nth(1).unwrap().parse().unwrap();
+    (status, answer[split + 4..].to_vec())
+}
+
+fn json(body: &[u8]) -> serde_json::Value {
+    serde_json::from_slice(body).unwrap_or_else(|e| {
+        panic!("not JSON ({e}): {}", String::from_utf8_lossy(body));
+    })
+}
+
+/// What `spdcam estimate --json` gives for the example under `name`.
+fn expected(name: &str) -> serde_json::Value {
+    estimate_photo_bytes(
+        EXAMPLE,
+        name,
+        &ModelSet::shipped().unwrap(),
+        &PhotoOptions::default(),
+        &DataDir::new(None),
+        &Grid::parse("400-700:5").unwrap(),
+    )
+    .unwrap()
+    .to_json()
+    .unwrap()
+}
+
+#[test]
+fn twenty_concurrent_uploads_are_all_answered_correctly() {
+    let server = start(16 << 20);
+    let addr = server.addr();
+    let want = expected("room-0.jpg");
+    let answers: Vec<(u16, serde_json::Value)> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..20)
+            .map(|i| {
+                s.spawn(move || {
+                    let name = format!("room-{i}.jpg");
+                    let body = form(&[("photo", Some(name.as_str()), EXAMPLE)]);
+                    let (status, body) =
+                        request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+                    (status, json(&body))
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for (i, (status, got)) in answers.iter().enumerate() {
+        assert_eq!(*status, 200, "{got}");
+        assert_eq!(got["name"], format!("room-{i}.jpg"));
+        assert_eq!(got["spd"], want["spd"]);
+        assert_eq!(got["colorimetry"], want["colorimetry"]);
+        assert_eq!(got["photo"]["corners"], want["photo"]["corners"]);
+    }
+    server.stop();
+}
+
+#[test]
+fn the_answer_equals_the_library_estimate() {
+    let server = start(16 << 20);
+    let body = form(&[("photo", Some("sg-telelumen.jpg"), EXAMPLE)]);
+    let (status, got) = request(
+        server.addr(),
+        "POST",
+        "/api/estimate",
+        Some(body.as_slice()),
+    );
+    assert_eq!(status, 200);
+    assert_eq!(json(&got), expected("sg-telelumen.jpg"));
+    server.stop();
+}
+
+#[test]
+fn an_upload_over_the_limit_is_refused_with_413() {
+    let server = start(100 << 10);
+    let body = form(&[("photo", Some("big.jpg"), EXAMPLE)]);
+    let (status, got) = request(
+        server.addr(),
+        "POST",
+        "/api/estimate",
+        Some(body.as_slice()),
+    );
+    assert_eq!(status, 413);
+    let message = json(&got)["error"].as_str().unwrap().to_string();
+    assert!(message.contains("limit"), "{message}");
+    // Still serving afterwards.
+    let (status, _) = request(server.addr(), "GET", "/api/locus", None);
+    assert_eq!(status, 200);
+    server.stop();
+}
+
+#[test]
+fn bad_input_gets_a_clear_error_and_the_server_keeps_serving() {
+    let server = start(16 << 20);
+    let addr = server.addr();
+    let cases: [(Vec<u8>, u16, &str); 4] = [
+        (
+            form(&[("photo", Some("notes.txt"), b"not a photo at all")]),
+            400,
+            "not an image",
+        ),
+        (form(&[("other", None, b"x")]), 400, "no field 'photo'"),
+        (
+            form(&[
+                ("photo", Some("p.jpg"), EXAMPLE),
+                ("corners", None, b"1,2,3"),
+            ]),
+            400,
+            "eight numbers",
+        ),
+        (b"--garbage".to_vec(), 400, "multipart"),
+    ];
+    for (body, want_status, want_text) in cases {
+        let (status, got) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+        assert_eq!(status, want_status);
+        let message = json(&got)["error"].as_str().unwrap().to_string();
+        assert!(message.contains(want_text), "{message}");
+    }
+    let (status, got) = request(addr, "GET", "/no/such/page", None);
+    assert_eq!(status, 404);
+    assert!(json(&got)["error"].is_string());
+    let (status, _) = request(addr, "GET", "/api/estimate", None);
+    assert_eq!(status, 405);
+    let body = form(&[("photo", Some("p.jpg"), EXAMPLE)]);
+    let (status, got) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+    assert_eq!(status, 200);
+    assert_eq!(json(&got)["spd"], expected("p.jpg")["spd"]);
+    server.stop();
+}
+
+#[test]
+fn a_job_is_polled_until_its_estimate_is_done() {
+    let server = start(16 << 20);
+    let addr = server.addr();
+    let body = form(&[("photo", Some("p.jpg"), EXAMPLE)]);
+    let (status, got) = request(addr, "POST", "/api/jobs", Some(body.as_slice()));
+    assert_eq!(status, 202);
+    let id = json(&got)["id"].as_str().unwrap().to_string();
+    let mut states = Vec::new();
+    let result = loop {
+        let (status, got) = request(addr, "GET", &format!("/api/jobs/{id}"), None);
+        assert_eq!(status, 200);
+        let got = json(&got);
+        let state = got["state"].as_str().unwrap().to_string();
+        assert!(
+            ["queued", "running", "done"].contains(&state.as_str()),
+            "{got}"
+        );
+        states.push(state);
+        if got["state"] == "done" {
+            break got["result"].clone();
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(result["spd"], expected("p.jpg")["spd"]);
+    let (status, _) = request(addr, "GET", "/api/jobs/999999", None);
+    assert_eq!(status, 404);
+    server.stop();
+}
+
+#[test]
+fn the_page_and_its_assets_are_embedded() {
+    let server = start(16 << 20);
+    for (path, needle) in [
+        ("/", "<html"),
+        ("/app.js", "api/jobs/"),
+        ("/style.css", "{"),
+    ] {
+        let (status, body) = request(server.addr(), "GET", path, None);
+        assert_eq!(status, 200, "{path}");
+        assert!(String::from_utf8_lossy(&body).contains(needle), "{path}");
+    }
+    let (status, body) = request(server.addr(), "GET", "/example.jpg", None);
+    assert_eq!(status, 200);
+    assert_eq!(body, EXAMPLE);
+    server.stop();
+}

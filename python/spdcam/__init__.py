@@ -1,0 +1,485 @@
+"""spdcam: the spectral power distribution (SPD) of the light from a photo of a colour chart.
+
+A thin layer over spdcam's Rust libraries (the same code as the ``spdcam`` command line):
+photos and feature rows in, numpy arrays out, errors as :class:`SpdcamError` with the
+command line's messages, and ``to_colour()`` for colour-science users.
+
+>>> import spdcam
+>>> e = spdcam.estimate("examples/sg-telelumen.jpg")        # doctest: +SKIP
+>>> e.wavelengths, e.spd, e.xy, e.cct, e.detection.chart      # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _native
+from ._native import SpdcamError
+
+__version__: str = _native.__version__
+
+__all__ = [
+    "SpdcamError",
+    "Model",
+    "Detection",
+    "Estimate",
+    "Estimates",
+    "load_model",
+    "shipped_model",
+    "read_photo",
+    "estimate",
+    "estimate_features",
+    "Rendering",
+    "render",
+    "__version__",
+]
+
+PhotoLike = Union[str, "os.PathLike[str]", bytes, np.ndarray]
+Progress = Callable[[int, int], None]
+
+DEFAULT_RANGE = "400-700:5"
+
+
+class Model:
+    """A set of trained models; an estimate picks the one for the chart a photo shows.
+
+    Get the shipped models with :func:`shipped_model` and one model file (``.spdm``) with
+    :func:`load_model`.
+    """
+
+    def __init__(self, native: "_native.Models") -> None:
+        self._native = native
+        described = native.describe()
+        #: The models' names as messages give them.
+        self.names: list[str] = [d[0] for d in described]
+        #: The chart each model reads (``None`` when the file names none).
+        self.charts: list[Optional[str]] = [d[1] for d in described]
+        #: The feature columns each model reads (``p01_r, p01_g, …``).
+        self.feature_names: list[list[str]] = [d[2] for d in described]
+        #: The wavelength grid each model estimates, ``START-END:STEP`` in nm.
+        self.grids: list[str] = [d[3] for d in described]
+
+    def __repr__(self) -> str:
+        return f"Model({', '.join(self.names)})"
+
+
+_SHIPPED: Optional[Model] = None
+
+
+def shipped_model() -> Model:
+    """The models shipped inside spdcam, one per chart (loaded once)."""
+    global _SHIPPED
+    if _SHIPPED is None:
+        _SHIPPED = Model(_native.Models.shipped())
+    return _SHIPPED
+
+
+def load_model(path: Union[str, "os.PathLike[str]"]) -> Model:
+    """One model from a ``.spdm`` file (as made by ``spdcam train``)."""
+    return Model(_native.Models.load(os.fspath(path)))
+
+
+def _models(model: Union[Model, str, "os.PathLike[str]", None]) -> "_native.Models":
+    if model is None:
+        return shipped_model()._native
+    if isinstance(model, Model):
+        return model._native
+    return load_model(model)._native
+
+
+@dataclass(frozen=True)
+class Detection:
+    """Where the chart is in a photo and what its patches gave."""
+
+    #: The chart found (e.g. ``colorchecker_sg140``).
+    chart: str
+    #: ``"detected"`` or ``"corners"`` (given by the caller).
+    method: str
+    #: 0…1: how sure the chart's placement and orientation are (below 0.8: check it).
+    confidence: float
+    #: The chart's outer corners in photo pixels, TL, TR, BR, BL: shape (4, 2).
+    corners: np.ndarray
+    #: Chart coordinates (patch pitch units) → photo pixels: shape (3, 3).
+    homography: np.ndarray
+    #: The feature columns, ``p01_r, p01_g, …``.
+    feature_names: list[str]
+    #: The model's input: mean encoded sRGB (0–255) of each feature patch, flattened.
+    features: np.ndarray
+    #: Every patch's robust mean encoded sRGB (0–255): shape (patches, 3).
+    patch_rgb: np.ndarray
+    #: Every patch's standard deviation (0–255): shape (patches, 3).
+    patch_std: np.ndarray
+    #: Every patch's centre in photo pixels: shape (patches, 2).
+    patch_centres: np.ndarray
+    #: Patches with more than a quarter of their pixels clipped (their value is a lower bound).
+    clipped: np.ndarray
+    #: Patches nearly black in every channel (their colour is mostly noise).
+    dark: np.ndarray
+    #: What the user should know (clipping, low confidence, dark patches).
+    warnings: list[str]
+    #: The photo's size in pixels, (width, height).
+    size: tuple[int, int]
+
+    @staticmethod
+    def _from_json(p: dict[str, Any]) -> "Detection":
+        patches = p["patches"]
+        return Detection(
+            chart=p["chart"],
+            method=p["method"],
+            confidence=float(p["confidence"]),
+            corners=np.asarray(p["corners"], dtype=float),
+            homography=np.asarray(p["homography"], dtype=float),
+            feature_names=list(p["feature_names"]),
+            features=np.asarray(p["features"], dtype=np.float32),
+            patch_rgb=np.asarray([q["rgb"] for q in patches], dtype=np.float32),
+            patch_std=np.asarray([q["std"] for q in patches], dtype=np.float32),
+            patch_centres=np.asarray([q["centre"] for q in patches], dtype=float),
+            clipped=np.asarray([q["clipped"] for q in patches], dtype=bool),
+            dark=np.asarray([q["dark"] for q in patches], dtype=bool),
+            warnings=list(p["warnings"]),
+            size=(int(p["width"]), int(p["height"])),
+        )
+
+
+def _to_colour(wavelengths: np.ndarray, spd: np.ndarray, name: str) -> Any:
+    try:
+        import colour
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("to_colour() needs colour-science: pip install colour-science") from e
+    return colour.SpectralDistribution(dict(zip(wavelengths.tolist(), spd.tolist())), name=name)
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """One estimate of the light: its SPD and what it means."""
+
+    #: The photo's name (file name, or the ``source`` given), or ``estimate_N`` for rows.
+    name: str
+    #: The model that made it.
+    model: str
+    #: The SPD's wavelengths (nm).
+    wavelengths: np.ndarray
+    #: The relative SPD, peak 1.
+    spd: np.ndarray
+    #: CIE 1931 2° chromaticity of the SPD.
+    xy: np.ndarray
+    #: Correlated colour temperature (K, Ohno 2014); ``None`` farther than |Duv| 0.05.
+    cct: Optional[float]
+    #: Distance from the Planckian locus in CIE 1960 uv; ``None`` with ``cct``.
+    duv: Optional[float]
+    #: Where the chart was and what it gave (estimates from photos).
+    detection: Optional[Detection] = None
+    #: The lighting-quality metrics of the SPD as the library computes them (CRI, TM-30,
+    #: α-opic, …; ``spdcam estimate --json``'s ``metrics``); empty where not computed.
+    metrics: dict[str, Any] = field(default_factory=dict)
+    #: An uncertainty band of the SPD (lower, upper) when the model gives one; the shipped
+    #: models give none.
+    band: Optional[tuple[np.ndarray, np.ndarray]] = None
+    #: The library's JSON of the estimate (as ``spdcam estimate --json`` prints it).
+    json: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    @staticmethod
+    def _from_json(text: str) -> "Estimate":
+        v = json.loads(text)
+        c = v["colorimetry"]
+        return Estimate(
+            name=v["name"],
+            model=v["model"],
+            wavelengths=np.asarray(v["wavelength_nm"], dtype=float),
+            spd=np.asarray(v["spd"], dtype=float),
+            xy=np.asarray(c["xy"], dtype=float),
+            cct=c["cct"],
+            duv=c["duv"],
+            detection=Detection._from_json(v["photo"]) if v.get("photo") else None,
+            metrics=dict(v.get("metrics") or {}),
+            json=v,
+        )
+
+    def to_colour(self) -> Any:
+        """The SPD as a ``colour.SpectralDistribution`` (needs colour-science)."""
+        return _to_colour(self.wavelengths, self.spd, self.name)
+
+
+@dataclass(frozen=True)
+class Estimates:
+    """Estimates for many feature rows, as arrays with one row per estimate."""
+
+    #: The model that made them.
+    model: str
+    #: The SPDs' wavelengths (nm): shape (wavelengths,).
+    wavelengths: np.ndarray
+    #: The relative SPDs, peak 1: shape (rows, wavelengths).
+    spd: np.ndarray
+    #: CIE 1931 2° chromaticities: shape (rows, 2).
+    xy: np.ndarray
+    #: CCT (K); NaN farther than |Duv| 0.05 from the Planckian locus: shape (rows,).
+    cct: np.ndarray
+    #: Duv; NaN with CCT: shape (rows,).
+    duv: np.ndarray
+
+    def __len__(self) -> int:
+        return self.spd.shape[0]
+
+    def __getitem__(self, i: int) -> Estimate:
+        cct, duv = float(self.cct[i]), float(self.duv[i])
+        return Estimate(
+            name=f"estimate_{range(len(self))[i] + 1}",
+            model=self.model,
+            wavelengths=self.wavelengths,
+            spd=self.spd[i],
+            xy=self.xy[i],
+            cct=None if np.isnan(cct) else cct,
+            duv=None if np.isnan(duv) else duv,
+        )
+
+    def to_colour(self) -> Any:
+        """The SPDs as a ``colour.MultiSpectralDistributions`` (needs colour-science)."""
+        try:
+            import colour
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("to_colour() needs colour-science: pip install colour-science") from e
+        labels = [f"estimate_{i + 1}" for i in range(len(self))]
+        return colour.MultiSpectralDistributions(
+            self.spd.T, self.wavelengths, labels=labels, name=self.model
+        )
+
+    def to_pandas(self) -> Any:
+        """The SPDs as a pandas DataFrame: one row per estimate, one column per wavelength."""
+        import pandas as pd
+
+        return pd.DataFrame(
+            self.spd,
+            columns=[f"{w:g}" for w in self.wavelengths],
+            index=[f"estimate_{i + 1}" for i in range(len(self))],
+        )
+
+
+def read_photo(path: Union[str, "os.PathLike[str]"]) -> np.ndarray:
+    """The photo file at ``path`` decoded as spdcam decodes it (JPEG, PNG, TIFF; EXIF
+    orientation applied): an H×W×3 array of encoded sRGB, uint8 or uint16 as stored."""
+    width, height, bits, data = _native.read_photo(os.fspath(path))
+    dtype = np.uint8 if bits == 8 else np.uint16
+    return np.frombuffer(data, dtype=dtype).reshape(height, width, 3)
+
+
+def _pixels(array: np.ndarray, source: str) -> np.ndarray:
+    """An H×W×3 array as C-contiguous uint8 or uint16 (floats 0–1 → 16 bits)."""
+    a = np.asarray(array)
+    if a.ndim != 3 or a.shape[2] != 3:
+        raise SpdcamError(f"{source}: an H×W×3 RGB array is needed; the array has shape {a.shape}")
+    if a.dtype == np.uint8 or a.dtype == np.uint16:
+        return np.ascontiguousarray(a)
+    if np.issubdtype(a.dtype, np.floating):
+        if not np.all(np.isfinite(a)):
+            raise SpdcamError(f"{source}: the array holds values that are not finite numbers")
+        lo, hi = float(a.min()), float(a.max())
+        if lo < 0.0 or hi > 1.0:
+            raise SpdcamError(
+                f"{source}: float pixels must be encoded sRGB in 0–1; the array spans {lo:g}…{hi:g}"
+            )
+        return np.ascontiguousarray(np.rint(a * 65535.0).astype(np.uint16))
+    raise SpdcamError(
+        f"{source}: pixels must be uint8, uint16 or float (0–1); the array is {a.dtype}"
+    )
+
+
+def _estimate_one(
+    photo: PhotoLike,
+    models: "_native.Models",
+    chart: Optional[str],
+    corners: Optional[list[tuple[float, float]]],
+    range: str,
+    source: Optional[str],
+) -> Estimate:
+    if isinstance(photo, (bytes, bytearray, memoryview)):
+        text = _native.estimate_encoded(
+            bytes(photo), source or "photo bytes", models, chart, corners, range
+        )
+    elif isinstance(photo, np.ndarray):
+        name = source or "photo array"
+        pixels = _pixels(photo, name)
+        h, w, _ = pixels.shape
+        bits = 8 if pixels.dtype == np.uint8 else 16
+        text = _native.estimate_pixels(
+            pixels.tobytes(), w, h, bits, name, models, chart, corners, range
+        )
+    elif isinstance(photo, (str, os.PathLike)):
+        path = os.fspath(photo)
+        if not os.path.isfile(path):
+            raise FileNotFoundError(f"cannot use photo {path}: no such file")
+        text = _native.estimate_file(path, models, chart, corners, range)
+    else:
+        raise TypeError(
+            "a photo is a path, the bytes of a JPEG/PNG/TIFF file, or an H×W×3 numpy array; "
+            f"got {type(photo).__name__}"
+        )
+    return Estimate._from_json(text)
+
+
+def _corners(corners: Optional[Iterable[Sequence[float]]]) -> Optional[list[tuple[float, float]]]:
+    if corners is None:
+        return None
+    points = [tuple(float(v) for v in p) for p in corners]
+    if len(points) != 4 or any(len(p) != 2 for p in points):
+        raise SpdcamError("corners needs four points (x, y): x1,y1,x2,y2,x3,y3,x4,y4")
+    return [(p[0], p[1]) for p in points]
+
+
+def estimate(
+    photo: Union[PhotoLike, Sequence[PhotoLike]],
+    *,
+    chart: Optional[str] = None,
+    corners: Optional[Iterable[Sequence[float]]] = None,
+    range: str = DEFAULT_RANGE,
+    model: Union[Model, str, "os.PathLike[str]", None] = None,
+    source: Optional[str] = None,
+    progress: Union[bool, Progress, None] = None,
+) -> Union[Estimate, list[Estimate]]:
+    """Estimates the light from a photo of a colour chart, as ``spdcam estimate PHOTO``.
+
+    ``photo`` is a path, the bytes of a JPEG/PNG/TIFF file, or an H×W×3 array of encoded
+    sRGB (uint8, uint16, or float in 0–1); a list of them gives a list of estimates.
+    ``chart`` looks only for that chart; ``corners`` gives the chart's four outer corners
+    in pixels (any order) instead of detecting it; ``range`` is the output grid
+    ``START-END[:STEP]`` in nm; ``model`` a :class:`Model` or a ``.spdm`` path (default:
+    the shipped models); ``source`` names in-memory photos in messages. For lists,
+    ``progress`` is a callback ``(done, total)``, or ``True`` for a tqdm bar (when tqdm is
+    installed). The work runs without the GIL. Raises :class:`SpdcamError` (a
+    ``ValueError``) with the command line's message when the photo cannot be used.
+    """
+    models = _models(model)
+    points = _corners(corners)
+    if isinstance(photo, (list, tuple)):
+        report = _progress(progress, len(photo))
+        out = []
+        for i, p in enumerate(photo):
+            out.append(_estimate_one(p, models, chart, points, range, source))
+            report(i + 1)
+        return out
+    return _estimate_one(photo, models, chart, points, range, source)
+
+
+def _progress(progress: Union[bool, Progress, None], total: int) -> Callable[[int], None]:
+    if callable(progress):
+        return lambda done: progress(done, total)
+    if progress:
+        try:
+            from tqdm.auto import tqdm
+        except ImportError:
+            return lambda done: None
+        bar = tqdm(total=total, desc="spdcam")
+
+        def step(done: int) -> None:
+            bar.update(done - bar.n)
+            if done == total:
+                bar.close()
+
+        return step
+    return lambda done: None
+
+
+def estimate_features(
+    features: Any,
+    names: Optional[Sequence[str]] = None,
+    *,
+    range: str = DEFAULT_RANGE,
+    model: Union[Model, str, "os.PathLike[str]", None] = None,
+    source: str = "features",
+) -> Estimates:
+    """Estimates the light for chart feature rows, as ``spdcam estimate --features``.
+
+    ``features`` is a 2-D array (rows × columns; one row is one estimate, values on any
+    scale, e.g. 0–255), a 1-D array for one row, or a pandas DataFrame whose columns name
+    the features. ``names`` are the columns (``p01_r, p01_g, …``); by default the columns of
+    the model that reads that many. Returns :class:`Estimates` (arrays over the rows).
+    """
+    if names is None and hasattr(features, "columns") and hasattr(features, "to_numpy"):
+        names = [str(c) for c in features.columns]
+        features = features.to_numpy()
+    a = np.asarray(features)
+    if a.ndim == 1:
+        a = a[np.newaxis, :]
+    if a.ndim != 2 or a.shape[0] == 0 or a.shape[1] == 0:
+        raise SpdcamError(f"{source}: a rows × features array is needed; the shape is {a.shape}")
+    if not np.issubdtype(a.dtype, np.number) or np.issubdtype(a.dtype, np.complexfloating):
+        raise SpdcamError(f"{source}: features must be real numbers; the array is {a.dtype}")
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    rows, cols = a.shape
+    if names is not None:
+        names = [str(n) for n in names]
+        if len(names) != cols:
+            raise SpdcamError(f"{source}: {len(names)} names for {cols} feature columns")
+    model_name, wl, spd, xy, cct, duv = _native.estimate_rows(
+        a.tobytes(), rows, _models(model), names, source, range
+    )
+    wavelengths = np.frombuffer(wl, dtype=np.float64)
+    return Estimates(
+        model=model_name,
+        wavelengths=wavelengths,
+        spd=np.frombuffer(spd, dtype=np.float64).reshape(rows, wavelengths.size),
+        xy=np.frombuffer(xy, dtype=np.float64).reshape(rows, 2),
+        cct=np.frombuffer(cct, dtype=np.float64),
+        duv=np.frombuffer(duv, dtype=np.float64),
+    )
+
+
+@dataclass(frozen=True)
+class Rendering:
+    """A chart rendered under a light by a simulated camera."""
+
+    #: The rendered chart, encoded sRGB 0–1: shape (height, width, 3), float32.
+    image: np.ndarray
+    #: The feature columns, ``p01_r, p01_g, …``.
+    feature_names: list[str]
+    #: The feature row (mean encoded sRGB 0–255 of each feature patch), as a model reads it.
+    features: np.ndarray
+
+    def to_uint8(self) -> np.ndarray:
+        """The image as 8-bit sRGB, as ``spdcam render`` writes it to PNG."""
+        return np.rint(np.clip(self.image, 0.0, 1.0) * 255.0).astype(np.uint8)
+
+
+def render(
+    spd: Any,
+    wavelengths: Optional[Sequence[float]] = None,
+    *,
+    camera: str = "nikon_d5100_npl",
+    chart: str = "colorchecker24",
+    patch_px: int = 24,
+    seed: int = 0,
+) -> Rendering:
+    """Renders a chart photographed under a light, as ``spdcam render`` with its default
+    camera settings: the same light and seed give the same image and features.
+
+    ``spd`` names a light (``"D65"``, ``"A"``, ``"cct:4000"``, ``"daylight:5000"``,
+    ``"planck:3000"``, a spectral CSV path), or is its values on ``wavelengths`` (nm), or a
+    ``colour.SpectralDistribution``. ``camera`` and ``chart`` are built-in names (``spdcam
+    list``) or CSV files.
+    """
+    if hasattr(spd, "wavelengths") and hasattr(spd, "values") and wavelengths is None:
+        wavelengths, spd = spd.wavelengths, spd.values
+    if isinstance(spd, (str, os.PathLike)):
+        if wavelengths is not None:
+            raise SpdcamError("wavelengths go with SPD values, not with a named light")
+        args: tuple = (os.fspath(spd), None, None)
+    else:
+        values = np.asarray(spd, dtype=np.float64).ravel()
+        if wavelengths is None:
+            raise SpdcamError("SPD values need their wavelengths (nm)")
+        wl = np.asarray(wavelengths, dtype=np.float64).ravel()
+        if wl.size != values.size:
+            raise SpdcamError(f"{wl.size} wavelengths for {values.size} SPD values")
+        args = ("light", wl.tolist(), values.tolist())
+    width, height, data, names, features = _native.render(
+        *args, camera=camera, chart=chart, patch_px=patch_px, seed=seed
+    )
+    return Rendering(
+        image=np.frombuffer(data, dtype=np.float32).reshape(height, width, 3),
+        feature_names=list(names),
+        features=np.asarray(features, dtype=np.float32),
+    )

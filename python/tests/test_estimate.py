@@ -1,0 +1,105 @@
+"""spdcam.estimate and spdcam.estimate_features against the command line and by hand."""
+
+import csv
+
+import numpy as np
+import pytest
+
+import spdcam
+from conftest import ROOT, TRUTH
+
+
+def read_spectral_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], np.array([[float(v) for v in r] for r in rows[1:] if r])
+    return header, body[:, 0], body[:, 1:]
+
+
+def gfc(a, b):
+    """Goodness-of-fit coefficient (Hernández-Andrés et al. 2001): |Σab| / √(Σa²·Σb²)."""
+    return abs(np.dot(a, b)) / np.sqrt(np.dot(a, a) * np.dot(b, b))
+
+
+def test_the_example_photo_round_trip(example):
+    e = spdcam.estimate(example)
+    assert e.name == "sg-telelumen.jpg"
+    assert e.model == "the shipped colorchecker_sg96 model"
+    np.testing.assert_array_equal(e.wavelengths, np.arange(400.0, 701.0, 5.0))
+    assert e.spd.shape == (61,) and e.spd.max() == pytest.approx(1.0)
+    d = e.detection
+    assert d.chart == "colorchecker_sg140" and d.method == "detected"
+    assert d.confidence > 0.8
+    assert d.corners.shape == (4, 2) and d.homography.shape == (3, 3)
+    assert d.features.shape == (288,) and len(d.feature_names) == 288
+    assert d.patch_rgb.shape == (140, 3) and d.clipped.shape == (140,)
+    # The estimate is the light: close in shape to the true SPD measured beside the chart.
+    _, wl, truth = read_spectral_csv(TRUTH)
+    t = np.interp(e.wavelengths, wl, truth[:, 0])
+    assert gfc(t, e.spd) > 0.9
+    # The same photo as bytes and as the decoded array gives the same estimate.
+    from_bytes = spdcam.estimate(example.read_bytes(), source="sg-telelumen.jpg")
+    from_array = spdcam.estimate(spdcam.read_photo(example))
+    np.testing.assert_array_equal(from_bytes.spd, e.spd)
+    np.testing.assert_array_equal(from_array.spd, e.spd)
+    assert from_array.duv == e.duv and from_array.name == "photo array"
+    # The detection's features, estimated as a row, give the same SPD again.
+    row = spdcam.estimate_features(d.features, d.feature_names)
+    np.testing.assert_allclose(row.spd[0], e.spd, rtol=0, atol=1e-12)
+
+
+def test_an_array_estimate_equals_the_cli_csv(example, cli, tmp_path):
+    out = tmp_path / "spd.csv"
+    done = cli("estimate", str(example), "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    header, wl, values = read_spectral_csv(out)
+    assert header == ["wavelength_nm", "sg-telelumen.jpg"]
+    e = spdcam.estimate(spdcam.read_photo(example))
+    np.testing.assert_array_equal(e.wavelengths, wl)
+    np.testing.assert_allclose(e.spd, values[:, 0], rtol=1e-12, atol=1e-15)
+
+
+def test_float_and_16_bit_arrays_are_the_same_photo(example):
+    pixels = spdcam.read_photo(example)
+    assert pixels.dtype == np.uint8 and pixels.shape == (1500, 2000, 3)
+    wide = pixels.astype(np.uint16) * 257
+    as_float = pixels.astype(np.float64) / 255.0
+    a = spdcam.estimate(pixels)
+    for other in (wide, as_float):
+        b = spdcam.estimate(other)
+        assert b.detection.chart == a.detection.chart
+        np.testing.assert_allclose(b.spd, a.spd, atol=2e-3)
+
+
+def test_many_feature_rows_are_estimated_at_once(example):
+    e = spdcam.estimate(example)
+    rows = np.tile(e.detection.features, (1000, 1)).astype(np.float64)
+    rows[1::2] *= 0.5  # exposure: the scaler normalises each row by its maximum
+    many = spdcam.estimate_features(rows)
+    assert len(many) == 1000 and many.spd.shape == (1000, 61)
+    np.testing.assert_allclose(many.spd, np.tile(e.spd, (1000, 1)), atol=1e-9)
+    np.testing.assert_allclose(many.xy[0], e.xy, atol=1e-12)
+    assert many[3].duv == e.duv and many[3].name == "estimate_4"
+    frame = many.to_pandas()
+    assert frame.shape == (1000, 61) and list(frame.columns[:2]) == ["400", "405"]
+
+
+def test_a_dataframe_names_its_columns(example):
+    import pandas as pd
+
+    e = spdcam.estimate(example)
+    frame = pd.DataFrame([e.detection.features], columns=e.detection.feature_names)
+    shuffled = frame[list(reversed(frame.columns))]
+    with pytest.raises(spdcam.SpdcamError, match="p96_b"):
+        spdcam.estimate_features(shuffled)
+    np.testing.assert_allclose(spdcam.estimate_features(frame).spd[0], e.spd, atol=1e-12)
+
+
+def test_the_model_file_and_the_shipped_models_agree(example):
+    shipped = spdcam.shipped_model()
+    assert "colorchecker_sg96" in shipped.charts
+    loaded = spdcam.load_model(ROOT / "models" / "colorchecker_sg96.spdm")
+    a = spdcam.estimate(example)
+    b = spdcam.estimate(example, model=loaded)
+    np.testing.assert_array_equal(a.spd, b.spd)
+    assert b.model.endswith("colorchecker_sg96.spdm")
