@@ -196,7 +196,10 @@ impl SimpleCamera {
         Ok(linear
             .iter()
             .flat_map(|v| {
-                (0..3).map(move |c| (255.0 * srgb_encode((v[c] * scale).clamp(0.0, 1.0))).round())
+                (0..3).map(move |c| {
+                    let encoded: f64 = srgb_encode((v[c] * scale).clamp(0.0, 1.0));
+                    (255.0 * encoded).round()
+                })
             })
             .collect())
     }

@@ -121,13 +121,7 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
         model.check_features(&chart.feature_names(), &chart_name)?;
         let truth = on_grid(&library, &model.grid())?;
         let average = average_spd(&truth, &fit_lamps);
-        md += &format!(
-            "### `{}` ({chart_name})\n\n",
-            path.file_name().map_or_else(
-                || path.display().to_string(),
-                |n| n.to_string_lossy().into()
-            )
-        );
+        md += &format!("### `{}` ({chart_name})\n\n", file_name(path));
         md += "| lamp type | lamps (val / test) | average SPD (val) | (a) randomised in-camera (val) | (b) simple camera (val) | average SPD (test) | (a) test | (b) test |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
         let mut cells: Vec<[LampScores; 3]> = Vec::new();
         for (k, ids) in lamps.iter().enumerate() {
@@ -188,7 +182,7 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
         for (path, scores) in &real_rows {
             md += &format!(
                 "| `{}` | {:.4} | {:.4} | {:.4} |\n",
-                path.display(),
+                file_name(path),
                 scores[0],
                 scores[1],
                 scores[2]
@@ -211,6 +205,14 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");
     Ok(())
+}
+
+/// A model's file name, for the tables (directories differ between machines).
+fn file_name(path: &std::path::Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    )
 }
 
 /// Every lamp of the library on `grid` (linear interpolation), normalised by its maximum.
