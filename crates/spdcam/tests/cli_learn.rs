@@ -173,8 +173,10 @@ fn train_estimate_evaluate_finetune() {
         &s(&spd),
         "--range",
         "420-680:10",
+        "--layout",
+        "wide",
     ]);
-    assert!(out.contains("800 estimate(s)"), "{out}");
+    assert!(out.contains("800 estimates"), "{out}");
     let csv = std::fs::read_to_string(&spd).unwrap();
     assert!(csv.starts_with("wavelength_nm,estimate_1,estimate_2,"));
     assert_eq!(csv.lines().count(), 28);
