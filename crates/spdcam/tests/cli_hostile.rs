@@ -446,7 +446,28 @@ fn errors_about_wide_files_and_bad_cells_stay_short_and_precise() {
     assert!(e.contains("2000 in all"), "{e}");
 
     let features = dir.join("nan.csv");
-    std::fs::write(&features, "p01_r,p01_g,p01_b\n10,20,30\n40,nan,60\n").unwrap();
+    // ColorChecker 24 features (72 columns, a shipped model reads them), p01_g of the
+    // second row NaN.
+    let header: Vec<String> = (1..=24)
+        .flat_map(|p| ["r", "g", "b"].map(|c| format!("p{p:02}_{c}")))
+        .collect();
+    let row = |second: &str| {
+        (0..72)
+            .map(|i| {
+                if i == 1 {
+                    second.to_string()
+                } else {
+                    "50".to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    std::fs::write(
+        &features,
+        format!("{}\n{}\n{}\n", header.join(","), row("50"), row("nan")),
+    )
+    .unwrap();
     let e = fails_fast(&["estimate", "--features", s(&features)]);
     assert!(
         e.contains("line 3") && e.contains("p01_g") && e.contains("NaN"),

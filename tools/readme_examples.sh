@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# Runs every command block of README.md (each ```sh fence) as written, in order, the way a
+# new user meets them, and fails on the first block that fails:
+#  - in a copy of the repository's tracked files with nothing beside it and no SPDCAM_DATA
+#    for the first block (the README's two fresh-clone commands: a test that reads the
+#    measured data fails there),
+#  - then with the measured data beside the copy (../shared, linked to the one beside this
+#    repository) for the blocks after it, `spdcam` on PATH once the install block has run.
+#
+#   bash tools/readme_examples.sh           # every block
+#   bash tools/readme_examples.sh --list    # the blocks, numbered, without running them
+#
+# The copy lives at a fixed place under the cargo target directory's parent, so that runs
+# reuse what the previous one compiled.
+set -euo pipefail
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/spdcam/target}"
+export CARGO_TERM_COLOR=never
+unset SPDCAM_DATA
+
+# The README's ```sh blocks, each one NUL-terminated.
+blocks() {
+    python3 - "$1" <<'EOF'
+import re, sys
+text = open(sys.argv[1], encoding="utf-8").read()
+for block in re.findall(r"^```sh\n(.*?)^```", text, flags=re.S | re.M):
+    sys.stdout.write(block + "\0")
+EOF
+}
+
+mapfile -d '' all < <(blocks "$repo/README.md")
+if [ "${#all[@]}" -lt 2 ]; then
+    echo "error: README.md has ${#all[@]} command block(s); expected the fresh-clone commands and more" >&2
+    exit 1
+fi
+if [ "${1:-}" = "--list" ]; then
+    for i in "${!all[@]}"; do printf '── block %d ──\n%s' "$((i + 1))" "${all[$i]}"; done
+    exit 0
+fi
+
+work="$(dirname "$CARGO_TARGET_DIR")/readme-examples"
+rm -rf "$work"
+mkdir -p "$work/spdcam" "$work/cargo-home/bin"
+(cd "$repo" && git ls-files -z | tar --null -T - -cf -) | tar -xf - -C "$work/spdcam"
+# `cargo install` puts spdcam here; what the user's PATH would hold.
+export CARGO_INSTALL_ROOT="$work/cargo-home"
+export PATH="$work/cargo-home/bin:$PATH"
+
+run_block() {
+    local n="$1" text="$2" start
+    start=$(date +%s)
+    printf '\n── README block %d of %d ──\n%s' "$n" "${#all[@]}" "$text"
+    (cd "$work/spdcam" && bash -euo pipefail -c "$text")
+    echo "── block $n passed in $(($(date +%s) - start)) s"
+}
+
+# Block 1: nothing beside the repository.
+if [ -e "$work/shared" ]; then
+    echo "error: $work/shared exists; the first block must run with nothing beside the copy" >&2
+    exit 1
+fi
+run_block 1 "${all[0]}"
+
+# The rest: the measured data beside the repository, as the README's examples expect it.
+if ! [ -d "$repo/../shared/data" ]; then
+    echo "error: the README's later examples need the measured data at ../shared/data beside the repository" >&2
+    exit 1
+fi
+ln -s "$(cd "$repo/../shared" && pwd)" "$work/shared"
+for i in $(seq 1 $((${#all[@]} - 1))); do
+    run_block "$((i + 1))" "${all[$i]}"
+done
+echo
+echo "all ${#all[@]} README command blocks passed"
