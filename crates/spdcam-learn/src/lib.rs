@@ -6,6 +6,7 @@
 mod burn_net;
 pub mod error;
 pub mod evaluate;
+pub mod recipe;
 pub mod synthetic;
 pub mod train;
 

@@ -1,15 +1,19 @@
 //! `spdcam finetune`: the thesis's transfer learning (section 6.4) — a new output layer, then
 //! all layers (or only the new one) trained on a small dataset of the new camera or lights.
+//! With no recipe flags, the recipe is chosen by cross-validation on the data given
+//! (`spdcam_learn::recipe`), the model left unchanged among the candidates.
 
 use crate::train::{load_set, reporter, sibling, write_log, ScheduleArgs};
 use anyhow::Result;
 use clap::Args;
 use spdcam_core::fsio;
 use spdcam_learn::model::Model;
-use spdcam_learn::train::{finetune, FinetuneOptions};
+use spdcam_learn::recipe;
+use spdcam_learn::train::{finetune, FinetuneOptions, TrainingSet};
 use std::path::PathBuf;
 
-/// Options of `spdcam finetune`.
+/// Options of `spdcam finetune`. Without --freeze, --refit-pca, --keep-output, --epochs,
+/// --batch, --lr or --patience the recipe is chosen by 5-fold cross-validation on the data.
 #[derive(Debug, Args)]
 pub struct FinetuneArgs {
     /// The pretrained model.
@@ -34,11 +38,28 @@ pub struct FinetuneArgs {
     schedule: ScheduleArgs,
 }
 
+impl FinetuneArgs {
+    /// Whether a flag gives the recipe by hand.
+    fn recipe_given(&self) -> bool {
+        let s = &self.schedule;
+        self.freeze
+            || self.refit_pca
+            || self.keep_output
+            || s.epochs.is_some()
+            || s.batch.is_some()
+            || s.lr.is_some()
+            || s.patience.is_some()
+    }
+}
+
 /// Runs `spdcam finetune`.
 pub fn run(args: FinetuneArgs) -> Result<()> {
     fsio::check_writable(&args.output)?;
     let model = Model::load(&args.model)?;
     let data = load_set(&args.data)?;
+    if !args.recipe_given() {
+        return run_chosen(&args, &model, &data);
+    }
     let val = args.schedule.val.as_deref().map(load_set).transpose()?;
     let base = FinetuneOptions::thesis();
     let options = FinetuneOptions {
@@ -81,4 +102,37 @@ pub fn run(args: FinetuneArgs) -> Result<()> {
         &sibling(&args.output, ".log.csv"),
         &sibling(&args.output, ".loss.svg"),
     )
+}
+
+/// Chooses the recipe by cross-validation on `data`, prints every candidate's score, and
+/// writes the model the best one gives (trained on all of `data`).
+fn run_chosen(args: &FinetuneArgs, model: &Model, data: &TrainingSet) -> Result<()> {
+    let backend = args.schedule.device.backend();
+    println!(
+        "choosing a fine-tuning recipe for {} by {}-fold cross-validation on {} ({} samples)",
+        args.model.display(),
+        recipe::FOLDS.min(data.samples.len() / 2),
+        args.data.display(),
+        data.samples.len()
+    );
+    let scored = recipe::choose(model, data, args.schedule.seed, backend)?;
+    for s in &scored {
+        println!(
+            "  {:<36} cross-validated GFC {:.5}",
+            s.recipe.name, s.cv_gfc
+        );
+    }
+    let best = &scored[0];
+    let chosen = match &best.recipe.options {
+        None => model.clone(),
+        Some(options) => finetune(model, data, Some(data), options, &mut |_| {})?.model,
+    };
+    chosen.save(&args.output)?;
+    println!(
+        "chosen: {} (cross-validated GFC {:.5}) → {}",
+        best.recipe.name,
+        best.cv_gfc,
+        args.output.display()
+    );
+    Ok(())
 }

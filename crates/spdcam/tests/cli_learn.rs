@@ -228,6 +228,39 @@ fn train_estimate_evaluate_finetune() {
     ]);
     assert!(tuned.is_file());
 
+    // With no recipe flags, the recipe is chosen by cross-validation: every candidate scored
+    // (the model unchanged among them), the best one named and written.
+    let chosen = dir.join("chosen.spdm");
+    let out = ok(&[
+        "finetune",
+        "--model",
+        &s(&model),
+        "--data",
+        &s(&small),
+        "-o",
+        &s(&chosen),
+    ]);
+    assert!(out.contains("5-fold cross-validation"), "{out}");
+    for name in [
+        "the model unchanged",
+        "all layers, about 150 steps",
+        "output layer only",
+    ] {
+        assert!(out.contains(name), "{name}: {out}");
+    }
+    let scores: Vec<f64> = out
+        .lines()
+        .filter_map(|l| l.split("cross-validated GFC ").nth(1))
+        .map(|v| v.split([' ', ')']).next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(scores.len(), 5, "four candidates and the choice: {out}");
+    assert!(
+        scores[..4].windows(2).all(|w| w[0] >= w[1]),
+        "best first: {out}"
+    );
+    assert_eq!(scores[4], scores[0], "the best is chosen: {out}");
+    assert!(chosen.is_file());
+
     // Features of another chart, and a file that is not a model: clear errors.
     let (_, other) = dataset(&dir, "other", 20, 30, 4);
     let err = fails(&[
