@@ -336,16 +336,34 @@ fn spd_svg(e: &Value, truth: Option<&[f64]>, bands: &[Option<(Vec<f64>, Vec<f64>
         "<polyline class=\"spd\" points=\"{}\" fill=\"none\" stroke=\"#1f5fbf\" stroke-width=\"2.5\"/>",
         line(&spd)
     );
-    let mut legend = vec![("estimate", "#1f5fbf", "")];
+    let mut legend = vec![("estimate", "#1f5fbf", " stroke-width=\"2\"")];
     if truth.is_some() {
-        legend.push(("true SPD", "#222", " stroke-dasharray=\"6 4\""));
+        legend.push((
+            "true SPD",
+            "#222",
+            " stroke-width=\"2\" stroke-dasharray=\"6 4\"",
+        ));
     }
-    for (k, (label, colour, dash)) in legend.iter().enumerate() {
+    if bands[1].is_some() {
+        legend.push((
+            "68 % band",
+            "#1f5fbf",
+            " stroke-width=\"10\" stroke-opacity=\"0.32\"",
+        ));
+    }
+    if bands[0].is_some() {
+        legend.push((
+            "95 % band",
+            "#1f5fbf",
+            " stroke-width=\"10\" stroke-opacity=\"0.18\"",
+        ));
+    }
+    for (k, (label, colour, style)) in legend.iter().enumerate() {
         let ly = top_px + 14.0 + 16.0 * k as f64;
         let _ = write!(
             s,
-            "<line x1=\"{0}\" x2=\"{1}\" y1=\"{ly}\" y2=\"{ly}\" stroke=\"{colour}\" \
-             stroke-width=\"2\"{dash}/><text x=\"{2}\" y=\"{3}\">{label}</text>",
+            "<line x1=\"{0}\" x2=\"{1}\" y1=\"{ly}\" y2=\"{ly}\" stroke=\"{colour}\"{style}/>\
+             <text x=\"{2}\" y=\"{3}\">{label}</text>",
             right - 120.0,
             right - 96.0,
             right - 90.0,
@@ -1012,6 +1030,7 @@ mod tests {
         assert!(html.contains("<polygon class=\"band95\""));
         assert!(html.contains("<polygon class=\"band68\""));
         assert!(html.contains("68 % and 95 % uncertainty bands"));
+        assert!(html.contains(">68 % band</text>") && html.contains(">95 % band</text>"));
         // Keys the report does not know go to the details table; the plotted bands do not.
         assert!(html.contains(
             "<tr data-key=\"expected_gfc\"><th>expected_gfc</th><td class=\"num\">0.9912</td>"
