@@ -1,14 +1,16 @@
 // End-to-end tests of the `spdcam serve` page in headless Chromium, as a person would use it.
-// Usage: node e2e.mjs URL EXPECTED.json PHOTO TRUTH.csv ARTEFACT_DIR
-// EXPECTED.json is `spdcam estimate --json PHOTO` (an array of one estimate).
+// Usage: node e2e.mjs URL EXPECTED.json PHOTO TRUTH.csv ARTEFACT_DIR [REPORT.html]
+// EXPECTED.json is `spdcam estimate --json PHOTO` (an array of one estimate); REPORT.html,
+// when given, is `spdcam estimate --report REPORT.html PHOTO`, opened offline from its file.
 import { chromium } from 'playwright-core';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
+import { pathToFileURL } from 'node:url';
 
-const [url, expectedPath, photoPath, truthPath, artefacts] = process.argv.slice(2);
+const [url, expectedPath, photoPath, truthPath, artefacts, reportPath] = process.argv.slice(2);
 if (!artefacts) {
-  console.error('usage: node e2e.mjs URL EXPECTED.json PHOTO TRUTH.csv ARTEFACT_DIR');
+  console.error('usage: node e2e.mjs URL EXPECTED.json PHOTO TRUTH.csv ARTEFACT_DIR [REPORT.html]');
   process.exit(2);
 }
 const expected = JSON.parse(readFileSync(expectedPath, 'utf8'))[0];
@@ -178,6 +180,46 @@ await test('the page asked for nothing outside the local server and raised no sc
   check(foreign.length === 0, `requests elsewhere: ${foreign.join(', ')}`);
   check(pageErrors.length === 0, `script errors: ${pageErrors.join('; ')}`);
 });
+
+if (reportPath) {
+  await test('the CLI report opens offline with its numbers, plots and photo', async () => {
+    await context.setOffline(true);
+    const tab = await context.newPage();
+    const errors = [];
+    const requests = [];
+    tab.on('pageerror', (e) => errors.push(e.message));
+    tab.on('request', (r) => {
+      if (!r.url().startsWith('file:') && !r.url().startsWith('data:')) requests.push(r.url());
+    });
+    await tab.goto(pathToFileURL(reportPath).href, { waitUntil: 'load' });
+    const shown = async (key) => (await tab.locator(`#estimate-1 [data-key="${key}"]`).first().textContent()).trim();
+    const m = expected.metrics;
+    check(await shown('cri_ra') === m.cri_ra.toFixed(1), `Ra ${await shown('cri_ra')}, expected ${m.cri_ra.toFixed(1)}`);
+    check(await shown('tm30_rf') === m.tm30_rf.toFixed(1), `Rf ${await shown('tm30_rf')}, expected ${m.tm30_rf.toFixed(1)}`);
+    check(await shown('tm30_rg') === m.tm30_rg.toFixed(1), `Rg ${await shown('tm30_rg')}, expected ${m.tm30_rg.toFixed(1)}`);
+    check(await shown('cct_k') === m.cct_k.toFixed(0), `CCT ${await shown('cct_k')}, expected ${m.cct_k.toFixed(0)}`);
+    check(await shown('gfc') === expected.truth.gfc.toFixed(4), `GFC ${await shown('gfc')}, expected ${expected.truth.gfc.toFixed(4)}`);
+    const size = (selector) => tab.evaluate((sel) => {
+      const r = document.querySelector(sel).getBoundingClientRect();
+      return [r.width, r.height];
+    }, selector);
+    for (const selector of ['#estimate-1 svg.spd-plot', '#estimate-1 svg.tm30-cvg']) {
+      const [w, h] = await size(selector);
+      check(w > 0 && h > 0, `${selector} drawn ${w} × ${h}`);
+    }
+    check(await tab.locator('#estimate-1 svg.spd-plot polyline.spd').count() === 1, 'no SPD line');
+    check(await tab.locator('#estimate-1 svg.tm30-cvg polygon.test').count() === 1, 'no TM-30 test polygon');
+    const image = await tab.evaluate(() => {
+      const img = document.querySelector('#estimate-1 img.photo');
+      return img && img.complete ? img.naturalWidth : 0;
+    });
+    check(image > 0 && image <= 1200, `the photo is ${image} px wide`);
+    await tab.screenshot({ path: join(artefacts, 'report.png'), fullPage: true });
+    check(requests.length === 0, `the report asked for ${requests.join(', ')}`);
+    check(errors.length === 0, `script errors: ${errors.join('; ')}`);
+    await tab.close();
+  });
+}
 
 await context.close();
 rmSync(profile, { recursive: true, force: true });

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # End-to-end tests of `spdcam serve` in headless Chromium: installs what is missing
 # (Debian's chromium, playwright-core from npm), builds spdcam, starts the server on a free
-# loopback port, and runs the browser tests against the CLI's own estimate of the example.
-# Screenshots go to $SPDCAM_WEB_ARTEFACTS (default: <target dir>/web-tests).
+# loopback port, and runs the browser tests against the CLI's own estimate of the example;
+# then opens the CLI's HTML report of the example offline from its file.
+# Screenshots and the report go to $SPDCAM_WEB_ARTEFACTS (default: <target dir>/web-tests).
 # Ends with "N passed, N failed" and a non-zero status when a test failed.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -37,6 +38,7 @@ cleanup() {
 trap cleanup EXIT
 
 "$bin" estimate --json "$photo" >"$work/expected.json"
+"$bin" estimate "$photo" --report "$artefacts/report.html" >/dev/null
 "$bin" serve --port 0 >"$work/serve.log" 2>&1 &
 server=$!
 url=""
@@ -53,4 +55,4 @@ if [ -z "$url" ]; then
     exit 1
 fi
 echo "server: $url"
-node "$here/e2e.mjs" "$url" "$work/expected.json" "$photo" "$truth" "$artefacts"
+node "$here/e2e.mjs" "$url" "$work/expected.json" "$photo" "$truth" "$artefacts" "$artefacts/report.html"

@@ -33,6 +33,7 @@ pub mod network;
 pub mod pca;
 pub mod plot;
 pub mod record;
+pub mod report;
 pub mod scale;
 pub mod shipped;
 pub mod stream;

@@ -11,12 +11,13 @@ use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
 use spdcam_core::metrics;
-use spdcam_core::photo::{self, PhotoAnalysis};
+use spdcam_core::photo::{self, ChartTemplate, PhotoAnalysis};
 use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_infer::estimate::{analyse_photos, chart_templates, estimate_analysis};
 use spdcam_infer::estimate::{Colorimetry, Score};
 use spdcam_infer::plot::spds_svg;
+use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
 use spdcam_infer::stream::{
     estimate_block, long_header, long_rows, row_name, FeatureStream, GridMap, Layout,
     WIDE_LAYOUT_MAX_ROWS,
@@ -65,6 +66,12 @@ pub struct EstimateArgs {
     /// when it exists.
     #[arg(long, value_name = "FILE.csv")]
     truth: Option<PathBuf>,
+    /// Also write one self-contained HTML page of the estimates (a section each: the photo
+    /// with the chart found, the SPD plot, colorimetry, every lighting metric, the TM-30
+    /// colour vector graphic, the score against the truth, every other number); it loads
+    /// nothing from the network. With --features: the first 20 rows.
+    #[arg(long, value_name = "FILE.html")]
+    report: Option<PathBuf>,
     #[command(flatten)]
     photo: PhotoArgs,
 }
@@ -175,6 +182,15 @@ fn truths(
         .collect()
 }
 
+/// What [`estimate_from_photos`] gives: the estimates, their photos, the charts looked
+/// for, and how many photos gave none.
+struct PhotoEstimates {
+    estimates: Vec<Estimate>,
+    photos: Vec<PathBuf>,
+    templates: Vec<ChartTemplate>,
+    failed: usize,
+}
+
 /// Estimates from the photos, one per photo that could be used; the photos that could not
 /// (no chart found, no model for its chart, unreadable) are reported on stderr and counted.
 fn estimate_from_photos(
@@ -182,10 +198,10 @@ fn estimate_from_photos(
     models: &ModelSet,
     data_dir: &DataDir,
     grid: &Grid,
-) -> Result<(Vec<Estimate>, Vec<PathBuf>, usize)> {
+) -> Result<PhotoEstimates> {
     let options = args.photo.options()?;
     let templates = chart_templates(models, options.chart.as_deref(), data_dir)?;
-    let results = analyse_photos(&args.photos, &options, templates)?;
+    let results = analyse_photos(&args.photos, &options, templates.clone())?;
     let labels = photo_labels(&args.photos);
     let mut analyses: Vec<(PathBuf, String, PhotoAnalysis)> = Vec::new();
     let mut failed = 0;
@@ -227,7 +243,12 @@ fn estimate_from_photos(
             }
         }
     }
-    Ok((estimates, paths, failed))
+    Ok(PhotoEstimates {
+        estimates,
+        photos: paths,
+        templates,
+        failed,
+    })
 }
 
 /// Runs `spdcam estimate`.
@@ -237,6 +258,9 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         .flatten()
     {
         fsio::check_parent_dir(path)?;
+    }
+    if let Some(report) = &args.report {
+        fsio::check_writable(report)?;
     }
     if args.photo.json && args.output.as_deref().is_some_and(fsio::is_stdout) {
         bail!("--json and -o - both write to standard output; choose one");
@@ -252,7 +276,12 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     if args.layout == Some(LayoutArg::Long) && args.output.is_some() {
         bail!("--layout long is for --features; estimates of photos are written wide");
     }
-    let (mut estimates, photos, failed) = estimate_from_photos(&args, &models, data_dir, &grid)?;
+    let PhotoEstimates {
+        mut estimates,
+        photos,
+        templates,
+        failed,
+    } = estimate_from_photos(&args, &models, data_dir, &grid)?;
     if estimates.is_empty() {
         bail!(
             "no estimate: none of the {} photo(s) could be used (see the errors above)",
@@ -285,6 +314,19 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             format!("Estimated SPDs ({shown} of {})", set.len())
         };
         write_plot(plot, &spds_svg(&title, &grid, &series)?)?;
+    }
+    if let Some(path) = &args.report {
+        let items = estimates
+            .iter()
+            .zip(&photos)
+            .zip(truths)
+            .map(|((e, photo), truth)| report_item(e, Some((photo, &templates)), truth))
+            .collect::<Result<Vec<_>>>()?;
+        let title = match estimates.as_slice() {
+            [one] => format!("The light in {}", one.name),
+            all => format!("The light in {} photos", all.len()),
+        };
+        write_report(path, &title, &items)?;
     }
     if args.photo.json {
         let json = estimates
@@ -489,6 +531,27 @@ fn run_features(args: &EstimateArgs, path: &Path, models: &ModelSet, grid: &Grid
         println!("\n]");
     }
     let detailed = run.rows <= DETAILED_MAX;
+    if let Some(report) = &args.report {
+        let items = run
+            .first
+            .iter()
+            .enumerate()
+            .map(|(row, (name, spd, score))| {
+                let e = run.estimate(name.clone(), spd.clone(), *score)?;
+                report_item(&e, None, run.truth(row)?.map(<[f64]>::to_vec))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let title = if run.rows > items.len() {
+            format!(
+                "The light of {source}: the first {} of {} rows",
+                items.len(),
+                run.rows
+            )
+        } else {
+            format!("The light of {source}")
+        };
+        write_report(report, &title, &items)?;
+    }
     if let Some(plot) = &args.plot {
         let series: Vec<(String, Vec<f64>)> = run
             .first
@@ -538,6 +601,9 @@ fn run_features(args: &EstimateArgs, path: &Path, models: &ModelSet, grid: &Grid
     }
     if let Some(plot) = &args.plot {
         println!("plot → {}", plot.display());
+    }
+    if let Some(report) = &args.report {
+        println!("report → {}", report.display());
     }
     Ok(())
 }
@@ -592,6 +658,55 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     if let Some(plot) = &args.plot {
         println!("plot → {}", plot.display());
     }
+    if let Some(report) = &args.report {
+        println!("report → {}", report.display());
+    }
+}
+
+/// One estimate of the report: its JSON, for a photo the photo with the chart found
+/// (decoded again and drawn as `--debug` draws it, among the charts of `templates`), and
+/// its truth.
+fn report_item(
+    estimate: &Estimate,
+    photo: Option<(&PathBuf, &[ChartTemplate])>,
+    truth: Option<Vec<f64>>,
+) -> Result<ReportItem> {
+    let image = match (photo, &estimate.photo) {
+        (Some((path, templates)), Some(analysis)) => {
+            let template = templates
+                .iter()
+                .find(|t| t.name == analysis.chart)
+                .with_context(|| {
+                    format!(
+                        "{}: no template of chart {}",
+                        path.display(),
+                        analysis.chart
+                    )
+                })?;
+            let decoded = photo::load_photo(path)?;
+            Some(ReportImage {
+                mime: "image/jpeg",
+                bytes: photo::analysis_overlay_jpeg(
+                    &decoded,
+                    template,
+                    analysis,
+                    REPORT_IMAGE_WIDTH,
+                )?,
+            })
+        }
+        _ => None,
+    };
+    Ok(ReportItem {
+        estimate: estimate.to_json()?,
+        image,
+        truth_spd: truth,
+    })
+}
+
+/// Writes the report of `items` to `path` atomically.
+fn write_report(path: &Path, title: &str, items: &[ReportItem]) -> Result<()> {
+    fsio::write_atomic(path, report_html(title, items).as_bytes())?;
+    Ok(())
 }
 
 /// The main lighting-quality numbers on one line, `—` where undefined.

@@ -2,6 +2,7 @@
 //! outline with its first corner marked, every sampled region with its patch number, and,
 //! when no chart was found, the patch candidates the search saw.
 
+use super::batch::PhotoAnalysis;
 use super::detect::SearchTrace;
 use super::geometry::Homography;
 use super::load::Photo;
@@ -170,6 +171,47 @@ pub fn debug_overlay(
     }
     image::RgbImage::from_raw(canvas.width as u32, canvas.height as u32, canvas.rgb)
         .unwrap_or_default()
+}
+
+/// The debug image of an analysed photo (its chart outline and sampled squares, as
+/// [`debug_overlay`] draws them), reduced to at most `max_width` px wide and encoded as
+/// JPEG: small enough to embed in a report.
+pub fn analysis_overlay_jpeg(
+    photo: &Photo,
+    template: &ChartTemplate,
+    analysis: &PhotoAnalysis,
+    max_width: u32,
+) -> Result<Vec<u8>> {
+    let detection = Detection {
+        chart: analysis.chart.clone(),
+        corners: analysis.corners,
+        homography: analysis.homography,
+        confidence: analysis.confidence,
+    };
+    let mut image = debug_overlay(photo, Some((template, &detection, &analysis.patches)), None);
+    if image.width() > max_width && max_width > 0 {
+        let height = (u64::from(image.height()) * u64::from(max_width) / u64::from(image.width()))
+            .max(1) as u32;
+        image = image::imageops::resize(
+            &image,
+            max_width,
+            height,
+            image::imageops::FilterType::Triangle,
+        );
+    }
+    let mut bytes = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut bytes, 85)
+        .write_image(
+            image.as_raw(),
+            image.width(),
+            image.height(),
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(|e| Error::Image {
+            context: analysis.source.clone(),
+            message: e.to_string(),
+        })?;
+    Ok(bytes)
 }
 
 /// Encodes the debug image as PNG and writes it to `path` atomically.
