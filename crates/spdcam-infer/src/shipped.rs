@@ -6,10 +6,16 @@ use crate::model::Model;
 
 /// The shipped models: chart name and `.spdm` bytes (`models/<chart>.spdm`, each made by the
 /// seeded commands in the README).
-const SHIPPED: &[(&str, &[u8])] = &[(
-    "colorchecker_sg96",
-    include_bytes!("../../../models/colorchecker_sg96.spdm"),
-)];
+const SHIPPED: &[(&str, &[u8])] = &[
+    (
+        "colorchecker_sg96",
+        include_bytes!("../../../models/colorchecker_sg96.spdm"),
+    ),
+    (
+        "colorchecker24",
+        include_bytes!("../../../models/colorchecker24.spdm"),
+    ),
+];
 
 /// A model with the name messages use for it.
 #[derive(Debug, Clone)]
