@@ -30,6 +30,8 @@ use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 const WORST_NAMED: usize = 3;
 /// Fewer usable patches than this leave the self-check's 6 parameters per channel too free.
 const MIN_CHECK_PATCHES: usize = 12;
+/// Fewer patches than this on a half leave its 4 parameters per channel too free.
+const MIN_HALF_PATCHES: usize = 8;
 /// Perturbed copies of the features whose estimates measure the spread.
 pub const JITTER_COPIES: usize = 16;
 /// Relative size (standard deviation) of the perturbation of each feature: about the
@@ -43,6 +45,10 @@ const JITTER_SEED: u64 = 0x7472_7573_7400_0001;
 pub struct SelfCheck {
     /// Mean over the patches of the RGB residual relative to the chart's mean RGB length.
     pub mean: f64,
+    /// The mean residual, on the same scale, when each half of the chart (left and right,
+    /// top and bottom; the larger) is predicted by the colour map of the other half: large
+    /// when the halves are lit differently (two lights, glare).
+    pub split: f64,
     /// The largest patch residual, on the same scale.
     pub worst: f64,
     /// The worst patches, 1-based in feature order (`p07` is 7), worst first.
@@ -121,7 +127,8 @@ impl ChartCheck {
     /// `0…scale`, three per patch). Patches with `skip[i]` (clipped, dark) are left out.
     ///
     /// The predicted raw RGB (Σλ camera · reflectance · SPD) is mapped to the photo's linear
-    /// RGB (sRGB decoded, IEC 61966-2-1) by a per-photo affine colour correction fitted by
+    /// RGB (the tone curve undone, see [`untone`]; of the tone curves tried on a grid the one
+    /// that fits best) by a per-photo affine colour correction fitted by
     /// least squares (Hong, Luo & Rhodes 2001, "A study of digital camera colorimetric
     /// characterisation based on polynomial modelling", Color Res. Appl. 26: 76–84): a 3×3
     /// matrix (camera and white balance), an offset (flare) and a linear light gradient
@@ -157,54 +164,101 @@ impl ChartCheck {
             .iter()
             .map(|w| std::array::from_fn(|c| w[c].iter().zip(spd).map(|(a, b)| a * b).sum()))
             .collect();
-        let observed: Vec<[f64; 3]> = features
-            .chunks_exact(3)
-            .map(|p| std::array::from_fn(|c| srgb_decode((p[c] / scale).clamp(0.0, 1.0))))
-            .collect();
+        let mut best: Option<SelfCheck> = None;
+        for &gamma in &TONE_GAMMAS {
+            for &contrast in &TONE_CONTRASTS {
+                let observed: Vec<[f64; 3]> = features
+                    .chunks_exact(3)
+                    .map(|p| {
+                        std::array::from_fn(|c| {
+                            untone((p[c] / scale).clamp(0.0, 1.0), gamma, contrast)
+                        })
+                    })
+                    .collect();
+                let s = self.fit(&predicted, &observed, &used)?;
+                if best.as_ref().is_none_or(|b| s.mean < b.mean) {
+                    best = Some(s);
+                }
+            }
+        }
+        best.ok_or_else(|| InferError::invalid("self-check: no tone curve to try"))
+    }
+
+    /// The self-check's fit of `predicted` raw RGB to `observed` linear RGB over the
+    /// patches `used` (see [`ChartCheck::check`]).
+    fn fit(
+        &self,
+        predicted: &[[f64; 3]],
+        observed: &[[f64; 3]],
+        used: &[usize],
+    ) -> Result<SelfCheck> {
         let level = |v: &[[f64; 3]]| {
             used.iter().map(|&i| v[i].iter().sum::<f64>()).sum::<f64>() / used.len() as f64
         };
-        let (pl, ol) = (level(&predicted), level(&observed));
+        let (pl, ol) = (level(predicted), level(observed));
         if !(pl > 0.0 && ol > 0.0) {
             return Err(InferError::invalid(
                 "self-check: the chart or the light is black",
             ));
         }
-        let design = |i: usize| -> [f64; 6] {
+        let design = |i: usize| -> Vec<f64> {
             let p = predicted[i].map(|v| v / pl);
             let l = p.iter().sum::<f64>() / 3.0;
             let [x, y] = self.centres[i];
-            [p[0], p[1], p[2], 1.0, x * l, y * l]
+            vec![p[0], p[1], p[2], 1.0, x * l, y * l]
         };
-        let a = DMatrix::from_fn(used.len(), 6, |r, k| design(used[r])[k]);
-        let b = DMatrix::from_fn(used.len(), 3, |r, c| observed[used[r]][c] / ol);
-        let solved = a
-            .svd(true, true)
-            .solve(&b, 1e-10)
-            .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))?;
+        let target = |i: usize| observed[i].map(|v| v / ol);
         let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let mean_length = used
-            .iter()
-            .map(|&i| norm(observed[i].map(|v| v / ol)))
-            .sum::<f64>()
-            / used.len() as f64;
-        let mut residuals: Vec<(usize, f64)> = used
-            .iter()
-            .map(|&i| {
-                let d = design(i);
-                let fit: [f64; 3] =
-                    std::array::from_fn(|c| (0..6).map(|k| d[k] * solved[(k, c)]).sum());
-                let obs = observed[i].map(|v| v / ol);
-                (
-                    i,
-                    norm(std::array::from_fn(|c| fit[c] - obs[c])) / mean_length,
-                )
-            })
-            .collect();
+        let mean_length = used.iter().map(|&i| norm(target(i))).sum::<f64>() / used.len() as f64;
+        let global = least_squares(used, 6, &design, &target)?;
+        let residual = |i: usize, solved: &DMatrix<f64>, columns: usize| -> f64 {
+            let d = design(i);
+            let t = target(i);
+            let fit: [f64; 3] =
+                std::array::from_fn(|c| (0..columns).map(|k| d[k] * solved[(k, c)]).sum());
+            norm(std::array::from_fn(|c| fit[c] - t[c])) / mean_length
+        };
+        let mut residuals: Vec<(usize, f64)> =
+            used.iter().map(|&i| (i, residual(i, &global, 6))).collect();
         let mean = residuals.iter().map(|r| r.1).sum::<f64>() / residuals.len() as f64;
         residuals.sort_by(|a, b| b.1.total_cmp(&a.1));
+        // Halves: the colour map fitted to one half of the chart (the gradient fixed at the
+        // whole chart's) predicts the other half (a Chow-type test for one map across the
+        // chart; Chow 1960, Econometrica 28: 591–605).
+        let gradient = |i: usize| -> [f64; 3] {
+            let d = design(i);
+            std::array::from_fn(|c| d[4] * global[(4, c)] + d[5] * global[(5, c)])
+        };
+        let flat = |i: usize| -> [f64; 3] {
+            let (t, g) = (target(i), gradient(i));
+            std::array::from_fn(|c| t[c] - g[c])
+        };
+        let mut split = 0.0f64;
+        for axis in 0..2 {
+            let (a, b): (Vec<usize>, Vec<usize>) =
+                used.iter().partition(|&&i| self.centres[i][axis] < 0.0);
+            if a.len() < MIN_HALF_PATCHES || b.len() < MIN_HALF_PATCHES {
+                continue;
+            }
+            let mut cross = 0.0;
+            for (fit_on, judged) in [(&a, &b), (&b, &a)] {
+                let solved = least_squares(fit_on, 4, &design, &flat)?;
+                cross += judged
+                    .iter()
+                    .map(|&i| {
+                        let d = design(i);
+                        let t = flat(i);
+                        let f: [f64; 3] =
+                            std::array::from_fn(|c| (0..4).map(|k| d[k] * solved[(k, c)]).sum());
+                        norm(std::array::from_fn(|c| f[c] - t[c])) / mean_length
+                    })
+                    .sum::<f64>();
+            }
+            split = split.max(cross / used.len() as f64);
+        }
         Ok(SelfCheck {
             mean,
+            split,
             worst: residuals[0].1,
             worst_patches: residuals
                 .iter()
@@ -213,6 +267,40 @@ impl ChartCheck {
                 .collect(),
         })
     }
+}
+
+/// Gammas of the tone curves the self-check tries (the virtual camera's range, 0.7–1.3).
+const TONE_GAMMAS: [f64; 5] = [0.7, 0.85, 1.0, 1.15, 1.3];
+/// Contrasts of the S-curves the self-check tries (the virtual camera's range, ±0.4).
+const TONE_CONTRASTS: [f64; 5] = [-0.4, -0.2, 0.0, 0.2, 0.4];
+
+/// Linear RGB from an encoded value `y` (0–1) of a camera whose tone curve is a power
+/// `gamma` on linear values, the sRGB encoding (IEC 61966-2-1) and the contrast S-curve
+/// `e + contrast·e(1−e)(2e−1)` (the virtual camera's in-camera stage): the S-curve inverted
+/// by Newton's method (monotone for |contrast| ≤ 0.5), decoded, raised to 1/gamma.
+fn untone(y: f64, gamma: f64, contrast: f64) -> f64 {
+    let mut e = y;
+    for _ in 0..8 {
+        let f = e + contrast * e * (1.0 - e) * (2.0 * e - 1.0) - y;
+        let df = 1.0 + contrast * (-6.0 * e * e + 6.0 * e - 1.0);
+        e = (e - f / df).clamp(0.0, 1.0);
+    }
+    srgb_decode(e).powf(1.0 / gamma)
+}
+
+/// The least-squares solution (SVD) of design(i)[..columns] · X = target(i) over the
+/// patches `rows`.
+fn least_squares(
+    rows: &[usize],
+    columns: usize,
+    design: &dyn Fn(usize) -> Vec<f64>,
+    target: &dyn Fn(usize) -> [f64; 3],
+) -> Result<DMatrix<f64>> {
+    let a = DMatrix::from_fn(rows.len(), columns, |r, k| design(rows[r])[k]);
+    let b = DMatrix::from_fn(rows.len(), 3, |r, c| target(rows[r])[c]);
+    a.svd(true, true)
+        .solve(&b, 1e-10)
+        .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))
 }
 
 /// The scale of a feature row: 255 when any value exceeds 1, else 1 (as the feature checks
@@ -348,6 +436,9 @@ pub struct Calibration {
     /// The 99th percentile of the self-check's mean residual on the calibration photos, when
     /// the chart's reflectances were at hand; above it the estimate is doubtful.
     pub self_check_doubtful: Option<f64>,
+    /// The 99th percentile of the self-check's half-to-half residual ([`SelfCheck::split`])
+    /// on the calibration photos; above it the estimate is doubtful.
+    pub split_doubtful: Option<f64>,
     /// The 99th percentile of the number of clipped feature patches on the calibration
     /// photos (saturated colours clip a channel under narrow-band light, and the model was
     /// trained with them); more make the estimate doubtful.
@@ -574,6 +665,23 @@ pub fn assess(
                     "the estimated light does not explain the photo: self-check residual {:.3} (clean photos stay below {level:.3}; worst patches {})",
                     s.mean,
                     s.worst_patches.iter().map(|p| format!("p{p:02}")).collect::<Vec<_>>().join(", ")
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.split_doubtful)) {
+        if s.split > level {
+            let v = if s.split > UNUSABLE_SELF_CHECK_FACTOR * level {
+                Verdict::Unusable
+            } else {
+                Verdict::Doubtful
+            };
+            lower(
+                v,
+                format!(
+                    "the two halves of the chart look lit differently (two lights, glare): half-to-half residual {:.3} (clean photos stay below {level:.3})",
+                    s.split
                 ),
                 &mut reasons,
             );
@@ -825,7 +933,7 @@ mod tests {
     fn a_calibration_whose_arrays_disagree_is_refused() {
         let text = r#"{"model":"0","chart":"c","method":"m","wavelength_nm":[400,410],
             "floor":[0.1],"scale68":[1,1],"scale95":[2,2],"difficulty_edges":[],
-            "expected_gfc":[0.9],"difficulty_doubtful":0.1,"self_check_doubtful":null,
+            "expected_gfc":[0.9],"difficulty_doubtful":0.1,"self_check_doubtful":null,"split_doubtful":null,
             "clipped_doubtful":0}"#;
         let err = Calibration::from_json(text, "c.json")
             .unwrap_err()
