@@ -456,3 +456,58 @@ fn many_feature_rows_stream_to_the_long_layout() {
     assert!(err.contains("--layout long is for --features"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A scene photo of another chart that the detector takes for a ColorChecker 24 (its grey
+/// row in place, the other 18 patches in another order): the estimate does not explain the
+/// photo, so it is called unusable and its numbers are not printed.
+#[test]
+fn a_photo_of_another_chart_is_unusable() {
+    let dir = scratch("wrong-chart");
+    let table = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/colorchecker24.csv"),
+    )
+    .unwrap();
+    let order = [
+        8, 3, 6, 5, 15, 16, 2, 12, 0, 1, 13, 10, 17, 9, 14, 11, 4, 7, 18, 19, 20, 21, 22, 23,
+    ];
+    let shuffled: String = table
+        .lines()
+        .map(|line| {
+            let cells: Vec<&str> = line.split(',').collect();
+            let mut out = vec![cells[0]];
+            out.extend(order.iter().map(|&p| cells[1 + p]));
+            out.join(",") + "\n"
+        })
+        .collect();
+    let chart = dir.join("other.csv");
+    std::fs::write(&chart, shuffled).unwrap();
+    let photo = dir.join("other.jpg");
+    ok(&[
+        "render",
+        "--spd",
+        "A",
+        "--chart",
+        &s(&chart),
+        "--layout",
+        "4x6",
+        "--scene",
+        "1200x900",
+        "-o",
+        &s(&photo),
+    ]);
+    let out = ok(&["estimate", &s(&photo)]);
+    assert!(out.contains("colorchecker24 detected"), "{out}");
+    assert!(
+        out.contains("UNUSABLE") && out.contains("does not explain"),
+        "{out}"
+    );
+    assert!(
+        !out.contains("relative SPD"),
+        "no numbers for an unusable estimate:\n{out}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", &s(&photo), "--json"])).unwrap();
+    assert_eq!(json[0]["verdict"], "unusable");
+    assert!(json[0]["self_check"]["mean"].as_f64().unwrap() > 0.2);
+    std::fs::remove_dir_all(&dir).ok();
+}
