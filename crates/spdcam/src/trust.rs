@@ -20,12 +20,15 @@ use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::lighting::{LampLibrary, ValidationSplit};
+use spdcam_core::photo::scene::{self, SceneOptions};
+use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_core::{metrics, seed};
+use spdcam_infer::estimate::{estimate_photo_bytes, PhotoOptions};
 use spdcam_infer::trust::{
     self, assess, Calibration, ChartCheck, PhotoFlags, Verdict, JITTER_COPIES, JITTER_SIGMA,
 };
-use spdcam_infer::Model;
+use spdcam_infer::{Model, ModelSet};
 use std::path::{Path, PathBuf};
 
 /// Options of `spdcam trust`.
@@ -444,6 +447,145 @@ fn calibrate(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
     Ok(())
 }
 
+/// Scene photos per kind in [`scene_verdicts`].
+const SCENES: usize = 20;
+
+/// The chart as photos show it for `model_chart` (the SG's 96 patches are read from the
+/// whole 140-patch chart).
+fn photo_chart(model_chart: &str) -> &str {
+    if model_chart == "colorchecker_sg96" {
+        "colorchecker_sg140"
+    } else {
+        model_chart
+    }
+}
+
+/// Scene photos (the code of `spdcam render --scene`: the chart placed in a cluttered scene
+/// with perspective, blur, vignetting, noise and JPEG) of [`SCENES`] test lamps, each by a
+/// held-out camera, found, sampled and estimated like a user's photo: clean, of another
+/// chart (the non-grey patches in another order), the right half of the chart lit by
+/// another lamp, and with glare. Per kind: the share not `ok` (or refused: no chart found),
+/// and the share the self-check flags.
+fn scene_verdicts(
+    model: &Model,
+    cal: &Calibration,
+    model_chart: &str,
+    setup: &Setup,
+    data_dir: &DataDir,
+    seed: u64,
+) -> Result<[(f64, f64); 4]> {
+    let name = photo_chart(model_chart);
+    let chart = Chart::resolve(name, None, data_dir, &GRID)?;
+    let template = ChartTemplate::from_chart(&chart)?;
+    let chart = chart.with_layout(scene::scene_layout(&template))?;
+    let mut wrong = chart.clone();
+    let movable: Vec<usize> = chart
+        .feature_patches
+        .iter()
+        .copied()
+        .filter(|p| template.neutrals.iter().all(|n| n.0 != *p))
+        .collect();
+    let mut order = movable.clone();
+    order.shuffle(&mut SmallRng::seed_from_u64(seed));
+    let mut items: Vec<Vec<f64>> = chart.reflectances.items().to_vec();
+    for (&to, &from) in movable.iter().zip(&order) {
+        items[to] = chart.reflectances.item(from).to_vec();
+    }
+    wrong.reflectances = SpectralSet::on_grid(&GRID, chart.reflectances.names().to_vec(), items)?;
+    let config = CameraConfig::default();
+    let pool = camera_pool(&setup.cameras, 0, seed, &chart, config, &GRID)?;
+    let wrong_pool = camera_pool(&setup.cameras, 0, seed, &wrong, config, &GRID)?;
+    let ids = setup
+        .library
+        .positions(setup.split.lamps(LampPart::Test), "the split's test lamps")?;
+    let models = ModelSet::single(model.clone(), "model");
+    let options = PhotoOptions {
+        chart: Some(name.to_string()),
+        ..PhotoOptions::default()
+    };
+    let mut counts = [(0usize, 0usize); 4];
+    for i in 0..SCENES {
+        let lamp = ids[i * ids.len() / SCENES];
+        let other = ids[(i * ids.len() / SCENES + ids.len() / 2) % ids.len()];
+        let k = i % pool.len();
+        let shot_seed = seed::derive(seed, i as u64);
+        let clean = pool[k]
+            .render(&setup.library.spds[lamp], shot_seed, false)?
+            .image;
+        let lit_b = pool[k]
+            .render(&setup.library.spds[other], shot_seed, false)?
+            .image;
+        let mut half = clean.clone();
+        for plane in 0..3 {
+            for y in 0..half.height {
+                for x in half.width / 2..half.width {
+                    half.planes[plane][y * half.width + x] =
+                        lit_b.planes[plane][y * half.width + x];
+                }
+            }
+        }
+        let mut glared = clean.clone();
+        let mean = clean
+            .planes
+            .iter()
+            .flatten()
+            .map(|&v| srgb_decode(f64::from(v)))
+            .sum::<f64>()
+            / (3 * clean.width * clean.height) as f64;
+        let side = clean.width as f64;
+        for plane in 0..3 {
+            for y in 0..glared.height {
+                for x in 0..glared.width {
+                    let d2 = ((x * x + y * y) as f64) / (side * side);
+                    let add = GLARE_LEVEL * mean * (-d2 / (2.0 * GLARE_WIDTH * GLARE_WIDTH)).exp();
+                    let v = &mut glared.planes[plane][y * glared.width + x];
+                    *v = srgb_encode((srgb_decode(f64::from(*v)) + add).min(1.0)) as f32;
+                }
+            }
+        }
+        let other_chart = wrong_pool[k]
+            .render(&setup.library.spds[lamp], shot_seed, false)?
+            .image;
+        for (kind, image) in [clean, other_chart, half, glared].iter().enumerate() {
+            let shot = scene::photograph(
+                image,
+                &chart.layout,
+                &template,
+                &chart.feature_patches,
+                shot_seed,
+                &SceneOptions {
+                    width: 1200,
+                    height: 900,
+                    ..SceneOptions::default()
+                },
+            )?;
+            match estimate_photo_bytes(
+                &shot.jpeg,
+                "scene.jpg",
+                &models,
+                &options,
+                data_dir,
+                &model.grid(),
+            ) {
+                Ok(e) => {
+                    let t = e.trust.context("an estimate without a verdict")?;
+                    counts[kind].0 += usize::from(t.verdict != Verdict::Ok);
+                    let flagged = t.self_check.as_ref().is_some_and(|s| {
+                        cal.self_check_doubtful.is_some_and(|l| s.mean > l)
+                            || cal.split_doubtful.is_some_and(|l| s.split > l)
+                    });
+                    counts[kind].1 += usize::from(flagged);
+                }
+                Err(_) => {
+                    counts[kind].0 += 1;
+                    counts[kind].1 += 1;
+                }
+            }
+        }
+    }
+    Ok(counts.map(|(n, f)| (n as f64 / SCENES as f64, f as f64 / SCENES as f64)))
+}
+
 /// The options that made the photos, as a command line.
 fn photo_args(p: &Photos) -> String {
     let mut out: String = p
@@ -642,6 +784,17 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
          | model | photos | clean: flagged | clean: not ok | wrong chart: flagged | half-lit: flagged | glare: flagged | bad (all three): flagged |\n\
          |---|---:|---:|---:|---:|---:|---:|---:|\n",
     );
+    let mut scenes = format!(
+        "## Scene photos\n\n\
+         Photos made with the code of `spdcam render --scene` ({SCENES} test lamps, one photo each \
+         per kind, 1200×900, by the held-out cameras with the default camera stage, noise \
+         included), found, sampled and estimated like a user's photo. Share not `ok` (in \
+         brackets: flagged by the self-check); a photo in which no chart is found counts as \
+         both. Another chart: the non-grey patches in another order. Half-lit: the right half \
+         of the chart image lit by another test lamp. Glare: as above, on the chart image.\n\n\
+         | model | photos per kind | clean | another chart | half-lit | glare |\n\
+         |---|---:|---:|---:|---:|---:|\n"
+    );
     md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
     for ((path, model, chart_name), cal_path) in models.iter().zip(&args.calibration) {
         let text = std::fs::read_to_string(cal_path)
@@ -731,10 +884,25 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
             100.0 * g,
             100.0 * (w + h + g) / 3.0
         );
+        let [c, w, h, g] =
+            scene_verdicts(model, &cal, chart_name, &setup, data_dir, args.photos.seed)?;
+        scenes += &format!(
+            "| `{name}` | {SCENES} | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) |\n",
+            100.0 * c.0,
+            100.0 * c.1,
+            100.0 * w.0,
+            100.0 * w.1,
+            100.0 * h.0,
+            100.0 * h.1,
+            100.0 * g.0,
+            100.0 * g.1
+        );
         eprintln!("{}: measured", path.display());
     }
     md.push('\n');
     md += &flags;
+    md.push('\n');
+    md += &scenes;
     md += &format!(
         "\nGoals: the 95 % band covers 90–97 % of the true values; ρ ≥ 0.6; the self-check flags \
          ≥ 95 % of the bad photos and < 5 % of the clean ones. Photos: {} per lamp, seed {}.\n\n",
