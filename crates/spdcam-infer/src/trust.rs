@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! features ─► model ─► SPD ─┬─► chart reflectances × SPD × camera ─► 3×3 + offset + gradient
-//!                           │     fitted to the photo ─► residual (self-check)
+//!                           │     fitted to the photo (tone curve undone) ─► residual and
+//!                           │     half-to-half residual (self-check)
 //! features ± 2 % ─► model ──┴─► spread of the SPDs ─► × calibrated quantiles ─► bands, GFC
 //!            detection, clipping, self-check, spread ─► verdict: ok / doubtful / unusable
 //! ```
@@ -461,7 +462,8 @@ pub const UNUSABLE_CLIPPED_SHARE: f64 = 0.5;
 pub const DOUBTFUL_DARK_SHARE: f64 = 0.25;
 
 impl Calibration {
-    /// Reads a calibration from JSON, checked against `model`'s grid.
+    /// Reads a calibration from JSON (`shown` names it in errors), its arrays checked to
+    /// agree in length.
     pub fn from_json(text: &str, shown: &str) -> Result<Calibration> {
         let c: Calibration =
             serde_json::from_str(text).map_err(|e| InferError::invalid(format!("{shown}: {e}")))?;
