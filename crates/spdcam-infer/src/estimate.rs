@@ -10,6 +10,7 @@
 use crate::error::{InferError, Result};
 use crate::model::Model;
 use crate::shipped::ModelSet;
+use crate::trust::{self, PhotoFlags, Trust};
 use serde::Serialize;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
@@ -281,12 +282,18 @@ pub struct Estimate {
     pub truth: Option<Score>,
     /// The analysis of the photo, for estimates from photos.
     pub photo: Option<PhotoAnalysis>,
+    /// How far the estimate can be trusted (verdict, reasons, self-check, bands), when
+    /// judged.
+    pub trust: Option<Trust>,
 }
 
 impl Estimate {
     /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`,
     /// `metrics` (every [`LightingMetrics`] key), `truth`, and for photos `photo` (chart, method, confidence, corners, homography, features and
-    /// `features_by_name`, every patch with its statistics and flags, warnings).
+    /// `features_by_name`, every patch with its statistics and flags, warnings). Judged
+    /// estimates add `verdict`, `reasons`, `self_check` ({mean, worst, worst_patches} or
+    /// null), `expected_gfc`, and `band68` and `band95` ({lower, upper} on the SPD's
+    /// wavelengths), the last three null without a calibration.
     pub fn to_json(&self) -> Result<serde_json::Value> {
         let mut v = serde_json::json!({
             "name": self.name,
@@ -299,6 +306,15 @@ impl Estimate {
         });
         if let Some(a) = &self.photo {
             v["photo"] = analysis_json(a)?;
+        }
+        if let Some(t) = &self.trust {
+            let u = t.uncertainty.as_ref();
+            v["verdict"] = serde_json::json!(t.verdict);
+            v["reasons"] = serde_json::json!(t.reasons);
+            v["self_check"] = serde_json::json!(t.self_check);
+            v["expected_gfc"] = serde_json::json!(u.map(|u| u.expected_gfc));
+            v["band68"] = serde_json::json!(u.map(|u| &u.band68));
+            v["band95"] = serde_json::json!(u.map(|u| &u.band95));
         }
         Ok(v)
     }
@@ -327,7 +343,7 @@ pub fn analysis_json(analysis: &PhotoAnalysis) -> Result<serde_json::Value> {
 }
 
 /// Estimates for feature rows: each row through the model for its columns, labelled
-/// `estimate_1…`, on `grid`.
+/// `estimate_1…`, on `grid`; not judged (see [`judge_estimate`]), so many rows stay fast.
 pub fn estimate_features(
     models: &ModelSet,
     features: &FeatureRows,
@@ -350,9 +366,30 @@ pub fn estimate_features(
                 metrics: LightingMetrics::from_samples(&grid.wavelengths(), set.item(i)),
                 truth: None,
                 photo: None,
+                trust: None,
             })
         })
         .collect()
+}
+
+/// Judges an estimate made from feature `row` (no photo) by the model of `models` for
+/// `names`, and keeps the verdict in it ([`trust::judge`]).
+pub fn judge_estimate(
+    estimate: &mut Estimate,
+    models: &ModelSet,
+    names: &[String],
+    row: &[f64],
+    data_dir: &DataDir,
+) -> Result<()> {
+    let chosen = models.require(names, &estimate.name)?;
+    estimate.trust = Some(trust::judge(
+        &chosen.model,
+        row,
+        &PhotoFlags::default(),
+        data_dir,
+        &estimate.grid,
+    )?);
+    Ok(())
 }
 
 /// How photos are analysed: which charts to look for, and optional corners or debug image.
@@ -447,11 +484,14 @@ pub fn analyse_photos(
         .collect())
 }
 
-/// The estimate for an analysed photo, with the model for its chart, labelled `name`.
+/// The estimate for an analysed photo, with the model for its chart, labelled `name`,
+/// judged ([`trust::judge`]; the chart's reflectances from `data_dir` when it is not built
+/// in).
 pub fn estimate_analysis(
     models: &ModelSet,
     analysis: PhotoAnalysis,
     name: String,
+    data_dir: &DataDir,
     grid: &Grid,
 ) -> Result<Estimate> {
     let rows = FeatureRows::of_analyses(&[&analysis])?;
@@ -471,6 +511,13 @@ pub fn estimate_analysis(
         grid,
     )?;
     let spd = set.item(0).to_vec();
+    let feature_patches = chosen
+        .model
+        .photo_chart()
+        .filter(|t| t.name == analysis.chart)
+        .map(|t| t.feature_patches.as_slice());
+    let flags = trust::photo_flags(&analysis, feature_patches);
+    let trust = trust::judge(&chosen.model, &rows.values, &flags, data_dir, grid)?;
     Ok(Estimate {
         name,
         model: chosen.name.clone(),
@@ -480,6 +527,7 @@ pub fn estimate_analysis(
         spd,
         truth: None,
         photo: Some(analysis),
+        trust: Some(trust),
     })
 }
 
@@ -500,7 +548,7 @@ pub fn estimate_photo(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| path.display().to_string());
-    estimate_analysis(models, analysis, name, grid)
+    estimate_analysis(models, analysis, name, data_dir, grid)
 }
 
 /// Analyses a decoded photo: the chart found (or placed by `options.corners`) among the
@@ -543,7 +591,7 @@ pub fn estimate_decoded(
     grid: &Grid,
 ) -> Result<Estimate> {
     let analysis = analyse_decoded(photo, models, options, data_dir)?;
-    estimate_analysis(models, analysis, photo.source.clone(), grid)
+    estimate_analysis(models, analysis, photo.source.clone(), data_dir, grid)
 }
 
 /// [`estimate_photo`] for a photo held in memory, labelled `name`.
@@ -556,7 +604,7 @@ pub fn estimate_photo_bytes(
     grid: &Grid,
 ) -> Result<Estimate> {
     let analysis = analyse_photo_bytes(bytes, name, models, options, data_dir)?;
-    estimate_analysis(models, analysis, name.to_string(), grid)
+    estimate_analysis(models, analysis, name.to_string(), data_dir, grid)
 }
 
 /// `colorchecker_sg96, colorchecker24`: the charts the set's models read.

@@ -38,6 +38,7 @@ pub mod scale;
 pub mod shipped;
 pub mod stream;
 pub mod target;
+pub mod trust;
 
 pub use error::{InferError, Result};
 pub use estimate::{

@@ -193,6 +193,19 @@ impl Model {
         &self.header
     }
 
+    /// FNV-1a 64 of the network's parameter values (f32 LE, in order), as 16 hex digits:
+    /// tells this model's weights from another's, so a calibration is used only for the
+    /// model it was measured on.
+    pub fn fingerprint(&self) -> String {
+        let bytes: Vec<u8> = self
+            .network
+            .parameters()
+            .iter()
+            .flat_map(|p| p.data.iter().flat_map(|v| v.to_le_bytes()))
+            .collect();
+        format!("{:016x}", fnv1a(&bytes))
+    }
+
     /// The network.
     pub fn network(&self) -> &Network {
         &self.network

@@ -16,12 +16,13 @@ use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_infer::estimate::{analyse_photos, chart_templates, estimate_analysis};
 use spdcam_infer::estimate::{Colorimetry, Score};
-use spdcam_infer::plot::spds_svg;
+use spdcam_infer::plot::spds_band_svg;
 use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
 use spdcam_infer::stream::{
     estimate_block, long_header, long_rows, row_name, FeatureStream, GridMap, Layout,
     WIDE_LAYOUT_MAX_ROWS,
 };
+use spdcam_infer::trust::{self, PhotoFlags, Trust, Uncertainty, Verdict};
 use spdcam_infer::{Estimate, Model, ModelSet};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -232,7 +233,7 @@ fn estimate_from_photos(
         if !quiet(args) {
             println!("{}", photo_args::describe(&analysis));
         }
-        match estimate_analysis(models, analysis, label, grid) {
+        match estimate_analysis(models, analysis, label, data_dir, grid) {
             Ok(e) => {
                 estimates.push(e);
                 paths.push(path);
@@ -271,7 +272,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     let models = load_models(args.model.as_deref())?;
     let grid = Grid::parse(&args.range)?;
     if let Some(path) = &args.features {
-        return run_features(&args, path, &models, &grid);
+        return run_features(&args, path, &models, data_dir, &grid);
     }
     if args.layout == Some(LayoutArg::Long) && args.output.is_some() {
         bail!("--layout long is for --features; estimates of photos are written wide");
@@ -301,7 +302,10 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         estimates.iter().map(|e| e.spd.clone()).collect(),
     )?;
     if let Some(out) = &args.output {
-        fsio::write_output(out, set.to_csv_string().as_bytes())?;
+        fsio::write_output(
+            out,
+            with_bands(&estimates, &grid)?.to_csv_string().as_bytes(),
+        )?;
     }
     if let Some(plot) = &args.plot {
         let shown = set.len().min(20);
@@ -313,7 +317,11 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         } else {
             format!("Estimated SPDs ({shown} of {})", set.len())
         };
-        write_plot(plot, &spds_svg(&title, &grid, &series)?)?;
+        let bands: Vec<Option<&Uncertainty>> = estimates[..shown]
+            .iter()
+            .map(|e| e.trust.as_ref().and_then(|t| t.uncertainty.as_ref()))
+            .collect();
+        write_plot(plot, &spds_band_svg(&title, &grid, &series, &bands)?)?;
     }
     if let Some(path) = &args.report {
         let items = estimates
@@ -355,8 +363,8 @@ struct FeatureRun {
     model: String,
     grid: Grid,
     truths: Option<SpectralSet>,
-    /// The first [`DETAILED_MAX`] estimates, without colorimetry until printed.
-    first: Vec<(String, Vec<f64>, Option<Score>)>,
+    /// The first [`DETAILED_MAX`] estimates, without colorimetry until printed, judged.
+    first: Vec<(String, Vec<f64>, Option<Score>, Trust)>,
     rows: usize,
     /// (sum of GFC, sum of RMSE) over the scored estimates.
     score_sums: (f64, f64),
@@ -380,7 +388,13 @@ impl FeatureRun {
     }
 
     /// One full estimate (colorimetry and lighting metrics computed: they are asked for).
-    fn estimate(&self, name: String, spd: Vec<f64>, truth: Option<Score>) -> Result<Estimate> {
+    fn estimate(
+        &self,
+        name: String,
+        spd: Vec<f64>,
+        truth: Option<Score>,
+        trust: Option<Trust>,
+    ) -> Result<Estimate> {
         Ok(Estimate {
             colorimetry: Colorimetry::of(&spd, &self.grid)?,
             metrics: LightingMetrics::from_samples(&self.grid.wavelengths(), &spd),
@@ -390,18 +404,24 @@ impl FeatureRun {
             spd,
             truth,
             photo: None,
+            trust,
         })
     }
 
     /// Takes the SPDs of the rows from `first_row` on: scores, keeps, prints JSON, writes.
+    /// `features` are the rows' features, `judge` judges one of them.
     fn add(
         &mut self,
         first_row: usize,
         spds: Vec<f64>,
+        features: &[f64],
+        judge: &dyn Fn(&[f64]) -> Result<Trust>,
         json: bool,
         out: &mut Option<&mut dyn Write>,
     ) -> Result<()> {
         let width = self.grid.count;
+        let columns = features.len() / (spds.len() / width).max(1);
+        let row = |k: usize| &features[k * columns..(k + 1) * columns];
         let scores: Vec<Option<Score>> = spds
             .chunks_exact(width)
             .enumerate()
@@ -416,14 +436,24 @@ impl FeatureRun {
         }
         for (k, spd) in spds.chunks_exact(width).enumerate() {
             if self.first.len() < DETAILED_MAX {
-                self.first
-                    .push((row_name(first_row + k), spd.to_vec(), scores[k]));
+                self.first.push((
+                    row_name(first_row + k),
+                    spd.to_vec(),
+                    scores[k],
+                    judge(row(k))?,
+                ));
             }
         }
         if json {
             let mut text = String::new();
             for (k, spd) in spds.chunks_exact(width).enumerate() {
-                let e = self.estimate(row_name(first_row + k), spd.to_vec(), scores[k])?;
+                let trust = judge(row(k))?;
+                let e = self.estimate(
+                    row_name(first_row + k),
+                    spd.to_vec(),
+                    scores[k],
+                    Some(trust),
+                )?;
                 text.push_str(if self.json_started { ",\n" } else { "[\n" });
                 self.json_started = true;
                 text.push_str(&serde_json::to_string_pretty(&e.to_json()?)?);
@@ -471,10 +501,25 @@ impl FeatureRun {
 /// linear in the rows and memory bounded whatever their number. Colorimetry (xy, CCT, Duv)
 /// and the lighting metrics are computed only for what is printed: the estimates shown in
 /// full (up to 20), the plot's title, and every estimate of `--json`.
-fn run_features(args: &EstimateArgs, path: &Path, models: &ModelSet, grid: &Grid) -> Result<()> {
+fn run_features(
+    args: &EstimateArgs,
+    path: &Path,
+    models: &ModelSet,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<()> {
     let mut stream = FeatureStream::open(path)?;
     let source = path.display().to_string();
     let chosen = models.require(stream.names(), &source)?;
+    let judge = |row: &[f64]| -> Result<Trust> {
+        Ok(trust::judge(
+            &chosen.model,
+            row,
+            &PhotoFlags::default(),
+            data_dir,
+            grid,
+        )?)
+    };
     let map = GridMap::new(&chosen.model.grid(), grid)?;
     let mut run = FeatureRun {
         model: chosen.name.clone(),
@@ -499,7 +544,14 @@ fn run_features(args: &EstimateArgs, path: &Path, models: &ModelSet, grid: &Grid
         while let Some(block) = stream.next_block(rows)? {
             let spds = estimate_block(&chosen.model, &block, stream.names(), &source, &map)?;
             rows += block.rows;
-            run.add(block.first_row, spds, args.photo.json, out)?;
+            run.add(
+                block.first_row,
+                spds,
+                &block.values,
+                &judge,
+                args.photo.json,
+                out,
+            )?;
         }
         if rows == 0 {
             bail!("{source}: no rows of features below the header");
@@ -536,8 +588,8 @@ fn run_features(args: &EstimateArgs, path: &Path, models: &ModelSet, grid: &Grid
             .first
             .iter()
             .enumerate()
-            .map(|(row, (name, spd, score))| {
-                let e = run.estimate(name.clone(), spd.clone(), *score)?;
+            .map(|(row, (name, spd, score, trust))| {
+                let e = run.estimate(name.clone(), spd.clone(), *score, Some(trust.clone()))?;
                 report_item(&e, None, run.truth(row)?.map(<[f64]>::to_vec))
             })
             .collect::<Result<Vec<_>>>()?;
@@ -556,16 +608,18 @@ fn run_features(args: &EstimateArgs, path: &Path, models: &ModelSet, grid: &Grid
         let series: Vec<(String, Vec<f64>)> = run
             .first
             .iter()
-            .map(|(n, spd, _)| (n.clone(), spd.clone()))
+            .map(|(n, spd, _, _)| (n.clone(), spd.clone()))
             .collect();
         let title = if run.rows == 1 {
-            let (name, spd, _) = &run.first[0];
-            let e = run.estimate(name.clone(), spd.clone(), None)?;
+            let (name, spd, _, _) = &run.first[0];
+            let e = run.estimate(name.clone(), spd.clone(), None, None)?;
             format!("Estimated SPD: {}", e.colorimetry.label())
         } else {
             format!("Estimated SPDs ({} of {})", series.len(), run.rows)
         };
-        write_plot(plot, &spds_svg(&title, grid, &series)?)?;
+        let bands: Vec<Option<&Uncertainty>> =
+            run.first.iter().map(|f| f.3.uncertainty.as_ref()).collect();
+        write_plot(plot, &spds_band_svg(&title, grid, &series, &bands)?)?;
     }
     if quiet(args) {
         return Ok(());
@@ -574,7 +628,7 @@ fn run_features(args: &EstimateArgs, path: &Path, models: &ModelSet, grid: &Grid
         let first = std::mem::take(&mut run.first);
         first
             .into_iter()
-            .map(|(name, spd, score)| run.estimate(name, spd, score))
+            .map(|(name, spd, score, trust)| run.estimate(name, spd, score, Some(trust)))
             .collect::<Result<Vec<_>>>()?
     } else {
         Vec::new()
@@ -616,10 +670,27 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     println!("{} estimate(s) with {}", estimates.len(), models.join(", "));
     let detailed = estimates.len() <= DETAILED_MAX;
     for e in estimates {
-        if detailed {
+        let unusable = e
+            .trust
+            .as_ref()
+            .is_some_and(|t| t.verdict == Verdict::Unusable);
+        if unusable {
+            println!("{}: UNUSABLE, no estimate to rely on", e.name);
+        } else if detailed {
             println!("{}: {}", e.name, e.colorimetry.label());
             println!("  relative SPD: {}", spd_line(&e.spd, &e.grid));
             println!("  {}", metrics_line(&e.metrics));
+        }
+        if let Some(t) = &e.trust {
+            println!("  {}", trust_line(t));
+            if let (Some(u), false) = (&t.uncertainty, unusable) {
+                println!(
+                    "  expected GFC {:.3}; 95 % band {:.2} wide on average (68 %: {:.2}; SPD peak 1)",
+                    u.expected_gfc,
+                    u.band95.mean_width(),
+                    u.band68.mean_width()
+                );
+            }
         }
         if let Some(s) = e.truth {
             println!(
@@ -641,6 +712,13 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
              (`spdcam metrics` on a wider SPD, `--json` for every number)",
             estimates[0].grid.start_nm,
             estimates[0].grid.end_nm()
+        );
+    }
+    if estimates.iter().any(|e| e.trust.is_some()) {
+        println!(
+            "verdict: ok, doubtful (use with care) or unusable, from the detection, clipped and \
+             dark patches, the self-check (the chart re-rendered under the estimate) and the \
+             calibrated uncertainty; the bands hold the true SPD at 68 % and 95 % per wavelength"
         );
     }
     if estimates.iter().any(|e| e.truth.is_some()) {
@@ -707,6 +785,35 @@ fn report_item(
 fn write_report(path: &Path, title: &str, items: &[ReportItem]) -> Result<()> {
     fsio::write_atomic(path, report_html(title, items).as_bytes())?;
     Ok(())
+}
+
+/// The verdict and its reasons on one line: `verdict: doubtful (2 of 24 patches are …)`.
+fn trust_line(t: &Trust) -> String {
+    if t.reasons.is_empty() {
+        format!("verdict: {}", t.verdict.label())
+    } else {
+        format!("verdict: {} ({})", t.verdict.label(), t.reasons.join("; "))
+    }
+}
+
+/// The estimates' SPDs as a spectral set, each followed by its bands when it has them:
+/// `<name>_lower68, <name>_upper68, <name>_lower95, <name>_upper95`.
+fn with_bands(estimates: &[Estimate], grid: &Grid) -> Result<SpectralSet> {
+    let mut names = Vec::new();
+    let mut values = Vec::new();
+    for e in estimates {
+        names.push(e.name.clone());
+        values.push(e.spd.clone());
+        if let Some(u) = e.trust.as_ref().and_then(|t| t.uncertainty.as_ref()) {
+            for (band, level) in [(&u.band68, "68"), (&u.band95, "95")] {
+                names.push(format!("{}_lower{level}", e.name));
+                values.push(band.lower.clone());
+                names.push(format!("{}_upper{level}", e.name));
+                values.push(band.upper.clone());
+            }
+        }
+    }
+    Ok(SpectralSet::on_grid(grid, names, values)?)
 }
 
 /// The main lighting-quality numbers on one line, `—` where undefined.

@@ -26,6 +26,8 @@ mod serve;
 mod sim2real_curve;
 #[cfg(feature = "train")]
 mod train;
+#[cfg(feature = "train")]
+mod trust;
 mod validate_lamps;
 
 use clap::{Parser, Subcommand};
@@ -81,6 +83,9 @@ enum Command {
     Coverage(Box<coverage::CoverageArgs>),
     /// Real lamps: the validation split, the lamp-family fits, the validation protocol.
     Lamps(lamps::LampsArgs),
+    #[cfg(feature = "train")]
+    /// Calibrate and measure how far estimates can be trusted (bands, verdicts).
+    Trust(trust::TrustArgs),
 }
 
 /// Output piped into a program that stops reading (`spdcam … | head`) ends spdcam quietly,
@@ -123,6 +128,8 @@ fn main() -> ExitCode {
         Command::Serve(args) => serve::run(args, &data_dir),
         Command::Coverage(args) => coverage::run(*args, &data_dir),
         Command::Lamps(args) => lamps::run(args, &data_dir),
+        #[cfg(feature = "train")]
+        Command::Trust(args) => trust::run(args, &data_dir),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -77,23 +77,7 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
     }
     let library = args.library.read(data_dir, &GRID)?;
     let split = ValidationSplit::read(&args.split)?;
-    let dir = in_data_dir(args.cameras.as_deref(), "cameras", data_dir)?;
-    let available = camera_names(&dir)?;
-    let mut held_out: Vec<Sensitivities> = Vec::new();
-    for name in &split.cameras.held_out {
-        if !available.contains(name) {
-            bail!("held-out camera '{name}' is not in {}", dir.display());
-        }
-        let path = dir.join(format!("{name}.csv"));
-        // The same cameras training skips (unusable curves) are skipped here, named.
-        match sensitivities(&path.to_string_lossy(), data_dir, &GRID) {
-            Ok(s) => held_out.push(s),
-            Err(e) => eprintln!("warning: skipping held-out camera {name}: {e:#}"),
-        }
-    }
-    if held_out.is_empty() {
-        bail!("none of the split's held-out cameras could be read");
-    }
+    let held_out = held_out_cameras(&split, args.cameras.as_deref(), data_dir)?;
     let parts = [
         ("validation", LampPart::Validation),
         ("test", LampPart::Test),
@@ -215,8 +199,34 @@ fn file_name(path: &std::path::Path) -> String {
     )
 }
 
+/// The split's held-out cameras from `dir` (default: the data directory's cameras/); the
+/// cameras training skips (unusable curves) are skipped here too, named.
+pub(crate) fn held_out_cameras(
+    split: &ValidationSplit,
+    dir: Option<&std::path::Path>,
+    data_dir: &DataDir,
+) -> Result<Vec<Sensitivities>> {
+    let dir = in_data_dir(dir, "cameras", data_dir)?;
+    let available = camera_names(&dir)?;
+    let mut held_out: Vec<Sensitivities> = Vec::new();
+    for name in &split.cameras.held_out {
+        if !available.contains(name) {
+            bail!("held-out camera '{name}' is not in {}", dir.display());
+        }
+        let path = dir.join(format!("{name}.csv"));
+        match sensitivities(&path.to_string_lossy(), data_dir, &GRID) {
+            Ok(s) => held_out.push(s),
+            Err(e) => eprintln!("warning: skipping held-out camera {name}: {e:#}"),
+        }
+    }
+    if held_out.is_empty() {
+        bail!("none of the split's held-out cameras could be read");
+    }
+    Ok(held_out)
+}
+
 /// Every lamp of the library on `grid` (linear interpolation), normalised by its maximum.
-fn on_grid(library: &LampLibrary, grid: &Grid) -> Result<Vec<Vec<f64>>> {
+pub(crate) fn on_grid(library: &LampLibrary, grid: &Grid) -> Result<Vec<Vec<f64>>> {
     let set = SpectralSet::on_grid(&library.grid, library.names.clone(), library.spds.clone())?;
     let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
     Ok(set

@@ -84,11 +84,11 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
     // The lighting-quality line and its legend.
     assert!(out.contains("  Ra ") && out.contains("M-EDER"), "{out}");
     // The truth file beside the photo is found and scored.
-    let gfc = number_after(&out, "GFC");
+    let gfc = number_after(&out, "against the true SPD: GFC");
     assert!(gfc > 0.9 && gfc <= 1.0, "GFC {gfc}:\n{out}");
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(
-        text.starts_with("wavelength_nm,sg-telelumen.jpg\n400,"),
+        text.starts_with("wavelength_nm,sg-telelumen.jpg,sg-telelumen.jpg_lower68,sg-telelumen.jpg_upper68,sg-telelumen.jpg_lower95,sg-telelumen.jpg_upper95\n400,"),
         "{text}"
     );
     assert_eq!(text.lines().count(), 62);
@@ -145,7 +145,10 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
     }
     std::fs::write(&flat, text).unwrap();
     let out = ok(&["estimate", EXAMPLE, "--truth", &s(&flat)]);
-    assert!(number_after(&out, "GFC") < gfc, "{out}");
+    assert!(
+        number_after(&out, "against the true SPD: GFC") < gfc,
+        "{out}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -177,11 +180,37 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
     ]);
     assert!(out.contains("colorchecker24 detected"), "{out}");
     assert!(out.contains("the shipped colorchecker24 model"), "{out}");
-    let gfc = number_after(&out, "GFC");
+    let gfc = number_after(&out, "against the true SPD: GFC");
     assert!(gfc > 0.95, "CIE A through the CC24 model: GFC {gfc}\n{out}");
-    assert!(std::fs::read_to_string(&csv)
-        .unwrap()
-        .starts_with("wavelength_nm,cc24.jpg\n"));
+    // A clean rendered photo: trusted, with its expected GFC and band.
+    assert!(out.contains("verdict: ok"), "{out}");
+    let expected = number_after(&out, "expected GFC");
+    assert!((0.9..=1.0).contains(&expected), "{out}");
+    assert!(out.contains("95 % band"), "{out}");
+    assert!(std::fs::read_to_string(&csv).unwrap().starts_with(
+        "wavelength_nm,cc24.jpg,cc24.jpg_lower68,cc24.jpg_upper68,cc24.jpg_lower95,cc24.jpg_upper95\n"
+    ));
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", &s(&photo), "--json"])).unwrap();
+    let e = &json[0];
+    assert_eq!(e["verdict"], "ok", "{}", e["reasons"]);
+    let spd = e["spd"].as_array().unwrap();
+    for band in ["band68", "band95"] {
+        let lower = e[band]["lower"].as_array().unwrap();
+        let upper = e[band]["upper"].as_array().unwrap();
+        assert_eq!((lower.len(), upper.len()), (spd.len(), spd.len()));
+        for ((l, u), v) in lower.iter().zip(upper).zip(spd) {
+            let (l, u, v) = (
+                l.as_f64().unwrap(),
+                u.as_f64().unwrap(),
+                v.as_f64().unwrap(),
+            );
+            assert!(l <= v + 1e-9 && v <= u + 1e-9, "{band}: {l} {v} {u}");
+        }
+    }
+    let check = &e["self_check"];
+    assert!(check["mean"].as_f64().unwrap() < 0.1, "{check}");
+    assert_eq!(check["worst_patches"].as_array().unwrap().len(), 3);
 
     // Features are written for any chart; with a model for another chart there is no
     // estimate, and the run says so and fails, leaving no SPD file.
@@ -281,7 +310,7 @@ fn bad_photos_give_clear_errors_and_no_output() {
     );
     let written = std::fs::read_to_string(&csv).unwrap();
     assert!(
-        written.starts_with("wavelength_nm,sg-telelumen.jpg\n"),
+        written.starts_with("wavelength_nm,sg-telelumen.jpg,sg-telelumen.jpg_lower68,"),
         "{written}"
     );
     std::fs::remove_dir_all(&dir).ok();
@@ -325,7 +354,7 @@ fn a_chart_image_from_render_is_estimated() {
     // inside the photo, not for one that is the whole image), found among every chart.
     let out = ok(&["--data-dir", &data, "estimate", &s(&chart)]);
     assert!(out.contains("colorchecker_sg96 detected"), "{out}");
-    let gfc = number_after(&out, "GFC");
+    let gfc = number_after(&out, "against the true SPD: GFC");
     assert!(gfc > 0.99, "GFC {gfc}:\n{out}");
     let cct = number_after(&out, "CCT");
     assert!((5800.0..7200.0).contains(&cct), "CCT {cct}:\n{out}");
@@ -422,5 +451,60 @@ fn many_feature_rows_stream_to_the_long_layout() {
     assert_eq!(csv_cells(&small).len(), 4);
     let err = fails(&["estimate", EXAMPLE, "-o", &s(&small), "--layout", "long"]);
     assert!(err.contains("--layout long is for --features"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A scene photo of another chart that the detector takes for a ColorChecker 24 (its grey
+/// row in place, the other 18 patches in another order): the estimate does not explain the
+/// photo, so it is called unusable and its numbers are not printed.
+#[test]
+fn a_photo_of_another_chart_is_unusable() {
+    let dir = scratch("wrong-chart");
+    let table = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/colorchecker24.csv"),
+    )
+    .unwrap();
+    let order = [
+        8, 3, 6, 5, 15, 16, 2, 12, 0, 1, 13, 10, 17, 9, 14, 11, 4, 7, 18, 19, 20, 21, 22, 23,
+    ];
+    let shuffled: String = table
+        .lines()
+        .map(|line| {
+            let cells: Vec<&str> = line.split(',').collect();
+            let mut out = vec![cells[0]];
+            out.extend(order.iter().map(|&p| cells[1 + p]));
+            out.join(",") + "\n"
+        })
+        .collect();
+    let chart = dir.join("other.csv");
+    std::fs::write(&chart, shuffled).unwrap();
+    let photo = dir.join("other.jpg");
+    ok(&[
+        "render",
+        "--spd",
+        "A",
+        "--chart",
+        &s(&chart),
+        "--layout",
+        "4x6",
+        "--scene",
+        "1200x900",
+        "-o",
+        &s(&photo),
+    ]);
+    let out = ok(&["estimate", &s(&photo)]);
+    assert!(out.contains("colorchecker24 detected"), "{out}");
+    assert!(
+        out.contains("UNUSABLE") && out.contains("does not explain"),
+        "{out}"
+    );
+    assert!(
+        !out.contains("relative SPD"),
+        "no numbers for an unusable estimate:\n{out}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", &s(&photo), "--json"])).unwrap();
+    assert_eq!(json[0]["verdict"], "unusable");
+    assert!(json[0]["self_check"]["mean"].as_f64().unwrap() > 0.2);
     std::fs::remove_dir_all(&dir).ok();
 }

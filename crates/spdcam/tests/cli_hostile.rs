@@ -385,7 +385,7 @@ fn estimates_go_to_standard_output_with_dash() {
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.starts_with("wavelength_nm,sg-telelumen.jpg\n400,"),
+        text.starts_with("wavelength_nm,sg-telelumen.jpg,sg-telelumen.jpg_lower68,"),
         "{text}"
     );
     assert_eq!(text.lines().count(), 62, "the CSV and nothing else: {text}");

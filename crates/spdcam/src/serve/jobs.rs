@@ -71,7 +71,13 @@ impl Engine {
             Err(e) => return Outcome::Failed(400, e.to_string()),
         };
         drop(upload.bytes);
-        let estimate = match estimate_analysis(&self.models, analysis, upload.name, &self.grid) {
+        let estimate = match estimate_analysis(
+            &self.models,
+            analysis,
+            upload.name,
+            &self.data_dir,
+            &self.grid,
+        ) {
             Ok(e) => e,
             Err(e) => return Outcome::Failed(422, e.to_string()),
         };

@@ -1,0 +1,945 @@
+//! How far an estimate can be trusted: a self-check that re-renders the chart under the
+//! estimated light, per-wavelength uncertainty bands with an expected GFC, and one verdict.
+//!
+//! ```text
+//! features ─► model ─► SPD ─┬─► chart reflectances × SPD × camera ─► 3×3 + offset + gradient
+//!                           │     fitted to the photo (tone curve undone) ─► residual and
+//!                           │     half-to-half residual (self-check)
+//! features ± 2 % ─► model ──┴─► spread of the SPDs ─► × calibrated quantiles ─► bands, GFC
+//!            detection, clipping, self-check, spread ─► verdict: ok / doubtful / unusable
+//! ```
+//!
+//! The bands and the expected GFC come from a calibration file per model, measured on
+//! held-out virtual photos of held-out lamps (`spdcam trust calibrate`, docs/trust.md).
+
+use crate::error::{InferError, Result};
+use crate::model::Model;
+use nalgebra::DMatrix;
+use rand::rngs::SmallRng;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
+use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::camera::sensor::Sensitivities;
+use spdcam_core::chart::Chart;
+use spdcam_core::colorimetry::srgb_decode;
+use spdcam_core::metrics;
+use spdcam_core::photo::{PatchSample, PhotoAnalysis};
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+
+/// How many patches the self-check names as the worst.
+const WORST_NAMED: usize = 3;
+/// Fewer usable patches than this leave the self-check's 6 parameters per channel too free.
+const MIN_CHECK_PATCHES: usize = 12;
+/// Fewer patches than this on a half leave its 4 parameters per channel too free.
+const MIN_HALF_PATCHES: usize = 8;
+/// Perturbed copies of the features whose estimates measure the spread.
+pub const JITTER_COPIES: usize = 16;
+/// Relative size (standard deviation) of the perturbation of each feature: about the
+/// patch-to-patch noise of an 8-bit JPEG of a chart plus the sampling error.
+pub const JITTER_SIGMA: f64 = 0.02;
+/// Seed of the perturbations, fixed so an estimate is reproducible.
+const JITTER_SEED: u64 = 0x7472_7573_7400_0001;
+
+/// How well the estimated light explains the photo's patches.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SelfCheck {
+    /// Mean over the patches of the RGB residual relative to the chart's mean RGB length.
+    pub mean: f64,
+    /// The mean residual, on the same scale, when each half of the chart (left and right,
+    /// top and bottom; the larger) is predicted by the colour map of the other half: large
+    /// when the halves are lit differently (two lights, glare).
+    pub split: f64,
+    /// The largest patch residual, on the same scale.
+    pub worst: f64,
+    /// The worst patches, 1-based in feature order (`p07` is 7), worst first.
+    pub worst_patches: Vec<usize>,
+}
+
+/// The chart's feature patches seen by a reference camera, ready to be lit by an SPD.
+#[derive(Debug, Clone)]
+pub struct ChartCheck {
+    /// Per feature patch: reference camera sensitivity × reflectance, per channel.
+    weights: Vec<[Vec<f64>; 3]>,
+    /// Per feature patch: its centre across the chart, −½…½.
+    centres: Vec<[f64; 2]>,
+    grid: Grid,
+}
+
+impl ChartCheck {
+    /// `chart` seen by `camera`, both on `grid`.
+    pub fn new(chart: &Chart, camera: &Sensitivities, grid: &Grid) -> Result<ChartCheck> {
+        chart.reflectances.require_grid(grid, "chart")?;
+        camera.curves.require_grid(grid, "camera")?;
+        let (rows, cols) = (chart.layout.rows, chart.layout.cols);
+        let weights = chart
+            .feature_patches
+            .iter()
+            .map(|&p| {
+                let refl = chart.reflectances.item(p);
+                std::array::from_fn(|c| {
+                    let s = camera.curves.item(c);
+                    s.iter().zip(refl).map(|(a, b)| a * b).collect()
+                })
+            })
+            .collect();
+        let centres = chart
+            .feature_patches
+            .iter()
+            .map(|&p| {
+                [
+                    ((p % cols) as f64 + 0.5) / cols as f64 - 0.5,
+                    ((p / cols) as f64 + 0.5) / rows as f64 - 0.5,
+                ]
+            })
+            .collect();
+        Ok(ChartCheck {
+            weights,
+            centres,
+            grid: *grid,
+        })
+    }
+
+    /// The self-check for `model`'s chart on its grid, seen by the built-in Nikon D5100
+    /// (NPL, Darrodi et al. 2015); `None` when the chart's reflectances are not at hand
+    /// (the ColorChecker SG's come from the data directory).
+    pub fn for_model(model: &Model, data_dir: &DataDir) -> Result<Option<ChartCheck>> {
+        let grid = model.grid();
+        let Some(name) = model.header().chart.as_deref() else {
+            return Ok(None);
+        };
+        let Ok(chart) = Chart::resolve(name, None, data_dir, &grid) else {
+            return Ok(None);
+        };
+        if chart.feature_names() != model.feature_names() {
+            return Ok(None);
+        }
+        let table = &builtin::CAMERAS[0];
+        let camera = Sensitivities::new(table.name, &table.load()?, &grid)?;
+        Ok(Some(ChartCheck::new(&chart, &camera, &grid)?))
+    }
+
+    /// The number of feature patches.
+    pub fn patches(&self) -> usize {
+        self.weights.len()
+    }
+
+    /// Checks `spd` (on the check's grid) against one feature row (encoded sRGB on
+    /// `0…scale`, three per patch). Patches with `skip[i]` (clipped, dark) are left out.
+    ///
+    /// The predicted raw RGB (Σλ camera · reflectance · SPD) is mapped to the photo's linear
+    /// RGB (the tone curve undone, see [`untone`]; of the tone curves tried on a grid the one
+    /// that fits best) by a per-photo affine colour correction fitted by
+    /// least squares (Hong, Luo & Rhodes 2001, "A study of digital camera colorimetric
+    /// characterisation based on polynomial modelling", Color Res. Appl. 26: 76–84): a 3×3
+    /// matrix (camera and white balance), an offset (flare) and a linear light gradient
+    /// across the chart. What the fit cannot explain is the residual.
+    pub fn check(
+        &self,
+        spd: &[f64],
+        features: &[f64],
+        scale: f64,
+        skip: &[bool],
+    ) -> Result<SelfCheck> {
+        let n = self.weights.len();
+        if spd.len() != self.grid.count || features.len() != 3 * n {
+            return Err(InferError::invalid(format!(
+                "self-check: {} SPD values and {} features for {} values and {} patches",
+                spd.len(),
+                features.len(),
+                self.grid.count,
+                n
+            )));
+        }
+        let used: Vec<usize> = (0..n)
+            .filter(|&i| !skip.get(i).copied().unwrap_or(false))
+            .collect();
+        if used.len() < MIN_CHECK_PATCHES {
+            return Err(InferError::invalid(format!(
+                "self-check: {} usable patches, at least {MIN_CHECK_PATCHES} needed",
+                used.len()
+            )));
+        }
+        let predicted: Vec<[f64; 3]> = self
+            .weights
+            .iter()
+            .map(|w| std::array::from_fn(|c| w[c].iter().zip(spd).map(|(a, b)| a * b).sum()))
+            .collect();
+        let mut best: Option<SelfCheck> = None;
+        for &gamma in &TONE_GAMMAS {
+            for &contrast in &TONE_CONTRASTS {
+                let observed: Vec<[f64; 3]> = features
+                    .chunks_exact(3)
+                    .map(|p| {
+                        std::array::from_fn(|c| {
+                            untone((p[c] / scale).clamp(0.0, 1.0), gamma, contrast)
+                        })
+                    })
+                    .collect();
+                let s = self.fit(&predicted, &observed, &used)?;
+                if best.as_ref().is_none_or(|b| s.mean < b.mean) {
+                    best = Some(s);
+                }
+            }
+        }
+        best.ok_or_else(|| InferError::invalid("self-check: no tone curve to try"))
+    }
+
+    /// The self-check's fit of `predicted` raw RGB to `observed` linear RGB over the
+    /// patches `used` (see [`ChartCheck::check`]).
+    fn fit(
+        &self,
+        predicted: &[[f64; 3]],
+        observed: &[[f64; 3]],
+        used: &[usize],
+    ) -> Result<SelfCheck> {
+        let level = |v: &[[f64; 3]]| {
+            used.iter().map(|&i| v[i].iter().sum::<f64>()).sum::<f64>() / used.len() as f64
+        };
+        let (pl, ol) = (level(predicted), level(observed));
+        if !(pl > 0.0 && ol > 0.0) {
+            return Err(InferError::invalid(
+                "self-check: the chart or the light is black",
+            ));
+        }
+        let design = |i: usize| -> Vec<f64> {
+            let p = predicted[i].map(|v| v / pl);
+            let l = p.iter().sum::<f64>() / 3.0;
+            let [x, y] = self.centres[i];
+            vec![p[0], p[1], p[2], 1.0, x * l, y * l]
+        };
+        let target = |i: usize| observed[i].map(|v| v / ol);
+        let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let mean_length = used.iter().map(|&i| norm(target(i))).sum::<f64>() / used.len() as f64;
+        let global = least_squares(used, 6, &design, &target)?;
+        let residual = |i: usize, solved: &DMatrix<f64>, columns: usize| -> f64 {
+            let d = design(i);
+            let t = target(i);
+            let fit: [f64; 3] =
+                std::array::from_fn(|c| (0..columns).map(|k| d[k] * solved[(k, c)]).sum());
+            norm(std::array::from_fn(|c| fit[c] - t[c])) / mean_length
+        };
+        let mut residuals: Vec<(usize, f64)> =
+            used.iter().map(|&i| (i, residual(i, &global, 6))).collect();
+        let mean = residuals.iter().map(|r| r.1).sum::<f64>() / residuals.len() as f64;
+        residuals.sort_by(|a, b| b.1.total_cmp(&a.1));
+        // Halves: the colour map fitted to one half of the chart (the gradient fixed at the
+        // whole chart's) predicts the other half (a Chow-type test for one map across the
+        // chart; Chow 1960, Econometrica 28: 591–605).
+        let gradient = |i: usize| -> [f64; 3] {
+            let d = design(i);
+            std::array::from_fn(|c| d[4] * global[(4, c)] + d[5] * global[(5, c)])
+        };
+        let flat = |i: usize| -> [f64; 3] {
+            let (t, g) = (target(i), gradient(i));
+            std::array::from_fn(|c| t[c] - g[c])
+        };
+        let mut split = 0.0f64;
+        for axis in 0..2 {
+            let (a, b): (Vec<usize>, Vec<usize>) =
+                used.iter().partition(|&&i| self.centres[i][axis] < 0.0);
+            if a.len() < MIN_HALF_PATCHES || b.len() < MIN_HALF_PATCHES {
+                continue;
+            }
+            let mut cross = 0.0;
+            for (fit_on, judged) in [(&a, &b), (&b, &a)] {
+                let solved = least_squares(fit_on, 4, &design, &flat)?;
+                cross += judged
+                    .iter()
+                    .map(|&i| {
+                        let d = design(i);
+                        let t = flat(i);
+                        let f: [f64; 3] =
+                            std::array::from_fn(|c| (0..4).map(|k| d[k] * solved[(k, c)]).sum());
+                        norm(std::array::from_fn(|c| f[c] - t[c])) / mean_length
+                    })
+                    .sum::<f64>();
+            }
+            split = split.max(cross / used.len() as f64);
+        }
+        Ok(SelfCheck {
+            mean,
+            split,
+            worst: residuals[0].1,
+            worst_patches: residuals
+                .iter()
+                .take(WORST_NAMED)
+                .map(|r| r.0 + 1)
+                .collect(),
+        })
+    }
+}
+
+/// Gammas of the tone curves the self-check tries (the virtual camera's range, 0.7–1.3).
+const TONE_GAMMAS: [f64; 5] = [0.7, 0.85, 1.0, 1.15, 1.3];
+/// Contrasts of the S-curves the self-check tries (the virtual camera's range, ±0.4).
+const TONE_CONTRASTS: [f64; 5] = [-0.4, -0.2, 0.0, 0.2, 0.4];
+
+/// Linear RGB from an encoded value `y` (0–1) of a camera whose tone curve is a power
+/// `gamma` on linear values, the sRGB encoding (IEC 61966-2-1) and the contrast S-curve
+/// `e + contrast·e(1−e)(2e−1)` (the virtual camera's in-camera stage): the S-curve inverted
+/// by Newton's method (monotone for |contrast| ≤ 0.5), decoded, raised to 1/gamma.
+fn untone(y: f64, gamma: f64, contrast: f64) -> f64 {
+    let mut e = y;
+    for _ in 0..8 {
+        let f = e + contrast * e * (1.0 - e) * (2.0 * e - 1.0) - y;
+        let df = 1.0 + contrast * (-6.0 * e * e + 6.0 * e - 1.0);
+        e = (e - f / df).clamp(0.0, 1.0);
+    }
+    srgb_decode(e).powf(1.0 / gamma)
+}
+
+/// The least-squares solution (SVD) of design(i)[..columns] · X = target(i) over the
+/// patches `rows`.
+fn least_squares(
+    rows: &[usize],
+    columns: usize,
+    design: &dyn Fn(usize) -> Vec<f64>,
+    target: &dyn Fn(usize) -> [f64; 3],
+) -> Result<DMatrix<f64>> {
+    let a = DMatrix::from_fn(rows.len(), columns, |r, k| design(rows[r])[k]);
+    let b = DMatrix::from_fn(rows.len(), 3, |r, c| target(rows[r])[c]);
+    a.svd(true, true)
+        .solve(&b, 1e-10)
+        .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))
+}
+
+/// The scale of a feature row: 255 when any value exceeds 1, else 1 (as the feature checks
+/// tell them apart).
+pub fn feature_scale(row: &[f64]) -> f64 {
+    if row.iter().any(|&v| v > 1.0) {
+        255.0
+    } else {
+        1.0
+    }
+}
+
+/// Whether a patch's encoded RGB has a channel at the top of the scale.
+pub fn clipped_patch(rgb: &[f64], scale: f64) -> bool {
+    rgb.iter().any(|&v| v >= 0.995 * scale)
+}
+
+/// The number of clipped patches of a feature row (see [`clipped_patch`]).
+pub fn clipped_patches(row: &[f64]) -> usize {
+    let scale = feature_scale(row);
+    row.chunks_exact(3)
+        .filter(|p| clipped_patch(p, scale))
+        .count()
+}
+
+/// Patches to leave out of the self-check when no photo analysis flags them: a channel at
+/// the top of the scale (clipped) or every channel below 2 % of it (dark).
+pub fn flag_patches(row: &[f64], scale: f64) -> Vec<bool> {
+    row.chunks_exact(3)
+        .map(|p| clipped_patch(p, scale) || p.iter().all(|&v| v < 0.02 * scale))
+        .collect()
+}
+
+/// The spread of the model's estimates when each feature is perturbed by ±[`JITTER_SIGMA`]
+/// (multiplicative, log-normal): per wavelength, the standard deviation of the
+/// peak-normalised SPDs of [`JITTER_COPIES`] perturbed copies. Where many lights give nearly
+/// the same photo the network's answer is steep in its input and the spread is large — a
+/// sensitivity analysis of the inverse map (Saltelli et al. 2008, "Global Sensitivity
+/// Analysis: The Primer", ch. 1).
+pub fn spread(model: &Model, row: &[f64]) -> Result<Vec<f64>> {
+    let scale = feature_scale(row);
+    let noise =
+        Normal::new(0.0, JITTER_SIGMA).map_err(|e| InferError::invalid(format!("jitter: {e}")))?;
+    let mut rng = SmallRng::seed_from_u64(JITTER_SEED);
+    let mut rows = Vec::with_capacity(JITTER_COPIES * row.len());
+    for _ in 0..JITTER_COPIES {
+        rows.extend(
+            row.iter()
+                .map(|&v| (v * noise.sample(&mut rng).exp()).clamp(0.0, scale)),
+        );
+    }
+    let d = model.grid().count;
+    let spds: Vec<Vec<f64>> = model
+        .estimate_rows(&rows)?
+        .chunks_exact(d)
+        .map(metrics::normalise_by_max)
+        .collect();
+    Ok((0..d)
+        .map(|k| {
+            let m = spds.iter().map(|s| s[k]).sum::<f64>() / spds.len() as f64;
+            (spds.iter().map(|s| (s[k] - m).powi(2)).sum::<f64>() / (spds.len() - 1) as f64).sqrt()
+        })
+        .collect())
+}
+
+/// A band around the SPD on its wavelengths.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Band {
+    /// The lower edge, never below 0.
+    pub lower: Vec<f64>,
+    /// The upper edge.
+    pub upper: Vec<f64>,
+}
+
+/// Per-wavelength 68 % and 95 % bands and the GFC to expect.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Uncertainty {
+    /// Where the true (peak-normalised) SPD lies with 68 % probability, per wavelength.
+    pub band68: Band,
+    /// The same at 95 %.
+    pub band95: Band,
+    /// The GFC such estimates reach, in the median, on the calibration photos as hard.
+    pub expected_gfc: f64,
+    /// The mean spread of the perturbed estimates (see [`spread`]).
+    pub difficulty: f64,
+}
+
+impl Band {
+    /// The mean width (SPD peak = 1).
+    pub fn mean_width(&self) -> f64 {
+        let n = self.upper.len().max(1) as f64;
+        self.upper
+            .iter()
+            .zip(&self.lower)
+            .map(|(u, l)| u - l)
+            .sum::<f64>()
+            / n
+    }
+}
+
+/// A model's uncertainty calibration: measured once on held-out virtual photos of held-out
+/// lamps (`spdcam trust calibrate`), a small JSON file per model.
+///
+/// The band is a scaled-residual conformal band (Lei et al. 2018, "Distribution-free
+/// predictive inference for regression", JASA 113: 1094–1111, section 5.2, locally weighted
+/// residuals): with the spread s(λ) of the perturbed estimates and a floor f(λ) (the median
+/// absolute error at λ), the q-quantile of |error(λ)| / (f(λ) + s(λ)) over the calibration
+/// photos times (f(λ) + s(λ)) is the band's half-width. The expected GFC is the median GFC of
+/// the calibration photos in the same difficulty bin (equal-count bins of the mean spread).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Calibration {
+    /// The calibrated model's [`Model::fingerprint`].
+    pub model: String,
+    /// The model's chart.
+    pub chart: String,
+    /// How the calibration photos were made.
+    pub method: String,
+    /// The model's wavelengths (nm).
+    pub wavelength_nm: Vec<f64>,
+    /// f(λ): the median absolute error of the peak-normalised estimate.
+    pub floor: Vec<f64>,
+    /// The 68 % quantile of |error| / (f + s), per wavelength.
+    pub scale68: Vec<f64>,
+    /// The 95 % quantile of the same.
+    pub scale95: Vec<f64>,
+    /// Upper edges of the difficulty bins but the last (ascending).
+    pub difficulty_edges: Vec<f64>,
+    /// The median GFC per difficulty bin (one more than the edges).
+    pub expected_gfc: Vec<f64>,
+    /// The 99th percentile of the difficulty on the calibration photos: harder photos are
+    /// unlike the lights the model knows, or many lights give nearly the same photo.
+    pub difficulty_doubtful: f64,
+    /// The 99th percentile of the self-check's mean residual on the calibration photos, when
+    /// the chart's reflectances were at hand; above it the estimate is doubtful.
+    pub self_check_doubtful: Option<f64>,
+    /// The 99th percentile of the self-check's half-to-half residual ([`SelfCheck::split`])
+    /// on the calibration photos; above it the estimate is doubtful.
+    pub split_doubtful: Option<f64>,
+    /// The 99th percentile of the number of clipped feature patches on the calibration
+    /// photos (saturated colours clip a channel under narrow-band light, and the model was
+    /// trained with them); more make the estimate doubtful.
+    pub clipped_doubtful: usize,
+}
+
+/// Estimates above this detection confidence are placed surely; the photo analysis warns
+/// below the same level.
+pub const SURE_DETECTION: f64 = 0.8;
+/// Self-check residuals this many times the calibration's doubtful level make an estimate
+/// unusable: the light found does not explain the photo.
+pub const UNUSABLE_SELF_CHECK_FACTOR: f64 = 3.0;
+/// Below this expected GFC an estimate is doubtful (GFC 0.95 is the thesis's "acceptable"
+/// level of spectral match; Hernández-Andrés et al. 2001, JOSA A 18: 412–420).
+pub const DOUBTFUL_GFC: f64 = 0.95;
+/// A share of clipped feature patches above this makes an estimate unusable: half the
+/// chart says only that it is brighter than the camera records.
+pub const UNUSABLE_CLIPPED_SHARE: f64 = 0.5;
+/// A share of dark feature patches above this makes an estimate doubtful.
+pub const DOUBTFUL_DARK_SHARE: f64 = 0.25;
+
+impl Calibration {
+    /// Reads a calibration from JSON (`shown` names it in errors), its arrays checked to
+    /// agree in length.
+    pub fn from_json(text: &str, shown: &str) -> Result<Calibration> {
+        let c: Calibration =
+            serde_json::from_str(text).map_err(|e| InferError::invalid(format!("{shown}: {e}")))?;
+        let d = c.wavelength_nm.len();
+        if d == 0
+            || c.floor.len() != d
+            || c.scale68.len() != d
+            || c.scale95.len() != d
+            || c.expected_gfc.len() != c.difficulty_edges.len() + 1
+        {
+            return Err(InferError::invalid(format!(
+                "{shown}: the calibration's arrays do not agree in length"
+            )));
+        }
+        Ok(c)
+    }
+
+    /// The bands and expected GFC of `spd` (the model's peak-normalised estimate) whose
+    /// perturbed estimates spread by `spread`.
+    pub fn uncertainty(&self, spd: &[f64], spread: &[f64]) -> Result<Uncertainty> {
+        let d = self.floor.len();
+        if spd.len() != d || spread.len() != d {
+            return Err(InferError::invalid(format!(
+                "the calibration has {d} wavelengths, the estimate {}",
+                spd.len()
+            )));
+        }
+        let band = |scale: &[f64]| Band {
+            lower: (0..d)
+                .map(|k| (spd[k] - scale[k] * (self.floor[k] + spread[k])).max(0.0))
+                .collect(),
+            upper: (0..d)
+                .map(|k| spd[k] + scale[k] * (self.floor[k] + spread[k]))
+                .collect(),
+        };
+        let difficulty = spread.iter().sum::<f64>() / d as f64;
+        let bin = self
+            .difficulty_edges
+            .iter()
+            .take_while(|&&e| difficulty > e)
+            .count();
+        Ok(Uncertainty {
+            band68: band(&self.scale68),
+            band95: band(&self.scale95),
+            expected_gfc: self.expected_gfc[bin],
+            difficulty,
+        })
+    }
+}
+
+/// One word for how far an estimate can be trusted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// Nothing found against it.
+    Ok,
+    /// Use with care: see the reasons.
+    Doubtful,
+    /// Do not use the numbers: the photo does not say what the light is.
+    Unusable,
+}
+
+impl Verdict {
+    /// `ok`, `doubtful` or `unusable`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Ok => "ok",
+            Verdict::Doubtful => "doubtful",
+            Verdict::Unusable => "unusable",
+        }
+    }
+}
+
+/// How far an estimate can be trusted: the verdict, why, and the measurements behind it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trust {
+    /// The verdict.
+    pub verdict: Verdict,
+    /// What lowered it, and checks that could not be made.
+    pub reasons: Vec<String>,
+    /// The self-check, when the chart's reflectances were at hand.
+    pub self_check: Option<SelfCheck>,
+    /// Bands and expected GFC, when the model has a calibration.
+    pub uncertainty: Option<Uncertainty>,
+}
+
+/// What the photo analysis found that bears on trust (all `None`/empty for feature rows).
+#[derive(Debug, Clone, Default)]
+pub struct PhotoFlags {
+    /// The detection's confidence.
+    pub confidence: Option<f64>,
+    /// Per feature patch: clipped.
+    pub clipped: Vec<bool>,
+    /// Per feature patch: dark.
+    pub dark: Vec<bool>,
+}
+
+/// Judges one estimate: `row` the features, `spd` the model's estimate on its own grid
+/// (peak-normalised), `flags` what the photo analysis found. The thresholds are constants
+/// of this module and levels of the calibration, chosen before any result was seen
+/// (docs/trust.md).
+pub fn assess(
+    model: &Model,
+    calibration: Option<&Calibration>,
+    check: Option<&ChartCheck>,
+    row: &[f64],
+    spd: &[f64],
+    flags: &PhotoFlags,
+) -> Result<Trust> {
+    let mut verdict = Verdict::Ok;
+    let mut reasons = Vec::new();
+    let mut lower = |v: Verdict, reason: String, reasons: &mut Vec<String>| {
+        if v as u8 > verdict as u8 {
+            verdict = v;
+        }
+        reasons.push(reason);
+    };
+    if let Some(c) = flags.confidence.filter(|&c| c < SURE_DETECTION) {
+        lower(
+            Verdict::Doubtful,
+            format!("the chart was found with confidence {c:.2} only"),
+            &mut reasons,
+        );
+    }
+    let scale = feature_scale(row);
+    let patches = row.len() / 3;
+    let mut skip = flag_patches(row, scale);
+    for (i, s) in skip.iter_mut().enumerate() {
+        *s |= flags.clipped.get(i).copied().unwrap_or(false)
+            || flags.dark.get(i).copied().unwrap_or(false);
+    }
+    let clipped = (0..patches)
+        .filter(|&i| {
+            flags.clipped.get(i).copied().unwrap_or(false)
+                || clipped_patch(&row[3 * i..3 * i + 3], scale)
+        })
+        .count();
+    let clipped_doubtful = calibration.map_or(0, |c| c.clipped_doubtful);
+    if clipped as f64 > UNUSABLE_CLIPPED_SHARE * patches as f64 {
+        lower(
+            Verdict::Unusable,
+            format!("{clipped} of {patches} patches are clipped (overexposed)"),
+            &mut reasons,
+        );
+    } else if clipped > clipped_doubtful {
+        lower(
+            Verdict::Doubtful,
+            format!(
+                "{clipped} of {patches} patches are clipped (overexposed; at most {clipped_doubtful} in the calibration photos)"
+            ),
+            &mut reasons,
+        );
+    }
+    let dark = (0..patches)
+        .filter(|&i| {
+            flags.dark.get(i).copied().unwrap_or(false)
+                || row[3 * i..3 * i + 3].iter().all(|&v| v < 0.02 * scale)
+        })
+        .count();
+    if dark as f64 > DOUBTFUL_DARK_SHARE * patches as f64 {
+        lower(
+            Verdict::Doubtful,
+            format!("{dark} of {patches} patches are nearly black (underexposed)"),
+            &mut reasons,
+        );
+    }
+    let self_check = match check {
+        Some(c) => match c.check(spd, row, scale, &skip) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                lower(
+                    Verdict::Unusable,
+                    format!("no self-check: {e}"),
+                    &mut reasons,
+                );
+                None
+            }
+        },
+        None => {
+            reasons.push("no self-check: the chart's reflectances are not at hand (the data directory holds them)".into());
+            None
+        }
+    };
+    let uncertainty = match calibration {
+        Some(cal) => Some(cal.uncertainty(spd, &spread(model, row)?)?),
+        None => {
+            reasons.push("no uncertainty: the model has no calibration".into());
+            None
+        }
+    };
+    if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.self_check_doubtful)) {
+        if s.mean > level {
+            let v = if s.mean > UNUSABLE_SELF_CHECK_FACTOR * level {
+                Verdict::Unusable
+            } else {
+                Verdict::Doubtful
+            };
+            lower(
+                v,
+                format!(
+                    "the estimated light does not explain the photo: self-check residual {:.3} (clean photos stay below {level:.3}; worst patches {})",
+                    s.mean,
+                    s.worst_patches.iter().map(|p| format!("p{p:02}")).collect::<Vec<_>>().join(", ")
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.split_doubtful)) {
+        if s.split > level {
+            let v = if s.split > UNUSABLE_SELF_CHECK_FACTOR * level {
+                Verdict::Unusable
+            } else {
+                Verdict::Doubtful
+            };
+            lower(
+                v,
+                format!(
+                    "the two halves of the chart look lit differently (two lights, glare): half-to-half residual {:.3} (clean photos stay below {level:.3})",
+                    s.split
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(u), Some(cal)) = (&uncertainty, calibration) {
+        if u.difficulty > cal.difficulty_doubtful {
+            lower(
+                Verdict::Doubtful,
+                "many lights give nearly this photo, or it is unlike the training lights: the SPD's shape is uncertain (wide band)".into(),
+                &mut reasons,
+            );
+        }
+        if u.expected_gfc < DOUBTFUL_GFC {
+            lower(
+                Verdict::Doubtful,
+                format!("expected GFC {:.3} is below {DOUBTFUL_GFC}", u.expected_gfc),
+                &mut reasons,
+            );
+        }
+    }
+    Ok(Trust {
+        verdict,
+        reasons,
+        self_check,
+        uncertainty,
+    })
+}
+
+/// The calibrations shipped with the models (`models/<chart>.trust.json`, made by
+/// `spdcam trust calibrate`); each names the model it was measured on.
+const SHIPPED_CALIBRATIONS: &[(&str, &str)] = &[
+    (
+        "the colorchecker_sg96 calibration",
+        include_str!("../../../models/colorchecker_sg96.trust.json"),
+    ),
+    (
+        "the colorchecker24 calibration",
+        include_str!("../../../models/colorchecker24.trust.json"),
+    ),
+];
+
+/// The shipped calibration measured on `model`, if any.
+pub fn calibration_for(model: &Model) -> Result<Option<Calibration>> {
+    let fingerprint = model.fingerprint();
+    for (name, text) in SHIPPED_CALIBRATIONS {
+        let c = Calibration::from_json(text, name)?;
+        if c.model == fingerprint {
+            return Ok(Some(c));
+        }
+    }
+    Ok(None)
+}
+
+/// The flags of an analysed photo's feature patches: `feature_patches` are their indices
+/// among the chart's patches (row-major) when the chart has patches that are not features.
+pub fn photo_flags(analysis: &PhotoAnalysis, feature_patches: Option<&[usize]>) -> PhotoFlags {
+    let count = analysis.features.len() / 3;
+    let indices: Vec<usize> = match feature_patches {
+        Some(f) if f.len() == count => f.to_vec(),
+        _ if analysis.patches.len() == count => (0..count).collect(),
+        _ => Vec::new(),
+    };
+    let flag = |get: fn(&PatchSample) -> bool| -> Vec<bool> {
+        indices
+            .iter()
+            .map(|&i| {
+                analysis
+                    .patches
+                    .iter()
+                    .find(|p| p.patch == i)
+                    .is_some_and(get)
+            })
+            .collect()
+    };
+    PhotoFlags {
+        confidence: Some(analysis.confidence),
+        clipped: flag(|p| p.clipped),
+        dark: flag(|p| p.dark),
+    }
+}
+
+/// Judges an estimate by `model` from feature `row`, with the checks of [`assess`]; the
+/// bands are resampled onto `grid` (linear within, the edge value held beyond).
+pub fn judge(
+    model: &Model,
+    row: &[f64],
+    flags: &PhotoFlags,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Trust> {
+    let spd = metrics::normalise_by_max(&model.estimate(row)?);
+    let calibration = calibration_for(model)?;
+    let check = ChartCheck::for_model(model, data_dir)?;
+    let mut trust = assess(
+        model,
+        calibration.as_ref(),
+        check.as_ref(),
+        row,
+        &spd,
+        flags,
+    )?;
+    let mg = model.grid();
+    if *grid != mg {
+        if let Some(u) = &mut trust.uncertainty {
+            for band in [&mut u.band68, &mut u.band95] {
+                let set = SpectralSet::on_grid(
+                    &mg,
+                    vec!["lower".into(), "upper".into()],
+                    vec![band.lower.clone(), band.upper.clone()],
+                )?;
+                let (set, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
+                band.lower = set.item(0).iter().map(|v| v.max(0.0)).collect();
+                band.upper = set.item(1).to_vec();
+            }
+        }
+    }
+    Ok(trust)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::estimate::{estimate_features, judge_estimate, FeatureRows};
+    use crate::shipped::ModelSet;
+    use spdcam_core::colorimetry::srgb_encode;
+    use spdcam_core::illuminant::StandardIlluminant;
+
+    fn cc24_check(grid: &Grid) -> ChartCheck {
+        let chart = Chart::colorchecker24(grid).unwrap();
+        let table = &builtin::CAMERAS[0];
+        let camera = Sensitivities::new(table.name, &table.load().unwrap(), grid).unwrap();
+        ChartCheck::new(&chart, &camera, grid).unwrap()
+    }
+
+    /// Features of the check's own chart under `spd`: raw RGB through a colour matrix with
+    /// cross-talk, an offset and a gradient, sRGB-encoded on 0–255.
+    fn features_of(check: &ChartCheck, spd: &[f64]) -> Vec<f64> {
+        let raw: Vec<[f64; 3]> = check
+            .weights
+            .iter()
+            .map(|w| std::array::from_fn(|c| w[c].iter().zip(spd).map(|(a, b)| a * b).sum()))
+            .collect();
+        let peak = raw.iter().flatten().copied().fold(0.0f64, f64::max);
+        let m = [[0.9, 0.15, -0.05], [0.1, 0.8, 0.1], [-0.02, 0.2, 0.7]];
+        raw.iter()
+            .zip(&check.centres)
+            .flat_map(|(p, [x, _])| {
+                let gain = 0.8 * (1.0 + 0.1 * x) / peak;
+                (0..3).map(move |c| {
+                    let lin = gain * (0..3).map(|k| m[c][k] * p[k]).sum::<f64>() + 0.01;
+                    255.0 * srgb_encode(lin.clamp(0.0, 1.0))
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_perfect_estimate_explains_the_photo_and_a_wrong_chart_does_not() {
+        let grid = Grid::parse("400-700:5").unwrap();
+        let check = cc24_check(&grid);
+        let spd = StandardIlluminant::A.spd(&grid).unwrap();
+        let row = features_of(&check, &spd);
+        let skip = vec![false; check.patches()];
+        let good = check.check(&spd, &row, 255.0, &skip).unwrap();
+        assert!(good.mean < 0.01, "perfect estimate: residual {}", good.mean);
+        // The same colours in another order: a chart the light cannot explain.
+        let mut wrong = Vec::new();
+        for p in (0..check.patches()).rev() {
+            wrong.extend_from_slice(&row[3 * p..3 * p + 3]);
+        }
+        let bad = check.check(&spd, &wrong, 255.0, &skip).unwrap();
+        assert!(
+            bad.mean > 10.0 * good.mean.max(0.01),
+            "wrong chart: {}",
+            bad.mean
+        );
+        assert_eq!(bad.worst_patches.len(), WORST_NAMED);
+        assert!(bad.worst >= bad.mean);
+    }
+
+    #[test]
+    fn shipped_models_carry_their_calibrations() {
+        for m in ModelSet::shipped().unwrap().models() {
+            let c = calibration_for(&m.model).unwrap().expect("a calibration");
+            assert_eq!(Some(c.chart.as_str()), m.model.header().chart.as_deref());
+            assert_eq!(c.floor.len(), m.model.grid().count);
+            assert!(c.scale68.iter().zip(&c.scale95).all(|(a, b)| a <= b));
+        }
+    }
+
+    #[test]
+    fn a_wrong_charts_features_are_not_ok_and_bands_hold_the_estimate() {
+        let models = ModelSet::shipped().unwrap();
+        let model = &models.for_chart("colorchecker24").unwrap().model;
+        let grid = model.grid();
+        let check = cc24_check(&grid);
+        let row = features_of(&check, &StandardIlluminant::D65.spd(&grid).unwrap());
+        let mut wrong = Vec::new();
+        for p in (0..check.patches()).rev() {
+            wrong.extend_from_slice(&row[3 * p..3 * p + 3]);
+        }
+        let rows = FeatureRows::from_values(
+            model.feature_names().to_vec(),
+            [row.clone(), wrong.clone()].concat(),
+            "test",
+        )
+        .unwrap();
+        let mut estimates = estimate_features(&models, &rows, "test", &grid).unwrap();
+        let data_dir = DataDir::new(None);
+        for (e, r) in estimates.iter_mut().zip([&row, &wrong]) {
+            judge_estimate(e, &models, model.feature_names(), r, &data_dir).unwrap();
+        }
+        let t = estimates[1].trust.as_ref().unwrap();
+        assert_ne!(t.verdict, Verdict::Ok, "{:?}", t.reasons);
+        assert!(t.self_check.as_ref().unwrap().mean > 0.2);
+
+        let e = &estimates[0];
+        let json = e.to_json().unwrap();
+        for key in [
+            "verdict",
+            "reasons",
+            "self_check",
+            "expected_gfc",
+            "band68",
+            "band95",
+        ] {
+            assert!(json.get(key).is_some_and(|v| !v.is_null()), "no {key}");
+        }
+        assert_eq!(
+            json["band95"]["lower"].as_array().unwrap().len(),
+            e.spd.len()
+        );
+        let u = e.trust.as_ref().unwrap().uncertainty.as_ref().unwrap();
+        assert!((0.0..=1.0).contains(&u.expected_gfc));
+        for k in 0..e.spd.len() {
+            let (l95, l68, u68, u95) = (
+                u.band95.lower[k],
+                u.band68.lower[k],
+                u.band68.upper[k],
+                u.band95.upper[k],
+            );
+            assert!(0.0 <= l95 && l95 <= l68 && l68 <= e.spd[k] + 1e-9, "at {k}");
+            assert!(e.spd[k] <= u68 + 1e-9 && u68 <= u95, "at {k}");
+        }
+    }
+
+    #[test]
+    fn a_calibration_whose_arrays_disagree_is_refused() {
+        let text = r#"{"model":"0","chart":"c","method":"m","wavelength_nm":[400,410],
+            "floor":[0.1],"scale68":[1,1],"scale95":[2,2],"difficulty_edges":[],
+            "expected_gfc":[0.9],"difficulty_doubtful":0.1,"self_check_doubtful":null,"split_doubtful":null,
+            "clipped_doubtful":0}"#;
+        let err = Calibration::from_json(text, "c.json")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("c.json"), "{err}");
+    }
+}
