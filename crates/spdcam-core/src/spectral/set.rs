@@ -326,7 +326,7 @@ fn format_number(v: f64) -> String {
 }
 
 fn csv_escape(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
+    if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
         s.to_string()
@@ -338,6 +338,17 @@ mod tests {
     use super::*;
 
     const SAMPLE: &str = "wavelength_nm,a,b\n400,0.1,1\n410,0.25,2\n420,0.5,3\n";
+
+    #[test]
+    fn names_with_quotes_and_line_breaks_survive_the_round_trip() {
+        // Found by the spectral_csv fuzz target: a carriage return inside a quoted name was
+        // written unquoted and broke the row.
+        let text = "wavelength_nm,\"a\rb\",\"c\"\"d\",\"e\nf\"\n400,1,2,3\n410,4,5,6\n";
+        let set = SpectralSet::from_csv_str(text, "names.csv").unwrap();
+        assert_eq!(set.names(), ["a\rb", "c\"d", "e\nf"]);
+        let again = SpectralSet::from_csv_str(&set.to_csv_string(), "again.csv").unwrap();
+        assert_eq!(set, again);
+    }
 
     #[test]
     fn csv_round_trip_keeps_every_number() {
