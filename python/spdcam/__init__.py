@@ -177,9 +177,16 @@ class Estimate:
     #: The lighting-quality metrics of the SPD as the library computes them (CRI, TM-30,
     #: α-opic, …; ``spdcam estimate --json``'s ``metrics``); empty where not computed.
     metrics: dict[str, Any] = field(default_factory=dict)
-    #: An uncertainty band of the SPD (lower, upper) when the model gives one; the shipped
-    #: models give none.
+    #: The 95 % band of the SPD (lower, upper) on ``wavelengths``, peak 1, when the model
+    #: has a calibration (the shipped ones do); ``band68`` the same at 68 %.
     band: Optional[tuple[np.ndarray, np.ndarray]] = None
+    band68: Optional[tuple[np.ndarray, np.ndarray]] = None
+    #: ``"ok"``, ``"doubtful"`` or ``"unusable"``, and why (README: how far to trust an
+    #: estimate); ``None`` where the estimate was not judged.
+    verdict: Optional[str] = None
+    reasons: list[str] = field(default_factory=list)
+    #: The GFC such photos reach, from the model's calibration.
+    expected_gfc: Optional[float] = None
     #: The library's JSON of the estimate (as ``spdcam estimate --json`` prints it).
     json: dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -197,12 +204,24 @@ class Estimate:
             duv=c["duv"],
             detection=Detection._from_json(v["photo"]) if v.get("photo") else None,
             metrics=dict(v.get("metrics") or {}),
+            band=_band(v.get("band95")),
+            band68=_band(v.get("band68")),
+            verdict=v.get("verdict"),
+            reasons=list(v.get("reasons") or []),
+            expected_gfc=v.get("expected_gfc"),
             json=v,
         )
 
     def to_colour(self) -> Any:
         """The SPD as a ``colour.SpectralDistribution`` (needs colour-science)."""
         return _to_colour(self.wavelengths, self.spd, self.name)
+
+
+def _band(value: Optional[dict[str, Any]]) -> Optional[tuple[np.ndarray, np.ndarray]]:
+    """A band of the library's JSON (``{"lower": [...], "upper": [...]}``) as two arrays."""
+    if not value:
+        return None
+    return (np.asarray(value["lower"], dtype=float), np.asarray(value["upper"], dtype=float))
 
 
 @dataclass(frozen=True)

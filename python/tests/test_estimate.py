@@ -37,6 +37,14 @@ def test_the_example_photo_round_trip(example):
     _, wl, truth = read_spectral_csv(TRUTH)
     t = np.interp(e.wavelengths, wl, truth[:, 0])
     assert gfc(t, e.spd) > 0.9
+    # Judged, with bands around the SPD as the library's JSON gives them.
+    assert e.verdict in ("ok", "doubtful", "unusable") and isinstance(e.reasons, list)
+    assert 0.0 < e.expected_gfc <= 1.0
+    for lower, upper in (e.band, e.band68):
+        assert lower.shape == upper.shape == e.spd.shape
+        assert np.all(lower <= upper)
+    np.testing.assert_array_equal(e.band[0], e.json["band95"]["lower"])
+    assert np.all(e.band[0] <= e.band68[0]) and np.all(e.band68[1] <= e.band[1])
     # The same photo as bytes and as the decoded array gives the same estimate.
     from_bytes = spdcam.estimate(example.read_bytes(), source="sg-telelumen.jpg")
     from_array = spdcam.estimate(spdcam.read_photo(example))
@@ -53,7 +61,10 @@ def test_an_array_estimate_equals_the_cli_csv(example, cli, tmp_path):
     done = cli("estimate", str(example), "-o", str(out))
     assert done.returncode == 0, done.stderr
     header, wl, values = read_spectral_csv(out)
-    assert header == ["wavelength_nm", "sg-telelumen.jpg"]
+    # The SPD, then its 68 % and 95 % bands.
+    assert header == ["wavelength_nm", "sg-telelumen.jpg"] + [
+        f"sg-telelumen.jpg_{edge}{level}" for level in (68, 95) for edge in ("lower", "upper")
+    ]
     e = spdcam.estimate(spdcam.read_photo(example))
     np.testing.assert_array_equal(e.wavelengths, wl)
     np.testing.assert_allclose(e.spd, values[:, 0], rtol=1e-12, atol=1e-15)

@@ -85,7 +85,13 @@ impl ModelSet {
         if let Some(m) = self.for_features(names) {
             return Ok(m);
         }
-        if let [only] = self.models.as_slice() {
+        // One model reads this many columns: its own check names the column that differs.
+        let same_count: Vec<&NamedModel> = self
+            .models
+            .iter()
+            .filter(|m| m.model.feature_names().len() == names.len())
+            .collect();
+        if let [only] = same_count.as_slice() {
             only.model.check_features(names, source)?;
         }
         let known = self
@@ -125,6 +131,20 @@ mod tests {
             let found = set.for_features(m.model.feature_names()).unwrap();
             assert_eq!(found.name, m.name);
         }
+    }
+
+    #[test]
+    fn features_of_a_known_count_in_another_order_name_the_column() {
+        let set = ModelSet::shipped().unwrap();
+        let mut names = set
+            .for_chart("colorchecker24")
+            .unwrap()
+            .model
+            .feature_names()
+            .to_vec();
+        names.reverse();
+        let err = set.require(&names, "f.csv").unwrap_err().to_string();
+        assert!(err.contains("f.csv") && err.contains("p24_b"), "{err}");
     }
 
     #[test]
