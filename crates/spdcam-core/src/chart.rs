@@ -191,6 +191,22 @@ pub const CHART_NAMES: &[(&str, &str)] = &[
 ];
 
 impl Chart {
+    /// Centre of each feature patch on the chart, in chart widths and heights from the
+    /// chart's centre (−0.5…0.5 left to right and top to bottom), in feature order: where a
+    /// patch sits for models of light varying across the chart (a gradient, two halves).
+    pub fn feature_centres(&self) -> Vec<[f64; 2]> {
+        let (rows, cols) = (self.layout.rows, self.layout.cols);
+        self.feature_patches
+            .iter()
+            .map(|&p| {
+                [
+                    ((p % cols) as f64 + 0.5) / cols as f64 - 0.5,
+                    ((p / cols) as f64 + 0.5) / rows as f64 - 0.5,
+                ]
+            })
+            .collect()
+    }
+
     /// A chart whose every patch is a feature, laid out `rows × cols` with the thesis's
     /// 24 px patches and no gap, reflectances resampled onto `grid`.
     pub fn from_reflectances(

@@ -71,8 +71,6 @@ impl SimpleCamera {
                 sensitivities.name
             )));
         }
-        let cols = chart.layout.cols;
-        let rows = chart.layout.rows;
         let weights: Vec<[Vec<f64>; 3]> = chart
             .feature_patches
             .iter()
@@ -88,16 +86,7 @@ impl SimpleCamera {
                 })
             })
             .collect();
-        let centres = chart
-            .feature_patches
-            .iter()
-            .map(|&p| {
-                [
-                    ((p % cols) as f64 + 0.5) / cols as f64 - 0.5,
-                    ((p / cols) as f64 + 0.5) / rows as f64 - 0.5,
-                ]
-            })
-            .collect();
+        let centres = chart.feature_centres();
         let d65 = StandardIlluminant::D65.spd(grid)?;
         let observer = Observer::cie1931(grid)?;
         let white_y = observer.white_xyz(&d65)[1];

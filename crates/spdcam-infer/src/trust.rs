@@ -71,7 +71,6 @@ impl ChartCheck {
     pub fn new(chart: &Chart, camera: &Sensitivities, grid: &Grid) -> Result<ChartCheck> {
         chart.reflectances.require_grid(grid, "chart")?;
         camera.curves.require_grid(grid, "camera")?;
-        let (rows, cols) = (chart.layout.rows, chart.layout.cols);
         let weights = chart
             .feature_patches
             .iter()
@@ -83,16 +82,7 @@ impl ChartCheck {
                 })
             })
             .collect();
-        let centres = chart
-            .feature_patches
-            .iter()
-            .map(|&p| {
-                [
-                    ((p % cols) as f64 + 0.5) / cols as f64 - 0.5,
-                    ((p / cols) as f64 + 0.5) / rows as f64 - 0.5,
-                ]
-            })
-            .collect();
+        let centres = chart.feature_centres();
         Ok(ChartCheck {
             weights,
             centres,

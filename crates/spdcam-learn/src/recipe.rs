@@ -41,20 +41,7 @@ pub struct Scored {
 /// --finetune`; 600 for when there are more photos); and the output layer alone, the feature
 /// layers frozen, for 600 steps.
 pub fn candidates(n: usize, seed: u64, backend: Backend) -> Vec<Recipe> {
-    let batch = 16.min(n.max(1));
-    let steps = |count: usize| FinetuneOptions {
-        schedule: Schedule {
-            epochs: (count / n.max(1).div_ceil(batch)).clamp(10, 400),
-            batch,
-            lr: 2e-4,
-            patience: None,
-            plateau: None,
-        },
-        keep_output: true,
-        seed,
-        backend,
-        ..FinetuneOptions::thesis()
-    };
+    let steps = |count: usize| all_layers(n, count, seed, backend);
     vec![
         Recipe {
             name: "the model unchanged",
@@ -76,6 +63,26 @@ pub fn candidates(n: usize, seed: u64, backend: Backend) -> Vec<Recipe> {
             }),
         },
     ]
+}
+
+/// All layers trained from the model's own output layer on `n` samples for about `steps`
+/// optimiser steps: batches of at most 16, learning rate 2e-4, no early stopping (too few
+/// samples to hold some back), between 10 and 400 epochs.
+pub fn all_layers(n: usize, steps: usize, seed: u64, backend: Backend) -> FinetuneOptions {
+    let batch = 16.min(n.max(1));
+    FinetuneOptions {
+        schedule: Schedule {
+            epochs: (steps / n.max(1).div_ceil(batch)).clamp(10, 400),
+            batch,
+            lr: 2e-4,
+            patience: None,
+            plateau: None,
+        },
+        keep_output: true,
+        seed,
+        backend,
+        ..FinetuneOptions::thesis()
+    }
 }
 
 /// The rows `rows` of `set`, as a set of their own.

@@ -12,8 +12,10 @@ use spdcam_core::dataset::{Columns, Precision, SampleBatch};
 use spdcam_core::metrics;
 use spdcam_core::spectral::Grid;
 use spdcam_learn::model::Model;
+use spdcam_learn::recipe;
+use spdcam_learn::record::Backend;
 use spdcam_learn::record::DataInfo;
-use spdcam_learn::train::{finetune, FinetuneOptions, Schedule, TrainingSet};
+use spdcam_learn::train::{finetune, FinetuneOptions, TrainingSet};
 use std::collections::BTreeMap;
 
 /// How the curve is measured.
@@ -103,19 +105,7 @@ fn model_gfc(model: &Model, set: &Measured, test: &[usize], set_grid: &Grid) -> 
 /// for early stopping: the photos themselves validate, so the kept epoch is the one that
 /// fits them best.
 fn recipe(n: usize, seed: u64) -> FinetuneOptions {
-    let batch = 16.min(n);
-    FinetuneOptions {
-        schedule: Schedule {
-            epochs: (150 / n.div_ceil(batch)).clamp(10, 200),
-            batch,
-            lr: 2e-4,
-            patience: None,
-            plateau: None,
-        },
-        keep_output: true,
-        seed,
-        ..FinetuneOptions::thesis()
-    }
+    recipe::all_layers(n, 150, seed, Backend::Cpu)
 }
 
 /// Fits the baselines on the photos `train` and returns each one's mean GFC on the photos

@@ -4,8 +4,8 @@
 //! docs/trust.md).
 
 use crate::calibrate::read_measured;
-use crate::lamps::{in_data_dir, LibraryArgs};
-use crate::validate_lamps::{held_out_cameras, on_grid};
+use crate::lamps::in_data_dir;
+use crate::validate_lamps::{held_out_cameras, on_grid, HeldOutPhotos};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use rand::rngs::SmallRng;
@@ -46,33 +46,11 @@ enum TrustCommand {
     Report(Box<ReportArgs>),
 }
 
-/// The held-out photos both subcommands make.
-#[derive(Debug, Args)]
-struct Photos {
-    /// Models (repeatable).
-    #[arg(long, required = true)]
-    model: Vec<PathBuf>,
-    /// The validation split (`spdcam lamps split`).
-    #[arg(long, value_name = "SPLIT.json")]
-    split: PathBuf,
-    #[command(flatten)]
-    library: LibraryArgs,
-    /// Directory of camera sensitivity CSVs holding the split's held-out cameras; default:
-    /// the data directory's cameras/.
-    #[arg(long, value_name = "DIR")]
-    cameras: Option<PathBuf>,
-    /// Photos of each lamp, each by a held-out camera and in-camera settings drawn at random.
-    #[arg(long, default_value_t = 8)]
-    shots: u64,
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-}
-
 /// Options of `spdcam trust calibrate`.
 #[derive(Debug, Args)]
 struct CalibrateArgs {
     #[command(flatten)]
-    photos: Photos,
+    photos: HeldOutPhotos,
     /// Directory to write `<chart>.trust.json` into.
     #[arg(short, long)]
     output: PathBuf,
@@ -82,7 +60,7 @@ struct CalibrateArgs {
 #[derive(Debug, Args)]
 struct ReportArgs {
     #[command(flatten)]
-    photos: Photos,
+    photos: HeldOutPhotos,
     /// The calibrations, in the order of the models.
     #[arg(long, required = true)]
     calibration: Vec<PathBuf>,
@@ -132,7 +110,7 @@ struct Setup {
     cameras: Vec<Sensitivities>,
 }
 
-impl Photos {
+impl HeldOutPhotos {
     fn setup(&self, data_dir: &DataDir) -> Result<Setup> {
         if self.shots == 0 {
             bail!("--shots must be at least 1");
@@ -587,7 +565,7 @@ fn scene_verdicts(
 }
 
 /// The options that made the photos, as a command line.
-fn photo_args(p: &Photos) -> String {
+fn photo_args(p: &HeldOutPhotos) -> String {
     let mut out: String = p
         .model
         .iter()

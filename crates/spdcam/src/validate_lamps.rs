@@ -25,26 +25,34 @@ use spdcam_core::{metrics, seed};
 use spdcam_infer::Model;
 use std::path::PathBuf;
 
-/// Options of `spdcam lamps validate`.
+/// Held-out lamps photographed by held-out cameras: the models, the split and how many
+/// photos (shared by `spdcam lamps validate` and `spdcam trust`).
 #[derive(Debug, Args)]
-pub struct ValidateArgs {
-    /// Models to score (repeatable).
+pub(crate) struct HeldOutPhotos {
+    /// Models (repeatable).
     #[arg(long, required = true)]
-    model: Vec<PathBuf>,
+    pub(crate) model: Vec<PathBuf>,
     /// The validation split (`spdcam lamps split`).
     #[arg(long, value_name = "SPLIT.json")]
-    split: PathBuf,
+    pub(crate) split: PathBuf,
     #[command(flatten)]
-    library: LibraryArgs,
+    pub(crate) library: LibraryArgs,
     /// Directory of camera sensitivity CSVs holding the split's held-out cameras; default:
     /// the data directory's cameras/.
     #[arg(long, value_name = "DIR")]
-    cameras: Option<PathBuf>,
-    /// Photos of each lamp, each by a camera and settings drawn at random.
+    pub(crate) cameras: Option<PathBuf>,
+    /// Photos of each lamp, each by a held-out camera and in-camera settings drawn at random.
     #[arg(long, default_value_t = 8)]
-    shots: u64,
+    pub(crate) shots: u64,
     #[arg(long, default_value_t = 1)]
-    seed: u64,
+    pub(crate) seed: u64,
+}
+
+/// Options of `spdcam lamps validate`.
+#[derive(Debug, Args)]
+pub struct ValidateArgs {
+    #[command(flatten)]
+    photos: HeldOutPhotos,
     /// The thesis's data (holding measured/…); default: the data directory's thesis/.
     #[arg(long)]
     thesis_data: Option<PathBuf>,
@@ -72,12 +80,12 @@ type LampScores = Vec<f64>;
 
 /// Runs `spdcam lamps validate`.
 pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
-    if args.shots == 0 {
+    if args.photos.shots == 0 {
         bail!("--shots must be at least 1");
     }
-    let library = args.library.read(data_dir, &GRID)?;
-    let split = ValidationSplit::read(&args.split)?;
-    let held_out = held_out_cameras(&split, args.cameras.as_deref(), data_dir)?;
+    let library = args.photos.library.read(data_dir, &GRID)?;
+    let split = ValidationSplit::read(&args.photos.split)?;
+    let held_out = held_out_cameras(&split, args.photos.cameras.as_deref(), data_dir)?;
     let parts = [
         ("validation", LampPart::Validation),
         ("test", LampPart::Test),
@@ -88,6 +96,7 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
         .collect::<spdcam_core::Result<_>>()?;
     let fit_lamps = library.positions(split.lamps(LampPart::Fit), "the split's fit lamps")?;
     let models = args
+        .photos
         .model
         .iter()
         .map(|p| Ok((p.clone(), Model::load(p)?)))
@@ -109,17 +118,17 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
         md += "| lamp type | lamps (val / test) | average SPD (val) | (a) randomised in-camera (val) | (b) simple camera (val) | average SPD (test) | (a) test | (b) test |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
         let mut cells: Vec<[LampScores; 3]> = Vec::new();
         for (k, ids) in lamps.iter().enumerate() {
-            let stream = seed::derive(args.seed, k as u64);
-            let a = pipeline_photos(&held_out, &chart, &library, ids, args.shots, stream)?;
-            let b = simple_photos(&held_out, &chart, &library, ids, args.shots, stream)?;
+            let stream = seed::derive(args.photos.seed, k as u64);
+            let a = pipeline_photos(&held_out, &chart, &library, ids, args.photos.shots, stream)?;
+            let b = simple_photos(&held_out, &chart, &library, ids, args.photos.shots, stream)?;
             let baseline: LampScores = ids
                 .iter()
                 .map(|&i| metrics::gfc(&truth[i], &average).unwrap_or(0.0))
                 .collect();
             cells.push([
                 baseline,
-                score(model, &a, &truth, ids, args.shots)?,
-                score(model, &b, &truth, ids, args.shots)?,
+                score(model, &a, &truth, ids, args.photos.shots)?,
+                score(model, &b, &truth, ids, args.photos.shots)?,
             ]);
         }
         let kinds: Vec<Option<LampType>> = LampType::ALL
@@ -182,9 +191,9 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
          applied, D65-fitted colour matrix, auto exposure, a little flare and gradient, sRGB, \
          8 bit) with the same cameras. Average SPD: the mean of the split's fit lamps, the \
          estimate of a model that knows nothing. Seed {}.\n",
-        args.shots,
+        args.photos.shots,
         held_out.len(),
-        args.seed
+        args.photos.seed
     );
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");

@@ -1,49 +1,13 @@
 //! `spdcam estimate PHOTO`: the main job, end to end, with the shipped model and no data
 //! directory; features of charts no model knows; bad photos.
 
+mod common;
+
+use common::{fails, ok, s, scratch, spdcam};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 /// The example photo the README's first command estimates, and its true SPD beside it.
 const EXAMPLE: &str = "../../examples/sg-telelumen.jpg";
-
-/// spdcam with no data directory: what it does here works on a fresh clone.
-fn spdcam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(args)
-        .env_remove("SPDCAM_DATA")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("spdcam runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = spdcam(args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "spdcam {args:?} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
-
-fn fails(args: &[&str]) -> String {
-    let out = spdcam(args);
-    assert!(!out.status.success(), "spdcam {args:?} should fail");
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("spdcam-cli-estimate-{name}"));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> String {
-    p.display().to_string()
-}
 
 /// The number after `key` in `text`.
 fn number_after(text: &str, key: &str) -> f64 {

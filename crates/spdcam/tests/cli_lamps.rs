@@ -1,45 +1,10 @@
 //! Real lamps from the command line: `spdcam coverage` on SPDs a test writes, the `lamp:` and
 //! `blend:` recipes, and (with the measured data) the validation split and protocol.
 
+mod common;
+
+use common::{fails, ok, s, scratch};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn spdcam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(args)
-        .env_remove("SPDCAM_DATA")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("spdcam runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = spdcam(args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "spdcam {args:?} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
-
-fn fails(args: &[&str]) -> String {
-    let out = spdcam(args);
-    assert!(!out.status.success(), "spdcam {args:?} should fail");
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("spdcam-cli-lamps-{name}"));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> String {
-    p.to_string_lossy().into_owned()
-}
 
 /// The cells of the table row whose first cell starts with `label`.
 fn row<'a>(table: &'a str, label: &str) -> Vec<&'a str> {

@@ -1,44 +1,14 @@
 //! `spdcam estimate --report`: the HTML page of the example photo, of several photos and of
 //! feature rows, with the shipped models and no data directory; unwritable paths.
 
+mod common;
+
+use common::{ok, s, scratch, spdcam};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 /// The example photo, with its true SPD beside it.
 const EXAMPLE: &str = "../../examples/sg-telelumen.jpg";
-
-/// spdcam with no data directory: what it does here works on a fresh clone.
-fn spdcam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(args)
-        .env_remove("SPDCAM_DATA")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("spdcam runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = spdcam(args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "spdcam {args:?} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("spdcam-cli-report-{name}"));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> String {
-    p.display().to_string()
-}
 
 /// The files in `dir`, by name.
 fn files(dir: &Path) -> Vec<String> {
