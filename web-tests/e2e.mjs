@@ -100,6 +100,12 @@ await test('an uploaded photo shows the SPD, xy, CCT and Duv of `spdcam estimate
   const duv = c.duv === null ? '–' : (c.duv >= 0 ? '+' : '') + c.duv.toFixed(4);
   check(await text(page, '#cct') === cct, `CCT ${await text(page, '#cct')} vs ${c.cct}`);
   check(await text(page, '#duv') === duv, `Duv ${await text(page, '#duv')} vs ${c.duv}`);
+  // Ra with its calibrated 95 % interval, as the JSON gives them.
+  const ra = expected.metrics.cri_ra;
+  const raHalf = expected.metric_uncertainty && expected.metric_uncertainty.cri_ra;
+  check(raHalf && raHalf.half95 > 0, 'the CLI gives Ra an interval');
+  const raShown = await text(page, '#metric-cri_ra');
+  check(raShown === `${ra.toPrecision(4)} ± ${raHalf.half95.toPrecision(4)}`, `Ra shown as ${raShown}`);
   const points = await plottedSpd(page, expected.name);
   check(points && points.length === expected.spd.length, `plotted ${points && points.length} points`);
   const wl = expected.wavelength_nm;

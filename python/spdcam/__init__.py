@@ -187,6 +187,15 @@ class Estimate:
     reasons: list[str] = field(default_factory=list)
     #: The GFC such photos reach, from the model's calibration.
     expected_gfc: Optional[float] = None
+    #: Half-widths of the calibrated 68 % and 95 % intervals of the single-number metrics,
+    #: by key (``{"cri_ra": {"half68": 1.9, "half95": 4.0}, …}``: Ra 82 ± 4 at 95 %); empty
+    #: without a calibration.
+    metric_uncertainty: dict[str, dict[str, float]] = field(default_factory=dict)
+    #: For photos whose EXIF gives aperture, time and ISO: approximate absolute levels
+    #: (``illuminance_lux``, ``ppfd_umol_m2_s``, ``melanopic_edi_lux``,
+    #: ``spectral_irradiance_w_m2_nm``, ``note``); ``None`` otherwise, with the reason in
+    #: ``json["absolute_reason"]``.
+    absolute: Optional[dict[str, Any]] = None
     #: The library's JSON of the estimate (as ``spdcam estimate --json`` prints it).
     json: dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -209,6 +218,8 @@ class Estimate:
             verdict=v.get("verdict"),
             reasons=list(v.get("reasons") or []),
             expected_gfc=v.get("expected_gfc"),
+            metric_uncertainty=dict(v.get("metric_uncertainty") or {}),
+            absolute=v.get("absolute"),
             json=v,
         )
 

@@ -7,6 +7,7 @@
 //!     (ModelSet) ─► SPD ─► Estimate (SPD, colorimetry, score against a truth, photo analysis)
 //! ```
 
+use crate::absolute::{absolute_level, Absolute};
 use crate::error::{InferError, Result};
 use crate::model::Model;
 use crate::shipped::ModelSet;
@@ -285,6 +286,9 @@ pub struct Estimate {
     /// How far the estimate can be trusted (verdict, reasons, self-check, bands), when
     /// judged.
     pub trust: Option<Trust>,
+    /// For photos: the approximate absolute levels from the EXIF exposure, or why there are
+    /// none.
+    pub absolute: Option<Absolute>,
 }
 
 impl Estimate {
@@ -292,8 +296,12 @@ impl Estimate {
     /// `metrics` (every [`LightingMetrics`] key), `truth`, and for photos `photo` (chart, method, confidence, corners, homography, features and
     /// `features_by_name`, every patch with its statistics and flags, warnings). Judged
     /// estimates add `verdict`, `reasons`, `self_check` ({mean, worst, worst_patches} or
-    /// null), `expected_gfc`, and `band68` and `band95` ({lower, upper} on the SPD's
-    /// wavelengths), the last three null without a calibration.
+    /// null), `expected_gfc`, `band68` and `band95` ({lower, upper} on the SPD's
+    /// wavelengths) and `metric_uncertainty` ({key: {half68, half95}} for the
+    /// single-number metrics), the last four null without a calibration. Photo estimates add
+    /// `absolute` (approximate illuminance, PPFD, melanopic EDI and spectral irradiance from
+    /// the EXIF exposure, see [`crate::absolute`]) or, when there is none, `absolute: null`
+    /// and `absolute_reason`.
     pub fn to_json(&self) -> Result<serde_json::Value> {
         let mut v = serde_json::json!({
             "name": self.name,
@@ -307,6 +315,14 @@ impl Estimate {
         if let Some(a) = &self.photo {
             v["photo"] = analysis_json(a)?;
         }
+        match &self.absolute {
+            Some(Ok(level)) => v["absolute"] = serde_json::json!(level),
+            Some(Err(reason)) => {
+                v["absolute"] = serde_json::Value::Null;
+                v["absolute_reason"] = serde_json::json!(reason);
+            }
+            None => {}
+        }
         if let Some(t) = &self.trust {
             let u = t.uncertainty.as_ref();
             v["verdict"] = serde_json::json!(t.verdict);
@@ -315,6 +331,12 @@ impl Estimate {
             v["expected_gfc"] = serde_json::json!(u.map(|u| u.expected_gfc));
             v["band68"] = serde_json::json!(u.map(|u| &u.band68));
             v["band95"] = serde_json::json!(u.map(|u| &u.band95));
+            // Intervals of metrics the estimate defines only.
+            v["metric_uncertainty"] = serde_json::json!(u.map(|u| u
+                .metrics
+                .iter()
+                .filter(|(key, _)| self.metrics.scalar(key).is_some())
+                .collect::<std::collections::BTreeMap<_, _>>()));
         }
         Ok(v)
     }
@@ -367,6 +389,7 @@ pub fn estimate_features(
                 truth: None,
                 photo: None,
                 trust: None,
+                absolute: None,
             })
         })
         .collect()
@@ -518,16 +541,25 @@ pub fn estimate_analysis(
         .map(|t| t.feature_patches.as_slice());
     let flags = trust::photo_flags(&analysis, feature_patches);
     let trust = trust::judge(&chosen.model, &rows.values, &flags, data_dir, grid)?;
+    let metrics = LightingMetrics::from_samples(&grid.wavelengths(), &spd);
+    let unusable: Vec<bool> = (0..flags.clipped.len())
+        .map(|k| flags.clipped[k] || flags.dark.get(k).copied().unwrap_or(false))
+        .collect();
+    let absolute = match chosen.model.header().chart.as_deref() {
+        Some(chart) => absolute_level(&analysis, chart, &spd, grid, &metrics, &unusable, data_dir)?,
+        None => Err("the model names no chart".into()),
+    };
     Ok(Estimate {
         name,
         model: chosen.name.clone(),
         grid: *grid,
         colorimetry: Colorimetry::of(&spd, grid)?,
-        metrics: LightingMetrics::from_samples(&grid.wavelengths(), &spd),
+        metrics,
         spd,
         truth: None,
         photo: Some(analysis),
         trust: Some(trust),
+        absolute: Some(absolute),
     })
 }
 

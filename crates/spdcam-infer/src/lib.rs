@@ -26,6 +26,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod absolute;
 pub mod error;
 pub mod estimate;
 pub mod model;

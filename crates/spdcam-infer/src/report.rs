@@ -36,13 +36,14 @@ pub struct ReportItem {
 
 /// Keys of the estimate's JSON shown in their own sections (dotted paths); the details
 /// table shows every other value.
-const SHOWN: [&str; 19] = [
+const SHOWN: [&str; 20] = [
     "name",
     "model",
     "wavelength_nm",
     "spd",
     "colorimetry",
     "metrics",
+    "metric_uncertainty",
     "truth",
     "verdict",
     "reasons",
@@ -158,7 +159,7 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
     summary_table(out, e);
     tm30(out, &e["metrics"]);
     out.push_str("</div>\n<div>\n");
-    metrics_tables(out, &e["metrics"]);
+    metrics_tables(out, &e["metrics"], &e["metric_uncertainty"]);
     warnings(out, e);
     let mut rows = Vec::new();
     details(e, "", &shown, &mut rows);
@@ -582,15 +583,27 @@ fn metric_value(key: &str, v: &Value) -> String {
     }
 }
 
-/// Every lighting metric (undefined ones with their reason); R1–R14 in a table of their own.
-fn metrics_tables(out: &mut String, m: &Value) {
+/// A metric's 95 % half-width as the report shows it (no sign, the value's decimals).
+fn interval_value(key: &str, half95: f64) -> String {
+    match key {
+        "cct_k" => format!("± {half95:.0}"),
+        "duv" => format!("± {half95:.4}"),
+        "cri_ra" | "cri_r9" | "tm30_rf" | "tm30_rg" => format!("± {half95:.1}"),
+        _ => format!("± {}", fmt(half95)),
+    }
+}
+
+/// Every lighting metric (undefined ones with their reason) with its 95 % interval from
+/// `intervals` (the estimate's `metric_uncertainty`) when there is one; R1–R14 in a table of
+/// their own.
+fn metrics_tables(out: &mut String, m: &Value, intervals: &Value) {
     let Some(obj) = m.as_object() else {
         return;
     };
     let reasons = &m["reasons"];
     out.push_str(
         "<h3>Lighting metrics</h3>\n<table class=\"metrics\"><tr><th>metric</th><th>value</th>\
-         <th>unit</th></tr>\n",
+         <th>95 %</th><th>unit</th></tr>\n",
     );
     let mut keys: Vec<&String> = obj.keys().collect();
     let rank = |k: &str| {
@@ -614,7 +627,7 @@ fn metrics_tables(out: &mut String, m: &Value) {
                 let why = reasons[key.as_str()].as_str().unwrap_or("undefined");
                 let _ = writeln!(
                     out,
-                    "<tr><th>{}</th><td class=\"undefined\" data-key=\"{}\" colspan=\"2\">— ({})</td></tr>",
+                    "<tr><th>{}</th><td class=\"undefined\" data-key=\"{}\" colspan=\"3\">— ({})</td></tr>",
                     esc(&label),
                     esc(key),
                     esc(why)
@@ -624,7 +637,7 @@ fn metrics_tables(out: &mut String, m: &Value) {
                 for (part, value) in parts {
                     let _ = writeln!(
                         out,
-                        "<tr><th>{} {}</th><td class=\"num\" data-key=\"{}.{}\">{}</td><td>{}</td></tr>",
+                        "<tr><th>{} {}</th><td class=\"num\" data-key=\"{}.{}\">{}</td><td></td><td>{}</td></tr>",
                         esc(&label),
                         esc(alpha_label(part)),
                         esc(key),
@@ -635,12 +648,19 @@ fn metrics_tables(out: &mut String, m: &Value) {
                 }
             }
             _ => {
+                let interval = intervals[key.as_str()]["half95"]
+                    .as_f64()
+                    .map(|h| interval_value(key, h))
+                    .unwrap_or_default();
                 let _ = writeln!(
                     out,
-                    "<tr><th>{}</th><td class=\"num\" data-key=\"{}\">{}</td><td>{}</td></tr>",
+                    "<tr><th>{}</th><td class=\"num\" data-key=\"{}\">{}</td>\
+                     <td class=\"num\" data-key=\"{}.half95\">{}</td><td>{}</td></tr>",
                     esc(&label),
                     esc(key),
                     esc(&metric_value(key, v)),
+                    esc(key),
+                    esc(&interval),
                     unit
                 );
             }
@@ -659,7 +679,7 @@ fn metrics_tables(out: &mut String, m: &Value) {
         let _ = writeln!(
             out,
             "<tr><th>TM-30 fidelity of the {} colour samples</th><td class=\"num\" \
-             data-key=\"tm30_rf_ces\">lowest {:.1} (CES {}), highest {:.1} (CES {})</td><td></td></tr>",
+             data-key=\"tm30_rf_ces\">lowest {:.1} (CES {}), highest {:.1} (CES {})</td><td></td><td></td></tr>",
             ces.len(),
             lo.1,
             lo.0 + 1,
@@ -682,7 +702,16 @@ fn metrics_tables(out: &mut String, m: &Value) {
                     i + 1
                 );
             }
-            out.push_str("</tr></table>\n");
+            out.push_str("</tr>");
+            if let Some(h) = intervals["cri_r9"]["half95"].as_f64() {
+                let _ = write!(
+                    out,
+                    "<tr><th>95 %</th>{}<td class=\"num\" data-key=\"cri_r9.half95\">{}</td></tr>",
+                    "<td></td>".repeat(8),
+                    esc(&interval_value("cri_r9", h))
+                );
+            }
+            out.push_str("</table>\n");
         }
         _ => {
             if let Some(why) = reasons["cri_r"].as_str() {
@@ -1000,6 +1029,8 @@ mod tests {
             "spd": spd,
             "colorimetry": {"xy": [0.4476, 0.4074], "cct": 2856.0, "duv": 0.0001},
             "metrics": {"cri_ra": 81.26, "tm30_rf": null,
+                        "cri_r": [80.0, 81.0, 82.0, 83.0, 84.0, 85.0, 86.0, 87.0, 20.5, 60.0, 70.0,
+                                  71.0, 72.0, 73.0],
                         "reasons": {"tm30_rf": "the SPD does not cover 380–780 nm"},
                         "warnings": []},
             "truth": null,
@@ -1008,6 +1039,8 @@ mod tests {
             "band68": {"lower": low68, "upper": high68},
             "band95": {"lower": low95, "upper": high95},
             "expected_gfc": 0.9912,
+            "metric_uncertainty": {"cri_ra": {"half68": 1.9, "half95": 4.04},
+                                   "cri_r9": {"half68": 7.0, "half95": 15.26}},
             "self_check": {"passed": true, "residual": 0.0123}
         })
     }
@@ -1042,6 +1075,10 @@ mod tests {
         assert!(html.contains("— (the SPD does not cover 380–780 nm)"));
         assert!(html.contains("<h2>room &lt;1&gt;.jpg</h2>"));
         assert!(html.contains("data-key=\"cri_ra\">81.3</td>"));
+        // Metric intervals stand beside their values, not in the details.
+        assert!(html.contains("data-key=\"cri_ra.half95\">± 4.0</td>"));
+        assert!(html.contains("data-key=\"cri_r9.half95\">± 15.3</td>"));
+        assert!(!html.contains("data-key=\"metric_uncertainty"));
     }
 
     #[test]

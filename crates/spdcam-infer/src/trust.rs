@@ -25,7 +25,9 @@ use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::srgb_decode;
 use spdcam_core::metrics;
 use spdcam_core::photo::{PatchSample, PhotoAnalysis};
+use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use std::collections::BTreeMap;
 
 /// How many patches the self-check names as the worst.
 const WORST_NAMED: usize = 3;
@@ -325,36 +327,76 @@ pub fn flag_patches(row: &[f64], scale: f64) -> Vec<bool> {
         .collect()
 }
 
-/// The spread of the model's estimates when each feature is perturbed by ±[`JITTER_SIGMA`]
-/// (multiplicative, log-normal): per wavelength, the standard deviation of the
-/// peak-normalised SPDs of [`JITTER_COPIES`] perturbed copies. Where many lights give nearly
-/// the same photo the network's answer is steep in its input and the spread is large — a
-/// sensitivity analysis of the inverse map (Saltelli et al. 2008, "Global Sensitivity
-/// Analysis: The Primer", ch. 1).
-pub fn spread(model: &Model, row: &[f64]) -> Result<Vec<f64>> {
-    let scale = feature_scale(row);
-    let noise =
-        Normal::new(0.0, JITTER_SIGMA).map_err(|e| InferError::invalid(format!("jitter: {e}")))?;
-    let mut rng = SmallRng::seed_from_u64(JITTER_SEED);
-    let mut rows = Vec::with_capacity(JITTER_COPIES * row.len());
-    for _ in 0..JITTER_COPIES {
-        rows.extend(
-            row.iter()
-                .map(|&v| (v * noise.sample(&mut rng).exp()).clamp(0.0, scale)),
-        );
+/// The model's estimates of [`JITTER_COPIES`] copies of one feature row, each feature
+/// perturbed by ±[`JITTER_SIGMA`] (multiplicative, log-normal), peak-normalised. Where many
+/// lights give nearly the same photo the network's answer is steep in its input and the
+/// copies spread widely — a sensitivity analysis of the inverse map (Saltelli et al. 2008,
+/// "Global Sensitivity Analysis: The Primer", ch. 1), propagated to the metrics by Monte
+/// Carlo (JCGM 101:2008, GUM Supplement 1, section 7).
+#[derive(Debug, Clone)]
+pub struct Perturbed {
+    copies: Vec<Vec<f64>>,
+}
+
+impl Perturbed {
+    /// The perturbed estimates of `row` by `model` (a fixed seed: reproducible).
+    pub fn of(model: &Model, row: &[f64]) -> Result<Perturbed> {
+        let scale = feature_scale(row);
+        let noise = Normal::new(0.0, JITTER_SIGMA)
+            .map_err(|e| InferError::invalid(format!("jitter: {e}")))?;
+        let mut rng = SmallRng::seed_from_u64(JITTER_SEED);
+        let mut rows = Vec::with_capacity(JITTER_COPIES * row.len());
+        for _ in 0..JITTER_COPIES {
+            rows.extend(
+                row.iter()
+                    .map(|&v| (v * noise.sample(&mut rng).exp()).clamp(0.0, scale)),
+            );
+        }
+        let d = model.grid().count;
+        let copies = model
+            .estimate_rows(&rows)?
+            .chunks_exact(d)
+            .map(metrics::normalise_by_max)
+            .collect();
+        Ok(Perturbed { copies })
     }
-    let d = model.grid().count;
-    let spds: Vec<Vec<f64>> = model
-        .estimate_rows(&rows)?
-        .chunks_exact(d)
-        .map(metrics::normalise_by_max)
-        .collect();
-    Ok((0..d)
-        .map(|k| {
-            let m = spds.iter().map(|s| s[k]).sum::<f64>() / spds.len() as f64;
-            (spds.iter().map(|s| (s[k] - m).powi(2)).sum::<f64>() / (spds.len() - 1) as f64).sqrt()
-        })
-        .collect())
+
+    /// Per wavelength, the standard deviation of the copies.
+    pub fn spread(&self) -> Vec<f64> {
+        let d = self.copies.first().map_or(0, Vec::len);
+        (0..d)
+            .map(|k| sample_std(self.copies.iter().map(|s| s[k])))
+            .collect()
+    }
+
+    /// Per single-number metric ([`SCALAR_KEYS`]), the standard deviation of its values
+    /// over the copies (on `wavelengths`, the model's grid); a metric undefined for more than
+    /// a quarter of the copies has none.
+    pub fn metric_spread(&self, wavelengths: &[f64]) -> BTreeMap<String, f64> {
+        let all: Vec<LightingMetrics> = self
+            .copies
+            .iter()
+            .map(|s| LightingMetrics::from_samples(wavelengths, s))
+            .collect();
+        SCALAR_KEYS
+            .iter()
+            .filter_map(|&key| {
+                let values: Vec<f64> = all.iter().filter_map(|m| m.scalar(key)).collect();
+                (4 * values.len() >= 3 * all.len() && values.len() > 1)
+                    .then(|| (key.to_string(), sample_std(values.into_iter())))
+            })
+            .collect()
+    }
+}
+
+/// The sample standard deviation (n − 1) of `values`; 0 for fewer than two.
+fn sample_std(values: impl Iterator<Item = f64> + Clone) -> f64 {
+    let n = values.clone().count();
+    if n < 2 {
+        return 0.0;
+    }
+    let mean = values.clone().sum::<f64>() / n as f64;
+    (values.map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt()
 }
 
 /// A band around the SPD on its wavelengths.
@@ -375,8 +417,37 @@ pub struct Uncertainty {
     pub band95: Band,
     /// The GFC such estimates reach, in the median, on the calibration photos as hard.
     pub expected_gfc: f64,
-    /// The mean spread of the perturbed estimates (see [`spread`]).
+    /// The mean spread of the perturbed estimates (see [`Perturbed::spread`]).
     pub difficulty: f64,
+    /// Half-widths of the 68 % and 95 % intervals of the single-number metrics, by key
+    /// ([`SCALAR_KEYS`]): "Ra 82 ± 4" is `cri_ra` ± `half95`. Only metrics the calibration
+    /// measured and the perturbed copies define.
+    pub metrics: BTreeMap<String, MetricInterval>,
+}
+
+/// The calibrated half-widths of one metric's intervals, in the metric's unit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MetricInterval {
+    /// The true value lies within ± this of the estimate's with 68 % probability.
+    pub half68: f64,
+    /// The same at 95 %.
+    pub half95: f64,
+}
+
+/// One metric's calibration: the same scaled-residual conformal rule as the bands (see
+/// [`Calibration`]) with the metric's spread over the perturbed copies as the scale.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MetricCalibration {
+    /// The metric's key ([`SCALAR_KEYS`]).
+    pub key: String,
+    /// The median absolute error of the metric on the calibration photos.
+    pub floor: f64,
+    /// The 68 % quantile of |error| / (floor + spread).
+    pub scale68: f64,
+    /// The 95 % quantile of the same.
+    pub scale95: f64,
+    /// How many calibration photos defined the metric (for the estimate and the truth).
+    pub photos: usize,
 }
 
 impl Band {
@@ -427,6 +498,9 @@ pub struct Calibration {
     /// The 99th percentile of the self-check's mean residual on the calibration photos, when
     /// the chart's reflectances were at hand; above it the estimate is doubtful.
     pub self_check_doubtful: Option<f64>,
+    /// Per single-number metric, its interval's calibration (absent from older files).
+    #[serde(default)]
+    pub metrics: Vec<MetricCalibration>,
     /// The 99th percentile of the self-check's half-to-half residual ([`SelfCheck::split`])
     /// on the calibration photos; above it the estimate is doubtful.
     pub split_doubtful: Option<f64>,
@@ -471,9 +545,15 @@ impl Calibration {
         Ok(c)
     }
 
-    /// The bands and expected GFC of `spd` (the model's peak-normalised estimate) whose
-    /// perturbed estimates spread by `spread`.
-    pub fn uncertainty(&self, spd: &[f64], spread: &[f64]) -> Result<Uncertainty> {
+    /// The bands, expected GFC and metric intervals of `spd` (the model's peak-normalised
+    /// estimate) whose perturbed estimates spread by `spread` per wavelength and by
+    /// `metric_spread` per metric ([`Perturbed`]).
+    pub fn uncertainty(
+        &self,
+        spd: &[f64],
+        spread: &[f64],
+        metric_spread: &BTreeMap<String, f64>,
+    ) -> Result<Uncertainty> {
         let d = self.floor.len();
         if spd.len() != d || spread.len() != d {
             return Err(InferError::invalid(format!(
@@ -500,6 +580,20 @@ impl Calibration {
             band95: band(&self.scale95),
             expected_gfc: self.expected_gfc[bin],
             difficulty,
+            metrics: self
+                .metrics
+                .iter()
+                .filter_map(|m| {
+                    let s = metric_spread.get(&m.key)?;
+                    Some((
+                        m.key.clone(),
+                        MetricInterval {
+                            half68: m.scale68 * (m.floor + s),
+                            half95: m.scale95 * (m.floor + s),
+                        },
+                    ))
+                })
+                .collect(),
         })
     }
 }
@@ -638,7 +732,14 @@ pub fn assess(
         }
     };
     let uncertainty = match calibration {
-        Some(cal) => Some(cal.uncertainty(spd, &spread(model, row)?)?),
+        Some(cal) => {
+            let perturbed = Perturbed::of(model, row)?;
+            Some(cal.uncertainty(
+                spd,
+                &perturbed.spread(),
+                &perturbed.metric_spread(&model.grid().wavelengths()),
+            )?)
+        }
         None => {
             reasons.push("no uncertainty: the model has no calibration".into());
             None

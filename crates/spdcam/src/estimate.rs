@@ -22,8 +22,9 @@ use spdcam_infer::stream::{
     estimate_block, long_header, long_rows, row_name, FeatureStream, GridMap, Layout,
     WIDE_LAYOUT_MAX_ROWS,
 };
-use spdcam_infer::trust::{self, PhotoFlags, Trust, Uncertainty, Verdict};
+use spdcam_infer::trust::{self, MetricInterval, PhotoFlags, Trust, Uncertainty, Verdict};
 use spdcam_infer::{Estimate, Model, ModelSet};
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -405,6 +406,7 @@ impl FeatureRun {
             truth,
             photo: None,
             trust,
+            absolute: None,
         })
     }
 
@@ -677,9 +679,31 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
         if unusable {
             println!("{}: UNUSABLE, no estimate to rely on", e.name);
         } else if detailed {
-            println!("{}: {}", e.name, e.colorimetry.label());
+            let intervals = e
+                .trust
+                .as_ref()
+                .and_then(|t| t.uncertainty.as_ref())
+                .map(|u| &u.metrics);
+            println!(
+                "{}: {}",
+                e.name,
+                colorimetry_line(&e.colorimetry, intervals)
+            );
             println!("  relative SPD: {}", spd_line(&e.spd, &e.grid));
-            println!("  {}", metrics_line(&e.metrics));
+            println!("  {}", metrics_line(&e.metrics, intervals));
+            match (&e.absolute, e.photo.as_ref().and_then(|p| p.exposure)) {
+                (Some(Ok(a)), _) => println!(
+                    "  absolute (approximate, from {}): {:.0} lx, PPFD {}, melanopic EDI {}",
+                    a.exposure.label(),
+                    a.illuminance_lux,
+                    a.ppfd_umol_m2_s
+                        .map_or_else(|| "—".into(), |v| format!("{v:.1} µmol/m²/s")),
+                    a.melanopic_edi_lux
+                        .map_or_else(|| "—".into(), |v| format!("{v:.0} lx")),
+                ),
+                (Some(Err(reason)), Some(_)) => println!("  no absolute levels: {reason}"),
+                _ => {}
+            }
         }
         if let Some(t) = &e.trust {
             println!("  {}", trust_line(t));
@@ -708,7 +732,8 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
         println!(
             "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and gamut; \
              M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: scotopic/photopic; \
-             PPF: µmol/s of 400–700 nm photons per klm; computed on the estimate's {}–{} nm only \
+             PPF: µmol/s of 400–700 nm photons per klm; ± the 95 % interval when calibrated; \
+             computed on the estimate's {}–{} nm only \
              (`spdcam metrics` on a wider SPD, `--json` for every number)",
             estimates[0].grid.start_nm,
             estimates[0].grid.end_nm()
@@ -816,19 +841,46 @@ fn with_bands(estimates: &[Estimate], grid: &Grid) -> Result<SpectralSet> {
     Ok(SpectralSet::on_grid(grid, names, values)?)
 }
 
-/// The main lighting-quality numbers on one line, `—` where undefined.
-fn metrics_line(m: &LightingMetrics) -> String {
-    let f = |v: Option<f64>, d: usize| v.map_or_else(|| "—".into(), |v| format!("{v:.d$}"));
+/// The main lighting-quality numbers on one line, `—` where undefined, each with its 95 %
+/// interval when the estimate has one: `Ra 82 ± 4 (R9 20 ± 15), …`.
+fn metrics_line(
+    m: &LightingMetrics,
+    intervals: Option<&BTreeMap<String, MetricInterval>>,
+) -> String {
+    let f = |key: &str, d: usize, unit: f64| {
+        let Some(v) = m.scalar(key) else {
+            return "—".to_string();
+        };
+        match intervals.and_then(|i| i.get(key)) {
+            Some(i) => format!("{:.d$} ± {:.d$}", unit * v, unit * i.half95),
+            None => format!("{:.d$}", unit * v),
+        }
+    };
     format!(
         "Ra {} (R9 {}), Rf {}, Rg {}, M-EDER {}, S/P {}, PPF {}",
-        f(m.cri_ra, 0),
-        f(m.cri_r.map(|r| r[8]), 0),
-        f(m.tm30_rf, 0),
-        f(m.tm30_rg, 0),
-        f(m.mel_der, 2),
-        f(m.sp_ratio, 2),
-        f(m.ppf_per_lux.map(|v| 1000.0 * v), 1),
+        f("cri_ra", 0, 1.0),
+        f("cri_r9", 0, 1.0),
+        f("tm30_rf", 0, 1.0),
+        f("tm30_rg", 0, 1.0),
+        f("mel_der", 2, 1.0),
+        f("sp_ratio", 2, 1.0),
+        f("ppf_per_lux", 1, 1000.0),
     )
+}
+
+/// xy, CCT and Duv of an estimate, CCT and Duv with their 95 % intervals when it has them.
+fn colorimetry_line(
+    c: &Colorimetry,
+    intervals: Option<&BTreeMap<String, MetricInterval>>,
+) -> String {
+    let half = |key: &str| intervals.and_then(|i| i.get(key)).map(|i| i.half95);
+    match (c.cct, c.duv, half("cct_k"), half("duv")) {
+        (Some(cct), Some(duv), Some(hc), Some(hd)) => format!(
+            "xy ({:.4}, {:.4}), CCT {cct:.0} ± {hc:.0} K, Duv {duv:+.4} ± {hd:.4}",
+            c.xy[0], c.xy[1]
+        ),
+        _ => c.label(),
+    }
 }
 
 /// The SPD every 25 nm, peak-normalised, on one terminal line: `400:0.12 425:0.40 …`.

@@ -22,13 +22,16 @@ use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::lighting::{LampLibrary, ValidationSplit};
 use spdcam_core::photo::scene::{self, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
+use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_core::{metrics, seed};
 use spdcam_infer::estimate::{estimate_photo_bytes, PhotoOptions};
 use spdcam_infer::trust::{
-    self, assess, Calibration, ChartCheck, PhotoFlags, Verdict, JITTER_COPIES, JITTER_SIGMA,
+    self, assess, Calibration, ChartCheck, MetricCalibration, Perturbed, PhotoFlags, Verdict,
+    JITTER_COPIES, JITTER_SIGMA,
 };
 use spdcam_infer::{Model, ModelSet};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Options of `spdcam trust`.
@@ -73,6 +76,8 @@ struct ReportArgs {
 }
 
 const GRID: Grid = Grid::SIMULATION;
+/// Fewer calibration photos defining a metric than this leave it without an interval.
+const MIN_METRIC_PHOTOS: usize = 40;
 /// Difficulty bins of the expected GFC (equal counts).
 const GFC_BINS: usize = 5;
 /// Share of the chart's mean linear level the glare adds at its brightest corner.
@@ -243,12 +248,15 @@ fn glare(chart: &Chart) -> Vec<f64> {
         .collect()
 }
 
-/// One feature row judged: the estimate, its spread, its GFC, its self-check.
+/// One feature row judged: the estimate, its spread, its GFC, its self-check, and per
+/// single-number metric its spread and (with a truth) its absolute error.
 struct Judged {
     spd: Vec<f64>,
     truth: Option<Vec<f64>>,
     spread: Vec<f64>,
     self_check: Option<(f64, f64)>,
+    metric_spread: BTreeMap<String, f64>,
+    metric_error: BTreeMap<String, f64>,
 }
 
 fn judge_rows(
@@ -273,9 +281,27 @@ fn judge_rows(
                     .map(|s| (s.mean, s.split)),
                 None => None,
             };
+            let perturbed = Perturbed::of(model, row)?;
+            let wavelengths = model.grid().wavelengths();
+            let truth = truths.map(|t| t[r].clone());
+            let metric_error = match &truth {
+                Some(t) => {
+                    let (e, t) = (
+                        LightingMetrics::from_samples(&wavelengths, &spd),
+                        LightingMetrics::from_samples(&wavelengths, t),
+                    );
+                    SCALAR_KEYS
+                        .iter()
+                        .filter_map(|&k| Some((k.to_string(), (e.scalar(k)? - t.scalar(k)?).abs())))
+                        .collect()
+                }
+                None => BTreeMap::new(),
+            };
             Ok(Judged {
-                spread: trust::spread(model, row)?,
-                truth: truths.map(|t| t[r].clone()),
+                spread: perturbed.spread(),
+                metric_spread: perturbed.metric_spread(&wavelengths),
+                metric_error,
+                truth,
                 spd,
                 self_check,
             })
@@ -366,6 +392,36 @@ fn fit_calibration(
         .filter_map(|j| j.self_check.map(|s| s.1))
         .collect();
     let (scale68, scale95) = (scale(0.68), scale(0.95));
+    let metric_calibrations = SCALAR_KEYS
+        .iter()
+        .filter_map(|&key| {
+            let pairs: Vec<(f64, f64)> = judged
+                .iter()
+                .filter_map(|j| Some((*j.metric_error.get(key)?, *j.metric_spread.get(key)?)))
+                .collect();
+            if pairs.len() < MIN_METRIC_PHOTOS {
+                return None;
+            }
+            let floor =
+                median(&mut pairs.iter().map(|p| p.0).collect::<Vec<_>>()).max(f64::EPSILON);
+            let scale = |q: f64| {
+                conformal_quantile(
+                    &mut pairs
+                        .iter()
+                        .map(|(e, s)| e / (floor + s))
+                        .collect::<Vec<_>>(),
+                    q,
+                )
+            };
+            Some(MetricCalibration {
+                key: key.to_string(),
+                floor,
+                scale68: scale(0.68),
+                scale95: scale(0.95),
+                photos: pairs.len(),
+            })
+        })
+        .collect();
     let mut clipped: Vec<f64> = features
         .iter()
         .map(|row| trust::clipped_patches(row) as f64)
@@ -386,6 +442,7 @@ fn fit_calibration(
         split_doubtful: (splits.len() == judged.len())
             .then(|| conformal_quantile(&mut splits, 0.99)),
         clipped_doubtful: conformal_quantile(&mut clipped, 0.99) as usize,
+        metrics: metric_calibrations,
     }
 }
 
@@ -600,6 +657,11 @@ data directory, so without it an SG estimate has no self-check (the reasons say 
 (log-normal); the spread s(λ) of the peak-normalised SPDs plus a floor f(λ) (the median \
 absolute error at λ on the calibration photos) is scaled by the conformal 68 % and 95 % \
 quantiles of |error(λ)|/(f(λ)+s(λ)) on the calibration photos.\n\
+- **Metric intervals.** The same rule for each single-number metric (CCT, Duv, Ra, R9, Rf, Rg, \
+M-EDER, S/P, PPF per lux, blue-light hazard efficacy): its standard deviation over the 16 \
+copies' metrics (Monte Carlo propagation, JCGM 101:2008) plus a floor (its median absolute \
+error on the calibration photos), scaled by the conformal quantiles of |error|/(floor + \
+spread). Estimates print the 95 % half-width: \"Ra 82 ± 4\".\n\
 - **Expected GFC.** The median GFC of the calibration photos in the same difficulty bin (five \
 equal-count bins of the mean spread; not rising with difficulty).\n\
 - **Verdict** (constants in `spdcam_infer::trust`, levels in the calibration file): `doubtful` \
@@ -649,7 +711,18 @@ fn spearman(a: &[f64], b: &[f64]) -> f64 {
     cov / (va * vb).sqrt()
 }
 
-/// One row of the report's first table: coverage, rank correlation, verdicts.
+/// Per metric, on one photo set: estimates whose true value lay within the 68 % and 95 %
+/// intervals, estimates with an interval, and the 95 % half-widths.
+#[derive(Default)]
+struct MetricCoverage {
+    in68: usize,
+    in95: usize,
+    total: usize,
+    half95: Vec<f64>,
+}
+
+/// One row of the report's first table (coverage, rank correlation, verdicts) and the
+/// metrics' coverage on the same photos.
 fn measure_row(
     label: &str,
     model: &Model,
@@ -657,14 +730,24 @@ fn measure_row(
     check: Option<&ChartCheck>,
     features: &[Vec<f64>],
     truths: &[Vec<f64>],
-) -> Result<String> {
+) -> Result<(String, BTreeMap<String, MetricCoverage>)> {
     let judged = judge_rows(model, check, features, Some(truths))?;
     let (mut in68, mut in95, mut total) = (0usize, 0usize, 0usize);
     let mut expected = Vec::new();
     let mut actual = Vec::new();
     let mut verdicts = [0usize; 3];
+    let mut coverage: BTreeMap<String, MetricCoverage> = BTreeMap::new();
     for (j, row) in judged.iter().zip(features) {
-        let u = cal.uncertainty(&j.spd, &j.spread)?;
+        let u = cal.uncertainty(&j.spd, &j.spread, &j.metric_spread)?;
+        for (key, &err) in &j.metric_error {
+            if let Some(interval) = u.metrics.get(key) {
+                let c = coverage.entry(key.clone()).or_default();
+                c.in68 += usize::from(err <= interval.half68);
+                c.in95 += usize::from(err <= interval.half95);
+                c.total += 1;
+                c.half95.push(interval.half95);
+            }
+        }
         let truth = j.truth.as_deref().unwrap_or_default();
         for (k, &t) in truth.iter().enumerate() {
             in68 += usize::from(u.band68.lower[k] <= t && t <= u.band68.upper[k]);
@@ -678,7 +761,7 @@ fn measure_row(
     }
     let n = judged.len() as f64;
     let difficulty: Vec<f64> = judged.iter().map(|j| -difficulty(j)).collect();
-    Ok(format!(
+    let row = format!(
         "| {label} | {} | {:.4} | {:.1} % | {:.1} % | {:.2} | {:.2} | {:.0} / {:.0} / {:.0} % |\n",
         judged.len(),
         actual.iter().sum::<f64>() / n,
@@ -689,7 +772,45 @@ fn measure_row(
         100.0 * verdicts[Verdict::Ok as usize] as f64 / n,
         100.0 * verdicts[Verdict::Doubtful as usize] as f64 / n,
         100.0 * verdicts[Verdict::Unusable as usize] as f64 / n,
-    ))
+    );
+    Ok((row, coverage))
+}
+
+/// The metrics' table of one model: per metric and photo set, the share of true values
+/// within the 68 % and 95 % intervals and the median 95 % half-width.
+fn metric_table(name: &str, sets: &[(String, BTreeMap<String, MetricCoverage>)]) -> String {
+    let mut t = format!(
+        "### `{name}`\n\n| metric |{}\n|---|{}\n",
+        sets.iter()
+            .map(|(l, _)| format!(" {l} |"))
+            .collect::<String>(),
+        "---:|".repeat(sets.len())
+    );
+    for key in SCALAR_KEYS {
+        t += &format!("| `{key}` |");
+        for (_, coverage) in sets {
+            t += &match coverage.get(key) {
+                Some(c) if c.total > 0 => format!(
+                    " {:.0} / {:.0} % (± {}) |",
+                    100.0 * c.in68 as f64 / c.total as f64,
+                    100.0 * c.in95 as f64 / c.total as f64,
+                    significant(median(&mut c.half95.clone()))
+                ),
+                _ => " – |".into(),
+            };
+        }
+        t.push('\n');
+    }
+    t
+}
+
+/// `v` with three significant digits.
+fn significant(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$}")
 }
 
 /// The real photo sets of the thesis: name, features, true SPDs on `grid` (peak 1).
@@ -773,6 +894,14 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
          | model | photos per kind | clean | another chart | half-lit | glare |\n\
          |---|---:|---:|---:|---:|---:|\n"
     );
+    let mut metrics_md = String::from(
+        "## Metric intervals\n\n\
+         Per single-number metric (computed on the model's wavelengths for the estimate and the \
+         truth alike): the share of photos whose true value lies within the estimate's 68 % and \
+         95 % intervals, and in brackets the median 95 % half-width (\"Ra 82 ± 4\"). Each \
+         interval is the metric's spread over the perturbed copies plus a floor, scaled by the \
+         calibration's conformal quantiles.\n\n",
+    );
     md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
     for ((path, model, chart_name), cal_path) in models.iter().zip(&args.calibration) {
         let text = std::fs::read_to_string(cal_path)
@@ -792,7 +921,8 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
             || path.display().to_string(),
             |n| n.to_string_lossy().into(),
         );
-        md += &measure_row(
+        let mut metric_sets = Vec::new();
+        let (row, coverage) = measure_row(
             &format!("`{name}` · held-out virtual (test lamps)"),
             model,
             &cal,
@@ -800,13 +930,15 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
             &shots.clean.features,
             &shots.clean.truths,
         )?;
+        md += &row;
+        metric_sets.push(("held-out virtual".to_string(), coverage));
         if chart_name == "colorchecker_sg96" {
             let thesis = match &args.thesis_data {
                 Some(p) => p.clone(),
                 None => in_data_dir(None, "thesis", data_dir)?,
             };
             for (label, rows) in real_sets(&thesis, &model.grid())? {
-                md += &measure_row(
+                let (row, coverage) = measure_row(
                     &format!("`{name}` · real: {label}"),
                     model,
                     &cal,
@@ -814,8 +946,12 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
                     &rows.features,
                     &rows.truths,
                 )?;
+                md += &row;
+                metric_sets.push((format!("real: {label}"), coverage));
             }
         }
+        metrics_md += &metric_table(&name, &metric_sets);
+        metrics_md.push('\n');
         let (Some(level), Some(split_level)) = (cal.self_check_doubtful, cal.split_doubtful) else {
             flags += &format!(
                 "| `{name}` | – | no self-check without the chart's reflectances | | | | | |\n"
@@ -878,6 +1014,7 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
         eprintln!("{}: measured", path.display());
     }
     md.push('\n');
+    md += &metrics_md;
     md += &flags;
     md.push('\n');
     md += &scenes;

@@ -151,6 +151,17 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
     let expected = number_after(&out, "expected GFC");
     assert!((0.9..=1.0).contains(&expected), "{out}");
     assert!(out.contains("95 % band"), "{out}");
+    // The metrics with their calibrated 95 % intervals.
+    assert!(out.contains(" K, Duv ") && out.contains("CCT "), "{out}");
+    let cct_line = out.lines().find(|l| l.contains("CCT ")).unwrap();
+    assert!(
+        cct_line.contains(" ± "),
+        "CCT with its interval: {cct_line}"
+    );
+    let line = out.lines().find(|l| l.contains("Ra ")).unwrap();
+    let (ra, rest) = line.split_once("Ra ").unwrap().1.split_once(" ± ").unwrap();
+    assert!(ra.parse::<f64>().is_ok(), "{line}");
+    assert!(number_after(rest, "") > 0.0, "{line}");
     assert!(std::fs::read_to_string(&csv).unwrap().starts_with(
         "wavelength_nm,cc24.jpg,cc24.jpg_lower68,cc24.jpg_upper68,cc24.jpg_lower95,cc24.jpg_upper95\n"
     ));
@@ -171,6 +182,17 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
             );
             assert!(l <= v + 1e-9 && v <= u + 1e-9, "{band}: {l} {v} {u}");
         }
+    }
+    // Every single-number metric the estimate defines has an interval, 68 % inside 95 %.
+    let intervals = &e["metric_uncertainty"];
+    for key in [
+        "cct_k", "duv", "cri_ra", "cri_r9", "tm30_rf", "mel_der", "sp_ratio",
+    ] {
+        let (h68, h95) = (
+            intervals[key]["half68"].as_f64().unwrap(),
+            intervals[key]["half95"].as_f64().unwrap(),
+        );
+        assert!(0.0 < h68 && h68 <= h95, "{key}: {intervals}");
     }
     let check = &e["self_check"];
     assert!(check["mean"].as_f64().unwrap() < 0.1, "{check}");
@@ -471,4 +493,145 @@ fn a_photo_of_another_chart_is_unusable() {
     assert_eq!(json[0]["verdict"], "unusable");
     assert!(json[0]["self_check"]["mean"].as_f64().unwrap() > 0.2);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `jpeg` with an EXIF segment (APP1, CIPA DC-008) right after its start-of-image marker
+/// giving aperture `f_number`, exposure time 1/`per_second` s and `iso`.
+fn with_exif(jpeg: &[u8], f_number: u32, per_second: u32, iso: u16) -> Vec<u8> {
+    use exif::experimental::Writer;
+    use exif::{Field, In, Rational, Tag, Value};
+    let fields = [
+        (
+            Tag::FNumber,
+            Value::Rational(vec![Rational {
+                num: f_number,
+                denom: 1,
+            }]),
+        ),
+        (
+            Tag::ExposureTime,
+            Value::Rational(vec![Rational {
+                num: 1,
+                denom: per_second,
+            }]),
+        ),
+        (Tag::PhotographicSensitivity, Value::Short(vec![iso])),
+    ]
+    .map(|(tag, value)| Field {
+        tag,
+        ifd_num: In::PRIMARY,
+        value,
+    });
+    let mut writer = Writer::new();
+    for f in &fields {
+        writer.push_field(f);
+    }
+    let mut tiff = std::io::Cursor::new(Vec::new());
+    writer.write(&mut tiff, false).unwrap();
+    let tiff = tiff.into_inner();
+    let mut out = jpeg[..2].to_vec();
+    out.extend_from_slice(&[0xFF, 0xE1]);
+    out.extend_from_slice(&u16::try_from(2 + 6 + tiff.len()).unwrap().to_be_bytes());
+    out.extend_from_slice(b"Exif\0\0");
+    out.extend_from_slice(&tiff);
+    out.extend_from_slice(&jpeg[2..]);
+    out
+}
+
+#[test]
+fn the_exif_exposure_gives_approximate_absolute_levels() {
+    let dir = scratch("exif");
+    let plain = dir.join("plain.jpg");
+    ok(&[
+        "render",
+        "--spd",
+        "D50",
+        "--scene",
+        "1200x900",
+        "-o",
+        &s(&plain),
+    ]);
+    let bytes = std::fs::read(&plain).unwrap();
+    let json = |name: &str, f: u32, per_second: u32, iso: u16| -> serde_json::Value {
+        let path = dir.join(name);
+        std::fs::write(&path, with_exif(&bytes, f, per_second, iso)).unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&ok(&["estimate", &s(&path), "--json"])).unwrap();
+        v[0].clone()
+    };
+    let e = json("f4.jpg", 4, 100, 100);
+    assert_eq!(e["photo"]["exposure"]["iso"], 100.0, "{}", e["photo"]);
+    let a = &e["absolute"];
+    let lux = a["illuminance_lux"]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{e}"));
+    // Each neutral patch used: its luminance from the exposure (ISO 12232 SOS, q = 0.65)
+    // equals the illuminance times its luminance factor / π. The factors of the ColorChecker
+    // 24's neutrals (white … black) from X-Rite's published CIELAB L* (D50, charts made
+    // after November 2014) agree with the chart's spectra to a few per cent.
+    let published_y =
+        [96.54f64, 81.26, 66.77, 50.87, 35.66, 20.46].map(|l| ((l + 16.0) / 116.0).powi(3));
+    let patches = a["patches"].as_array().unwrap();
+    assert!(!patches.is_empty(), "{a}");
+    for p in patches {
+        let feature = p[0].as_u64().unwrap() as usize;
+        assert!((19..=24).contains(&feature), "a neutral patch: {feature}");
+        let rgb: Vec<f64> = (0..3)
+            .map(|c| {
+                e["photo"]["features"][3 * (feature - 1) + c]
+                    .as_f64()
+                    .unwrap()
+                    / 255.0
+            })
+            .collect();
+        let decode = |v: f64| {
+            if v <= 0.04045 {
+                v / 12.92
+            } else {
+                ((v + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        let y = 0.2126 * decode(rgb[0]) + 0.7152 * decode(rgb[1]) + 0.0722 * decode(rgb[2]);
+        let luminance = (y / 0.18) * (10.0 / 100.0) * 16.0 / (0.65 * 0.01);
+        let from_patch = p[1].as_f64().unwrap() * published_y[feature - 19] / std::f64::consts::PI;
+        assert!(
+            (from_patch / luminance - 1.0).abs() < 0.08,
+            "patch {feature}: {from_patch} vs {luminance} cd/m²"
+        );
+    }
+    // PPFD and melanopic EDI scale the illuminance by the estimate's own ratios.
+    let m = &e["metrics"];
+    let close = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-9;
+    assert!(close(
+        a["ppfd_umol_m2_s"].as_f64().unwrap(),
+        lux * m["ppf_per_lux"].as_f64().unwrap()
+    ));
+    assert!(close(
+        a["melanopic_edi_lux"].as_f64().unwrap(),
+        lux * m["mel_der"].as_f64().unwrap()
+    ));
+    assert!(a["note"].as_str().unwrap().starts_with("approximate"));
+    // The same pixels taken with twice the time, or one stop more open, saw half the light.
+    let slower = json("slower.jpg", 4, 50, 100)["absolute"]["illuminance_lux"]
+        .as_f64()
+        .unwrap();
+    assert!(close(slower, lux / 2.0), "{slower} vs {lux}");
+    let wider = json("iso.jpg", 4, 100, 200)["absolute"]["illuminance_lux"]
+        .as_f64()
+        .unwrap();
+    assert!(close(wider, lux / 2.0), "{wider} vs {lux}");
+    // Text output names the exposure; a photo without EXIF has none and says nothing.
+    let text = ok(&["estimate", &s(&dir.join("f4.jpg"))]);
+    assert!(
+        text.contains("absolute (approximate, from f/4, 1/100 s, ISO 100):"),
+        "{text}"
+    );
+    let plain_json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", &s(&plain), "--json"])).unwrap();
+    assert!(plain_json[0]["absolute"].is_null());
+    assert!(plain_json[0]["absolute_reason"]
+        .as_str()
+        .unwrap()
+        .contains("EXIF"));
+    assert!(!ok(&["estimate", &s(&plain)]).contains("absolute"));
 }

@@ -2,6 +2,7 @@
 //! sample ─► features, confidence, flags and warnings; several photos in parallel.
 
 use super::detect::{detect_traced, from_corners, no_chart};
+use super::exposure::Exposure;
 use super::geometry::Homography;
 use super::load::{load_photo, Photo};
 use super::overlay::{debug_overlay, write_overlay};
@@ -59,6 +60,8 @@ pub struct PhotoAnalysis {
     pub patches: Vec<PatchSample>,
     /// What the user should know (clipping, low confidence, dark patches).
     pub warnings: Vec<String>,
+    /// The camera's exposure from the photo's EXIF, when it gives aperture, time and ISO.
+    pub exposure: Option<Exposure>,
 }
 
 /// Decodes, finds the chart, samples it. Writes the debug image when asked, also when no
@@ -163,6 +166,7 @@ fn assemble(
         features,
         patches,
         warnings,
+        exposure: photo.exposure,
     }
 }
 

@@ -1,6 +1,7 @@
 //! Reading photos: JPEG, PNG (8/16-bit), TIFF, with the EXIF orientation applied, into one
 //! compact buffer of encoded sRGB values (8 or 16 bits per channel, as the file had).
 
+use super::exposure::Exposure;
 use crate::error::{Error, Result};
 use crate::limits;
 use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader};
@@ -34,6 +35,8 @@ pub struct Photo {
     pub height: usize,
     /// What the decoder noticed but could decode past, e.g. a truncated file.
     pub warnings: Vec<String>,
+    /// The camera's exposure from the file's EXIF, when it gives aperture, time and ISO.
+    pub exposure: Option<Exposure>,
     pixels: Pixels,
 }
 
@@ -71,6 +74,7 @@ impl Photo {
             width,
             height,
             warnings: Vec::new(),
+            exposure: None,
             pixels,
         })
     }
@@ -238,10 +242,16 @@ pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
     let orientation = decoder
         .orientation()
         .unwrap_or(image::metadata::Orientation::NoTransforms);
+    let exposure = decoder
+        .exif_metadata()
+        .ok()
+        .flatten()
+        .and_then(Exposure::from_exif);
     let mut image = DynamicImage::from_decoder(decoder)
         .map_err(|e| image_error(format!("cannot decode (damaged or truncated?): {e}")))?;
     image.apply_orientation(orientation);
     let mut photo = Photo::from_image(source, image)?;
+    photo.exposure = exposure;
     if format == ImageFormat::Jpeg && jpeg_is_truncated(bytes) {
         photo.warnings.push(
             "the JPEG file is truncated (it ends before its end-of-image marker); the \

@@ -14,6 +14,7 @@
 
 mod batch;
 mod detect;
+pub mod exposure;
 mod geometry;
 mod lattice;
 mod load;
@@ -28,6 +29,7 @@ pub use batch::{
     write_features_csv, AnalyseOptions, PhotoAnalysis,
 };
 pub use detect::{detect, detect_at, detect_traced, from_corners, SearchTrace, DETECTION_SIZE};
+pub use exposure::Exposure;
 pub use geometry::{sort_corners, Homography};
 pub use load::{decode_photo, load_photo, Photo, MIN_PHOTO_SIDE};
 pub use overlay::{analysis_overlay_jpeg, debug_overlay, write_overlay, OVERLAY_SIZE};

@@ -107,6 +107,21 @@ pub const METRIC_KEYS: [&str; 18] = [
     "reasons",
 ];
 
+/// The single-number metrics a person quotes, by key: each has an uncertainty when an
+/// estimate has one (`cri_r9` is R9, saturated red, from `cri_r`).
+pub const SCALAR_KEYS: [&str; 10] = [
+    "cct_k",
+    "duv",
+    "cri_ra",
+    "cri_r9",
+    "tm30_rf",
+    "tm30_rg",
+    "mel_der",
+    "sp_ratio",
+    "ppf_per_lux",
+    "blh_efficacy_w_per_lm",
+];
+
 /// The CCT-dependent keys.
 const CCT_KEYS: [&str; 8] = [
     "cct_k",
@@ -225,6 +240,24 @@ impl LightingMetrics {
         m
     }
 
+    /// The value of the single-number metric `key` (one of [`SCALAR_KEYS`]), `None` when it
+    /// is undefined or `key` is not one of them.
+    pub fn scalar(&self, key: &str) -> Option<f64> {
+        match key {
+            "cct_k" => self.cct_k,
+            "duv" => self.duv,
+            "cri_ra" => self.cri_ra,
+            "cri_r9" => self.cri_r.map(|r| r[8]),
+            "tm30_rf" => self.tm30_rf,
+            "tm30_rg" => self.tm30_rg,
+            "mel_der" => self.mel_der,
+            "sp_ratio" => self.sp_ratio,
+            "ppf_per_lux" => self.ppf_per_lux,
+            "blh_efficacy_w_per_lm" => self.blh_efficacy_w_per_lm,
+            _ => None,
+        }
+    }
+
     fn set_reason(&mut self, keys: &[&str], reason: &str) {
         for k in keys {
             self.reasons.insert(k.to_string(), reason.to_string());
@@ -248,6 +281,12 @@ mod tests {
         assert!((m.mel_der.unwrap() - 1.0).abs() < 1e-12);
         assert!(m.cri_ra.unwrap() > 99.0 && m.tm30_rf.unwrap() > 99.0);
         assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        for key in SCALAR_KEYS {
+            assert!(m.scalar(key).is_some_and(f64::is_finite), "{key}");
+        }
+        assert_eq!(m.scalar("cri_r9"), Some(m.cri_r.unwrap()[8]));
+        assert_eq!(m.scalar("cri_ra"), m.cri_ra);
+        assert_eq!(m.scalar("no such metric"), None);
     }
 
     #[test]

@@ -418,14 +418,25 @@ const METRIC_LABELS = {
   alpha_opic_elr_mw_per_lm: 'α-opic ELR (mW/lm)', reasons: 'not given:',
 };
 
-/** A metrics object (possibly nested) as table rows; lists (per-sample values) are left out. */
-function metricRows(table, obj, prefix) {
+/** A metric's number as the page shows it. */
+function metricNumber(v) {
+  return Math.abs(v) >= 100 ? v.toFixed(0) : v.toPrecision(4);
+}
+
+/**
+ * A metrics object (possibly nested) as table rows; lists (per-sample values) are left out.
+ * `intervals` (the estimate's `metric_uncertainty`) adds "± half-width" (95 %) to top-level values.
+ */
+function metricRows(table, obj, prefix, intervals) {
   for (const [k, v] of Object.entries(obj)) {
     if (k === 'warnings') continue;
     const label = prefix ? `${prefix} ${METRIC_LABELS[k] || k}` : METRIC_LABELS[k] || k;
     if (v && typeof v === 'object' && !Array.isArray(v)) metricRows(table, v, label);
-    else if (typeof v === 'number') row(table, label, Math.abs(v) >= 100 ? v.toFixed(0) : v.toPrecision(4));
-    else if (typeof v === 'string' || typeof v === 'boolean') row(table, label, String(v));
+    else if (typeof v === 'number') {
+      const half = !prefix && intervals && intervals[k] ? intervals[k].half95 : null;
+      const shown = half != null ? `${metricNumber(v)} ± ${metricNumber(half)}` : metricNumber(v);
+      row(table, label, shown, prefix ? undefined : `metric-${k}`);
+    } else if (typeof v === 'string' || typeof v === 'boolean') row(table, label, String(v));
   }
 }
 
@@ -452,6 +463,12 @@ function renderSummary() {
   row(table, 'CCT', c.cct != null ? `${fmt(c.cct, 0)} K` : 'none (far from the Planckian locus)', 'cct');
   row(table, 'Duv', c.duv != null ? (c.duv >= 0 ? '+' : '') + fmt(c.duv, 4) : '–', 'duv');
   if (typeof r.expected_gfc === 'number') row(table, 'expected GFC', fmt(r.expected_gfc, 3), 'expected-gfc');
+  if (r.absolute) {
+    // Approximate absolute levels from the photo's EXIF exposure (see the JSON's note).
+    row(table, 'illuminance (approx.)', `${fmt(r.absolute.illuminance_lux, 0)} lx`, 'illuminance');
+    if (r.absolute.ppfd_umol_m2_s != null) row(table, 'PPFD (approx.)', `${fmt(r.absolute.ppfd_umol_m2_s, 1)} µmol m⁻² s⁻¹`);
+    if (r.absolute.melanopic_edi_lux != null) row(table, 'melanopic EDI (approx.)', `${fmt(r.absolute.melanopic_edi_lux, 0)} lx`);
+  }
   if (r.photo) {
     row(table, 'chart', r.photo.chart);
     row(table, 'found by', r.photo.method === 'corners' ? 'your corners' : 'detection', 'method');
@@ -467,7 +484,8 @@ function renderSummary() {
   }
   if (r.metrics && typeof r.metrics === 'object') {
     html('h2', {}, box, 'Lighting metrics');
-    metricRows(html('table', { id: 'metrics' }, box), r.metrics, '');
+    metricRows(html('table', { id: 'metrics' }, box), r.metrics, '', r.metric_uncertainty);
+    if (r.metric_uncertainty) html('p', { class: 'note' }, box, '± : the 95 % interval of the metric, calibrated on held-out lamps.');
   }
   const warnings = ((r.photo && r.photo.warnings) || []).concat((r.metrics && r.metrics.warnings) || []);
   if (warnings.length) {

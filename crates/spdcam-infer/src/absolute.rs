@@ -1,0 +1,152 @@
+//! Approximate absolute levels of an estimate from the photo's EXIF exposure: illuminance,
+//! PPFD, melanopic EDI and the SPD as spectral irradiance.
+//!
+//! ```text
+//! EXIF (N, t, ISO) + neutral patch's linear value y ─► luminance L (ISO 12232 SOS,
+//!     spdcam_core::photo::exposure) ─► illuminance E = π·L / ρ_Y (a Lambertian patch of
+//!     luminance factor ρ_Y under the estimated light) ─► PPFD = E·PPF/lx,
+//!     melanopic EDI = E·M-EDER (CIE S 026), E_e(λ) = E·S(λ) / (683.002·Σ S·V·Δλ)
+//! ```
+//!
+//! Every neutral feature patch of the chart that is neither clipped nor dark and renders
+//! between 0.05 and 0.6 of the output's white (where tone curves are nearest linear) gives
+//! one illuminance; the median is the answer. The result rests on the camera's ISO rating,
+//! its tone curve and the lens's vignetting, so it is approximate (tens of per cent): every
+//! output says so.
+
+use crate::error::Result;
+use serde::Serialize;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::chart::Chart;
+use spdcam_core::colorimetry::srgb_decode;
+use spdcam_core::colorimetry::Observer;
+use spdcam_core::photo::{Exposure, PhotoAnalysis};
+use spdcam_core::quality::LightingMetrics;
+use spdcam_core::spectral::Grid;
+
+/// CIE 015:2018 maximum luminous efficacy K_m of photopic vision, lm/W.
+pub const LUMINOUS_EFFICACY_LM_PER_W: f64 = 683.002;
+/// Reflectances varying less than this (standard deviation / mean over the grid) are
+/// neutral.
+const NEUTRAL_VARIATION: f64 = 0.1;
+/// The linear output values (0–1 of white) a patch may have to count: tone curves are
+/// nearest linear around the SOS grey (0.18).
+const USABLE_VALUES: (f64, f64) = (0.05, 0.6);
+/// What every absolute number carries.
+pub const APPROXIMATE: &str = "approximate (tens of per cent): from the EXIF exposure by the \
+     ISO 12232 standard output sensitivity, assuming the camera's ISO rating, a linear tone \
+     curve near mid-grey and a lens factor of 0.65; vignetting, exposure correction in the \
+     camera and a chart that is not square to the light change it";
+
+/// The absolute levels of a photo's estimate, or why there are none.
+pub type Absolute = std::result::Result<AbsoluteLevel, String>;
+
+/// The estimate in absolute units.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AbsoluteLevel {
+    /// Illuminance on the chart, lux.
+    pub illuminance_lux: f64,
+    /// Photosynthetic photon flux density (400–700 nm), µmol·m⁻²·s⁻¹.
+    pub ppfd_umol_m2_s: Option<f64>,
+    /// Melanopic equivalent daylight (D65) illuminance, lux (CIE S 026).
+    pub melanopic_edi_lux: Option<f64>,
+    /// The SPD as spectral irradiance on the chart, W·m⁻²·nm⁻¹, on the estimate's
+    /// wavelengths.
+    pub spectral_irradiance_w_m2_nm: Vec<f64>,
+    /// The exposure the numbers rest on.
+    pub exposure: Exposure,
+    /// The neutral feature patches used (1-based feature numbers) and each one's
+    /// illuminance, lux.
+    pub patches: Vec<(usize, f64)>,
+    /// How approximate the numbers are, and why.
+    pub note: &'static str,
+}
+
+/// The absolute levels of the estimate `spd` (on `grid`, any scale) with `metrics`, from the
+/// photo `analysis` of `chart_name`'s feature patches (`clipped`/`dark` per feature patch);
+/// `Ok(None)` with the reason when they cannot be had (no EXIF exposure, chart reflectances
+/// not at hand, no usable neutral patch).
+pub fn absolute_level(
+    analysis: &PhotoAnalysis,
+    chart_name: &str,
+    spd: &[f64],
+    grid: &Grid,
+    metrics: &LightingMetrics,
+    unusable: &[bool],
+    data_dir: &DataDir,
+) -> Result<Absolute> {
+    let Some(exposure) = analysis.exposure else {
+        return Ok(Err(
+            "the photo's EXIF gives no aperture, exposure time and ISO".into(),
+        ));
+    };
+    let Ok(chart) = Chart::resolve(chart_name, None, data_dir, grid) else {
+        return Ok(Err(format!(
+            "the reflectances of {chart_name} are not at hand (the data directory holds them)"
+        )));
+    };
+    let observer = Observer::cie1931(grid)?;
+    let patches = chart.feature_patches.len();
+    if analysis.features.len() != 3 * patches {
+        return Ok(Err(format!(
+            "the photo's features are not those of {chart_name}"
+        )));
+    }
+    let mut found: Vec<(usize, f64)> = (0..patches)
+        .filter(|&k| !unusable.get(k).copied().unwrap_or(false))
+        .filter_map(|k| {
+            let refl = chart.reflectances.item(chart.feature_patches[k]);
+            let mean = refl.iter().sum::<f64>() / refl.len() as f64;
+            let sd =
+                (refl.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / refl.len() as f64).sqrt();
+            if mean <= 0.0 || sd / mean > NEUTRAL_VARIATION {
+                return None;
+            }
+            let rgb = &analysis.features[3 * k..3 * k + 3];
+            let y: f64 = [0.2126, 0.7152, 0.0722]
+                .iter()
+                .zip(rgb)
+                .map(|(w, &v)| w * srgb_decode(f64::from(v) / 255.0))
+                .sum();
+            if !(USABLE_VALUES.0..=USABLE_VALUES.1).contains(&y) {
+                return None;
+            }
+            let factor = observer.reflectance_to_xyz(refl, spd)[1];
+            (factor > 0.0 && factor.is_finite())
+                .then(|| (k + 1, std::f64::consts::PI * exposure.luminance(y) / factor))
+        })
+        .collect();
+    if found.is_empty() {
+        return Ok(Err(format!(
+            "no neutral patch of {chart_name} is rendered between {} and {} of white without clipping",
+            USABLE_VALUES.0, USABLE_VALUES.1
+        )));
+    }
+    let mut values: Vec<f64> = found.iter().map(|p| p.1).collect();
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    let illuminance_lux = if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    };
+    found.sort_by_key(|p| p.0);
+    let luminous: f64 = observer
+        .cmf(1)
+        .iter()
+        .zip(spd)
+        .map(|(v, s)| v * s)
+        .sum::<f64>()
+        * grid.step_nm
+        * LUMINOUS_EFFICACY_LM_PER_W;
+    let scale = illuminance_lux / luminous;
+    Ok(Ok(AbsoluteLevel {
+        illuminance_lux,
+        ppfd_umol_m2_s: metrics.ppf_per_lux.map(|p| p * illuminance_lux),
+        melanopic_edi_lux: metrics.mel_der.map(|m| m * illuminance_lux),
+        spectral_irradiance_w_m2_nm: spd.iter().map(|s| s * scale).collect(),
+        exposure,
+        patches: found,
+        note: APPROXIMATE,
+    }))
+}
