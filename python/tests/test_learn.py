@@ -58,7 +58,7 @@ def test_generate_equals_the_command_line(cli, tmp_path):
     assert all(a[0] < b[0] for a, b in zip(calls, calls[1:]))
 
 
-def test_generate_resumes_and_replaces(data, tmp_path):
+def test_generate_resumes_and_replaces(tmp_path):
     first = spdcam.generate(tmp_path / "set", LIGHTING, 20, fast=True, progress=False)
     again = spdcam.generate(tmp_path / "set", LIGHTING, 20, fast=True, progress=False)
     assert again.to_arrow().equals(first.to_arrow())
@@ -110,7 +110,7 @@ def test_finetune_chooses_the_recipe_by_cross_validation(mlp, tmp_path):
     assert [d for d, _ in calls] == list(range(1, 10)) and {t for _, t in calls} == {9}
 
 
-def test_a_raising_callback_stops_nothing_but_is_raised(data, tmp_path):
+def test_an_exception_of_the_callback_reaches_the_caller(data, tmp_path):
     def boom(done, total):
         raise RuntimeError("stop")
 
