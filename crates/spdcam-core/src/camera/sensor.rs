@@ -17,6 +17,9 @@ pub struct Sensitivities {
     pub curves: SpectralSet,
 }
 
+/// Files skipped as no valid sensitivity set, each with why.
+pub type SkippedFiles = Vec<(PathBuf, Error)>;
+
 /// The range a camera's data must cover: where lights are estimated.
 const REQUIRED_RANGE_NM: (f64, f64) = (400.0, 700.0);
 /// A camera short of the required range is still accepted when its response at the
@@ -43,7 +46,7 @@ impl Sensitivities {
         dir: &Path,
         data_dir: &DataDir,
         grid: &Grid,
-    ) -> Result<(Vec<Sensitivities>, Vec<(PathBuf, Error)>)> {
+    ) -> Result<(Vec<Sensitivities>, SkippedFiles)> {
         let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
             .map_err(|e| Error::io(dir, e))?
             .filter_map(|e| e.ok().map(|e| e.path()))

@@ -7,7 +7,7 @@
 
 use crate::builtin::DataDir;
 use crate::camera::in_camera::InCamera;
-use crate::camera::sensor::Sensitivities;
+use crate::camera::sensor::{Sensitivities, SkippedFiles};
 use crate::camera::{Camera, CameraConfig};
 use crate::chart::Chart;
 use crate::error::{Error, Result};
@@ -332,7 +332,7 @@ impl Default for RandomiseRequest {
 
 /// What [`RandomiseRequest::build`] gives: the randomisation (none when no group is asked
 /// for) and the camera files of the `cameras` directory skipped as invalid, with why.
-pub type BuiltRandomisation = (Option<Randomisation>, Vec<(PathBuf, Error)>);
+pub type BuiltRandomisation = (Option<Randomisation>, SkippedFiles);
 
 impl RandomiseRequest {
     /// The randomisation asked for around the `base` camera: its pool built once (perturbed
