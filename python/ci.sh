@@ -14,8 +14,8 @@ rm -rf "$venv"
 pip=("$venv/bin/python" -m pip install --quiet --disable-pip-version-check)
 "${pip[@]}" pytest numpy colour-science nbclient nbformat ipykernel matplotlib pandas pyarrow
 "${pip[@]}" "$root/python"
-# The command line the tests compare with.
-cargo build --release --quiet --manifest-path "$root/Cargo.toml"
+# The command line the tests compare with (with `train`, for the training tests).
+cargo build --release --quiet --manifest-path "$root/Cargo.toml" --features spdcam/train
 export SPDCAM_BIN="$target/release/spdcam"
 cd "$root"
 "$venv/bin/python" -m pytest python/tests -q -p no:cacheprovider

@@ -36,10 +36,15 @@ __all__ = [
     "estimate_features",
     "Rendering",
     "render",
+    "Dataset",
+    "generate",
+    "train",
+    "finetune",
     "__version__",
 ]
 
 PhotoLike = Union[str, "os.PathLike[str]", bytes, np.ndarray]
+PathLike = Union[str, "os.PathLike[str]"]
 Progress = Callable[[int, int], None]
 
 DEFAULT_RANGE = "400-700:5"
@@ -326,29 +331,27 @@ def _estimate_one(
     range: str,
     source: Optional[str],
 ) -> Estimate:
+    native: _native.PhotoInput
     if isinstance(photo, (bytes, bytearray, memoryview)):
-        text = _native.estimate_encoded(
-            bytes(photo), source or "photo bytes", models, chart, corners, range
-        )
+        name = source or "photo bytes"
+        native = bytes(photo)
     elif isinstance(photo, np.ndarray):
         name = source or "photo array"
         pixels = _pixels(photo, name)
         h, w, _ = pixels.shape
-        bits = 8 if pixels.dtype == np.uint8 else 16
-        text = _native.estimate_pixels(
-            pixels.tobytes(), w, h, bits, name, models, chart, corners, range
-        )
+        native = (pixels.tobytes(), w, h, 8 if pixels.dtype == np.uint8 else 16)
     elif isinstance(photo, (str, os.PathLike)):
-        path = os.fspath(photo)
-        if not os.path.isfile(path):
-            raise FileNotFoundError(f"cannot use photo {path}: no such file")
-        text = _native.estimate_file(path, models, chart, corners, range)
+        name = native = os.fspath(photo)
+        if not os.path.isfile(name):
+            raise FileNotFoundError(f"cannot use photo {name}: no such file")
     else:
         raise TypeError(
             "a photo is a path, the bytes of a JPEG/PNG/TIFF file, or an H×W×3 numpy array; "
             f"got {type(photo).__name__}"
         )
-    return Estimate._from_json(text)
+    return Estimate._from_json(
+        _native.estimate_photo_json(native, name, models, chart, corners, range)
+    )
 
 
 def _corners(corners: Optional[Iterable[Sequence[float]]]) -> Optional[list[tuple[float, float]]]:
@@ -385,32 +388,60 @@ def estimate(
     models = _models(model)
     points = _corners(corners)
     if isinstance(photo, (list, tuple)):
-        report = _progress(progress, len(photo))
+        report = _reporter(progress, False, "spdcam")
         out = []
-        for i, p in enumerate(photo):
-            out.append(_estimate_one(p, models, chart, points, range, source))
-            report(i + 1)
+        try:
+            for i, p in enumerate(photo):
+                out.append(_estimate_one(p, models, chart, points, range, source))
+                if report is not None:
+                    report(i + 1, len(photo))
+        finally:
+            if isinstance(report, _Bar):
+                report.close()
         return out
     return _estimate_one(photo, models, chart, points, range, source)
 
 
-def _progress(progress: Union[bool, Progress, None], total: int) -> Callable[[int], None]:
+class _Bar:
+    """A tqdm bar fed ``(done, total)``, opened at the first report (tqdm is optional)."""
+
+    def __init__(self, tqdm: Any, desc: str) -> None:
+        self._tqdm, self._desc, self._bar = tqdm, desc, None
+
+    def __call__(self, done: int, total: int) -> None:
+        if self._bar is None:
+            self._bar = self._tqdm(total=total, desc=self._desc)
+        self._bar.total = total
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+
+
+def _reporter(progress: Union[bool, Progress, None], default: bool, desc: str) -> Optional[Any]:
+    """The ``(done, total)`` callback ``progress`` asks for: itself when callable, a tqdm
+    bar when ``True`` (or ``None`` with ``default``) and tqdm is installed, else ``None``."""
     if callable(progress):
-        return lambda done: progress(done, total)
-    if progress:
+        return progress
+    if progress or (progress is None and default):
         try:
             from tqdm.auto import tqdm
         except ImportError:
-            return lambda done: None
-        bar = tqdm(total=total, desc="spdcam")
+            return None
+        return _Bar(tqdm, desc)
+    return None
 
-        def step(done: int) -> None:
-            bar.update(done - bar.n)
-            if done == total:
-                bar.close()
 
-        return step
-    return lambda done: None
+def _run(progress: Union[bool, Progress, None], desc: str, work: Callable[[Any], Any]) -> Any:
+    """``work(callback)`` with the callback ``progress`` asks for (a tqdm bar by default);
+    the bar is closed when the work ends."""
+    report = _reporter(progress, True, desc)
+    try:
+        return work(report)
+    finally:
+        if isinstance(report, _Bar):
+            report.close()
 
 
 def estimate_features(
@@ -513,3 +544,179 @@ def render(
         feature_names=list(names),
         features=np.asarray(features, dtype=np.float32),
     )
+
+
+def _optional(module: str, what: str) -> Any:
+    """Imports an optional dependency, or says which package ``what`` needs."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as e:
+        package = module.split(".")[0]
+        raise ImportError(f"{what} needs {package}: pip install {package}") from e
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """A dataset directory as ``spdcam generate`` writes it: ``manifest.json`` (every
+    setting, the columns, the files) and ``samples/part-NNNNN.parquet`` (one row per sample:
+    ``sample``, ``family``, the features ``p01_r…``, the SPD ``spd_380…``, …)."""
+
+    #: The directory.
+    path: str
+
+    @property
+    def manifest(self) -> dict[str, Any]:
+        """The dataset's manifest (``manifest.json``)."""
+        with open(os.path.join(self.path, "manifest.json"), encoding="utf-8") as f:
+            return json.load(f)
+
+    def __len__(self) -> int:
+        return int(self.manifest["samples"])
+
+    def to_arrow(self) -> Any:
+        """The samples as one ``pyarrow.Table``, in sample order (needs pyarrow)."""
+        pq = _optional("pyarrow.parquet", "to_arrow()")
+        pa = _optional("pyarrow", "to_arrow()")
+        files = [os.path.join(self.path, f["name"]) for f in self.manifest["files"]]
+        return pa.concat_tables([pq.read_table(f) for f in files])
+
+    def to_pandas(self) -> Any:
+        """The samples as a pandas DataFrame, in sample order (needs pandas and pyarrow)."""
+        _optional("pandas", "to_pandas()")
+        return self.to_arrow().to_pandas()
+
+
+def generate(
+    output: PathLike,
+    lighting: str,
+    count: int,
+    *,
+    seed: int = 0,
+    chart: str = "colorchecker24",
+    camera: str = "nikon_d5100_npl",
+    spd_grid: str = "380-780:5",
+    fast: bool = False,
+    randomise: Union[str, Sequence[str], None] = None,
+    cameras: Union[str, Sequence[str], None] = None,
+    force: bool = False,
+    progress: Union[bool, Progress, None] = None,
+) -> Dataset:
+    """Generates a dataset of (features, SPD) samples from the virtual camera into the
+    directory ``output``, as ``spdcam generate --lighting LIGHTING --count COUNT --output
+    OUTPUT`` with the same options does: the same library run writes the same files.
+
+    ``lighting`` is a lighting recipe (``spdcam list lighting`` shows the forms); sample
+    ``i`` depends only on ``(seed, i)``. ``chart`` and ``camera`` are built-in names or CSV
+    files (the camera's other settings are the command line's defaults); ``spd_grid`` the
+    wavelengths the SPDs are stored at, ``START-END[:STEP]`` in nm; ``fast`` gives
+    noise-free patch-level features without an image; ``randomise`` the domain
+    randomisation groups (camera, exposure, wb, tone, jpeg, gradient) and ``cameras`` the
+    cameras ``camera`` draws from (a directory or names). An existing run in ``output`` is
+    resumed; ``force`` replaces it. ``progress`` is a callback ``(samples done, total)``;
+    by default a tqdm bar when tqdm is installed, ``False`` for none. The work runs without
+    the GIL. Raises :class:`SpdcamError` with the command line's message on bad input.
+    """
+    groups = [randomise] if isinstance(randomise, str) else list(randomise or [])
+    pool = cameras if cameras is None or isinstance(cameras, str) else ",".join(cameras)
+    path = os.fspath(output)
+    _run(
+        progress,
+        "samples",
+        lambda report: _native.generate(
+            path,
+            lighting,
+            max(int(count), 0),
+            seed=seed,
+            chart=chart,
+            camera=camera,
+            spd_grid=spd_grid,
+            fast=fast,
+            randomise=[g for group in groups for g in group.split(",")],
+            cameras=pool,
+            force=force,
+            progress=report,
+        ),
+    )
+    return Dataset(path)
+
+
+def _dataset_dir(data: Union[Dataset, PathLike]) -> str:
+    return data.path if isinstance(data, Dataset) else os.fspath(data)
+
+
+def train(
+    data: Union[Dataset, PathLike],
+    output: PathLike,
+    model: str = "cnn1d",
+    *,
+    epochs: Optional[int] = None,
+    seed: int = 1,
+    progress: Union[bool, Progress, None] = None,
+) -> Model:
+    """Trains a model on a dataset directory (or :class:`Dataset`) and writes it to
+    ``output`` (``.spdm``), as ``spdcam train --data DATA --model MODEL --output OUTPUT``:
+    ``model`` is ``"cnn1d"`` (the thesis's 1D CNN), ``"mlp"`` (its DNN) or ``"linear"``
+    (ridge regression); the default schedule, ``epochs`` overriding its count; ``seed`` for
+    the split, weights and shuffling. Returns the model loaded from ``output``.
+
+    ``progress`` is a callback ``(epochs done, epochs)``; by default a tqdm bar when tqdm
+    is installed, ``False`` for none. The work runs without the GIL. Raises
+    :class:`SpdcamError` with the command line's message on bad input.
+    """
+    out = os.fspath(output)
+    native = _run(
+        progress,
+        "epochs",
+        lambda report: _native.train(
+            _dataset_dir(data), out, model, epochs=epochs, seed=seed, progress=report
+        ),
+    )
+    return Model(native)
+
+
+def finetune(
+    model: PathLike,
+    data: Union[Dataset, PathLike],
+    output: PathLike,
+    *,
+    epochs: Optional[int] = None,
+    freeze: bool = False,
+    refit_pca: bool = False,
+    keep_output: bool = False,
+    seed: int = 1,
+    progress: Union[bool, Progress, None] = None,
+) -> Model:
+    """Fine-tunes the model file ``model`` on a (small) dataset directory, e.g. features
+    of one's own photos with their measured SPDs (``spdcam dataset import``), and writes
+    ``output``, as ``spdcam finetune --model MODEL --data DATA --output OUTPUT``.
+
+    With none of ``epochs``, ``freeze`` (train only the new output layer), ``refit_pca``
+    (a new PCA on the new data) and ``keep_output`` (keep the trained output layer) the
+    recipe is chosen by cross-validation on the data, the model unchanged among the
+    candidates (at least 4 samples); with any of them, the thesis's transfer learning with
+    those changes. Returns the model loaded from ``output``.
+
+    ``progress`` is a callback ``(done, total)`` counting the cross-validation's fits, or
+    epochs with a recipe given; by default a tqdm bar when tqdm is installed, ``False`` for
+    none. The work runs without the GIL. Raises :class:`SpdcamError` with the command
+    line's message on bad input.
+    """
+    out = os.fspath(output)
+    native = _run(
+        progress,
+        "fine-tuning",
+        lambda report: _native.finetune(
+            os.fspath(model),
+            _dataset_dir(data),
+            out,
+            epochs=epochs,
+            freeze=freeze,
+            refit_pca=refit_pca,
+            keep_output=keep_output,
+            seed=seed,
+            progress=report,
+        ),
+    )
+    return Model(native)

@@ -1,6 +1,9 @@
 """Type stub of the compiled part of spdcam (``spdcam._native``); use the ``spdcam`` API."""
 
-from typing import Optional, Sequence
+from typing import Callable, Optional, Sequence, Union
+
+Progress = Optional[Callable[[int, int], None]]
+"""A callback ``(done, total)``, called with the GIL held while long work runs."""
 
 __version__: str
 
@@ -16,32 +19,19 @@ class Models:
     def load(path: str) -> "Models": ...
     def describe(self) -> list[tuple[str, Optional[str], list[str], str]]: ...
 
-def estimate_file(
-    path: str,
-    models: Models,
-    chart: Optional[str] = None,
-    corners: Optional[Sequence[tuple[float, float]]] = None,
-    range: str = "400-700:5",
-) -> str: ...
-def estimate_encoded(
-    data: bytes,
+PhotoInput = Union[str, bytes, tuple[bytes, int, int, int]]
+"""A photo file's path, an encoded photo's bytes, or ``(pixels, width, height, bits)``."""
+
+def estimate_photo_json(
+    photo: PhotoInput,
     source: str,
     models: Models,
     chart: Optional[str] = None,
     corners: Optional[Sequence[tuple[float, float]]] = None,
     range: str = "400-700:5",
-) -> str: ...
-def estimate_pixels(
-    pixels: bytes,
-    width: int,
-    height: int,
-    bits: int,
-    source: str,
-    models: Models,
-    chart: Optional[str] = None,
-    corners: Optional[Sequence[tuple[float, float]]] = None,
-    range: str = "400-700:5",
-) -> str: ...
+) -> str:
+    """Estimates the light from a photo; the estimate as JSON text."""
+
 def estimate_rows(
     values: bytes,
     rows: int,
@@ -62,3 +52,41 @@ def render(
     patch_px: int = 24,
     seed: int = 0,
 ) -> tuple[int, int, bytes, list[str], list[float]]: ...
+def generate(
+    output: str,
+    lighting: str,
+    count: int,
+    seed: int = 0,
+    chart: str = "colorchecker24",
+    camera: str = "nikon_d5100_npl",
+    spd_grid: str = "380-780:5",
+    fast: bool = False,
+    randomise: Sequence[str] = ...,
+    cameras: Optional[str] = None,
+    force: bool = False,
+    progress: Progress = None,
+) -> int:
+    """Generates a dataset into ``output`` as ``spdcam generate``; the samples it holds."""
+
+def train(
+    data: str,
+    output: str,
+    model: str = "cnn1d",
+    epochs: Optional[int] = None,
+    seed: int = 1,
+    progress: Progress = None,
+) -> Models:
+    """Trains a model on a dataset as ``spdcam train``; the model written to ``output``."""
+
+def finetune(
+    model: str,
+    data: str,
+    output: str,
+    epochs: Optional[int] = None,
+    freeze: bool = False,
+    refit_pca: bool = False,
+    keep_output: bool = False,
+    seed: int = 1,
+    progress: Progress = None,
+) -> Models:
+    """Fine-tunes a model file on a dataset as ``spdcam finetune``; the model written."""

@@ -1,25 +1,36 @@
 //! `spdcam._native`: the Python binding of spdcam's libraries. Thin on purpose: every step
-//! is a library call (`spdcam_infer`, `spdcam_core`); this module only converts Python
-//! values, releases the GIL for the work, and turns errors into `spdcam.SpdcamError` with
-//! the command line's messages. The typed API is the Python package `spdcam` around it.
+//! is a library call (`spdcam_infer`, `spdcam_core`, `spdcam_learn`); this module only
+//! converts Python values, releases the GIL for the work, reports progress to a Python
+//! callback, and turns errors into `spdcam.SpdcamError` with the command line's messages.
+//! The typed API is the Python package `spdcam` around it.
 
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
-use spdcam_core::chart::{Chart, Layout};
-use spdcam_core::light;
+use spdcam_core::chart::{Chart, Layout, THESIS_PATCH_PX};
+use spdcam_core::dataset::randomise::RandomiseRequest;
+use spdcam_core::dataset::{GenerateEvent, GenerateOptions, GenerateRequest, Pipeline};
 use spdcam_core::photo::{decode_photo, load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
+use spdcam_core::{fsio, light};
 use spdcam_infer::estimate::estimate_decoded;
 use spdcam_infer::{
     estimate_features, estimate_photo, Estimate, FeatureRows, Model, ModelSet, PhotoOptions,
 };
-use std::path::PathBuf;
+use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
+use spdcam_learn::pca::Components;
+use spdcam_learn::recipe;
+use spdcam_learn::target::TargetKind;
+use spdcam_learn::train::{
+    add_photo_chart, Backend, FinetuneOptions, Progress, Schedule, TrainOptions, TrainingSet,
+};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::Instant;
 
 create_exception!(
@@ -76,48 +87,32 @@ impl Models {
     }
 }
 
-/// The library's photo options from the Python arguments.
-fn photo_options(chart: Option<String>, corners: Option<Vec<[f64; 2]>>) -> PhotoOptions {
-    PhotoOptions {
-        chart,
-        corners,
-        debug: None,
-    }
-}
-
 /// An estimate as the JSON text of `Estimate::to_json`.
 fn estimate_json(estimate: &Estimate) -> PyResult<String> {
     let value = estimate.to_json().map_err(py_err)?;
     serde_json::to_string(&value).map_err(py_err)
 }
 
-/// Estimates the light from the photo file at `path`; the result as JSON text.
-#[pyfunction]
-#[pyo3(signature = (path, models, chart=None, corners=None, range="400-700:5"))]
-fn estimate_file(
-    py: Python<'_>,
-    path: PathBuf,
-    models: &Models,
-    chart: Option<String>,
-    corners: Option<Vec<[f64; 2]>>,
-    range: &str,
-) -> PyResult<String> {
-    let grid = Grid::parse(range).map_err(py_err)?;
-    let options = photo_options(chart, corners);
-    py.allow_threads(|| {
-        estimate_photo(&path, &models.set, &options, &DataDir::new(None), &grid)
-            .map_err(|e| format!("cannot use photo {}: {e}", path.display()))
-    })
-    .map_err(SpdcamError::new_err)
-    .and_then(|e| estimate_json(&e))
+/// A photo as Python hands it over.
+#[derive(FromPyObject)]
+enum PhotoInput<'py> {
+    /// An encoded photo file's bytes (JPEG, PNG, TIFF).
+    Encoded(Bound<'py, PyBytes>),
+    /// Interleaved RGB pixels (`height × width × 3`, encoded sRGB) as native-endian bytes of
+    /// `u8` values, or of `u16` values when `bits` is 16: `(pixels, width, height, bits)`.
+    Pixels(Bound<'py, PyBytes>, usize, usize, u32),
+    /// A photo file.
+    Path(PathBuf),
 }
 
-/// Estimates the light from an encoded photo (JPEG, PNG, TIFF bytes) named `source`.
+/// Estimates the light from a photo: a file path, an encoded photo's bytes, or a tuple
+/// `(pixels, width, height, bits)` of RGB pixels; `source` names in-memory photos in
+/// messages. The result as JSON text.
 #[pyfunction]
-#[pyo3(signature = (data, source, models, chart=None, corners=None, range="400-700:5"))]
-fn estimate_encoded(
+#[pyo3(signature = (photo, source, models, chart=None, corners=None, range="400-700:5"))]
+fn estimate_photo_json(
     py: Python<'_>,
-    data: &[u8],
+    photo: PhotoInput<'_>,
     source: &str,
     models: &Models,
     chart: Option<String>,
@@ -125,49 +120,41 @@ fn estimate_encoded(
     range: &str,
 ) -> PyResult<String> {
     let grid = Grid::parse(range).map_err(py_err)?;
-    let options = photo_options(chart, corners);
-    let estimate = py
-        .allow_threads(|| {
-            let photo = decode_photo(data, source)?;
-            estimate_decoded(&photo, &models.set, &options, &DataDir::new(None), &grid)
-        })
-        .map_err(py_err)?;
-    estimate_json(&estimate)
-}
-
-/// Estimates the light from interleaved RGB pixels (`height × width × 3`, encoded sRGB) as
-/// native-endian bytes of `u8` values, or of `u16` values when `bits` is 16.
-#[pyfunction]
-#[pyo3(signature = (pixels, width, height, bits, source, models, chart=None, corners=None, range="400-700:5"))]
-#[allow(clippy::too_many_arguments)]
-fn estimate_pixels(
-    py: Python<'_>,
-    pixels: &[u8],
-    width: usize,
-    height: usize,
-    bits: u32,
-    source: &str,
-    models: &Models,
-    chart: Option<String>,
-    corners: Option<Vec<[f64; 2]>>,
-    range: &str,
-) -> PyResult<String> {
-    let grid = Grid::parse(range).map_err(py_err)?;
-    let options = photo_options(chart, corners);
-    let estimate = py
-        .allow_threads(|| {
-            let photo = if bits == 16 {
-                let values = pixels
-                    .chunks_exact(2)
-                    .map(|c| u16::from_ne_bytes([c[0], c[1]]))
-                    .collect();
-                Photo::from_rgb16(source, width, height, values)?
-            } else {
-                Photo::from_rgb8(source, width, height, pixels.to_vec())?
-            };
-            estimate_decoded(&photo, &models.set, &options, &DataDir::new(None), &grid)
-        })
-        .map_err(py_err)?;
+    let options = PhotoOptions {
+        chart,
+        corners,
+        debug: None,
+    };
+    let data_dir = DataDir::new(None);
+    let estimate = match photo {
+        PhotoInput::Path(path) => py
+            .allow_threads(|| estimate_photo(&path, &models.set, &options, &data_dir, &grid))
+            .map_err(|e| py_err(format!("cannot use photo {}: {e}", path.display())))?,
+        PhotoInput::Encoded(data) => {
+            let data = data.as_bytes();
+            py.allow_threads(|| {
+                let photo = decode_photo(data, source)?;
+                estimate_decoded(&photo, &models.set, &options, &data_dir, &grid)
+            })
+            .map_err(py_err)?
+        }
+        PhotoInput::Pixels(pixels, width, height, bits) => {
+            let pixels = pixels.as_bytes();
+            py.allow_threads(|| {
+                let photo = if bits == 16 {
+                    let values = pixels
+                        .chunks_exact(2)
+                        .map(|c| u16::from_ne_bytes([c[0], c[1]]))
+                        .collect();
+                    Photo::from_rgb16(source, width, height, values)?
+                } else {
+                    Photo::from_rgb8(source, width, height, pixels.to_vec())?
+                };
+                estimate_decoded(&photo, &models.set, &options, &data_dir, &grid)
+            })
+            .map_err(py_err)?
+        }
+    };
     estimate_json(&estimate)
 }
 
@@ -215,17 +202,9 @@ fn estimate_rows<'py>(
     range: &str,
 ) -> PyResult<RowsResult<'py>> {
     let grid = Grid::parse(range).map_err(py_err)?;
-    let values = f64_values(values);
-    let columns = if rows == 0 { 0 } else { values.len() / rows };
-    let names = match names {
-        Some(n) => n,
-        None => default_names(&models.set, columns, source)?,
-    };
+    let features = feature_rows(values, rows, &models.set, names, source)?;
     let estimates = py
-        .allow_threads(|| {
-            let features = FeatureRows::from_values(names, values, source)?;
-            estimate_features(&models.set, &features, source, &grid)
-        })
+        .allow_threads(|| estimate_features(&models.set, &features, source, &grid))
         .map_err(py_err)?;
     let model = estimates
         .first()
@@ -246,6 +225,23 @@ fn estimate_rows<'py>(
             estimates.iter().map(|e| e.colorimetry.duv.unwrap_or(nan)),
         ),
     ))
+}
+
+/// Feature rows from `values` (native-endian `f64` bytes of `rows` rows), one column per
+/// name of `names` (default: the columns of the model that reads that many).
+fn feature_rows(
+    values: &[u8],
+    rows: usize,
+    models: &ModelSet,
+    names: Option<Vec<String>>,
+    source: &str,
+) -> PyResult<FeatureRows> {
+    let values = f64_values(values);
+    let names = match names {
+        Some(n) => n,
+        None => default_names(models, values.len() / rows.max(1), source)?,
+    };
+    FeatureRows::from_values(names, values, source).map_err(py_err)
 }
 
 /// The feature names of the model that reads `columns` columns.
@@ -292,6 +288,19 @@ fn read_photo(py: Python<'_>, path: PathBuf) -> PyResult<(usize, usize, u32, Bou
     ))
 }
 
+/// The chart `name` laid out as `spdcam render` and `spdcam generate` lay it out by
+/// default: a grid of `patch_px` patches without gaps or border.
+fn grid_chart(
+    name: &str,
+    patch_px: usize,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> spdcam_core::Result<Chart> {
+    let chart = Chart::resolve(name, None, data_dir, grid)?;
+    let layout = Layout::grid(chart.layout.rows, chart.layout.cols, patch_px, 0, 0);
+    chart.with_layout(layout)
+}
+
 /// What `render` returns: width, height, the image as native-endian `f32` bytes (encoded
 /// sRGB 0–1, interleaved RGB), the feature names, and the features (mean sRGB 0–255).
 type RenderResult<'py> = (usize, usize, Bound<'py, PyBytes>, Vec<String>, Vec<f32>);
@@ -326,17 +335,8 @@ fn render<'py>(
                 }
                 _ => light::resolve_spd(spd, &data_dir, &grid)?.values,
             };
-            let chart = Chart::resolve(chart, None, &data_dir, &grid)?;
-            let layout = Layout::grid(chart.layout.rows, chart.layout.cols, patch_px, 0, 0);
-            let chart = chart.with_layout(layout)?;
-            let (name, measured) = builtin::resolve_table(
-                camera,
-                "camera",
-                builtin::CAMERAS,
-                &data_dir,
-                &["cameras", "thesis"],
-            )?;
-            let sensitivities = Sensitivities::new(&name, &measured, &grid)?;
+            let chart = grid_chart(chart, patch_px, &data_dir, &grid)?;
+            let sensitivities = Sensitivities::resolve(camera, &data_dir, &grid)?;
             let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid)?;
             let rendering = camera.render(&light, seed, false)?;
             Ok((rendering, camera.chart().feature_names()))
@@ -356,6 +356,253 @@ fn render<'py>(
         names,
         rendering.features,
     ))
+}
+
+/// Progress of long work for a Python callback `(done, total)`, called with the GIL taken
+/// and with counts that only grow; the first exception the callback raises is kept and
+/// raised by [`Reporter::finish`] once the work is over.
+struct Reporter {
+    callback: Option<Py<PyAny>>,
+    state: Mutex<Reported>,
+}
+
+/// What a [`Reporter`] has reported.
+#[derive(Default)]
+struct Reported {
+    done: u64,
+    total: u64,
+    error: Option<PyErr>,
+}
+
+impl Reporter {
+    fn new(callback: Option<Py<PyAny>>) -> Reporter {
+        Reporter {
+            callback,
+            state: Mutex::new(Reported::default()),
+        }
+    }
+
+    /// Calls the callback with `done` (when more than before) of `total`.
+    fn report(&self, done: impl FnOnce(u64) -> u64, total: Option<u64>) {
+        let Some(callback) = &self.callback else {
+            return;
+        };
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(total) = total {
+            state.total = total;
+        }
+        let done = done(state.done).min(state.total);
+        if done <= state.done || state.error.is_some() {
+            return;
+        }
+        state.done = done;
+        let total = state.total;
+        if let Err(e) = Python::with_gil(|py| callback.call1(py, (done, total))) {
+            state.error = Some(e);
+        }
+    }
+
+    /// Reports `done` of `total`.
+    fn at(&self, done: u64, total: u64) {
+        self.report(|_| done, Some(total));
+    }
+
+    /// Reports `n` more done.
+    fn add(&self, n: u64) {
+        self.report(|done| done + n, None);
+    }
+
+    /// Reports the work complete; the callback's first exception, if it raised one.
+    fn finish(self) -> PyResult<()> {
+        self.report(|_| u64::MAX, None);
+        let state = self.state.into_inner().unwrap_or_else(|e| e.into_inner());
+        state.error.map_or(Ok(()), Err)
+    }
+}
+
+/// Generates a dataset into `output` as `spdcam generate` does with the default camera
+/// settings (same library run, same files): `count` samples under the `lighting` recipe,
+/// sample `i` depending only on `(seed, i)`. Returns the samples the directory holds.
+#[pyfunction]
+#[pyo3(signature = (output, lighting, count, seed=0, chart="colorchecker24", camera="nikon_d5100_npl", spd_grid="380-780:5", fast=false, randomise=Vec::new(), cameras=None, force=false, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn generate(
+    py: Python<'_>,
+    output: PathBuf,
+    lighting: String,
+    count: u64,
+    seed: u64,
+    chart: &str,
+    camera: &str,
+    spd_grid: &str,
+    fast: bool,
+    randomise: Vec<String>,
+    cameras: Option<String>,
+    force: bool,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<u64> {
+    let reporter = Reporter::new(progress);
+    let manifest = py
+        .allow_threads(|| -> spdcam_core::Result<_> {
+            let grid = Grid::SIMULATION;
+            let data_dir = DataDir::new(None);
+            let request = GenerateRequest {
+                lighting,
+                camera: camera.to_string(),
+                chart: grid_chart(chart, THESIS_PATCH_PX, &data_dir, &grid)?,
+                config: CameraConfig::default(),
+                randomise: RandomiseRequest {
+                    groups: randomise,
+                    cameras,
+                    ..RandomiseRequest::default()
+                },
+                options: GenerateOptions {
+                    pipeline: if fast { Pipeline::Fast } else { Pipeline::Full },
+                    spd_grid: Grid::parse(spd_grid)?,
+                    ..GenerateOptions::new(count, seed)
+                },
+            };
+            request.run(
+                &output,
+                force,
+                &data_dir,
+                &mut |event| {
+                    if let GenerateEvent::Planned(plan) = event {
+                        reporter.at(0, plan.total() - plan.done());
+                    }
+                },
+                &|n| reporter.add(n),
+            )
+        })
+        .map_err(py_err)?;
+    reporter.finish()?;
+    Ok(manifest.samples)
+}
+
+/// The thesis's architecture `spdcam train --model` names: cnn1d, mlp or linear.
+fn architecture(model: &str) -> PyResult<Architecture> {
+    match model {
+        "cnn1d" => Ok(Architecture::Cnn1d(CnnSpec::thesis())),
+        "mlp" => Ok(Architecture::Mlp(MlpSpec::thesis())),
+        "linear" => Ok(Architecture::Linear { ridge: 0.0 }),
+        other => Err(SpdcamError::new_err(format!(
+            "unknown model '{other}'; valid: cnn1d, mlp, linear"
+        ))),
+    }
+}
+
+/// Saves `model` at `path` and loads it back as a model set named by the path.
+fn saved(model: &Model, path: &Path) -> Result<ModelSet, spdcam_learn::LearnError> {
+    model.save(path)?;
+    Ok(ModelSet::single(
+        Model::load(path)?,
+        path.display().to_string(),
+    ))
+}
+
+/// A training loop's progress as epochs done of `epochs`.
+fn epoch_progress(reporter: &Reporter, epochs: usize) -> impl FnMut(Progress) + '_ {
+    reporter.at(0, epochs as u64);
+    move |p| {
+        if let Progress::Epoch(r) = p {
+            reporter.at(r.epoch as u64, epochs as u64);
+        }
+    }
+}
+
+/// Trains a model on the dataset in `data` as `spdcam train --data DATA --model MODEL
+/// --output OUTPUT` does (the default preset, PCA target of 99 % variance, 400–700:5 nm,
+/// a tenth held out for validation), `epochs` overriding the preset's; writes the model
+/// file and returns it loaded from there.
+#[pyfunction]
+#[pyo3(signature = (data, output, model="cnn1d", epochs=None, seed=1, progress=None))]
+fn train(
+    py: Python<'_>,
+    data: PathBuf,
+    output: PathBuf,
+    model: &str,
+    epochs: Option<usize>,
+    seed: u64,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Models> {
+    let architecture = architecture(model)?;
+    let reporter = Reporter::new(progress);
+    let set = py
+        .allow_threads(|| -> Result<_, spdcam_learn::LearnError> {
+            fsio::check_writable(&output)?;
+            let set = TrainingSet::load(&data)?;
+            let mut schedule = Schedule::default_for(&architecture);
+            schedule.epochs = epochs.unwrap_or(schedule.epochs);
+            let options = TrainOptions {
+                target: TargetKind::Pca(Components::Variance(0.99)),
+                grid: Grid::parse("400-700:5")?,
+                schedule,
+                seed,
+                val_split: 0.1,
+                backend: Backend::Cpu,
+                architecture,
+            };
+            let mut on_epoch = epoch_progress(&reporter, options.schedule.epochs);
+            let mut model = spdcam_learn::train::train(&set, None, &options, &mut on_epoch)?.model;
+            add_photo_chart(&mut model, &DataDir::new(None))?;
+            saved(&model, &output)
+        })
+        .map_err(py_err)?;
+    reporter.finish()?;
+    Ok(Models { set })
+}
+
+/// Fine-tunes the model file `model` on the dataset in `data` as `spdcam finetune` does:
+/// with none of `epochs`, `freeze`, `refit_pca` and `keep_output` the recipe is chosen by
+/// cross-validation on the data (progress counts the fits), else the thesis's recipe with
+/// those changes (progress counts epochs). Writes `output` and returns it loaded.
+#[pyfunction]
+#[pyo3(signature = (model, data, output, epochs=None, freeze=false, refit_pca=false, keep_output=false, seed=1, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn finetune(
+    py: Python<'_>,
+    model: PathBuf,
+    data: PathBuf,
+    output: PathBuf,
+    epochs: Option<usize>,
+    freeze: bool,
+    refit_pca: bool,
+    keep_output: bool,
+    seed: u64,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Models> {
+    let reporter = Reporter::new(progress);
+    let set = py
+        .allow_threads(|| -> Result<_, spdcam_learn::LearnError> {
+            fsio::check_writable(&output)?;
+            let pretrained = Model::load(&model)?;
+            let set = TrainingSet::load(&data)?;
+            let tuned = if freeze || refit_pca || keep_output || epochs.is_some() {
+                let base = FinetuneOptions::thesis();
+                let options = FinetuneOptions {
+                    schedule: Schedule {
+                        epochs: epochs.unwrap_or(base.schedule.epochs),
+                        ..base.schedule
+                    },
+                    freeze_features: freeze,
+                    refit_pca,
+                    keep_output,
+                    seed,
+                    val_split: 0.1,
+                    backend: Backend::Cpu,
+                };
+                let mut on_epoch = epoch_progress(&reporter, options.schedule.epochs);
+                spdcam_learn::train::finetune(&pretrained, &set, None, &options, &mut on_epoch)?
+                    .model
+            } else {
+                let mut on_fit = |done: usize, all: usize| reporter.at(done as u64, all as u64);
+                recipe::tune(&pretrained, &set, seed, Backend::Cpu, &mut on_fit)?.model
+            };
+            saved(&tuned, &output)
+        })
+        .map_err(py_err)?;
+    reporter.finish()?;
+    Ok(Models { set })
 }
 
 /// Seconds the library alone takes for `repeats` estimates from the photo file at `path`
@@ -391,9 +638,7 @@ fn library_seconds_rows(
     repeats: usize,
 ) -> PyResult<f64> {
     let grid = Grid::parse("400-700:5").map_err(py_err)?;
-    let values = f64_values(values);
-    let names = default_names(&models.set, values.len() / rows.max(1), "features")?;
-    let features = FeatureRows::from_values(names, values, "features").map_err(py_err)?;
+    let features = feature_rows(values, rows, &models.set, None, "features")?;
     py.allow_threads(|| {
         let start = Instant::now();
         for _ in 0..repeats {
@@ -410,12 +655,13 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SpdcamError", m.py().get_type::<SpdcamError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<Models>()?;
-    m.add_function(wrap_pyfunction!(estimate_file, m)?)?;
-    m.add_function(wrap_pyfunction!(estimate_encoded, m)?)?;
-    m.add_function(wrap_pyfunction!(estimate_pixels, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate_photo_json, m)?)?;
     m.add_function(wrap_pyfunction!(estimate_rows, m)?)?;
     m.add_function(wrap_pyfunction!(read_photo, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(generate, m)?)?;
+    m.add_function(wrap_pyfunction!(train, m)?)?;
+    m.add_function(wrap_pyfunction!(finetune, m)?)?;
     m.add_function(wrap_pyfunction!(library_seconds_photo, m)?)?;
     m.add_function(wrap_pyfunction!(library_seconds_rows, m)?)?;
     Ok(())

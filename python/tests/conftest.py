@@ -19,10 +19,15 @@ def example() -> Path:
 
 @pytest.fixture(scope="session")
 def cli():
-    """Runs the `spdcam` command line (``$SPDCAM_BIN``, else ``cargo run --release``) in the
-    repository root without a data directory; returns the finished process."""
+    """Runs the `spdcam` command line (``$SPDCAM_BIN``, else ``cargo run --release`` with
+    the ``train`` feature) in the repository root without a data directory; returns the
+    finished process."""
     command = os.environ.get("SPDCAM_BIN")
-    base = shlex.split(command) if command else ["cargo", "run", "--release", "-q", "-p", "spdcam", "--"]
+    base = (
+        shlex.split(command)
+        if command
+        else ["cargo", "run", "--release", "-q", "-p", "spdcam", "--features", "train", "--"]
+    )
     env = {k: v for k, v in os.environ.items() if k != "SPDCAM_DATA"}
 
     def run(*args: str) -> subprocess.CompletedProcess:

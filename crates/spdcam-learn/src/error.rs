@@ -11,6 +11,17 @@ pub enum LearnError {
     /// An error of the inference crate (model files, scalings, targets).
     #[error(transparent)]
     Infer(#[from] spdcam_infer::InferError),
+    /// A dataset directory could not be opened or read (`action`: "opening", "reading").
+    #[error("{action} dataset {}: {source}", path.display())]
+    Dataset {
+        /// What failed.
+        action: &'static str,
+        /// The dataset directory.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: spdcam_core::Error,
+    },
     /// A setting or an input is out of range or inconsistent with another one.
     #[error("{0}")]
     Invalid(String),

@@ -107,12 +107,14 @@ fn subset(set: &TrainingSet, rows: &[usize]) -> Result<TrainingSet> {
 
 /// Scores every recipe of [`candidates`] on `data` by k-fold cross-validation (photo `i` in
 /// fold `i mod k`) and returns them best first. With too few photos to hold any back, the
-/// error says how many are needed.
+/// error says how many are needed. `progress` is told (fits done, fits in all) after each
+/// candidate of each fold.
 pub fn choose(
     model: &Model,
     data: &TrainingSet,
     seed: u64,
     backend: Backend,
+    progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<Scored>> {
     let n = data.samples.len();
     if n < MIN_SAMPLES {
@@ -123,6 +125,7 @@ pub fn choose(
     }
     let folds = FOLDS.min(n / 2);
     let mut sums = vec![0.0; candidates(n, seed, backend).len()];
+    let fits = folds * sums.len();
     for f in 0..folds {
         let (test, train): (Vec<usize>, Vec<usize>) = (0..n).partition(|i| i % folds == f);
         let test_set = subset(data, &test)?;
@@ -139,6 +142,7 @@ pub fn choose(
                 }
             };
             sums[k] += scored.per_sample.iter().map(|m| m.gfc).sum::<f64>();
+            progress(f * sums.len() + k + 1, fits);
         }
     }
     let mut scored: Vec<Scored> = candidates(n, seed, backend)
@@ -152,4 +156,39 @@ pub fn choose(
     // Best first; a tie keeps the simpler (earlier) recipe.
     scored.sort_by(|a, b| b.cv_gfc.total_cmp(&a.cv_gfc));
     Ok(scored)
+}
+
+/// What [`tune`] gives: every recipe scored, best first, and the model the best one made.
+#[derive(Debug, Clone)]
+pub struct Tuned {
+    /// The recipes with their cross-validated scores, best first.
+    pub scored: Vec<Scored>,
+    /// The model the best recipe gives, trained on all of the data.
+    pub model: Model,
+}
+
+/// Chooses the recipe by cross-validation on `data` ([`choose`]) and runs the best one on
+/// all of `data` (which also validates: too few samples to hold some back). `progress` is
+/// told (fits done, fits in all), the last fit being the chosen recipe's.
+pub fn tune(
+    model: &Model,
+    data: &TrainingSet,
+    seed: u64,
+    backend: Backend,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Tuned> {
+    let mut all = 0;
+    let scored = choose(model, data, seed, backend, &mut |done, fits| {
+        all = fits + 1;
+        progress(done, all);
+    })?;
+    let chosen = match &scored[0].recipe.options {
+        None => model.clone(),
+        Some(options) => finetune(model, data, Some(data), options, &mut |_| {})?.model,
+    };
+    progress(all, all);
+    Ok(Tuned {
+        scored,
+        model: chosen,
+    })
 }

@@ -17,10 +17,13 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use spdcam_core::dataset::{Columns, SampleBatch};
+use spdcam_core::builtin::DataDir;
+use spdcam_core::dataset::{Columns, Dataset, SampleBatch};
+use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::Grid;
 pub use spdcam_infer::record::{Backend, Schedule, TrainOptions};
 use std::ops::Range;
+use std::path::Path;
 use std::time::Instant;
 
 /// The burn device of `backend`, with autodiff; an error when this build lacks the backend.
@@ -51,6 +54,41 @@ pub struct TrainingSet {
     pub columns: Columns,
     /// Where they came from.
     pub info: DataInfo,
+}
+
+impl TrainingSet {
+    /// Reads the dataset directory `dir` (from `spdcam generate` or `spdcam dataset
+    /// import`) into memory.
+    pub fn load(dir: &Path) -> Result<TrainingSet> {
+        let failed = |action| {
+            move |source| LearnError::Dataset {
+                action,
+                path: dir.to_path_buf(),
+                source,
+            }
+        };
+        let dataset = Dataset::open(dir).map_err(failed("opening"))?;
+        let samples = dataset.load().map_err(failed("reading"))?;
+        Ok(TrainingSet {
+            samples,
+            columns: dataset.columns().clone(),
+            info: DataInfo::from_dataset(&dataset, &dir.display().to_string()),
+        })
+    }
+}
+
+/// Records in `model` the template of the chart it was trained on, so that it estimates
+/// from photos of that chart on its own; nothing for a chart no photo shows.
+pub fn add_photo_chart(model: &mut Model, data_dir: &DataDir) -> Result<()> {
+    let template = model
+        .header()
+        .chart
+        .as_deref()
+        .and_then(|chart| ChartTemplate::for_chart(chart, data_dir, &Grid::SIMULATION));
+    if let Some(template) = template {
+        model.set_photo_chart(template)?;
+    }
+    Ok(())
 }
 
 /// One epoch of a training log.

@@ -5,7 +5,7 @@
 use crate::render::CameraArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::Camera;
@@ -101,35 +101,20 @@ pub fn read_measured(features: &Path, spds: &Path, grid: &Grid) -> Result<Measur
     })
 }
 
-/// Measured sensitivities by name (built-in, data directory `cameras/` or `thesis/`, or file).
-pub fn sensitivities(name: &str, data_dir: &DataDir, grid: &Grid) -> Result<Sensitivities> {
-    let (name, measured) = builtin::resolve_table(
-        name,
-        "camera",
-        builtin::CAMERAS,
-        data_dir,
-        &["cameras", "thesis"],
-    )?;
-    Ok(Sensitivities::new(&name, &measured, grid)?)
-}
-
 /// Every camera sensitivity CSV in `dir`, sorted by file name; a file that is not a valid
 /// sensitivity set is skipped with a warning naming it and why.
 pub fn sensitivities_in(dir: &Path, data_dir: &DataDir, grid: &Grid) -> Result<Vec<Sensitivities>> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .with_context(|| format!("reading {}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-        .collect();
-    files.sort();
-    let mut sens = Vec::with_capacity(files.len());
-    for f in files {
-        match sensitivities(&f.to_string_lossy(), data_dir, grid) {
-            Ok(s) => sens.push(s),
-            Err(e) => eprintln!("warning: skipping camera {}: {e:#}", f.display()),
-        }
+    let (found, skipped) = Sensitivities::in_dir(dir, data_dir, grid)
+        .with_context(|| format!("reading {}", dir.display()))?;
+    for (f, e) in skipped {
+        warn_skipped(&f, &e);
     }
-    Ok(sens)
+    Ok(found)
+}
+
+/// The warning for a camera file skipped as no valid sensitivity set.
+pub fn warn_skipped(path: &Path, error: &spdcam_core::Error) {
+    eprintln!("warning: skipping camera {}: {error}", path.display());
 }
 
 /// The photos `indices` of a measured set as calibration photos.
@@ -160,7 +145,7 @@ pub fn read_in_camera(path: &Path) -> Result<InCamera> {
 pub fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
     let grid = Grid::SIMULATION;
     let chart: Chart = args.camera.chart(data_dir, &grid)?;
-    let sens = sensitivities(&args.camera.camera, data_dir, &grid)?;
+    let sens = Sensitivities::resolve(&args.camera.camera, data_dir, &grid)?;
     let camera = Camera::new(&sens, chart, args.camera.config()?, &grid)?;
     let measured = read_measured(&args.features, &args.spds, &grid)?;
     if args.photos == 0 {

@@ -1,9 +1,9 @@
 //! `spdcam evaluate`: score a model on a dataset and write a report directory.
 
-use crate::train::load_set;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::fsio::write_atomic;
@@ -162,7 +162,7 @@ fn worst_case_image(model: &Model, e: &Evaluation, data_dir: &DataDir) -> Result
         ..CameraConfig::default()
     };
     let camera = Camera::new(
-        &crate::calibrate::sensitivities(camera, data_dir, &grid)?,
+        &Sensitivities::resolve(camera, data_dir, &grid)?,
         chart,
         config,
         &grid,
@@ -197,7 +197,7 @@ fn worst_case_image(model: &Model, e: &Evaluation, data_dir: &DataDir) -> Result
 pub fn run(args: EvaluateArgs, data_dir: &DataDir) -> Result<()> {
     check_report_dir(&args.output, args.force)?;
     let model = Model::load(&args.model)?;
-    let set = load_set(&args.data)?;
+    let set = TrainingSet::load(&args.data)?;
     let e = evaluate(&model, &set)?;
     write_report(
         &args.output,

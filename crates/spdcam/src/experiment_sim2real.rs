@@ -3,13 +3,14 @@
 //! on or off, and scored (mean GFC) on the real measured sets; steps that use real photos
 //! (calibration) are cross-validated: calibrated on a few photos outside the test fold.
 
-use crate::calibrate::{photos, read_measured, sensitivities, sensitivities_in, Measured};
+use crate::calibrate::{photos, read_measured, sensitivities_in, Measured};
 use crate::ridge::Ridge;
 use crate::sim2real_curve::{learning_curve, CurveOptions};
 use anyhow::{Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::in_camera::{calibrate, InCamera};
+use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
@@ -170,7 +171,7 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
             ..config
         };
         Ok(Camera::new(
-            &sensitivities(cam, data_dir, &GRID)?,
+            &Sensitivities::resolve(cam, data_dir, &GRID)?,
             chart,
             config,
             &GRID,
@@ -185,7 +186,7 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
         Some(dir) => sensitivities_in(&dir, data_dir, &GRID)?,
         None => Vec::new(),
     };
-    sens.push(sensitivities(plain_cam, data_dir, &GRID)?);
+    sens.push(Sensitivities::resolve(plain_cam, data_dir, &GRID)?);
     let pool = camera_pool(&sens, 1, 11, &chart, config, &GRID)?;
     let pool_size = pool.len();
     let randomised = Randomisation::new(

@@ -3,7 +3,7 @@
 //! With no recipe flags, the recipe is chosen by cross-validation on the data given
 //! (`spdcam_learn::recipe`), the model left unchanged among the candidates.
 
-use crate::train::{load_set, reporter, sibling, write_log, ScheduleArgs};
+use crate::train::{reporter, sibling, write_log, ScheduleArgs};
 use anyhow::Result;
 use clap::Args;
 use spdcam_core::fsio;
@@ -56,11 +56,16 @@ impl FinetuneArgs {
 pub fn run(args: FinetuneArgs) -> Result<()> {
     fsio::check_writable(&args.output)?;
     let model = Model::load(&args.model)?;
-    let data = load_set(&args.data)?;
+    let data = TrainingSet::load(&args.data)?;
     if !args.recipe_given() {
         return run_chosen(&args, &model, &data);
     }
-    let val = args.schedule.val.as_deref().map(load_set).transpose()?;
+    let val = args
+        .schedule
+        .val
+        .as_deref()
+        .map(TrainingSet::load)
+        .transpose()?;
     let base = FinetuneOptions::thesis();
     let options = FinetuneOptions {
         schedule: args.schedule.apply(base.schedule),
@@ -115,19 +120,16 @@ fn run_chosen(args: &FinetuneArgs, model: &Model, data: &TrainingSet) -> Result<
         args.data.display(),
         data.samples.len()
     );
-    let scored = recipe::choose(model, data, args.schedule.seed, backend)?;
-    for s in &scored {
+    let tuned = recipe::tune(model, data, args.schedule.seed, backend, &mut |_, _| {})?;
+    let scored = &tuned.scored;
+    for s in scored {
         println!(
             "  {:<36} cross-validated GFC {:.5}",
             s.recipe.name, s.cv_gfc
         );
     }
     let best = &scored[0];
-    let chosen = match &best.recipe.options {
-        None => model.clone(),
-        Some(options) => finetune(model, data, Some(data), options, &mut |_| {})?.model,
-    };
-    chosen.save(&args.output)?;
+    tuned.model.save(&args.output)?;
     println!(
         "chosen: {} (cross-validated GFC {:.5}) → {}",
         best.recipe.name,

@@ -1,19 +1,18 @@
 //! `spdcam generate`: a dataset of (features, SPD) samples from the virtual camera.
 
 use crate::render::CameraArgs;
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use spdcam_core::builtin::DataDir;
-use spdcam_core::camera::sensor::Sensitivities;
-use spdcam_core::camera::{Camera, CameraConfig};
-use spdcam_core::chart::Chart;
-use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
-use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline, Shard, DEFAULT_CHUNK_SIZE};
-use spdcam_core::lighting::Lighting;
+use spdcam_core::dataset::randomise::{RandomiseRequest, DEFAULT_CAMERA_VARIANTS};
+use spdcam_core::dataset::{
+    GenerateEvent, GenerateOptions, GenerateRequest, Pipeline, Plan, Shard, DEFAULT_CHUNK_SIZE,
+};
 use spdcam_core::spectral::Grid;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// Options of `spdcam generate`.
@@ -66,7 +65,7 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "SPLIT.json")]
     camera_split: Option<PathBuf>,
     /// Perturbed copies of each camera in the pool (shift ±5 nm, gain ±10 %).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = DEFAULT_CAMERA_VARIANTS)]
     camera_variants: usize,
     #[command(flatten)]
     camera: CameraArgs,
@@ -102,59 +101,26 @@ pub fn progress_bar(total: u64, unit: &str) -> Option<ProgressBar> {
     Some(ProgressBar::new(total).with_style(style))
 }
 
-/// The randomisation `--randomise` asks for: a camera pool (built once) and parameter ranges.
-fn randomisation(
-    args: &GenerateArgs,
-    base: &Sensitivities,
-    chart: &Chart,
-    config: CameraConfig,
-    data_dir: &DataDir,
-    grid: &Grid,
-) -> Result<Option<Randomisation>> {
-    if args.randomise.is_empty() {
-        if args.cameras.is_some() || args.camera_split.is_some() {
-            bail!("--cameras and --camera-split need --randomise camera");
-        }
-        return Ok(None);
+/// Tells what a prepared run will do when it is not simply all of it: no samples in this
+/// shard, all of them already written, or a resumed run.
+fn report_plan(plan: &Plan, output: &Path, chunk_size: u64) {
+    if plan.total() == 0 {
+        eprintln!(
+            "warning: this shard holds no samples: the run has fewer files of {chunk_size} samples than shards"
+        );
+    } else if plan.done() == plan.total() {
+        eprintln!(
+            "{} already holds all {} samples of this run",
+            output.display(),
+            plan.total()
+        );
+    } else if plan.done() > 0 {
+        eprintln!(
+            "resuming: {} of {} samples were already written",
+            plan.done(),
+            plan.total()
+        );
     }
-    let groups: Vec<&str> = args.randomise.iter().map(|g| g.trim()).collect();
-    let ranges = InCameraRanges::for_groups(
-        &groups
-            .iter()
-            .copied()
-            .filter(|g| *g != "camera")
-            .collect::<Vec<_>>(),
-    )?;
-    let mut sens = vec![base.clone()];
-    if groups.contains(&"camera") {
-        let spec = args
-            .cameras
-            .as_deref()
-            .context("--randomise camera needs --cameras DIR or a list")?;
-        let dir = std::path::Path::new(spec);
-        sens = Vec::new();
-        if dir.is_dir() {
-            sens = crate::calibrate::sensitivities_in(dir, data_dir, grid)?;
-        } else {
-            for name in spec.split(',').map(str::trim).filter(|n| !n.is_empty()) {
-                sens.push(crate::calibrate::sensitivities(name, data_dir, grid)?);
-            }
-        }
-    }
-    if let Some(path) = &args.camera_split {
-        let split = spdcam_core::lighting::ValidationSplit::read(path)?;
-        sens.retain(|s| split.allows_training_camera(&s.name));
-        if sens.is_empty() {
-            bail!("every camera of the pool is held out by {}", path.display());
-        }
-    }
-    let variants = if groups.contains(&"camera") {
-        args.camera_variants
-    } else {
-        0
-    };
-    let pool = camera_pool(&sens, variants, args.seed, chart, config, grid)?;
-    Ok(Some(Randomisation::new(pool, ranges)?))
 }
 
 /// Runs `spdcam generate`.
@@ -177,43 +143,44 @@ pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
     if let Some(path) = &args.in_camera {
         config.in_camera = Some(crate::calibrate::read_in_camera(path)?);
     }
-    let chart = args.camera.chart(data_dir, &grid)?;
-    let base = crate::calibrate::sensitivities(&args.camera.camera, data_dir, &grid)?;
-    let camera = Camera::new(&base, chart.clone(), config, &grid)?;
-    let lighting = Lighting::parse(&args.lighting, data_dir, &grid)?;
-    let randomisation = randomisation(&args, &base, &chart, config, data_dir, &grid)?;
-    let mut generator = Generator::new(&camera, &lighting, options)?;
-    if let Some(r) = &randomisation {
-        generator = generator.with_randomisation(r)?;
-    }
-    let plan = generator.prepare(&args.output, args.force)?;
-    if plan.total() == 0 {
-        eprintln!(
-            "warning: this shard holds no samples: the run has fewer files of {} samples than shards",
-            args.chunk_size
-        );
-    } else if plan.done() == plan.total() {
-        eprintln!(
-            "{} already holds all {} samples of this run",
-            args.output.display(),
-            plan.total()
-        );
-    } else if plan.done() > 0 {
-        eprintln!(
-            "resuming: {} of {} samples were already written",
-            plan.done(),
-            plan.total()
-        );
-    }
-    let new = plan.total() - plan.done();
-    let bar = progress_bar(new, "samples");
-    let started = Instant::now();
-    let manifest = generator.run(&plan, &|n| {
-        if let Some(bar) = &bar {
-            bar.inc(n);
-        }
-    })?;
-    if let Some(bar) = bar {
+    let request = GenerateRequest {
+        lighting: args.lighting,
+        camera: args.camera.camera.clone(),
+        chart: args.camera.chart(data_dir, &grid)?,
+        config,
+        randomise: RandomiseRequest {
+            groups: args.randomise,
+            cameras: args.cameras,
+            camera_split: args.camera_split,
+            camera_variants: args.camera_variants,
+        },
+        options,
+    };
+    let bar = OnceLock::new();
+    let mut new = 0;
+    let mut started = Instant::now();
+    let manifest = request.run(
+        &args.output,
+        args.force,
+        data_dir,
+        &mut |event| match event {
+            GenerateEvent::Skipped(path, e) => crate::calibrate::warn_skipped(path, e),
+            GenerateEvent::Planned(plan) => {
+                report_plan(plan, &args.output, args.chunk_size);
+                new = plan.total() - plan.done();
+                started = Instant::now();
+                if let Some(b) = progress_bar(new, "samples") {
+                    let _ = bar.set(b);
+                }
+            }
+        },
+        &|n| {
+            if let Some(bar) = bar.get() {
+                bar.inc(n);
+            }
+        },
+    )?;
+    if let Some(bar) = bar.get() {
         bar.finish_and_clear();
     }
     let seconds = started.elapsed().as_secs_f64();

@@ -1,19 +1,16 @@
 //! `spdcam train`: fit a model (1D CNN, MLP or ridge baseline) to a dataset.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use spdcam_core::builtin::DataDir;
-use spdcam_core::dataset::Dataset;
 use spdcam_core::fsio;
-use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::Grid;
 use spdcam_learn::evaluate::loss_curve_svg;
 use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
 use spdcam_learn::pca::Components;
-use spdcam_learn::record::DataInfo;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{
-    train, Backend, EpochRecord, Progress, Schedule, TrainOptions, TrainingSet,
+    add_photo_chart, train, Backend, EpochRecord, Progress, Schedule, TrainOptions, TrainingSet,
 };
 use std::path::{Path, PathBuf};
 
@@ -166,20 +163,6 @@ pub struct TrainArgs {
     schedule: ScheduleArgs,
 }
 
-/// Reads a dataset directory into memory.
-pub fn load_set(dir: &Path) -> Result<TrainingSet> {
-    let dataset =
-        Dataset::open(dir).with_context(|| format!("opening dataset {}", dir.display()))?;
-    let samples = dataset
-        .load()
-        .with_context(|| format!("reading dataset {}", dir.display()))?;
-    Ok(TrainingSet {
-        samples,
-        columns: dataset.columns().clone(),
-        info: DataInfo::from_dataset(&dataset, &dir.display().to_string()),
-    })
-}
-
 /// Parses `0.99` (a share) or `12` (a count).
 fn parse_components(text: &str) -> Result<Components> {
     if let Ok(n) = text.parse::<usize>() {
@@ -256,8 +239,13 @@ pub fn run(args: TrainArgs, data_dir: &DataDir) -> Result<()> {
     for path in args.log.iter().chain(&args.plot) {
         fsio::check_writable(path)?;
     }
-    let data = load_set(&args.data)?;
-    let val = args.schedule.val.as_deref().map(load_set).transpose()?;
+    let data = TrainingSet::load(&args.data)?;
+    let val = args
+        .schedule
+        .val
+        .as_deref()
+        .map(TrainingSet::load)
+        .transpose()?;
     let architecture = match (args.model, args.ridge) {
         (ModelKind::Linear, Some(ridge)) if ridge.is_finite() && ridge > 0.0 => {
             Architecture::Linear { ridge }
@@ -297,14 +285,7 @@ pub fn run(args: TrainArgs, data_dir: &DataDir) -> Result<()> {
         bar.finish_and_clear();
     }
     let mut model = trained.model;
-    if let Some(template) = model
-        .header()
-        .chart
-        .as_deref()
-        .and_then(|chart| ChartTemplate::for_chart(chart, data_dir, &Grid::SIMULATION))
-    {
-        model.set_photo_chart(template)?;
-    }
+    add_photo_chart(&mut model, data_dir)?;
     model.save(&args.output)?;
     let t = model.training();
     println!(

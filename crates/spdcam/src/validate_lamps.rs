@@ -5,7 +5,7 @@
 //! the average-SPD baseline, for the validation lamps (choose on these) and the test lamps
 //! (report only). (c) The real photo sets of the thesis (SG 96 models only).
 
-use crate::calibrate::{read_measured, sensitivities, Measured};
+use crate::calibrate::{read_measured, Measured};
 use crate::lamps::{camera_names, in_data_dir, LibraryArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -223,7 +223,7 @@ pub(crate) fn held_out_cameras(
             bail!("held-out camera '{name}' is not in {}", dir.display());
         }
         let path = dir.join(format!("{name}.csv"));
-        match sensitivities(&path.to_string_lossy(), data_dir, &GRID) {
+        match Sensitivities::resolve(&path.to_string_lossy(), data_dir, &GRID) {
             Ok(s) => held_out.push(s),
             Err(e) => eprintln!("warning: skipping held-out camera {name}: {e:#}"),
         }

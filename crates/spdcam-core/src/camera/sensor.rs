@@ -1,11 +1,13 @@
 //! Sensor image formation (thesis Eq. 3.1–3.3): light × reflectance × sensitivity, integrated
 //! over wavelength, seen through a Bayer filter (single sensor) or by three sensors.
 
+use crate::builtin::{self, DataDir};
 use crate::chart::Chart;
 use crate::error::{Error, Result};
 use crate::raster::{CfaPattern, Mosaic, RgbImage};
 use crate::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 
 /// A camera's relative spectral sensitivities (R, G, B) on the simulation grid.
 #[derive(Debug, Clone)]
@@ -15,6 +17,9 @@ pub struct Sensitivities {
     pub curves: SpectralSet,
 }
 
+/// Files skipped as no valid sensitivity set, each with why.
+pub type SkippedFiles = Vec<(PathBuf, Error)>;
+
 /// The range a camera's data must cover: where lights are estimated.
 const REQUIRED_RANGE_NM: (f64, f64) = (400.0, 700.0);
 /// A camera short of the required range is still accepted when its response at the
@@ -22,6 +27,43 @@ const REQUIRED_RANGE_NM: (f64, f64) = (400.0, 700.0);
 const NEGLIGIBLE_EDGE: f64 = 0.02;
 
 impl Sensitivities {
+    /// The sensitivities `spec` names: a CSV file (r,g,b), a built-in camera, or a CSV in
+    /// the data directory's `cameras` or `thesis` folder; resampled onto `grid`.
+    pub fn resolve(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Sensitivities> {
+        let (name, measured) = builtin::resolve_table(
+            spec,
+            "camera",
+            builtin::CAMERAS,
+            data_dir,
+            &["cameras", "thesis"],
+        )?;
+        Sensitivities::new(&name, &measured, grid)
+    }
+
+    /// Every camera sensitivity CSV in `dir`, sorted by file name, and the files that are
+    /// not a valid sensitivity set, each with why (skipped).
+    pub fn in_dir(
+        dir: &Path,
+        data_dir: &DataDir,
+        grid: &Grid,
+    ) -> Result<(Vec<Sensitivities>, SkippedFiles)> {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|e| Error::io(dir, e))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+            .collect();
+        files.sort();
+        let mut found = Vec::with_capacity(files.len());
+        let mut skipped = Vec::new();
+        for f in files {
+            match Sensitivities::resolve(&f.to_string_lossy(), data_dir, grid) {
+                Ok(s) => found.push(s),
+                Err(e) => skipped.push((f, e)),
+            }
+        }
+        Ok((found, skipped))
+    }
+
     /// Checks and resamples measured sensitivities (three columns R, G, B, any sampling) onto
     /// `grid`; outside the data they are zero. The data must cover 400–700 nm, or fall to a
     /// negligible response at the uncovered edge.

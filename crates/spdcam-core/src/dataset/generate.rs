@@ -8,7 +8,7 @@ use super::manifest::{
     CameraInfo, ChartInfo, FileEntry, GenerateSettings, LightingInfo, Manifest, Origin, Pipeline,
     Shard,
 };
-use super::randomise::Randomisation;
+use super::randomise::{Randomisation, RandomiseRequest};
 use super::reader::read_sample_file;
 use super::spd_map::SpdMap;
 use super::writer::{
@@ -16,7 +16,10 @@ use super::writer::{
     write_sample_file, IMAGES_DIR, RUN_FILE, RUN_PARTS, SAMPLES_DIR,
 };
 use super::DEFAULT_CHUNK_SIZE;
-use crate::camera::{Camera, RenderBuffers};
+use crate::builtin::DataDir;
+use crate::camera::sensor::Sensitivities;
+use crate::camera::{Camera, CameraConfig, RenderBuffers};
+use crate::chart::Chart;
 use crate::error::{Error, Result};
 use crate::lighting::Lighting;
 use crate::spectral::Grid;
@@ -593,4 +596,68 @@ fn differing_settings(a: &RunRecord, b: &RunRecord) -> Vec<String> {
         );
     }
     names
+}
+
+/// A whole generate run as `spdcam generate` describes it: the lighting recipe and the
+/// camera by name, the chart and camera settings, the randomisation and the options.
+#[derive(Debug, Clone)]
+pub struct GenerateRequest {
+    /// The lighting recipe (`spdcam list lighting` shows the forms).
+    pub lighting: String,
+    /// The camera's sensitivities: a built-in name, a data-directory name or a CSV file.
+    pub camera: String,
+    /// The chart with its layout.
+    pub chart: Chart,
+    /// The camera's settings.
+    pub config: CameraConfig,
+    /// Domain randomisation per sample.
+    pub randomise: RandomiseRequest,
+    /// What to generate.
+    pub options: GenerateOptions,
+}
+
+/// What a [`GenerateRequest`] run tells its caller before it renders.
+#[derive(Debug)]
+pub enum GenerateEvent<'a> {
+    /// A file of the camera directory was skipped: it is no valid sensitivity set.
+    Skipped(&'a Path, &'a Error),
+    /// The directory is prepared: how many samples the run has and how many were there.
+    Planned(&'a Plan),
+}
+
+impl GenerateRequest {
+    /// Generates the dataset into `dir` (resuming a run there, or replacing what it holds
+    /// with `overwrite`); `events` hears of skipped cameras and the plan, `progress` of the
+    /// samples written. Returns the manifest written.
+    pub fn run(
+        &self,
+        dir: &Path,
+        overwrite: bool,
+        data_dir: &DataDir,
+        events: &mut dyn FnMut(GenerateEvent<'_>),
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Manifest> {
+        let grid = Grid::SIMULATION;
+        let base = Sensitivities::resolve(&self.camera, data_dir, &grid)?;
+        let camera = Camera::new(&base, self.chart.clone(), self.config, &grid)?;
+        let lighting = Lighting::parse(&self.lighting, data_dir, &grid)?;
+        let (randomisation, skipped) = self.randomise.build(
+            &base,
+            &self.chart,
+            self.config,
+            self.options.seed,
+            data_dir,
+            &grid,
+        )?;
+        for (path, error) in &skipped {
+            events(GenerateEvent::Skipped(path, error));
+        }
+        let mut generator = Generator::new(&camera, &lighting, self.options.clone())?;
+        if let Some(r) = &randomisation {
+            generator = generator.with_randomisation(r)?;
+        }
+        let plan = generator.prepare(dir, overwrite)?;
+        events(GenerateEvent::Planned(&plan));
+        generator.run(&plan, progress)
+    }
 }

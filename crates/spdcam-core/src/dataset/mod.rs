@@ -38,7 +38,7 @@ mod writer;
 pub use batch::{Columns, Counts, Precision, SampleBatch, SampleRow};
 pub use csv_io::{export_csv, import_csv, ExportOptions, ImportOptions, ImportReport};
 pub use file::{encode_parquet, encode_parquet_as, Compression, FileFormat, ZSTD_LEVEL};
-pub use generate::{GenerateOptions, Generator, Plan};
+pub use generate::{GenerateEvent, GenerateOptions, GenerateRequest, Generator, Plan};
 pub use lock::{DirLock, LockOwner, LOCK_FILE};
 pub use manifest::{
     sha256_hex, CameraInfo, ChartInfo, FileEntry, GenerateSettings, ImportSource, LightingInfo,

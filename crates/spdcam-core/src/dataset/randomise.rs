@@ -5,16 +5,19 @@
 //! The pool is built once (each camera fits its colour matrix once); sample `i`'s draw
 //! depends only on (seed, i).
 
+use crate::builtin::DataDir;
 use crate::camera::in_camera::InCamera;
-use crate::camera::sensor::Sensitivities;
+use crate::camera::sensor::{Sensitivities, SkippedFiles};
 use crate::camera::{Camera, CameraConfig};
 use crate::chart::Chart;
 use crate::error::{Error, Result};
+use crate::lighting::ValidationSplit;
 use crate::seed;
 use crate::spectral::{Grid, SpectralSet};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 
 /// Stream of the per-sample randomisation draws (apart from the light's and the noise's).
 const RANDOMISE_STREAM: u64 = 0x5241_4E44_0000_0001;
@@ -295,4 +298,96 @@ pub fn camera_pool(
         }
     }
     Ok(pool)
+}
+
+/// Perturbed copies of each camera in a pool unless a run asks for another number.
+pub const DEFAULT_CAMERA_VARIANTS: usize = 3;
+
+/// The randomisation a run asks for by name (`spdcam generate --randomise`, `--cameras`,
+/// `--camera-split`, `--camera-variants`); by default none.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RandomiseRequest {
+    /// Groups: camera (draw the camera from `cameras`), exposure, wb, tone, jpeg (draw those
+    /// in-camera parameters), gradient (uneven lighting); none: no randomisation.
+    pub groups: Vec<String>,
+    /// The cameras to draw from with `camera`: a directory of sensitivity CSVs or a
+    /// comma-separated list of names or files.
+    pub cameras: Option<String>,
+    /// A validation split whose held-out cameras are left out of the pool.
+    pub camera_split: Option<PathBuf>,
+    /// Perturbed copies of each camera in the pool (with `camera`).
+    pub camera_variants: usize,
+}
+
+impl Default for RandomiseRequest {
+    fn default() -> Self {
+        RandomiseRequest {
+            groups: Vec::new(),
+            cameras: None,
+            camera_split: None,
+            camera_variants: DEFAULT_CAMERA_VARIANTS,
+        }
+    }
+}
+
+/// What [`RandomiseRequest::build`] gives: the randomisation (none when no group is asked
+/// for) and the camera files of the `cameras` directory skipped as invalid, with why.
+pub type BuiltRandomisation = (Option<Randomisation>, SkippedFiles);
+
+impl RandomiseRequest {
+    /// The randomisation asked for around the `base` camera: its pool built once (perturbed
+    /// copies seeded with `seed`) photographing `chart` with `config`, and its ranges.
+    pub fn build(
+        &self,
+        base: &Sensitivities,
+        chart: &Chart,
+        config: CameraConfig,
+        seed: u64,
+        data_dir: &DataDir,
+        grid: &Grid,
+    ) -> Result<BuiltRandomisation> {
+        if self.groups.is_empty() {
+            if self.cameras.is_some() || self.camera_split.is_some() {
+                return Err(Error::invalid(
+                    "--cameras and --camera-split need --randomise camera",
+                ));
+            }
+            return Ok((None, Vec::new()));
+        }
+        let groups: Vec<&str> = self.groups.iter().map(|g| g.trim()).collect();
+        let with_camera = groups.contains(&"camera");
+        let others: Vec<&str> = groups.iter().copied().filter(|g| *g != "camera").collect();
+        let ranges = InCameraRanges::for_groups(&others)?;
+        let mut sens = vec![base.clone()];
+        let mut skipped = Vec::new();
+        if with_camera {
+            let spec = self.cameras.as_deref().ok_or_else(|| {
+                Error::invalid("--randomise camera needs --cameras DIR or a list")
+            })?;
+            let dir = Path::new(spec);
+            if dir.is_dir() {
+                (sens, skipped) = Sensitivities::in_dir(dir, data_dir, grid)?;
+            } else {
+                sens = spec
+                    .split(',')
+                    .map(str::trim)
+                    .filter(|n| !n.is_empty())
+                    .map(|name| Sensitivities::resolve(name, data_dir, grid))
+                    .collect::<Result<_>>()?;
+            }
+        }
+        if let Some(path) = &self.camera_split {
+            let split = ValidationSplit::read(path)?;
+            sens.retain(|s| split.allows_training_camera(&s.name));
+            if sens.is_empty() {
+                return Err(Error::invalid(format!(
+                    "every camera of the pool is held out by {}",
+                    path.display()
+                )));
+            }
+        }
+        let variants = if with_camera { self.camera_variants } else { 0 };
+        let pool = camera_pool(&sens, variants, seed, chart, config, grid)?;
+        Ok((Some(Randomisation::new(pool, ranges)?), skipped))
+    }
 }
