@@ -170,6 +170,9 @@ pub const THESIS_PATCH_PX: usize = 24;
 /// The largest reflectance a chart patch may have: fluorescent patches exceed 1 a little;
 /// a file in percent has values up to about 100.
 const MAX_REFLECTANCE: f64 = 2.0;
+/// Patches whose reflectance over 400–700 nm varies by less than this (standard deviation
+/// / mean) are neutral ([`Chart::neutral_features`]).
+pub const NEUTRAL_VARIATION: f64 = 0.1;
 /// Reflectance of a chart's matte black body, shown in gaps and borders.
 pub const DEFAULT_BACKGROUND: f64 = 0.04;
 
@@ -203,6 +206,37 @@ impl Chart {
                     ((p % cols) as f64 + 0.5) / cols as f64 - 0.5,
                     ((p / cols) as f64 + 0.5) / rows as f64 - 0.5,
                 ]
+            })
+            .collect()
+    }
+
+    /// The spectrally flat (neutral) feature patches, as (feature index, mean reflectance
+    /// over 400–700 nm): those whose reflectance varies by less than [`NEUTRAL_VARIATION`]
+    /// (standard deviation / mean) there. They reflect every light alike, so a photo's
+    /// neutral patches measure its exposure, flare and uneven lighting.
+    pub fn neutral_features(&self) -> Vec<(usize, f64)> {
+        let visible: Vec<usize> = self
+            .reflectances
+            .wavelengths()
+            .iter()
+            .enumerate()
+            .filter(|(_, w)| (400.0..=700.0).contains(*w))
+            .map(|(i, _)| i)
+            .collect();
+        self.feature_patches
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &p)| {
+                let refl = self.reflectances.item(p);
+                let n = visible.len() as f64;
+                let mean = visible.iter().map(|&i| refl[i]).sum::<f64>() / n;
+                let sd = (visible
+                    .iter()
+                    .map(|&i| (refl[i] - mean).powi(2))
+                    .sum::<f64>()
+                    / n)
+                    .sqrt();
+                (mean > 0.0 && sd / mean < NEUTRAL_VARIATION).then_some((k, mean))
             })
             .collect()
     }

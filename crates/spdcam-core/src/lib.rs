@@ -22,5 +22,6 @@ pub mod raster;
 pub mod seed;
 pub mod simple_camera;
 pub mod spectral;
+pub mod uneven_light;
 
 pub use error::{Error, Result};

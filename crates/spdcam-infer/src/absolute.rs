@@ -26,9 +26,6 @@ use spdcam_core::spectral::Grid;
 
 /// CIE 015:2018 maximum luminous efficacy K_m of photopic vision, lm/W.
 pub const LUMINOUS_EFFICACY_LM_PER_W: f64 = 683.002;
-/// Reflectances varying less than this (standard deviation / mean over the grid) are
-/// neutral.
-const NEUTRAL_VARIATION: f64 = 0.1;
 /// The linear output values (0–1 of white) a patch may have to count: tone curves are
 /// nearest linear around the SOS grey (0.18).
 const USABLE_VALUES: (f64, f64) = (0.05, 0.6);
@@ -92,16 +89,12 @@ pub fn absolute_level(
             "the photo's features are not those of {chart_name}"
         )));
     }
-    let mut found: Vec<(usize, f64)> = (0..patches)
-        .filter(|&k| !unusable.get(k).copied().unwrap_or(false))
-        .filter_map(|k| {
+    let mut found: Vec<(usize, f64)> = chart
+        .neutral_features()
+        .into_iter()
+        .filter(|&(k, _)| !unusable.get(k).copied().unwrap_or(false))
+        .filter_map(|(k, _)| {
             let refl = chart.reflectances.item(chart.feature_patches[k]);
-            let mean = refl.iter().sum::<f64>() / refl.len() as f64;
-            let sd =
-                (refl.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / refl.len() as f64).sqrt();
-            if mean <= 0.0 || sd / mean > NEUTRAL_VARIATION {
-                return None;
-            }
             let rgb = &analysis.features[3 * k..3 * k + 3];
             let y: f64 = [0.2126, 0.7152, 0.0722]
                 .iter()

@@ -24,6 +24,7 @@ use spdcam_core::photo::scene::{self, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_core::uneven_light::{Corrections, UnevenLight};
 use spdcam_core::{metrics, seed};
 use spdcam_infer::estimate::{estimate_photo_bytes, PhotoOptions};
 use spdcam_infer::trust::{
@@ -776,6 +777,58 @@ fn measure_row(
     Ok((row, coverage))
 }
 
+/// One row of the corrections table: the mean GFC of `model` on `features` as they are and
+/// with the photo's own flare and gradient corrections ([`UnevenLight`]), alone and together.
+fn corrections_row(
+    label: &str,
+    model: &Model,
+    chart: &Chart,
+    features: &[Vec<f64>],
+    truths: &[Vec<f64>],
+) -> Result<String> {
+    let fits: Vec<Option<UnevenLight>> = features
+        .iter()
+        .map(|row| UnevenLight::fit(chart, row, trust::feature_scale(row)).ok())
+        .collect();
+    let d = model.grid().count;
+    let mut cells = String::new();
+    for (flare, gradient) in [(false, false), (true, false), (false, true), (true, true)] {
+        let which = Corrections { flare, gradient };
+        let rows: Vec<f64> = features
+            .iter()
+            .zip(&fits)
+            .flat_map(|(row, fit)| match fit {
+                Some(f) => f.correct(chart, row, trust::feature_scale(row), which),
+                None => row.clone(),
+            })
+            .collect();
+        let spds = model.estimate_rows(&rows)?;
+        let mean = truths
+            .iter()
+            .enumerate()
+            .map(|(r, t)| metrics::gfc(t, &spds[r * d..(r + 1) * d]).unwrap_or(0.0))
+            .sum::<f64>()
+            / truths.len() as f64;
+        cells += &format!(" {mean:.4} |");
+    }
+    let fitted = fits.iter().filter(|f| f.is_some()).count();
+    let flare: Vec<f64> = fits.iter().flatten().map(|f| f.flare[1]).collect();
+    let gx: Vec<f64> = fits.iter().flatten().map(|f| f.gradient[1][0]).collect();
+    let median_of = |v: &[f64]| {
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            median(&mut v.to_vec())
+        }
+    };
+    Ok(format!(
+        "| {label} | {} | {fitted} | {:.3} | {:+.2} |{cells}\n",
+        features.len(),
+        median_of(&flare),
+        median_of(&gx)
+    ))
+}
+
 /// The metrics' table of one model: per metric and photo set, the share of true values
 /// within the 68 % and 95 % intervals and the median 95 % half-width.
 fn metric_table(name: &str, sets: &[(String, BTreeMap<String, MetricCoverage>)]) -> String {
@@ -902,6 +955,20 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
          interval is the metric's spread over the perturbed copies plus a floor, scaled by the \
          calibration's conformal quantiles.\n\n",
     );
+    let mut corrections_md = String::from(
+        "## The photo's own corrections\n\n\
+         Flare and the light's gradient across the chart measured on the chart's neutral \
+         patches of each photo (`spdcam_core::uneven_light`: per channel, a linear gain across \
+         the chart and an additive flare, least squares) and taken out of its features before \
+         the model; mean GFC with the features as they are, with the flare or the gradient \
+         corrected, and both. Fitted: photos with enough unclipped neutral patches (the others \
+         stay as they are). Median fitted flare (green, linear share of the feature scale) and \
+         gradient (green, relative gain per chart width). The SG's 96 centre patches hold 14 \
+         neutrals (two middle rows and a short column), the ColorChecker 24 six (one row: no \
+         vertical gradient).\n\n\
+         | model · photos | n | fitted | flare | gradient x | as they are | flare | gradient | both |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
     md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
     for ((path, model, chart_name), cal_path) in models.iter().zip(&args.calibration) {
         let text = std::fs::read_to_string(cal_path)
@@ -932,6 +999,13 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
         )?;
         md += &row;
         metric_sets.push(("held-out virtual".to_string(), coverage));
+        corrections_md += &corrections_row(
+            &format!("`{name}` · held-out virtual (test lamps)"),
+            model,
+            &chart,
+            &shots.clean.features,
+            &shots.clean.truths,
+        )?;
         if chart_name == "colorchecker_sg96" {
             let thesis = match &args.thesis_data {
                 Some(p) => p.clone(),
@@ -948,6 +1022,13 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
                 )?;
                 md += &row;
                 metric_sets.push((format!("real: {label}"), coverage));
+                corrections_md += &corrections_row(
+                    &format!("`{name}` · real: {label}"),
+                    model,
+                    &chart,
+                    &rows.features,
+                    &rows.truths,
+                )?;
             }
         }
         metrics_md += &metric_table(&name, &metric_sets);
@@ -1015,6 +1096,8 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
     }
     md.push('\n');
     md += &metrics_md;
+    md += &corrections_md;
+    md.push('\n');
     md += &flags;
     md.push('\n');
     md += &scenes;
