@@ -167,3 +167,66 @@ mod tests {
         assert!((fit.predict(&[1.0, 0.5, 1.0])[0] - 4.5).abs() < 1e-2);
     }
 }
+
+#[cfg(test)]
+mod reference {
+    use super::*;
+
+    /// A small noisy problem: 12 rows of 2 inputs and a bias to 3 non-negative targets.
+    fn problem() -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+        let x: Vec<Vec<f64>> = (0..12)
+            .map(|i| {
+                let t = i as f64;
+                vec![0.3 + 0.1 * t, 1.0 + (0.7 * t).sin(), 1.0]
+            })
+            .collect();
+        let y = x
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let e = 0.05 * (1.3 * i as f64).cos();
+                vec![
+                    (r[0] + 0.5 * r[1] + e).max(0.0),
+                    (0.2 + 0.3 * r[0] * r[1] - e).max(0.0),
+                    (1.0 - 0.4 * r[0] + 0.1 * r[1] + 2.0 * e).max(0.0),
+                ]
+            })
+            .collect();
+        (x, y)
+    }
+
+    #[test]
+    fn print_reference() {
+        let (x, y) = problem();
+        let prior = Ridge {
+            weights: DMatrix::from_row_slice(3, 3, &[1.0, 0.4, 0.0, 0.0, 0.5, 0.1, -0.3, 0.0, 0.9]),
+        };
+        let newprior = spdcam_learn::ridge::Ridge::from_weights(&[
+            vec![1.0, 0.4, 0.0],
+            vec![0.0, 0.5, 0.1],
+            vec![-0.3, 0.0, 0.9],
+        ])
+        .unwrap();
+        use spdcam_learn::ridge::Ridge as New;
+        let cases = [
+            ("fit", Ridge::fit(&x, &y, 1e-3, None).unwrap(), New::fit(&x, &y, 1e-3, None).unwrap()),
+            ("fit_prior", Ridge::fit(&x, &y, 0.1, Some(&prior)).unwrap(), New::fit(&x, &y, 0.1, Some(&newprior)).unwrap()),
+            ("cv", Ridge::fit_cv(&x, &y, 4, None).unwrap(), New::fit_cv(&x, &y, 4, None).unwrap()),
+            ("cv_prior", Ridge::fit_cv(&x, &y, 4, Some(&prior)).unwrap(), New::fit_cv(&x, &y, 4, Some(&newprior)).unwrap()),
+        ];
+        let mut worst = 0.0f64;
+        for (name, old, new) in cases {
+            let w: Vec<f64> = (0..3).flat_map(|t| (0..3).map(move |j| (t, j))).map(|(t, j)| old.weights[(t, j)]).collect();
+            println!("{name}: {w:?}");
+            for t in 0..3 {
+                for j in 0..3 {
+                    let (a, b) = (old.weights[(t, j)], new.weight(t, j));
+                    worst = worst.max((a - b).abs() / a.abs().max(1e-300));
+                }
+            }
+        }
+        println!("worst relative difference {worst:e}");
+        // The penalties CV picks: the scores of each.
+        assert!(worst < 1e-9);
+    }
+}
