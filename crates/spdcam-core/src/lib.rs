@@ -40,12 +40,12 @@
 //! let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid)?;
 //! let d65 = StandardIlluminant::D65.spd(&grid)?;
 //! let rendering = camera.render(&d65, 1, false)?;
-//! // Mean encoded sRGB of each patch: p01_r, p01_g, p01_b, …, p24_b.
+//! // Mean encoded sRGB (0–255) of each patch: p01_r, p01_g, p01_b, …, p24_b.
 //! let f = &rendering.features;
 //! assert_eq!(f.len(), 24 * 3);
-//! assert!(f.iter().all(|v| (0.0..=1.0).contains(v)));
+//! assert!(f.iter().all(|v| (0.0..=255.0).contains(v)));
 //! // Patch 19 (white) is brighter than patch 24 (black) in every channel.
-//! assert!((0..3).all(|c| f[18 * 3 + c] > f[23 * 3 + c] + 0.5));
+//! assert!((0..3).all(|c| f[18 * 3 + c] > f[23 * 3 + c] + 100.0));
 //! # Ok::<(), spdcam_core::Error>(())
 //! ```
 //!
@@ -84,7 +84,7 @@
 //! # Ok::<(), spdcam_core::Error>(())
 //! ```
 
-#![deny(missing_docs)]
+#![warn(missing_docs)]
 
 pub mod builtin;
 pub mod camera;

@@ -54,7 +54,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-#![deny(missing_docs)]
+#![warn(missing_docs)]
 
 pub mod error;
 pub mod estimate;

@@ -41,7 +41,7 @@
 //! # Ok::<(), spdcam_learn::LearnError>(())
 //! ```
 
-#![deny(missing_docs)]
+#![warn(missing_docs)]
 
 mod burn_net;
 pub mod error;

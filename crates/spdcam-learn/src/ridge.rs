@@ -64,13 +64,12 @@ impl Gram {
     /// The Gram matrices of input rows `x` and target rows `y` (as many, each of one length).
     pub fn from_rows(x: &[&[f64]], y: &[&[f64]]) -> Result<Gram> {
         let (Some(x0), Some(y0)) = (x.first(), y.first()) else {
-            return Err(LearnError::invalid("ridge regression needs at least one row"));
+            return Err(LearnError::invalid(
+                "ridge regression needs at least one row",
+            ));
         };
         let (d, m) = (x0.len(), y0.len());
-        if x.len() != y.len()
-            || x.iter().any(|r| r.len() != d)
-            || y.iter().any(|r| r.len() != m)
-        {
+        if x.len() != y.len() || x.iter().any(|r| r.len() != d) || y.iter().any(|r| r.len() != m) {
             return Err(LearnError::invalid(format!(
                 "ridge regression needs as many input rows as target rows, each of one length \
                  ({} input rows, {} target rows)",
@@ -157,7 +156,12 @@ impl Ridge {
 
     /// Fits rows `x` → `y` with the relative `penalty` (see [`Gram::solve_relative`]),
     /// shrinking towards `prior` if given.
-    pub fn fit(x: &[Vec<f64>], y: &[Vec<f64>], penalty: f64, prior: Option<&Ridge>) -> Result<Ridge> {
+    pub fn fit(
+        x: &[Vec<f64>],
+        y: &[Vec<f64>],
+        penalty: f64,
+        prior: Option<&Ridge>,
+    ) -> Result<Ridge> {
         Gram::from_rows(&borrow(x), &borrow(y))?.solve_relative(penalty, prior)
     }
 
@@ -215,13 +219,21 @@ impl Ridge {
     /// The prediction `Bᵀx` for one input row.
     pub fn predict(&self, x: &[f64]) -> Vec<f64> {
         (0..self.targets())
-            .map(|t| (0..self.inputs()).zip(x).map(|(j, v)| self.weights[(t, j)] * v).sum())
+            .map(|t| {
+                (0..self.inputs())
+                    .zip(x)
+                    .map(|(j, v)| self.weights[(t, j)] * v)
+                    .sum()
+            })
             .collect()
     }
 
     /// [`Ridge::predict`] clipped at zero, for targets that cannot be negative (spectra).
     pub fn predict_non_negative(&self, x: &[f64]) -> Vec<f64> {
-        self.predict(x).into_iter().map(|v: f64| v.max(0.0)).collect()
+        self.predict(x)
+            .into_iter()
+            .map(|v: f64| v.max(0.0))
+            .collect()
     }
 }
 

@@ -209,14 +209,33 @@ mod reference {
         .unwrap();
         use spdcam_learn::ridge::Ridge as New;
         let cases = [
-            ("fit", Ridge::fit(&x, &y, 1e-3, None).unwrap(), New::fit(&x, &y, 1e-3, None).unwrap()),
-            ("fit_prior", Ridge::fit(&x, &y, 0.1, Some(&prior)).unwrap(), New::fit(&x, &y, 0.1, Some(&newprior)).unwrap()),
-            ("cv", Ridge::fit_cv(&x, &y, 4, None).unwrap(), New::fit_cv(&x, &y, 4, None).unwrap()),
-            ("cv_prior", Ridge::fit_cv(&x, &y, 4, Some(&prior)).unwrap(), New::fit_cv(&x, &y, 4, Some(&newprior)).unwrap()),
+            (
+                "fit",
+                Ridge::fit(&x, &y, 1e-3, None).unwrap(),
+                New::fit(&x, &y, 1e-3, None).unwrap(),
+            ),
+            (
+                "fit_prior",
+                Ridge::fit(&x, &y, 0.1, Some(&prior)).unwrap(),
+                New::fit(&x, &y, 0.1, Some(&newprior)).unwrap(),
+            ),
+            (
+                "cv",
+                Ridge::fit_cv(&x, &y, 4, None).unwrap(),
+                New::fit_cv(&x, &y, 4, None).unwrap(),
+            ),
+            (
+                "cv_prior",
+                Ridge::fit_cv(&x, &y, 4, Some(&prior)).unwrap(),
+                New::fit_cv(&x, &y, 4, Some(&newprior)).unwrap(),
+            ),
         ];
         let mut worst = 0.0f64;
         for (name, old, new) in cases {
-            let w: Vec<f64> = (0..3).flat_map(|t| (0..3).map(move |j| (t, j))).map(|(t, j)| old.weights[(t, j)]).collect();
+            let w: Vec<f64> = (0..3)
+                .flat_map(|t| (0..3).map(move |j| (t, j)))
+                .map(|(t, j)| old.weights[(t, j)])
+                .collect();
             println!("{name}: {w:?}");
             for t in 0..3 {
                 for j in 0..3 {
