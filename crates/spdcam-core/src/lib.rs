@@ -84,7 +84,7 @@
 //! # Ok::<(), spdcam_core::Error>(())
 //! ```
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod builtin;
 pub mod camera;

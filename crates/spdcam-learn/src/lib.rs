@@ -41,7 +41,7 @@
 //! # Ok::<(), spdcam_learn::LearnError>(())
 //! ```
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 mod burn_net;
 pub mod error;

@@ -282,6 +282,110 @@ mod tests {
         assert!((fit.predict(&[1.0, 0.5, 1.0])[0] - 4.5).abs() < 1e-2);
     }
 
+    /// 12 noisy rows of 2 inputs and a bias to 3 non-negative targets.
+    fn noisy() -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+        let x: Vec<Vec<f64>> = (0..12)
+            .map(|i| {
+                let t = i as f64;
+                vec![0.3 + 0.1 * t, 1.0 + (0.7 * t).sin(), 1.0]
+            })
+            .collect();
+        let y = x
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let e = 0.05 * (1.3 * i as f64).cos();
+                vec![
+                    (r[0] + 0.5 * r[1] + e).max(0.0),
+                    (0.2 + 0.3 * r[0] * r[1] - e).max(0.0),
+                    (1.0 - 0.4 * r[0] + 0.1 * r[1] + 2.0 * e).max(0.0),
+                ]
+            })
+            .collect();
+        (x, y)
+    }
+
+    /// The weights (targets × inputs, row-major) the earlier nalgebra implementation of the
+    /// sim-to-real experiment gave on [`noisy`]: fixed penalties with and without a prior,
+    /// and 4-fold cross-validation with and without it.
+    #[test]
+    fn matches_the_earlier_implementation() {
+        let (x, y) = noisy();
+        let prior = Ridge::from_weights(&[
+            vec![1.0, 0.4, 0.0],
+            vec![0.0, 0.5, 0.1],
+            vec![-0.3, 0.0, 0.9],
+        ])
+        .unwrap();
+        let cases: [(Ridge, [f64; 9]); 4] = [
+            (
+                Ridge::fit(&x, &y, 1e-3, None).unwrap(),
+                [
+                    0.9882761293926465,
+                    0.4984497344577603,
+                    0.016159597864615762,
+                    0.4450942565464521,
+                    0.2805999157457793,
+                    -0.22131810496360307,
+                    -0.38931640192555106,
+                    0.10428647870659476,
+                    0.9937459847722709,
+                ],
+            ),
+            (
+                Ridge::fit(&x, &y, 0.1, Some(&prior)).unwrap(),
+                [
+                    1.004299999929651,
+                    0.48418978524464246,
+                    0.01676694205827816,
+                    0.18405246196811983,
+                    0.2893892701612391,
+                    0.0020797494981027943,
+                    -0.33081225595820757,
+                    0.09558398247041332,
+                    0.9491966367090119,
+                ],
+            ),
+            (
+                Ridge::fit_cv(&x, &y, 4, None).unwrap(),
+                [
+                    0.9975808338986046,
+                    0.500181480430187,
+                    0.006298877322412227,
+                    0.4512782805045743,
+                    0.28223934666148853,
+                    -0.22867861446397938,
+                    -0.401360160013817,
+                    0.10111782289457331,
+                    1.0086625960261568,
+                ],
+            ),
+            (
+                Ridge::fit_cv(&x, &y, 4, Some(&prior)).unwrap(),
+                [
+                    0.9986316567277683,
+                    0.5001395682927601,
+                    0.005447570714820821,
+                    0.44449257454615043,
+                    0.2815384062528339,
+                    -0.22175368410781812,
+                    -0.40072975503699826,
+                    0.1009511548968377,
+                    1.0083074375240224,
+                ],
+            ),
+        ];
+        for (k, (model, expected)) in cases.iter().enumerate() {
+            for (i, want) in expected.iter().enumerate() {
+                let got = model.weight(i / 3, i % 3);
+                assert!(
+                    (got - want).abs() <= 1e-9 * want.abs(),
+                    "case {k}, weight {i}: {got} against {want}"
+                );
+            }
+        }
+    }
+
     /// One input, one target, by hand: rows x = (1, 2), y = (2, 4) give XᵀX = 5, XᵀY = 10;
     /// with λ = 5 the weight is 10 / (5 + 5) = 1, towards a prior of 3 it is
     /// (10 + 5·3) / (5 + 5) = 2.5.

@@ -19,8 +19,6 @@ mod metrics;
 mod photo_args;
 mod plot_file;
 mod render;
-#[cfg(feature = "train")]
-mod ridge;
 mod serve;
 #[cfg(feature = "train")]
 mod sim2real_curve;
