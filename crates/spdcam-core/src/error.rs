@@ -72,7 +72,7 @@ impl Error {
 const LISTED_NAMES: usize = 10;
 
 /// Names for a one-line message: all of them joined by ", " when there are few, else the
-/// first [`LISTED_NAMES`] and how many there are (a file with 2000 columns must not make a
+/// first `LISTED_NAMES` (10) and how many there are (a file with 2000 columns must not make a
 /// 13 kB error line).
 pub fn brief_list<S: AsRef<str>>(names: &[S]) -> String {
     let shown: Vec<&str> = names.iter().take(LISTED_NAMES).map(AsRef::as_ref).collect();
