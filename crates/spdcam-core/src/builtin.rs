@@ -14,8 +14,11 @@ pub const DATA_DIR_ENV: &str = "SPDCAM_DATA";
 /// A built-in spectral table: its name, what it is, and its CSV text.
 #[derive(Debug, Clone, Copy)]
 pub struct BuiltinTable {
+    /// The name it is found by (`nikon_d5100_npl`).
     pub name: &'static str,
+    /// What it is and where it comes from, for `spdcam list`.
     pub description: &'static str,
+    /// The spectral CSV text (`wavelength_nm` and one column per item).
     pub csv: &'static str,
 }
 

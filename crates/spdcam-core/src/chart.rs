@@ -20,13 +20,21 @@ fn span(n: usize, patch: usize, gap: usize, border: usize) -> usize {
 /// `width × height` canvas. Gaps, margins and the canvas show the chart's background.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Layout {
+    /// Patch rows.
     pub rows: usize,
+    /// Patch columns.
     pub cols: usize,
+    /// Side of a square patch (pixels).
     pub patch_px: usize,
+    /// Background between neighbouring patches (pixels).
     pub gap_px: usize,
+    /// Left edge of the top-left patch (pixels).
     pub margin_x: usize,
+    /// Top edge of the top-left patch (pixels).
     pub margin_y: usize,
+    /// Canvas width (pixels).
     pub width: usize,
+    /// Canvas height (pixels).
     pub height: usize,
 }
 
@@ -157,9 +165,14 @@ impl Layout {
 /// layout), a flat background reflectance, and the patches whose colours are the features.
 #[derive(Debug, Clone)]
 pub struct Chart {
+    /// The chart's name (`colorchecker24`) or its file.
     pub name: String,
+    /// One reflectance (0…1, a little more for fluorescent patches) per patch, row-major
+    /// in the layout, on the simulation grid.
     pub reflectances: SpectralSet,
+    /// The flat reflectance of gaps, margins and the canvas.
     pub background_reflectance: f64,
+    /// Where the patches lie on the rendered image.
     pub layout: Layout,
     /// Indices (row-major) of the feature patches, in feature order.
     pub feature_patches: Vec<usize>,

@@ -8,14 +8,18 @@ pub enum Error {
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {
+        /// The file or directory.
         path: PathBuf,
+        /// What the operating system said.
         #[source]
         source: std::io::Error,
     },
     /// A spectral CSV (or other table) is malformed; `source_name` is the file or built-in name.
     #[error("{source_name}: {message}")]
     Parse {
+        /// The file or built-in table.
         source_name: String,
+        /// What is wrong, and where in it.
         message: String,
     },
     /// A value is out of its valid range or inconsistent with another one.
@@ -24,13 +28,21 @@ pub enum Error {
     /// A name was not found among the known ones.
     #[error("unknown {kind} '{name}'; valid: {valid}")]
     UnknownName {
+        /// What kind of thing was named (`camera`, `chart`, …).
         kind: &'static str,
+        /// The name given.
         name: String,
+        /// The names that are known, comma-separated.
         valid: String,
     },
     /// An image could not be decoded or encoded.
     #[error("{context}: {message}")]
-    Image { context: String, message: String },
+    Image {
+        /// The image file or what it was for.
+        context: String,
+        /// The decoder's or encoder's message.
+        message: String,
+    },
 }
 
 impl Error {
@@ -60,7 +72,7 @@ impl Error {
 const LISTED_NAMES: usize = 10;
 
 /// Names for a one-line message: all of them joined by ", " when there are few, else the
-/// first [`LISTED_NAMES`] and how many there are (a file with 2000 columns must not make a
+/// first `LISTED_NAMES` (10) and how many there are (a file with 2000 columns must not make a
 /// 13 kB error line).
 pub fn brief_list<S: AsRef<str>>(names: &[S]) -> String {
     let shown: Vec<&str> = names.iter().take(LISTED_NAMES).map(AsRef::as_ref).collect();

@@ -14,7 +14,9 @@ cct:CCT (CIE reference: Planckian below 5000 K, daylight from 5000 K), or a spec
 /// A light resolved to the simulation grid.
 #[derive(Debug, Clone)]
 pub struct ResolvedSpd {
+    /// A name for the light: the illuminant, `planck:CCT`, or the file (and column).
     pub name: String,
+    /// Relative spectral power on the grid it was resolved to.
     pub values: Vec<f64>,
     /// Present when the light came from a file: how it was resampled.
     pub resampling: Option<ResampleReport>,

@@ -5,9 +5,13 @@ use serde::{Deserialize, Serialize};
 /// Bayer colour-filter layouts, named by the top-left 2×2 block read row by row.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum CfaPattern {
+    /// Red, green / green, blue.
     Rggb,
+    /// Blue, green / green, red.
     Bggr,
+    /// Green, red / blue, green.
     Grbg,
+    /// Green, blue / red, green.
     Gbrg,
 }
 
@@ -47,9 +51,13 @@ impl CfaPattern {
 /// A single-channel raw image behind a Bayer filter, row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mosaic {
+    /// Width in pixels.
     pub width: usize,
+    /// Height in pixels.
     pub height: usize,
+    /// The colour filter array: which channel each pixel sees.
     pub pattern: CfaPattern,
+    /// `width × height` values, row-major (normalised raw signal, about 0…1).
     pub data: Vec<f32>,
 }
 
@@ -86,8 +94,12 @@ impl Mosaic {
 /// A three-channel image stored as three row-major planes (R, G, B).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RgbImage {
+    /// Width in pixels.
     pub width: usize,
+    /// Height in pixels.
     pub height: usize,
+    /// R, G and B, each `width × height` values row-major (about 0…1: linear camera
+    /// signal before the colour stage, encoded sRGB after it).
     pub planes: [Vec<f32>; 3],
 }
 

@@ -10,21 +10,52 @@
 //!              min-max)                                            or weights)      max-normalised)
 //! ```
 //!
-//! Estimating the light from a photo of a chart with the shipped models:
+//! The modules in pipeline order:
+//!
+//! - [`shipped`]: the models inside the binary and the [`ModelSet`] an estimate chooses
+//!   from; [`model`]: the `.spdm` file ([`record`]: how a model was trained).
+//! - [`scale`] (the feature and target scalings), [`network`] (the forward pass),
+//!   [`target`] and [`pca`] (from the network's outputs back to an SPD).
+//! - [`estimate`]: photo or feature rows → [`Estimate`] (SPD, colorimetry, lighting
+//!   metrics), the one path every front end calls; [`stream`]: any number of feature rows
+//!   in bounded memory.
+//! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
+//!   verdict); [`plot`] and [`report`]: SVG plots and the HTML report.
+//! - [`error`]: the crate's error type.
+//!
+//! Estimating the light from the example photo of a ColorChecker Digital SG with the
+//! shipped models:
 //!
 //! ```
 //! use spdcam_core::builtin::DataDir;
-//! use spdcam_core::spectral::Grid;
+//! use spdcam_core::spectral::{Grid, SpectralSet};
 //! use spdcam_infer::{estimate_photo, ModelSet, PhotoOptions};
+//! use std::path::Path;
 //!
+//! let examples = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
 //! let models = ModelSet::shipped()?;
-//! let photo = std::path::Path::new("../../examples/sg-telelumen.jpg");
 //! let grid = Grid::parse("400-700:5")?;
-//! let estimate = estimate_photo(photo, &models, &PhotoOptions::default(), &DataDir::new(None), &grid)?;
-//! assert_eq!(estimate.spd.len(), 61);
-//! println!("{}", estimate.colorimetry.label());
+//! let photo = Path::new(examples).join("sg-telelumen.jpg");
+//! let mut estimate =
+//!     estimate_photo(&photo, &models, &PhotoOptions::default(), &DataDir::new(None), &grid)?;
+//! assert_eq!(estimate.spd.len(), grid.count);
+//! // This spiky LED mix lies far from the Planckian locus: no CCT, the label says so.
+//! match estimate.colorimetry.cct {
+//!     Some(cct) => println!("CCT {cct:.0} K"),
+//!     None => println!("no CCT: {}", estimate.colorimetry.label()),
+//! }
+//! // The true SPD beside the photo (380–780 nm, 5 nm), on the estimate's wavelengths.
+//! let truth = SpectralSet::read_csv(&Path::new(examples).join("sg-telelumen.truth.csv"))?;
+//! let at = |nm: f64| truth.wavelengths().iter().position(|&w| w == nm).unwrap();
+//! let truth: Vec<f64> = grid.wavelengths().iter().map(|&nm| truth.item(0)[at(nm)]).collect();
+//! estimate.score_against(&truth)?;
+//! let gfc = estimate.truth.unwrap().gfc;
+//! println!("GFC against the truth {gfc:.4}");
+//! assert!(gfc > 0.9);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+
+#![deny(missing_docs)]
 
 pub mod absolute;
 pub mod error;

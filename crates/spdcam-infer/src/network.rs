@@ -1,6 +1,6 @@
 //! The networks' architectures and a plain-Rust forward pass of their trained weights.
 //!
-//! Training runs on burn (see [`crate::train`]); estimating does not need it: a [`Network`]
+//! Training runs on burn (`spdcam_learn::train`); estimating does not need it: a [`Network`]
 //! holds the weights as plain arrays and computes its output with a few matrix products
 //! (faer), with no autodiff bookkeeping. The layouts are channels-last:
 //!

@@ -120,8 +120,8 @@ impl ChartCheck {
     /// `0…scale`, three per patch). Patches with `skip[i]` (clipped, dark) are left out.
     ///
     /// The predicted raw RGB (Σλ camera · reflectance · SPD) is mapped to the photo's linear
-    /// RGB (the tone curve undone, see [`untone`]; of the tone curves tried on a grid the one
-    /// that fits best) by a per-photo affine colour correction fitted by
+    /// RGB (the tone curve undone: contrast S-curve, sRGB and a power; of the tone curves
+    /// tried on a grid the one that fits best) by a per-photo affine colour correction fitted by
     /// least squares (Hong, Luo & Rhodes 2001, "A study of digital camera colorimetric
     /// characterisation based on polynomial modelling", Color Res. Appl. 26: 76–84): a 3×3
     /// matrix (camera and white balance), an offset (flare) and a linear light gradient

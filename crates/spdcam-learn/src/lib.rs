@@ -2,11 +2,52 @@
 //! of the SPDs, the thesis's networks (1D CNN, MLP) trained with burn, a closed-form ridge
 //! baseline, fine-tuning and evaluation. The model file, the forward pass and the scalings
 //! live in `spdcam-infer` (re-exported here), which estimating needs without burn.
+//!
+//! The modules in pipeline order:
+//!
+//! - [`synthetic`]: a small synthetic dataset in memory, for tests and benchmarks (real
+//!   datasets come from `spdcam_core::dataset`).
+//! - [`train`]: PCA or channel-weight targets, the scalings, and the training loop (Adam,
+//!   early stopping) for the networks, or [`ridge`] regression in closed form for the
+//!   `linear` model; fine-tuning a trained model on a new dataset.
+//! - [`recipe`]: choosing a fine-tuning recipe for a few photos by cross-validation.
+//! - [`evaluate`]: scoring a model on a dataset (RMSE, GFC, SAM, SID; plots).
+//! - [`error`]: the crate's error type.
+//!
+//! Training the ridge baseline on a synthetic dataset and checking it on fresh samples:
+//!
+//! ```
+//! use spdcam_core::spectral::Grid;
+//! use spdcam_learn::network::Architecture;
+//! use spdcam_learn::pca::Components;
+//! use spdcam_learn::synthetic::gaussian_set;
+//! use spdcam_learn::target::TargetKind;
+//! use spdcam_learn::train::{train, Backend, Schedule, TrainOptions};
+//!
+//! let data = gaussian_set(400, 24, 1, 2);
+//! let options = TrainOptions {
+//!     architecture: Architecture::Linear { ridge: 0.0 },
+//!     target: TargetKind::Pca(Components::default()),
+//!     grid: Grid::ESTIMATION,
+//!     schedule: Schedule::thesis(),
+//!     seed: 7,
+//!     val_split: 0.15,
+//!     backend: Backend::Cpu,
+//! };
+//! let trained = train(&data, None, &options, &mut |_| {})?;
+//! let test = gaussian_set(20, 24, 99, 2);
+//! let estimates = trained.model.estimate_rows(&test.samples.features)?;
+//! assert_eq!(estimates.len(), 20 * Grid::ESTIMATION.count);
+//! # Ok::<(), spdcam_learn::LearnError>(())
+//! ```
+
+#![deny(missing_docs)]
 
 mod burn_net;
 pub mod error;
 pub mod evaluate;
 pub mod recipe;
+pub mod ridge;
 pub mod synthetic;
 pub mod train;
 

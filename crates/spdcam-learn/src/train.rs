@@ -8,11 +8,11 @@ use crate::model::Model;
 use crate::network::{Architecture, Network, Parameter};
 use crate::pca::Pca;
 use crate::record::{DataInfo, TrainingRecord};
+use crate::ridge::Gram;
 use crate::scale::{FeatureScaler, TargetScaler};
 use crate::target::{normalise, Channels, Target, TargetKind};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
-use faer::{linalg::solvers::Solve, Mat, Side};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rayon::prelude::*;
@@ -460,8 +460,9 @@ pub fn train_in_parts(
     Ok(Trained { model, log })
 }
 
-/// Closed-form ridge regression from normalised features (plus a bias) to scaled targets;
-/// with `ridge` 0, λ is chosen on the validation rows among 10⁻⁸…10⁰ (times the row count).
+/// Closed-form ridge regression ([`crate::ridge`]) from normalised features (plus a bias) to
+/// scaled targets, the feature weights penalised by λ·n (n rows) and the bias by 10⁻¹²·n;
+/// with `ridge` 0, λ is chosen on the validation rows among 10⁻⁸…10⁰.
 fn fit_ridge(
     train: &Prepared,
     val: &Prepared,
@@ -471,16 +472,19 @@ fn fit_ridge(
     fitted: &Fitted,
 ) -> Result<Network> {
     let n = train.rows;
-    let x = Mat::<f64>::from_fn(n, f + 1, |i, j| {
-        if j < f {
-            f64::from(train.x[i * f + j])
-        } else {
-            1.0
-        }
-    });
-    let y = Mat::<f64>::from_fn(n, k, |i, j| f64::from(train.y[i * k + j]));
-    let gram = x.transpose() * &x;
-    let xty = x.transpose() * &y;
+    let gram = Gram::from_fn(
+        n,
+        f + 1,
+        k,
+        |i, j| {
+            if j < f {
+                f64::from(train.x[i * f + j])
+            } else {
+                1.0
+            }
+        },
+        |i, j| f64::from(train.y[i * k + j]),
+    )?;
     let candidates: Vec<f64> = if ridge > 0.0 {
         vec![ridge]
     } else {
@@ -488,20 +492,14 @@ fn fit_ridge(
     };
     let mut best: Option<(f64, Network)> = None;
     for lambda in candidates {
-        let mut a = gram.clone();
-        for j in 0..f {
-            a[(j, j)] += lambda * n as f64;
-        }
-        a[(f, f)] += 1e-12 * n as f64;
-        let b = a
-            .llt(Side::Lower)
-            .map_err(|e| LearnError::Numerical(format!("ridge regression: {e:?}")))?
-            .solve(&xty);
+        let mut diagonal = vec![lambda * n as f64; f + 1];
+        diagonal[f] = 1e-12 * n as f64;
+        let b = gram.solve(&diagonal, None)?;
         let weight: Vec<f32> = (0..f)
             .flat_map(|i| (0..k).map(move |j| (i, j)))
-            .map(|(i, j)| b[(i, j)] as f32)
+            .map(|(i, j)| b.weight(j, i) as f32)
             .collect();
-        let bias: Vec<f32> = (0..k).map(|j| b[(f, j)] as f32).collect();
+        let bias: Vec<f32> = (0..k).map(|j| b.weight(j, f) as f32).collect();
         let net = Network::new(
             Architecture::Linear { ridge: lambda },
             f,

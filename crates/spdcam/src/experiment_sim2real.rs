@@ -4,7 +4,6 @@
 //! (calibration) are cross-validated: calibrated on a few photos outside the test fold.
 
 use crate::calibrate::{photos, read_measured, sensitivities_in, Measured};
-use crate::ridge::Ridge;
 use crate::sim2real_curve::{learning_curve, CurveOptions};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -20,6 +19,7 @@ use spdcam_core::lighting::Lighting;
 use spdcam_core::metrics;
 use spdcam_core::spectral::Grid;
 use spdcam_learn::model::Model;
+use spdcam_learn::ridge::Ridge;
 use std::path::{Path, PathBuf};
 
 /// Options of `spdcam sim2real`.
@@ -81,7 +81,7 @@ fn score(model: &Ridge, set: &Measured, indices: &[usize]) -> Result<f64> {
     let mut total = 0.0;
     for &i in indices {
         let truth = target(&set.spds[i]);
-        let est = model.predict(&inputs(&set.features[i]));
+        let est = model.predict_non_negative(&inputs(&set.features[i]));
         total += metrics::gfc(&truth, &est).unwrap_or(0.0);
     }
     Ok(total / indices.len() as f64)
@@ -106,7 +106,7 @@ fn train_virtual(
         .map(|i| inputs(batch.features_of(i)))
         .collect();
     let y: Vec<Vec<f64>> = (0..batch.len()).map(|i| target(batch.spd_of(i))).collect();
-    Ridge::fit(&x, &y, ridge, None)
+    Ok(Ridge::fit(&x, &y, ridge, None)?)
 }
 
 /// Ridge trained and tested on real photos (k-fold; the penalty chosen by an inner

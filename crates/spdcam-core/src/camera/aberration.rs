@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 /// Lateral chromatic aberration: red scaled by `1 + strength`, blue by `1 − strength`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LateralAberration {
+    /// The relative magnification difference (the thesis: 20/4000 = 0.005).
     pub strength: f64,
 }
 
@@ -87,9 +88,13 @@ impl LateralAberration {
 /// A rectangle of pixels: top-left corner, width and height.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Region {
+    /// Left column (pixels).
     pub x: usize,
+    /// Top row (pixels).
     pub y: usize,
+    /// Width (pixels).
     pub width: usize,
+    /// Height (pixels).
     pub height: usize,
 }
 
@@ -97,6 +102,7 @@ pub struct Region {
 /// [`LateralAberration::region`].
 #[derive(Debug, Clone, Default)]
 pub struct RegionPlanes {
+    /// The region's R, G and B after [`LateralAberration::region`].
     pub planes: [Vec<f32>; 3],
     taps: Vec<(usize, usize, f32)>,
 }

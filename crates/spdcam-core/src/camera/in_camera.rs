@@ -260,17 +260,21 @@ pub fn jpeg_quantise(rgb: [f32; 3], quality: u8) -> [f32; 3] {
 /// measured SPD of its light on the camera's simulation grid.
 #[derive(Debug, Clone)]
 pub struct CalibrationPhoto {
+    /// The photo's chart features (0–255).
     pub features: Vec<f64>,
+    /// The light's measured SPD on the camera's simulation grid.
     pub spd: Vec<f64>,
 }
 
 /// The result of [`calibrate`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Calibration {
+    /// The fitted in-camera rendering.
     pub in_camera: InCamera,
     /// Root-mean-square feature error (0–255) over the photos, before (neutral in-camera
     /// stage with auto exposure at the photos' level) and after the fit.
     pub rms_before: f64,
+    /// The same error with the fitted stage.
     pub rms_after: f64,
     /// Objective evaluations used.
     pub evaluations: usize,

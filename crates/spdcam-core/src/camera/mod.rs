@@ -32,14 +32,19 @@ use white_balance::{RegionGeometry, WhiteBalance};
 /// Every setting of the camera, one field per stage; `None` switches a stage off.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CameraConfig {
+    /// Sensor layout (single Bayer sensor or three sensors) and exposure.
     pub sensor: SensorConfig,
+    /// Sensor noise; `None`: noise-free.
     pub noise: Option<NoiseParams>,
     /// Used with a single sensor only.
     pub demosaic: DemosaicMethod,
+    /// How the white-balance gains are estimated.
     pub white_balance: WhiteBalance,
     /// Which image the white-balance statistics are taken from.
     pub white_balance_statistics: WhiteBalanceStatistics,
+    /// Lateral chromatic aberration; `None`: none.
     pub aberration: Option<LateralAberration>,
+    /// Colour correction to sRGB and the output bit depth.
     pub colour: ColourConfig,
     /// The JPEG camera's own rendering (auto exposure, partial white balance, tone curve…);
     /// `None` (the default) renders as the thesis did.
@@ -112,17 +117,24 @@ pub struct RenderBuffers {
 pub struct Stages {
     /// The mosaic after noise (single sensor only), normalised raw.
     pub cfa: Option<Mosaic>,
+    /// The image after demosaicing (linear camera RGB).
     pub demosaiced: Option<RgbImage>,
+    /// The image after white balance (linear camera RGB).
     pub white_balanced: Option<RgbImage>,
+    /// The image after lateral chromatic aberration, when that stage is on.
     pub aberrated: Option<RgbImage>,
 }
 
 /// One rendered chart: the final sRGB image (0…1, quantised), its features, its stages.
 #[derive(Debug, Clone)]
 pub struct Rendering {
+    /// The final image: encoded sRGB, quantised, on 0…1.
     pub image: RgbImage,
+    /// The features of the image ([`Camera::features`]): mean encoded sRGB, 0–255.
     pub features: Vec<f32>,
+    /// The intermediate images, when asked for.
     pub stages: Stages,
+    /// The gains (R, G, B) white balance applied to the camera signal.
     pub white_balance_gains: [f32; 3],
 }
 

@@ -114,9 +114,9 @@ const BLOCK: usize = 64;
 /// (`(ADU − black) / (full − black)`, so values may fall slightly below zero, as raw data do).
 /// Deterministic for a given `seed`, whatever the number of threads.
 ///
-/// Each band of [`ROWS_PER_STREAM`] rows draws its standard normal deviates from its own
-/// [`NormalStream`], a block at a time, so the arithmetic runs on vector instructions: every
-/// pixel brighter than [`NORMAL_APPROXIMATION_E`] electrons gets the normal approximation of
+/// Each band of `ROWS_PER_STREAM` rows draws its standard normal deviates from its own
+/// `NormalStream`, a block at a time, so the arithmetic runs on vector instructions: every
+/// pixel brighter than `NORMAL_APPROXIMATION_E` electrons gets the normal approximation of
 /// its shot noise plus read noise in one expression; the few darker ones are redone with
 /// exact Poisson shot noise from a second generator of the band.
 pub fn add_noise(data: &mut [f32], width: usize, params: &NoiseParams, seed: u64) {

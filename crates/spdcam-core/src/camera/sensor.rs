@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 /// A camera's relative spectral sensitivities (R, G, B) on the simulation grid.
 #[derive(Debug, Clone)]
 pub struct Sensitivities {
+    /// The camera's name (its table or file).
     pub name: String,
     /// Three items, R, G, B, on the simulation grid.
     pub curves: SpectralSet,
@@ -121,6 +122,7 @@ pub enum SensorMode {
 /// Sensor settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SensorConfig {
+    /// One Bayer sensor (demosaiced) or three full-resolution sensors.
     pub mode: SensorMode,
     /// The brightest raw value is scaled to this fraction of full scale (the thesis
     /// normalises to the maximum: 1.0).

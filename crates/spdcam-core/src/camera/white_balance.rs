@@ -18,10 +18,18 @@ pub enum WhiteBalance {
     WhitePatch,
     /// Shades of grey (Finlayson & Trezzi 2004): the Minkowski p-norm of each channel is grey;
     /// p = 6 is the paper's best and the thesis's choice.
-    ShadesOfGrey { p: f64 },
+    ShadesOfGrey {
+        /// The norm's exponent (≥ 1; 1 is grey world, ∞ white patch).
+        p: f64,
+    },
     /// Grey edge (van de Weijer, Gevers & Gijsenij 2007): the Minkowski p-norm of the
     /// gradient magnitude, after Gaussian smoothing with `sigma` px, is grey.
-    GreyEdge { p: f64, sigma: f64 },
+    GreyEdge {
+        /// The norm's exponent (≥ 1).
+        p: f64,
+        /// The Gaussian smoothing's standard deviation (pixels).
+        sigma: f64,
+    },
 }
 
 impl Default for WhiteBalance {
@@ -34,7 +42,9 @@ impl Default for WhiteBalance {
 /// area in pixels and the length of the boundary between each pair of touching regions.
 #[derive(Debug, Clone, Default)]
 pub struct RegionGeometry {
+    /// Each region's area (pixels).
     pub areas: Vec<f64>,
+    /// (region a, region b, length of their boundary in pixels) for each touching pair.
     pub boundaries: Vec<(usize, usize, f64)>,
 }
 

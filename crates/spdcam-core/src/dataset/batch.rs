@@ -23,8 +23,11 @@ pub enum Precision {
 /// hold them as DOUBLE, and are read as they are).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Columns {
+    /// Feature column names (`p01_r`, `p01_g`, …), in feature order.
     pub feature_names: Vec<String>,
+    /// Whether float columns are stored as 32- or 64-bit floats.
     pub feature_precision: Precision,
+    /// The wavelengths of the SPD columns.
     pub spd_grid: Grid,
     /// Names of the lighting's weights (channel drive levels); empty when it has none.
     pub weight_names: Vec<String>,
@@ -92,14 +95,21 @@ fn spd_column_name(nm: f64) -> String {
 /// Samples held in memory, each quantity row-major (`features[row * feature_count + j]`).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SampleBatch {
+    /// Features per sample.
     pub feature_count: usize,
+    /// SPD values per sample.
     pub spd_len: usize,
+    /// Lighting weights per sample (0 when the lighting has none).
     pub weight_count: usize,
     /// Sample index within its generating run (or row of the imported file).
     pub samples: Vec<u64>,
+    /// The lighting family each sample's light was drawn from.
     pub families: Vec<String>,
+    /// Chart features (mean encoded sRGB, 0–255), `feature_count` per sample.
     pub features: Vec<f64>,
+    /// Relative SPDs (maximum 1), `spd_len` per sample.
     pub spds: Vec<f64>,
+    /// Lighting weights (channel drive levels), `weight_count` per sample.
     pub weights: Vec<f64>,
     /// Lights drawn for this sample, the accepted one included.
     pub attempts: Vec<u32>,
@@ -108,11 +118,17 @@ pub struct SampleBatch {
 /// One sample borrowed from a batch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SampleRow<'a> {
+    /// Sample index within its generating run (or row of the imported file).
     pub sample: u64,
+    /// The lighting family its light was drawn from.
     pub family: &'a str,
+    /// Chart features (0–255).
     pub features: &'a [f64],
+    /// Relative SPD (maximum 1).
     pub spd: &'a [f64],
+    /// Lighting weights; empty when the lighting has none.
     pub weights: &'a [f64],
+    /// Lights drawn for the sample, the accepted one included.
     pub attempts: u32,
 }
 
@@ -196,8 +212,11 @@ impl SampleBatch {
 /// Counts gathered over the samples of a dataset.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Counts {
+    /// Samples.
     pub samples: u64,
+    /// Lights drawn for them, rejected draws included.
     pub attempts: u64,
+    /// Samples per lighting family.
     pub families: BTreeMap<String, u64>,
 }
 

@@ -33,6 +33,7 @@ pub struct ImportOptions {
 /// What [`import_csv`] did.
 #[derive(Debug, Clone)]
 pub struct ImportReport {
+    /// The manifest of the dataset written.
     pub manifest: Manifest,
     /// The largest feature value in the file, before scaling (a 0–1 file read as 0–255
     /// shows here).

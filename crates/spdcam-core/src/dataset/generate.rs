@@ -40,9 +40,11 @@ const BLOCK: u64 = 64;
 pub struct GenerateOptions {
     /// Samples of the whole run (all shards together).
     pub count: u64,
+    /// The run's seed: sample `i` depends only on it and `i`.
     pub seed: u64,
     /// Generate only this part of the run.
     pub shard: Option<Shard>,
+    /// Full image pipeline or fast patch-level features.
     pub pipeline: Pipeline,
     /// The grid SPDs are stored on (inside the simulation grid).
     pub spd_grid: Grid,

@@ -18,7 +18,9 @@ pub const LOCK_FILE: &str = ".spdcam-lock";
 /// Who holds a lock.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct LockOwner {
+    /// The holding process's id.
     pub pid: u32,
+    /// The host name of its machine.
     pub host: String,
     /// The process's start time in clock ticks since boot (Linux), to tell a reused pid.
     pub process_start: Option<u64>,

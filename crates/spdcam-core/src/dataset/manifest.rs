@@ -23,7 +23,9 @@ pub const FEATURE_SCALE: f64 = 255.0;
 /// an unfinished run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Manifest {
+    /// Always [`FORMAT`]: what the directory is.
     pub format: String,
+    /// The layout's version, [`FORMAT_VERSION`] when written by this spdcam.
     pub format_version: u32,
     /// Version of the spdcam that wrote the dataset.
     pub spdcam_version: String,
@@ -37,6 +39,7 @@ pub struct Manifest {
     pub families: BTreeMap<String, u64>,
     /// Features are mean encoded sRGB of each patch's central region on 0…`feature_scale`.
     pub feature_scale: f64,
+    /// The column names and the SPDs' wavelengths.
     pub columns: Columns,
     /// The sample files in row order.
     pub files: Vec<FileEntry>,
@@ -47,7 +50,9 @@ pub struct Manifest {
 /// One sample file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FileEntry {
+    /// Its path relative to the directory (`samples/part-00000.parquet`).
     pub name: String,
+    /// The samples (rows) it holds.
     pub rows: u64,
     /// SHA-256 of the file's bytes, lower-case hex (what `sha256sum` prints); absent in
     /// datasets written before checksums were kept.
@@ -98,13 +103,21 @@ pub enum Origin {
     /// Brought in from feature and SPD CSV files.
     Imported(ImportSource),
     /// Several datasets joined one after the other.
-    Merged { sources: Vec<Origin> },
+    Merged {
+        /// Each joined dataset's origin, in row order.
+        sources: Vec<Origin>,
+    },
     /// One part of a seeded train/val/test split of another dataset.
     Split {
+        /// Which part: `train`, `val` or `test`.
         part: String,
+        /// The shares of train, val and test.
         fractions: [f64; 3],
+        /// The seed of the shuffle.
         seed: u64,
+        /// Samples of the dataset that was split.
         source_samples: u64,
+        /// Where that dataset came from.
         source: Box<Origin>,
     },
 }
@@ -133,7 +146,9 @@ pub enum Pipeline {
 /// Part `index` of `count` of a run: a contiguous range of its sample files.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Shard {
+    /// This part, 0-based (below `count`).
     pub index: u32,
+    /// The parts the run is cut into.
     pub count: u32,
 }
 
@@ -166,11 +181,13 @@ impl std::fmt::Display for Shard {
 pub struct GenerateSettings {
     /// Samples of the whole run (all shards).
     pub count: u64,
+    /// The run's seed: every light, camera draw and noise derives from it and the sample.
     pub seed: u64,
     /// This part of the run; `None` for a whole run.
     pub shard: Option<Shard>,
     /// The samples `[start, end)` this directory holds.
     pub sample_range: [u64; 2],
+    /// Full image pipeline or fast patch-level features.
     pub pipeline: Pipeline,
     /// Samples per file; file `k` holds samples `[k·chunk_size, (k+1)·chunk_size)`.
     pub chunk_size: u64,
@@ -180,8 +197,11 @@ pub struct GenerateSettings {
     pub simulation_grid: Grid,
     /// How sample `i`'s light and noise are seeded.
     pub seeding: String,
+    /// The lighting recipe the lights were drawn from.
     pub lighting: LightingInfo,
+    /// The chart photographed.
     pub chart: ChartInfo,
+    /// The camera that photographed it.
     pub camera: CameraInfo,
     /// Domain randomisation (cameras and in-camera parameters drawn per sample), if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -191,16 +211,22 @@ pub struct GenerateSettings {
 /// The lighting recipe.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LightingInfo {
+    /// The recipe as given (`gaussian:7`, `telelumen:config1`, …).
     pub spec: String,
+    /// What the recipe draws, in words.
     pub description: String,
 }
 
 /// The chart the camera photographs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ChartInfo {
+    /// The chart's name or file.
     pub name: String,
+    /// Where its patches lie on the rendered image.
     pub layout: Layout,
+    /// The feature patches (row-major indices), in feature order.
     pub feature_patches: Vec<usize>,
+    /// The reflectance of gaps and margins.
     pub background_reflectance: f64,
 }
 
@@ -209,6 +235,7 @@ pub struct ChartInfo {
 pub struct CameraInfo {
     /// Name of the sensitivities.
     pub name: String,
+    /// Every stage's settings.
     pub config: CameraConfig,
     /// The D65-fitted camera RGB → XYZ matrix (rows), when colour correction is on.
     pub correction_matrix: Option<[[f64; 3]; 3]>,
@@ -217,7 +244,9 @@ pub struct CameraInfo {
 /// Where imported samples came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ImportSource {
+    /// The features CSV (as given).
     pub features_file: String,
+    /// The SPDs (or channel weights) CSV (as given).
     pub spds_file: String,
     /// When the second file held channel weights: the lighting whose channels made the SPDs.
     #[serde(default, skip_serializing_if = "Option::is_none")]

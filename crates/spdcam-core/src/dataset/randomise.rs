@@ -28,13 +28,21 @@ const PERTURB_STREAM: u64 = 0x5045_5254_0000_0001;
 /// whose range is `None` keeps the base camera's value.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub struct InCameraRanges {
+    /// Range of [`InCamera::exposure_target`] (fraction of full scale).
     pub exposure_target: Option<[f64; 2]>,
+    /// Range of [`InCamera::flare`] (share of the patches' mean raw value).
     pub flare: Option<[f64; 2]>,
+    /// Range of [`InCamera::adaptation`] (share of the white-balance correction).
     pub adaptation: Option<[f64; 2]>,
+    /// Range of [`InCamera::saturation`] (1 = unchanged).
     pub saturation: Option<[f64; 2]>,
+    /// Range of [`InCamera::shoulder`] (0 = hard clip).
     pub shoulder: Option<[f64; 2]>,
+    /// Range of [`InCamera::gamma`] (1 = the sRGB curve alone).
     pub gamma: Option<[f64; 2]>,
+    /// Range of [`InCamera::contrast`] (0 = none).
     pub contrast: Option<[f64; 2]>,
+    /// Range of [`InCamera::jpeg_quality`] (1–100).
     pub jpeg_quality: Option<[u8; 2]>,
     /// Largest magnitude of each lighting-gradient component, drawn uniformly in ±it.
     #[serde(default)]
@@ -130,7 +138,9 @@ pub struct Randomisation {
 pub struct RandomisationInfo {
     /// The pool's camera names (perturbed variants are named `NAME~k`).
     pub cameras: Vec<String>,
+    /// The ranges the in-camera parameters were drawn from.
     pub in_camera: InCameraRanges,
+    /// How each sample's camera and parameters derive from the seed, in words.
     pub seeding: String,
 }
 

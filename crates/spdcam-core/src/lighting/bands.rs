@@ -14,20 +14,42 @@ pub enum Shape {
     /// A single LED, Ohno's model: S(λ) = (g + 2g⁵)/3 with g = exp(−((λ − λ₀)/Δλ)²), λ₀ the
     /// peak and Δλ its half spectral width (Y. Ohno, "Spectral design considerations for
     /// white LED color rendering", Optical Engineering 44(11), 111302, 2005, eq. 1).
-    LedOhno2005 { peak_nm: f64, half_width_nm: f64 },
+    LedOhno2005 {
+        /// λ₀, the peak wavelength (nm).
+        peak_nm: f64,
+        /// Δλ, half the spectral width (nm).
+        half_width_nm: f64,
+    },
     /// A phosphor's emission band (Ce³⁺, Eu²⁺, Mn²⁺ …): a Gaussian in photon energy,
     /// exp(−(E − E₀)²/(2σ²)), as the configurational-coordinate model of a broad
     /// d→f band gives (G. Blasse, B. C. Grabmaier, *Luminescent Materials*, Springer 1994,
     /// ch. 2); on a wavelength axis it has the long tail towards the red that phosphors show.
-    PhosphorBand { peak_nm: f64, sigma_ev: f64 },
+    PhosphorBand {
+        /// The peak wavelength (nm), hc/E₀.
+        peak_nm: f64,
+        /// σ, the band's standard deviation in photon energy (eV).
+        sigma_ev: f64,
+    },
     /// An emission line (atomic lines of discharges, the narrow f→f lines of rare-earth
     /// phosphors) as a spectroradiometer of Gaussian bandpass records it:
     /// exp(−(λ − λ₀)²/(2σ²)).
-    Line { centre_nm: f64, sigma_nm: f64 },
+    Line {
+        /// λ₀, the line's wavelength (nm).
+        centre_nm: f64,
+        /// σ, the recorded bandpass's standard deviation (nm).
+        sigma_nm: f64,
+    },
     /// A filament: Planck's law at `cct_k` times a smooth filter
     /// exp(a·x + b·x²), x = (λ − 580 nm)/200 nm (a dimmer, a coated or dichroic
     /// reflector, a blue daylight filter), scaled so its largest value on 380–780 nm is 1.
-    Filament { cct_k: f64, tilt: f64, curve: f64 },
+    Filament {
+        /// The filament's temperature (K).
+        cct_k: f64,
+        /// a, the filter's linear term (positive: more red).
+        tilt: f64,
+        /// b, the filter's quadratic term.
+        curve: f64,
+    },
 }
 
 impl Shape {

@@ -10,6 +10,7 @@ use rand::Rng;
 /// Named channel SPDs on one grid; a light is their weighted sum, normalised by its maximum.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Channels {
+    /// Each channel's name (its CSV column).
     pub names: Vec<String>,
     /// One SPD per channel, on the grid the lighting was built for.
     pub spds: Vec<Vec<f64>>,
@@ -130,6 +131,7 @@ pub struct WeightRule {
     pub k: usize,
     /// Weights are uniform on [0, max), then rounded to `step`.
     pub max: f64,
+    /// The rounding step of a weight (0: not rounded).
     pub step: f64,
 }
 

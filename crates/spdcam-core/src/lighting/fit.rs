@@ -68,6 +68,7 @@ fn solve_on(a: &DMatrix<f64>, b: &DVector<f64>, passive: &[bool]) -> DVector<f64
 /// The result of a bounded least-squares search.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Minimum {
+    /// The parameters at the minimum found (within their bounds).
     pub x: Vec<f64>,
     /// Sum of squared residuals at `x`.
     pub cost: f64,

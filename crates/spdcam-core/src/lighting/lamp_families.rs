@@ -362,6 +362,7 @@ pub fn model_spectrum(
 /// One lamp's fitted parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FittedLamp {
+    /// The lamp's name in the library.
     pub name: String,
     /// The non-linear parameters ([`LampFamily::parameter_names`] order).
     pub theta: Vec<f64>,
@@ -374,8 +375,11 @@ pub struct FittedLamp {
 /// The lamps one family was fitted to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FamilyFit {
+    /// The spectral model the lamps were fitted with.
     pub family: LampFamily,
+    /// The names of its non-linear parameters, in [`FittedLamp::theta`] order.
     pub parameter_names: Vec<String>,
+    /// Every lamp fitted, with its parameters.
     pub lamps: Vec<FittedLamp>,
 }
 
@@ -384,6 +388,7 @@ pub struct FamilyFit {
 pub struct LampFits {
     /// What the lamps are and how they were fitted.
     pub method: String,
+    /// One entry per family.
     pub families: Vec<FamilyFit>,
 }
 

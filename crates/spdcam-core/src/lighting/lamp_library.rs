@@ -78,10 +78,13 @@ impl LampType {
 /// Measured lamps on one grid, each normalised by its maximum, with their types.
 #[derive(Debug, Clone)]
 pub struct LampLibrary {
+    /// Each lamp's name (its CSV column).
     pub names: Vec<String>,
+    /// Each lamp's type (LED, fluorescent, …), in [`LampLibrary::names`] order.
     pub types: Vec<LampType>,
     /// One SPD per lamp on [`LampLibrary::grid`], maximum 1.
     pub spds: Vec<Vec<f64>>,
+    /// The wavelengths of every SPD.
     pub grid: Grid,
 }
 

@@ -22,7 +22,9 @@ pub const TELELUMEN_BUDGET: f64 = 3.915;
 /// `budget`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PowerBudget {
+    /// Power each channel draws at weight 1 (the luminaire's units, e.g. optical power).
     pub power: Vec<f64>,
+    /// The most the channels may draw together, in the same units.
     pub budget: f64,
 }
 
@@ -37,9 +39,13 @@ impl PowerBudget {
 /// A luminaire with its draw rule and, optionally, its power budget.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Luminaire {
+    /// The luminaire's name (`telelumen`, `gaussian`, a file).
     pub name: String,
+    /// Its channel spectra.
     pub channels: Channels,
+    /// How a draw chooses the channel weights.
     pub rule: WeightRule,
+    /// A power limit that draws must respect; `None`: no limit.
     pub budget: Option<PowerBudget>,
 }
 

@@ -10,7 +10,9 @@ use rand::Rng;
 /// A set of measured SPDs on the working grid, each normalised by its maximum.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasuredSpds {
+    /// The set's name (its file or recipe name).
     pub name: String,
+    /// The SPDs, each with maximum 1.
     pub spds: Vec<Vec<f64>>,
     /// Mix two different SPDs of the set in random proportions instead of picking one.
     pub mix_pairs: bool,

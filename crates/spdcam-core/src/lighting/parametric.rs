@@ -14,7 +14,9 @@ use rand::Rng;
 /// cool lights are as far apart perceptually as they are in the sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CctRange {
+    /// The lowest CCT (K).
     pub min_k: f64,
+    /// The highest CCT (K).
     pub max_k: f64,
 }
 

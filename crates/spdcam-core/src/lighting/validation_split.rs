@@ -52,16 +52,22 @@ pub struct CameraSplit {
 pub struct ValidationSplit {
     /// How the split was made.
     pub method: String,
+    /// The seed of the split's shuffles.
     pub seed: u64,
+    /// The lamps of each part.
     pub lamps: LampSplit,
+    /// The cameras for training and held out.
     pub cameras: CameraSplit,
 }
 
 /// Which part of the lamp split.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LampPart {
+    /// The lamps the lamp families' parameters are fitted to.
     Fit,
+    /// The lamps models are chosen on.
     Validation,
+    /// The lamps only reported on.
     Test,
 }
 

@@ -9,7 +9,9 @@ use rayon::prelude::*;
 /// block are dropped.
 #[derive(Debug, Clone)]
 pub struct Level {
+    /// Width in (block) pixels.
     pub width: usize,
+    /// Height in (block) pixels.
     pub height: usize,
     /// R, G, B planes, row-major.
     pub planes: [Vec<f32>; 3],

@@ -21,7 +21,9 @@ pub const SCENE_PITCH_PX: usize = 50;
 /// How a scene is photographed; each range is drawn uniformly per scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneOptions {
+    /// Photo width in pixels.
     pub width: usize,
+    /// Photo height in pixels.
     pub height: usize,
     /// Width of the patch grid as a share of the photo's width.
     pub width_share: (f64, f64),

@@ -11,8 +11,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "GridFields")]
 pub struct Grid {
+    /// The first wavelength (nm).
     pub start_nm: f64,
+    /// The spacing of the samples (nm, positive).
     pub step_nm: f64,
+    /// The number of samples.
     pub count: usize,
 }
 

@@ -28,10 +28,15 @@ pub enum Extrapolation {
 /// What a resampling did: which method ran and how many target samples lay outside the data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ResampleReport {
+    /// The interpolation that ran (never [`Interpolation::Auto`]).
     pub method: Interpolation,
+    /// The source's first and last wavelength (nm).
     pub source_range_nm: (f64, f64),
+    /// Target samples below the source's range.
     pub filled_below: usize,
+    /// Target samples above the source's range.
     pub filled_above: usize,
+    /// What those samples received.
     pub extrapolation: Extrapolation,
 }
 
