@@ -2,7 +2,8 @@
 # End-to-end tests of `spdcam serve` in headless Chromium: installs what is missing
 # (Debian's chromium, playwright-core from npm), builds spdcam, starts the server on a free
 # loopback port, and runs the browser tests against the CLI's own estimate of the example;
-# then opens the CLI's HTML report of the example offline from its file.
+# then opens the CLI's HTML report of the example offline from its file. Before them, a
+# load check: 20 concurrent uploads of a 12-megapixel photo (web-tests/load.mjs).
 # Screenshots and the report go to $SPDCAM_WEB_ARTEFACTS (default: <target dir>/web-tests).
 # Ends with "N passed, N failed" and a non-zero status when a test failed.
 set -euo pipefail
@@ -55,4 +56,8 @@ if [ -z "$url" ]; then
     exit 1
 fi
 echo "server: $url"
+# Load: 20 concurrent uploads of a 12-megapixel photo, every answer checked, the server's
+# peak memory printed.
+"$bin" render --spd A --scene 4000x3000 -o "$work/12mp.jpg" >/dev/null
+node "$here/load.mjs" "$url" "$work/12mp.jpg" 20 "$server"
 node "$here/e2e.mjs" "$url" "$work/expected.json" "$photo" "$truth" "$artefacts" "$artefacts/report.html"
