@@ -40,6 +40,24 @@ pub struct UnevenLight {
     pub neutrals: usize,
 }
 
+impl UnevenLight {
+    /// How much the light's colour changes across the chart: the largest difference
+    /// between two channels' gradients (relative gain per chart width or height). One light
+    /// falling off across the chart changes every channel alike; two lights, one on each
+    /// side, do not.
+    pub fn colour_gradient(&self) -> f64 {
+        let mut most: f64 = 0.0;
+        for a in 0..3 {
+            for b in a + 1..3 {
+                for axis in 0..2 {
+                    most = most.max((self.gradient[a][axis] - self.gradient[b][axis]).abs());
+                }
+            }
+        }
+        most
+    }
+}
+
 /// Which corrections [`UnevenLight::correct`] applies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Corrections {
@@ -54,24 +72,46 @@ impl UnevenLight {
     /// `chart` in `row` (encoded sRGB on 0…`scale`, three values per feature patch); an error
     /// when fewer than [`MIN_NEUTRALS`] neutral patches are unclipped.
     pub fn fit(chart: &Chart, row: &[f64], scale: f64) -> Result<UnevenLight> {
-        if row.len() != 3 * chart.feature_patches.len() || scale <= 0.0 {
+        if row.len() != 3 * chart.feature_patches.len() {
             return Err(Error::invalid(format!(
                 "{} feature values for a chart of {} feature patches",
                 row.len(),
                 chart.feature_patches.len()
             )));
         }
-        let centres = chart.feature_centres();
+        UnevenLight::fit_neutrals(
+            &chart.neutral_features(),
+            &chart.feature_centres(),
+            row,
+            scale,
+        )
+        .map_err(|e| Error::invalid(format!("{}: {e}", chart.name)))
+    }
+
+    /// [`UnevenLight::fit`] from a chart's neutral features ([`Chart::neutral_features`])
+    /// and feature centres ([`Chart::feature_centres`]).
+    pub fn fit_neutrals(
+        neutral_features: &[(usize, f64)],
+        centres: &[[f64; 2]],
+        row: &[f64],
+        scale: f64,
+    ) -> Result<UnevenLight> {
+        if row.len() != 3 * centres.len() || scale <= 0.0 {
+            return Err(Error::invalid(format!(
+                "{} feature values for {} feature patches",
+                row.len(),
+                centres.len()
+            )));
+        }
         let linear = |k: usize, c: usize| srgb_decode((row[3 * k + c] / scale).clamp(0.0, 1.0));
-        let neutrals: Vec<(usize, f64)> = chart
-            .neutral_features()
-            .into_iter()
-            .filter(|&(k, _)| (0..3).all(|c| linear(k, c) < CLIPPED))
+        let neutrals: Vec<(usize, f64)> = neutral_features
+            .iter()
+            .copied()
+            .filter(|&(k, _)| k < centres.len() && (0..3).all(|c| linear(k, c) < CLIPPED))
             .collect();
         if neutrals.len() < MIN_NEUTRALS {
             return Err(Error::invalid(format!(
-                "{} has {} unclipped neutral patches; the light across it needs {MIN_NEUTRALS}",
-                chart.name,
+                "{} unclipped neutral patches; the light across the chart needs {MIN_NEUTRALS}",
                 neutrals.len()
             )));
         }
@@ -212,6 +252,7 @@ mod tests {
         assert!(err.to_string().contains("feature patches"), "{err}");
         // Every patch clipped.
         let err = UnevenLight::fit(&chart, &[255.0; 72], 255.0).unwrap_err();
+        assert!(err.to_string().starts_with("colorchecker24: 0 unclipped"), "{err}");
         assert!(
             err.to_string().contains("unclipped neutral patches"),
             "{err}"

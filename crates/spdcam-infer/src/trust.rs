@@ -26,6 +26,7 @@ use spdcam_core::colorimetry::srgb_decode;
 use spdcam_core::metrics;
 use spdcam_core::photo::{PatchSample, PhotoAnalysis};
 use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
+use spdcam_core::uneven_light::UnevenLight;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use std::collections::BTreeMap;
 
@@ -56,6 +57,9 @@ pub struct SelfCheck {
     pub worst: f64,
     /// The worst patches, 1-based in feature order (`p07` is 7), worst first.
     pub worst_patches: Vec<usize>,
+    /// How much the light's colour changes across the chart, measured on its neutral
+    /// patches ([`UnevenLight::colour_gradient`]); `None` with too few unclipped neutrals.
+    pub colour_gradient: Option<f64>,
 }
 
 /// The chart's feature patches seen by a reference camera, ready to be lit by an SPD.
@@ -65,6 +69,8 @@ pub struct ChartCheck {
     weights: Vec<[Vec<f64>; 3]>,
     /// Per feature patch: its centre across the chart, −½…½.
     centres: Vec<[f64; 2]>,
+    /// The neutral feature patches and their mean reflectances.
+    neutrals: Vec<(usize, f64)>,
     grid: Grid,
 }
 
@@ -88,6 +94,7 @@ impl ChartCheck {
         Ok(ChartCheck {
             weights,
             centres,
+            neutrals: chart.neutral_features(),
             grid: *grid,
         })
     }
@@ -250,6 +257,9 @@ impl ChartCheck {
             split = split.max(cross / used.len() as f64);
         }
         Ok(SelfCheck {
+            colour_gradient: UnevenLight::fit_neutrals(&self.neutrals, &self.centres, row, scale)
+                .ok()
+                .map(|u| u.colour_gradient()),
             mean,
             split,
             worst: residuals[0].1,
@@ -504,6 +514,11 @@ pub struct Calibration {
     /// The 99th percentile of the self-check's half-to-half residual ([`SelfCheck::split`])
     /// on the calibration photos; above it the estimate is doubtful.
     pub split_doubtful: Option<f64>,
+    /// The 99th percentile of the self-check's colour gradient across the chart
+    /// ([`SelfCheck::colour_gradient`]) on the calibration photos; above it the estimate is
+    /// doubtful (absent from older files).
+    #[serde(default)]
+    pub colour_gradient_doubtful: Option<f64>,
     /// The 99th percentile of the number of clipped feature patches on the calibration
     /// photos (saturated colours clip a channel under narrow-band light, and the model was
     /// trained with them); more make the estimate doubtful.
@@ -775,6 +790,20 @@ pub fn assess(
                 format!(
                     "the two halves of the chart look lit differently (two lights, glare): half-to-half residual {:.3} (clean photos stay below {level:.3})",
                     s.split
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(g), Some(level)) = (
+        self_check.as_ref().and_then(|s| s.colour_gradient),
+        calibration.and_then(|c| c.colour_gradient_doubtful),
+    ) {
+        if g > level {
+            lower(
+                Verdict::Doubtful,
+                format!(
+                    "the light's colour changes across the chart (two lights, or one light and a reflection): its neutral patches' colour gradient is {g:.2} (clean photos stay below {level:.2})"
                 ),
                 &mut reasons,
             );

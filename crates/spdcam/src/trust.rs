@@ -255,7 +255,8 @@ struct Judged {
     spd: Vec<f64>,
     truth: Option<Vec<f64>>,
     spread: Vec<f64>,
-    self_check: Option<(f64, f64)>,
+    /// The self-check's mean and split residuals and colour gradient.
+    self_check: Option<(f64, f64, Option<f64>)>,
     metric_spread: BTreeMap<String, f64>,
     metric_error: BTreeMap<String, f64>,
 }
@@ -279,7 +280,7 @@ fn judge_rows(
                 Some(c) => c
                     .check(&spd, row, scale, &trust::flag_patches(row, scale))
                     .ok()
-                    .map(|s| (s.mean, s.split)),
+                    .map(|s| (s.mean, s.split, s.colour_gradient)),
                 None => None,
             };
             let perturbed = Perturbed::of(model, row)?;
@@ -392,6 +393,10 @@ fn fit_calibration(
         .iter()
         .filter_map(|j| j.self_check.map(|s| s.1))
         .collect();
+    let mut gradients: Vec<f64> = judged
+        .iter()
+        .filter_map(|j| j.self_check.and_then(|s| s.2))
+        .collect();
     let (scale68, scale95) = (scale(0.68), scale(0.95));
     let metric_calibrations = SCALAR_KEYS
         .iter()
@@ -442,6 +447,9 @@ fn fit_calibration(
             .then(|| conformal_quantile(&mut checks, 0.99)),
         split_doubtful: (splits.len() == judged.len())
             .then(|| conformal_quantile(&mut splits, 0.99)),
+        // Measured where most photos had enough unclipped neutral patches.
+        colour_gradient_doubtful: (10 * gradients.len() >= 9 * judged.len())
+            .then(|| conformal_quantile(&mut gradients, 0.99)),
         clipped_doubtful: conformal_quantile(&mut clipped, 0.99) as usize,
         metrics: metric_calibrations,
     }
@@ -609,6 +617,9 @@ fn scene_verdicts(
                     let flagged = t.self_check.as_ref().is_some_and(|s| {
                         cal.self_check_doubtful.is_some_and(|l| s.mean > l)
                             || cal.split_doubtful.is_some_and(|l| s.split > l)
+                            || s.colour_gradient
+                                .zip(cal.colour_gradient_doubtful)
+                                .is_some_and(|(g, l)| g > l)
                     });
                     counts[kind].1 += usize::from(flagged);
                 }
@@ -652,7 +663,10 @@ flare, linear light gradient across the chart), fitted by least squares after un
 best of 25 tone curves (gamma 0.7–1.3 × S-curve contrast ±0.4), takes them to the photo's \
 linear RGB. `mean`/`worst`: the patch residuals relative to the chart's mean RGB length; \
 `split`: the residual when each half of the chart (left/right, top/bottom) is predicted by \
-the other half's map. The ColorChecker 24's reflectances are built in; the SG's come from the \
+the other half's map; `colour_gradient`: how differently the three channels brighten across \
+the chart on its neutral patches (a linear gain and a flare per channel fitted there, \
+`spdcam_core::uneven_light`; one light falling off brightens all alike, two lights do not). \
+The ColorChecker 24's reflectances are built in; the SG's come from the \
 data directory, so without it an SG estimate has no self-check (the reasons say so).\n\
 - **Bands.** The model is run on 16 copies of the features, each perturbed by 2 % \
 (log-normal); the spread s(λ) of the peak-normalised SPDs plus a floor f(λ) (the median \
@@ -668,7 +682,7 @@ equal-count bins of the mean spread; not rising with difficulty).\n\
 - **Verdict** (constants in `spdcam_infer::trust`, levels in the calibration file): `doubtful` \
 when the detection confidence is below 0.8, more feature patches are clipped than in 99 % of \
 the calibration photos, more than a quarter are nearly black, the self-check's mean or split \
-residual exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
+residual or colour gradient exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
 99th percentile (many lights give nearly this photo, or it is unlike the training lights), \
 or the expected GFC is below 0.95; `unusable` when more than half the patches are clipped, \
 the self-check cannot be made (too few usable patches) or a self-check residual exceeds \
@@ -926,7 +940,8 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
     );
     let mut flags = String::from(
         "## The self-check on clean and bad photos\n\n\
-         Share of photos whose self-check residual exceeds the calibration's doubtful level \
+         Share of photos whose self-check residual or colour gradient exceeds the \
+         calibration's doubtful level \
          (flagged), and share whose verdict is not `ok`. Clean: the test lamps' photos above. \
          Wrong chart: the same photos with the patches in a random order (a chart the model \
          does not read). Half-lit: the right half of the chart lit by the next lamp of the \
@@ -1045,7 +1060,11 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
                 .iter()
                 .filter(|j| {
                     j.self_check
-                        .is_none_or(|(m, s)| m > level || s > split_level)
+                        .is_none_or(|(m, s, g)| {
+                            m > level
+                                || s > split_level
+                                || g.zip(cal.colour_gradient_doubtful).is_some_and(|(g, l)| g > l)
+                        })
                 })
                 .count() as f64
                 / judged.len() as f64)
