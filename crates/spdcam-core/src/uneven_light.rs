@@ -252,7 +252,10 @@ mod tests {
         assert!(err.to_string().contains("feature patches"), "{err}");
         // Every patch clipped.
         let err = UnevenLight::fit(&chart, &[255.0; 72], 255.0).unwrap_err();
-        assert!(err.to_string().starts_with("colorchecker24: 0 unclipped"), "{err}");
+        assert!(
+            err.to_string().starts_with("colorchecker24: 0 unclipped"),
+            "{err}"
+        );
         assert!(
             err.to_string().contains("unclipped neutral patches"),
             "{err}"

@@ -26,8 +26,8 @@ use spdcam_core::colorimetry::srgb_decode;
 use spdcam_core::metrics;
 use spdcam_core::photo::{PatchSample, PhotoAnalysis};
 use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
-use spdcam_core::uneven_light::UnevenLight;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_core::uneven_light::UnevenLight;
 use std::collections::BTreeMap;
 
 /// How many patches the self-check names as the worst.
@@ -181,7 +181,13 @@ impl ChartCheck {
                 }
             }
         }
-        best.ok_or_else(|| InferError::invalid("self-check: no tone curve to try"))
+        let mut best =
+            best.ok_or_else(|| InferError::invalid("self-check: no tone curve to try"))?;
+        best.colour_gradient =
+            UnevenLight::fit_neutrals(&self.neutrals, &self.centres, features, scale)
+                .ok()
+                .map(|u| u.colour_gradient());
+        Ok(best)
     }
 
     /// The self-check's fit of `predicted` raw RGB to `observed` linear RGB over the
@@ -257,9 +263,7 @@ impl ChartCheck {
             split = split.max(cross / used.len() as f64);
         }
         Ok(SelfCheck {
-            colour_gradient: UnevenLight::fit_neutrals(&self.neutrals, &self.centres, row, scale)
-                .ok()
-                .map(|u| u.colour_gradient()),
+            colour_gradient: None,
             mean,
             split,
             worst: residuals[0].1,

@@ -1059,12 +1059,12 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
             Ok(judged
                 .iter()
                 .filter(|j| {
-                    j.self_check
-                        .is_none_or(|(m, s, g)| {
-                            m > level
-                                || s > split_level
-                                || g.zip(cal.colour_gradient_doubtful).is_some_and(|(g, l)| g > l)
-                        })
+                    j.self_check.is_none_or(|(m, s, g)| {
+                        m > level
+                            || s > split_level
+                            || g.zip(cal.colour_gradient_doubtful)
+                                .is_some_and(|(g, l)| g > l)
+                    })
                 })
                 .count() as f64
                 / judged.len() as f64)
