@@ -4,7 +4,7 @@
 mod common;
 
 use common::{fails, ok, s, scratch, spdcam};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The example photo the README's first command estimates, and its true SPD beside it.
 const EXAMPLE: &str = "../../examples/sg-telelumen.jpg";
@@ -304,7 +304,8 @@ fn bad_photos_give_clear_errors_and_no_output() {
 
 #[cfg(feature = "measured-data")]
 /// The shared data directory (for the SG 96 reflectances and the Canon curves).
-fn data_dir() -> PathBuf {
+fn data_dir() -> std::path::PathBuf {
+    use std::path::PathBuf;
     let root = std::env::var_os("SPDCAM_DATA")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
