@@ -60,12 +60,7 @@ pub fn run(args: FinetuneArgs) -> Result<()> {
     if !args.recipe_given() {
         return run_chosen(&args, &model, &data);
     }
-    let val = args
-        .schedule
-        .val
-        .as_deref()
-        .map(TrainingSet::load)
-        .transpose()?;
+    let val = args.schedule.load_val()?;
     let base = FinetuneOptions::thesis();
     let options = FinetuneOptions {
         schedule: args.schedule.apply(base.schedule),

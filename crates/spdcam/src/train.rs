@@ -106,6 +106,11 @@ pub struct ScheduleArgs {
 }
 
 impl ScheduleArgs {
+    /// The validation dataset of `--val`, read into memory, when given.
+    pub fn load_val(&self) -> Result<Option<TrainingSet>> {
+        Ok(self.val.as_deref().map(TrainingSet::load).transpose()?)
+    }
+
     /// `base` with the flags given here applied.
     pub fn apply(&self, mut base: Schedule) -> Schedule {
         if let Some(e) = self.epochs {
@@ -240,12 +245,7 @@ pub fn run(args: TrainArgs, data_dir: &DataDir) -> Result<()> {
         fsio::check_writable(path)?;
     }
     let data = TrainingSet::load(&args.data)?;
-    let val = args
-        .schedule
-        .val
-        .as_deref()
-        .map(TrainingSet::load)
-        .transpose()?;
+    let val = args.schedule.load_val()?;
     let architecture = match (args.model, args.ridge) {
         (ModelKind::Linear, Some(ridge)) if ridge.is_finite() && ridge > 0.0 => {
             Architecture::Linear { ridge }

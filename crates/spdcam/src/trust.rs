@@ -301,7 +301,12 @@ fn judge_rows(
             };
             Ok(Judged {
                 spread: perturbed.spread(),
-                metric_spread: perturbed.metric_spread(&wavelengths),
+                // The metrics' spread serves the intervals, measured only against a truth.
+                metric_spread: if truth.is_some() {
+                    perturbed.metric_spread(&wavelengths)
+                } else {
+                    BTreeMap::new()
+                },
                 metric_error,
                 truth,
                 spd,

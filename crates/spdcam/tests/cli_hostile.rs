@@ -1,29 +1,12 @@
 //! Hostile and careless input on the command line (issue 15): every case gets a clear
 //! error at once — no abort, no minutes of work, no lost output, no silent overwrite.
 
+mod common;
+
+use common::{s, scratch, spdcam};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::time::{Duration, Instant};
-
-fn spdcam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(args)
-        .env_remove("SPDCAM_DATA")
-        .output()
-        .expect("spdcam runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("spdcam-cli-hostile-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// Runs spdcam, expects it to fail within a few seconds, and returns its stderr.
 fn fails_fast(args: &[&str]) -> String {
@@ -55,7 +38,8 @@ fn sizes_from_options_are_capped_with_a_clear_error() {
             "SPDCAM_MAX_FILTER_SIGMA",
         ),
     ] {
-        let mut all = vec!["render", "--spd", "D65", "-o", s(&png)];
+        let png = s(&png);
+        let mut all = vec!["render", "--spd", "D65", "-o", &png];
         all.extend(args.iter().copied());
         let e = fails_fast(&all);
         assert!(e.contains(limit), "{args:?}: {e}");
@@ -67,7 +51,7 @@ fn sizes_from_options_are_capped_with_a_clear_error() {
         "--scene",
         "100000x100000",
         "-o",
-        s(&jpg),
+        &s(&jpg),
     ]);
     assert!(e.contains("SPDCAM_MAX_RENDER_PIXELS"), "{e}");
     let out = dir.join("d");
@@ -78,7 +62,7 @@ fn sizes_from_options_are_capped_with_a_clear_error() {
         "--count",
         "1000000000000",
         "-o",
-        s(&out),
+        &s(&out),
     ]);
     assert!(e.contains("SPDCAM_MAX_SAMPLES"), "{e}");
     let e = fails_fast(&[
@@ -90,7 +74,7 @@ fn sizes_from_options_are_capped_with_a_clear_error() {
         "--spd-grid",
         "380-780:0.00001",
         "-o",
-        s(&out),
+        &s(&out),
     ]);
     assert!(e.contains("SPDCAM_MAX_GRID_BANDS"), "{e}");
     assert!(!out.exists() || std::fs::read_dir(&out).unwrap().count() == 0);
@@ -108,7 +92,7 @@ fn a_negative_exposure_is_named_not_mistaken_for_an_option() {
         "--exposure",
         "-1",
         "-o",
-        s(&dir.join("c.png")),
+        &s(&dir.join("c.png")),
     ]);
     assert!(e.contains("--exposure -1") && e.contains("positive"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -146,7 +130,7 @@ fn dash_writes_to_standard_output() {
             "--noise",
             "off",
             "-o",
-            s(&png),
+            &s(&png),
             "--features",
             "-",
         ])
@@ -169,9 +153,9 @@ fn train_refuses_an_unwritable_model_path_before_training() {
         "--model",
         "mlp",
         "--data",
-        s(&dir.join("no-such-data")),
+        &s(&dir.join("no-such-data")),
         "-o",
-        s(&dir),
+        &s(&dir),
     ]);
     assert!(e.contains("is a directory"), "{e}");
     let e = fails_fast(&[
@@ -179,9 +163,9 @@ fn train_refuses_an_unwritable_model_path_before_training() {
         "--model",
         "mlp",
         "--data",
-        s(&dir.join("no-such-data")),
+        &s(&dir.join("no-such-data")),
         "-o",
-        s(&dir.join("missing/m.spdm")),
+        &s(&dir.join("missing/m.spdm")),
     ]);
     assert!(e.contains("does not exist"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -196,11 +180,11 @@ fn evaluate_refuses_to_overwrite_a_directory_of_user_files() {
     let e = fails_fast(&[
         "evaluate",
         "--model",
-        s(&dir.join("m.spdm")),
+        &s(&dir.join("m.spdm")),
         "--data",
-        s(&dir),
+        &s(&dir),
         "-o",
-        s(&dir),
+        &s(&dir),
     ]);
     assert!(e.contains("not empty") && e.contains("--force"), "{e}");
     assert_eq!(
@@ -225,14 +209,14 @@ fn a_damaged_dataset_fails_verification_and_a_failed_import_leaves_nothing() {
         "8",
         "--fast",
         "-o",
-        s(&data),
+        &s(&data),
     ]);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let ok = spdcam(&["dataset", "info", s(&data), "--verify"]);
+    let ok = spdcam(&["dataset", "info", &s(&data), "--verify"]);
     let text = String::from_utf8_lossy(&ok.stdout);
     assert!(
         ok.status.success() && text.contains("verified: 3 files, 20 samples"),
@@ -243,7 +227,7 @@ fn a_damaged_dataset_fails_verification_and_a_failed_import_leaves_nothing() {
     let at = bytes.len() / 2;
     bytes[at] ^= 1;
     std::fs::write(&part, bytes).unwrap();
-    let e = fails_fast(&["dataset", "info", s(&data), "--verify"]);
+    let e = fails_fast(&["dataset", "info", &s(&data), "--verify"]);
     assert!(
         e.contains("part-00001.parquet") && e.contains("checksum"),
         "{e}"
@@ -251,10 +235,10 @@ fn a_damaged_dataset_fails_verification_and_a_failed_import_leaves_nothing() {
     let e = fails_fast(&[
         "dataset",
         "export",
-        s(&data),
+        &s(&data),
         "--csv",
         "-o",
-        s(&dir.join("csv")),
+        &s(&dir.join("csv")),
     ]);
     assert!(e.contains("checksum"), "{e}");
 
@@ -265,11 +249,11 @@ fn a_damaged_dataset_fails_verification_and_a_failed_import_leaves_nothing() {
         "dataset",
         "import",
         "--features",
-        s(&f),
+        &s(&f),
         "--spds",
-        s(&spds),
+        &s(&spds),
         "-o",
-        s(&imported),
+        &s(&imported),
     ];
     let e = fails_fast(&import);
     assert!(e.contains("negative"), "{e}");
@@ -297,9 +281,9 @@ fn nonsense_features_and_truths_get_no_spd() {
     let features = dir.join("f.csv");
     let out = spdcam(&[
         "estimate",
-        s(&example_photo()),
+        &s(&example_photo()),
         "--features-out",
-        s(&features),
+        &s(&features),
     ]);
     assert!(
         out.status.success(),
@@ -316,11 +300,11 @@ fn nonsense_features_and_truths_get_no_spd() {
         path
     };
     let zero = write("zero.csv", &vec![0.0; values.len()]);
-    let e = fails_fast(&["estimate", "--features", s(&zero)]);
+    let e = fails_fast(&["estimate", "--features", &s(&zero)]);
     assert!(e.contains("black") && !e.contains("CCT"), "{e}");
     let mut negative = values.clone();
     negative[4] = -3.0;
-    let e = fails_fast(&["estimate", "--features", s(&write("neg.csv", &negative))]);
+    let e = fails_fast(&["estimate", "--features", &s(&write("neg.csv", &negative))]);
     assert!(e.contains("p02_g") && e.contains("-3"), "{e}");
     let grey: Vec<f64> = values
         .chunks(3)
@@ -329,12 +313,18 @@ fn nonsense_features_and_truths_get_no_spd() {
             [mean; 3]
         })
         .collect();
-    let e = fails_fast(&["estimate", "--features", s(&write("grey.csv", &grey))]);
+    let e = fails_fast(&["estimate", "--features", &s(&write("grey.csv", &grey))]);
     assert!(e.contains("greyscale"), "{e}");
 
     let truth = dir.join("zero-truth.csv");
     std::fs::write(&truth, "wavelength_nm,t\n380,0\n780,0\n").unwrap();
-    let e = fails_fast(&["estimate", "--features", s(&features), "--truth", s(&truth)]);
+    let e = fails_fast(&[
+        "estimate",
+        "--features",
+        &s(&features),
+        "--truth",
+        &s(&truth),
+    ]);
     assert!(e.contains("zero everywhere"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -348,7 +338,7 @@ fn a_greyscale_photo_gets_no_spd() {
         .grayscale()
         .save(&grey)
         .unwrap();
-    let e = fails_fast(&["estimate", s(&grey)]);
+    let e = fails_fast(&["estimate", &s(&grey)]);
     assert!(e.contains("grey.png"), "{e}");
     assert!(e.contains("greyscale"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -361,7 +351,7 @@ fn a_truncated_jpeg_is_estimated_with_a_warning() {
     let bytes = std::fs::read(example_photo()).unwrap();
     let cut = dir.join("cut.jpg");
     std::fs::write(&cut, &bytes[..bytes.len() * 99 / 100]).unwrap();
-    let out = spdcam(&["estimate", s(&cut)]);
+    let out = spdcam(&["estimate", &s(&cut)]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains("cut.jpg") && stderr.contains("truncated"),
@@ -374,7 +364,7 @@ fn a_truncated_jpeg_is_estimated_with_a_warning() {
 fn estimates_go_to_standard_output_with_dash() {
     let dir = scratch("estimate-stdout");
     let out = Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(["estimate", s(&example_photo()), "-o", "-"])
+        .args(["estimate", &s(&example_photo()), "-o", "-"])
         .current_dir(&dir)
         .output()
         .unwrap();
@@ -401,7 +391,7 @@ fn a_version_0_model_is_called_damaged_not_newer() {
     bytes[8..12].copy_from_slice(&0u32.to_le_bytes());
     let model = dir.join("v0.spdm");
     std::fs::write(&model, bytes).unwrap();
-    let e = fails_fast(&["estimate", s(&example_photo()), "--model", s(&model)]);
+    let e = fails_fast(&["estimate", &s(&example_photo()), "--model", &s(&model)]);
     assert!(
         e.contains("version 0") && e.contains("damaged") && !e.contains("newer"),
         "{e}"
@@ -438,9 +428,9 @@ fn errors_about_wide_files_and_bad_cells_stay_short_and_precise() {
         "--spd",
         "D65",
         "--camera",
-        s(&wide),
+        &s(&wide),
         "-o",
-        s(&png),
+        &s(&png),
     ]);
     assert!(e.len() < 600, "{} bytes: {e}", e.len());
     assert!(e.contains("2000 in all"), "{e}");
@@ -468,7 +458,7 @@ fn errors_about_wide_files_and_bad_cells_stay_short_and_precise() {
         format!("{}\n{}\n{}\n", header.join(","), row("50"), row("nan")),
     )
     .unwrap();
-    let e = fails_fast(&["estimate", "--features", s(&features)]);
+    let e = fails_fast(&["estimate", "--features", &s(&features)]);
     assert!(
         e.contains("line 3") && e.contains("p01_g") && e.contains("NaN"),
         "{e}"

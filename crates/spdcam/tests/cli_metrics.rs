@@ -1,23 +1,10 @@
 //! `spdcam metrics` as a user runs it: JSON with every key, a readable table, named lights, and
 //! clear errors on bad input.
 
+mod common;
+
+use common::{scratch, spdcam};
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn spdcam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(args)
-        .env_remove("SPDCAM_DATA")
-        .output()
-        .expect("spdcam runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("spdcam-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// The CIE 015 lamps the library's reference tests use (FL2, FL7, FL11, LED-B3, LED-RGB1, HP1).
 fn lamps_csv() -> PathBuf {

@@ -1,22 +1,10 @@
 //! `spdcam render` and `spdcam list` as a user runs them: outputs, and clear errors on bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn spdcam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(args)
-        .env_remove("SPDCAM_DATA")
-        .output()
-        .expect("spdcam runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("spdcam-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{scratch, spdcam};
+use std::path::Path;
+use std::process::Output;
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

@@ -1,5 +1,7 @@
 //! Locating the measured data that tests read (never shipped): `$SPDCAM_DATA`, else
-//! `../shared/data` beside the repository.
+//! `../shared/data` beside the repository. Second tier only: the tests that use it declare
+//! it under `#[cfg(feature = "measured-data")]`, and it compiles to nothing without it.
+#![cfg(feature = "measured-data")]
 
 use std::path::PathBuf;
 
