@@ -152,9 +152,11 @@ impl Layout {
     }
 
     /// The central sampling region of a patch: the thesis samples 14×14 px starting 5 px
-    /// inside a 24×24 patch; other sizes keep the same proportion. Returns (x0, y0, side).
+    /// inside a 24×24 patch; other sizes keep the same proportion
+    /// ([`crate::sampler::SAMPLING_FRACTION`]). Returns (x0, y0, side).
     pub fn sampling_region(&self, i: usize) -> (usize, usize, usize) {
-        let side = ((self.patch_px as f64 * 14.0 / 24.0).round() as usize).max(1);
+        let side =
+            ((self.patch_px as f64 * crate::sampler::SAMPLING_FRACTION).round() as usize).max(1);
         let inset = (self.patch_px - side) / 2;
         let (x0, y0) = self.patch_origin(i);
         (x0 + inset, y0 + inset, side)

@@ -16,6 +16,8 @@
 //!   camera to validate against.
 //! - [`dataset`]: (features, SPD) samples generated with the camera or imported, stored as
 //!   Parquet; [`seed`] makes every random draw depend only on the seed and the sample.
+//! - [`sampler`]: the one patch sampler (the region read and its robust statistic) that
+//!   turns pixels into features, for simulated images and photos alike.
 //! - [`photo`]: real photos — find the chart, rectify it, sample the patches into the same
 //!   feature row; [`feature_check`] rejects rows that cannot say anything about the light.
 //! - [`metrics`] (RMSE, GFC, SAM, SID between spectra), [`colorimetry`] (XYZ, CCT/Duv,
@@ -103,6 +105,7 @@ pub mod metrics;
 pub mod photo;
 pub mod quality;
 pub mod raster;
+pub mod sampler;
 pub mod seed;
 pub mod simple_camera;
 pub mod spectral;

@@ -1,5 +1,6 @@
 //! The virtual camera (thesis chapter 3): sensor ─► noise ─► demosaic ─► white balance ─►
-//! aberration ─► colour, each stage switchable, then the patch features.
+//! aberration ─► colour, each stage switchable, then the patch features by the sampler
+//! photos use too ([`crate::sampler`]).
 //!
 //! [`Camera::render`] runs the whole image pipeline; [`Camera::features_fast`] gives the
 //! noise-free features straight from patch-level values, without an image, for very large
@@ -18,6 +19,7 @@ use crate::colorimetry::Observer;
 use crate::error::{Error, Result};
 use crate::illuminant::StandardIlluminant;
 use crate::raster::{Mosaic, RgbImage};
+use crate::sampler::{self, SampleBuffers};
 use crate::seed;
 use crate::spectral::Grid;
 use aberration::LateralAberration;
@@ -110,6 +112,7 @@ pub struct RenderBuffers {
     scratch: Vec<f32>,
     binned: RgbImage,
     region: aberration::RegionPlanes,
+    samples: SampleBuffers,
 }
 
 /// The intermediate images of one render, for inspection (`--stages`).
@@ -130,7 +133,7 @@ pub struct Stages {
 pub struct Rendering {
     /// The final image: encoded sRGB, quantised, on 0…1.
     pub image: RgbImage,
-    /// The features of the image ([`Camera::features`]): mean encoded sRGB, 0–255.
+    /// The features of the image ([`Camera::features`]): robust mean encoded sRGB, 0–255.
     pub features: Vec<f32>,
     /// The intermediate images, when asked for.
     pub stages: Stages,
@@ -283,6 +286,7 @@ impl Camera {
             scratch: Vec::new(),
             binned: RgbImage::new(l.width / 2, l.height / 2),
             region: aberration::RegionPlanes::default(),
+            samples: SampleBuffers::default(),
         }
     }
 
@@ -410,7 +414,12 @@ impl Camera {
         out: &mut Vec<f32>,
     ) {
         self.capture_balanced(ic, light, seed, buffers, None);
-        let RenderBuffers { image, region, .. } = buffers;
+        let RenderBuffers {
+            image,
+            region,
+            samples,
+            ..
+        } = buffers;
         let layout = &self.chart.layout;
         for &p in &self.chart.feature_patches {
             let (x, y, side) = layout.sampling_region(p);
@@ -433,14 +442,15 @@ impl Camera {
                 }
             }
             let [r, g, b] = &region.planes;
-            let mut sum = [0.0f64; 3];
-            for ((&r, &g), &b) in r.iter().zip(g).zip(b) {
-                let encoded = self.finish_pixel(ic, [r, g, b]);
-                for (total, v) in sum.iter_mut().zip(encoded) {
-                    *total += f64::from(self.colour.quantise(v));
-                }
-            }
-            out.extend(sum.map(|s| (255.0 * s / (side * side) as f64) as f32));
+            samples.pixels.clear();
+            samples
+                .pixels
+                .extend(r.iter().zip(g).zip(b).map(|((&r, &g), &b)| {
+                    self.finish_pixel(ic, [r, g, b])
+                        .map(|v| self.colour.quantise(v))
+                }));
+            let (mean, _) = sampler::robust_mean(samples);
+            out.extend(mean.map(|m| (255.0 * m) as f32));
         }
     }
 
@@ -503,24 +513,29 @@ impl Camera {
         gains
     }
 
-    /// Features of a final image: the mean encoded sRGB (0–255) of each feature patch's
-    /// central sampling region, `p01_r, p01_g, p01_b, p02_r, …`.
+    /// Features of a final image: the robust mean encoded sRGB (0–255) of each feature
+    /// patch's central sampling region, by the sampler photos use ([`sampler`]),
+    /// `p01_r, p01_g, p01_b, p02_r, …`.
     pub fn features(&self, image: &RgbImage) -> Vec<f32> {
         let layout = &self.chart.layout;
         let mut out = Vec::with_capacity(self.chart.feature_patches.len() * 3);
+        let mut samples = SampleBuffers::default();
+        let [r, g, b] = &image.planes;
         for &p in &self.chart.feature_patches {
             let (x0, y0, side) = layout.sampling_region(p);
-            for plane in &image.planes {
-                let sum: f64 = (y0..y0 + side)
-                    .map(|y| {
-                        plane[y * image.width + x0..y * image.width + x0 + side]
-                            .iter()
-                            .map(|&v| v as f64)
-                            .sum::<f64>()
-                    })
-                    .sum();
-                out.push((255.0 * sum / (side * side) as f64) as f32);
+            samples.pixels.clear();
+            for y in y0..y0 + side {
+                let row = y * image.width + x0..y * image.width + x0 + side;
+                samples.pixels.extend(
+                    r[row.clone()]
+                        .iter()
+                        .zip(&g[row.clone()])
+                        .zip(&b[row])
+                        .map(|((&r, &g), &b)| [r, g, b]),
+                );
             }
+            let (mean, _) = sampler::robust_mean(&mut samples);
+            out.extend(mean.map(|m| (255.0 * m) as f32));
         }
         out
     }

@@ -68,9 +68,6 @@ pub const COLORCHECKER_SG_PATCH_FRACTION: f64 = 0.88;
 /// Patch fraction of other charts whose layout has no gap.
 pub const DEFAULT_PATCH_FRACTION: f64 = 0.85;
 
-/// Sampled side of a patch: the thesis samples 14 of 24 px, centred ([`crate::chart::Layout::sampling_region`]).
-pub const SAMPLING_FRACTION: f64 = 14.0 / 24.0;
-
 /// Wavelength range (nm) over which a patch must be flat to count as neutral.
 const NEUTRAL_RANGE_NM: (f64, f64) = (420.0, 680.0);
 /// Largest relative standard deviation of a neutral patch's reflectance over that range.

@@ -8,9 +8,10 @@ use super::geometry::Homography;
 use super::load::Photo;
 use super::pyramid::Level;
 use super::sample::PatchSample;
-use super::{ChartTemplate, Detection, SAMPLING_FRACTION};
+use super::{ChartTemplate, Detection};
 use crate::error::{Error, Result};
 use crate::fsio;
+use crate::sampler::SAMPLING_FRACTION;
 use image::ImageEncoder;
 use std::path::Path;
 

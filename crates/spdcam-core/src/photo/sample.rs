@@ -1,18 +1,18 @@
-//! Sampling the patches of a rectified chart: the centred square of each patch (the same
-//! share of the patch as the virtual camera samples), robust statistics that drop clipped
-//! and glare pixels, and flags for clipped or very dark patches.
+//! Sampling the patches of a rectified chart with the one sampler ([`crate::sampler`]: the
+//! centred square of each patch, the same share and the same robust statistic as the
+//! virtual camera), clipped pixels set aside as glare, and flags for clipped or very dark
+//! patches.
 
 use super::geometry::Homography;
 use super::load::Photo;
-use super::{ChartTemplate, SAMPLING_FRACTION};
+use super::ChartTemplate;
 use crate::error::{Error, Result};
+use crate::sampler::{robust_mean, SampleBuffers, SAMPLING_FRACTION};
 use rayon::prelude::*;
 use serde::Serialize;
 
 /// Most pixels read per patch (an even subsample beyond), which keeps large photos fast.
 const MAX_PIXELS: usize = 40_000;
-/// Share of pixels trimmed from each end of the lightness order.
-const TRIM: f64 = 0.1;
 /// A patch is clipped when more than this share of its pixels has a clipped channel.
 const CLIPPED_SHARE: f64 = 0.25;
 /// A patch is dark when its brightest channel's mean is below this (encoded, 0…1).
@@ -130,7 +130,7 @@ fn sample_patch(
     } else {
         kept
     };
-    let (mean, std) = robust_mean(values);
+    let (mean, std) = robust_mean(&mut SampleBuffers::with_pixels(values));
     Ok(PatchSample {
         patch: p,
         centre,
@@ -141,59 +141,4 @@ fn sample_patch(
         clipped: is_clipped,
         dark: mean.iter().all(|&v| v < DARK_LEVEL as f64),
     })
-}
-
-/// Mean and standard deviation after dropping lightness outliers (beyond 4 robust standard
-/// deviations of the median, e.g. specular glints or dust) and trimming [`TRIM`] of the
-/// rest from each end of the lightness order.
-fn robust_mean(mut values: Vec<[f32; 3]>) -> ([f64; 3], [f64; 3]) {
-    let light = |v: &[f32; 3]| v[0] + v[1] + v[2];
-    values.sort_by(|a, b| light(a).total_cmp(&light(b)));
-    let n = values.len();
-    let median = light(&values[n / 2]);
-    let mut dev: Vec<f32> = values.iter().map(|v| (light(v) - median).abs()).collect();
-    let mid = dev.len() / 2;
-    let mad = *dev.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
-    let limit = 4.0 * 1.4826 * mad + 6.0 / 255.0;
-    let inliers: Vec<[f32; 3]> = values
-        .into_iter()
-        .filter(|v| (light(v) - median).abs() <= limit)
-        .collect();
-    let m = inliers.len();
-    let cut = (m as f64 * TRIM) as usize;
-    let core = &inliers[cut..m - cut];
-    let k = core.len() as f64;
-    let mut mean = [0.0f64; 3];
-    for v in core {
-        for c in 0..3 {
-            mean[c] += v[c] as f64;
-        }
-    }
-    mean = mean.map(|s| s / k);
-    let mut var = [0.0f64; 3];
-    for v in core {
-        for c in 0..3 {
-            var[c] += (v[c] as f64 - mean[c]).powi(2);
-        }
-    }
-    (mean, var.map(|s| (s / k).sqrt()))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn glints_are_dropped_and_symmetric_noise_kept() {
-        let mut v: Vec<[f32; 3]> = (0..100)
-            .map(|i| {
-                let d = ((i % 10) as f32 - 4.5) / 255.0;
-                [0.4 + d, 0.3 + d, 0.2 + d]
-            })
-            .collect();
-        v.extend(std::iter::repeat_n([0.99, 0.99, 0.99], 8));
-        let (mean, _) = robust_mean(v);
-        assert!((mean[0] - 0.4).abs() < 1e-3, "{mean:?}");
-        assert!((mean[2] - 0.2).abs() < 1e-3, "{mean:?}");
-    }
 }
