@@ -4,8 +4,10 @@
 
 use spdcam_core::builtin::{self, DataDir};
 use spdcam_core::camera::colour::ColourTransform;
-use spdcam_core::camera::in_camera::{calibrate, jpeg_quantise, CalibrationPhoto, InCamera};
+use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
+use spdcam_core::camera::tone::jpeg_quantise;
+use spdcam_core::camera::white_balance;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry;
@@ -81,28 +83,28 @@ fn tone_stages_match_hand_computed_values() {
     };
     let y = enc(0.1);
     let want = y + 0.5 * y * (1.0 - y) * (2.0 * y - 1.0);
-    assert!((ic.tone(&ct, [0.1; 3])[0] - want).abs() < 1e-5);
+    assert!((ic.rendering().encode(&ct, [0.1; 3])[0] - want).abs() < 1e-5);
     // Shoulder 0.4: 1.2 rolls off to 0.6 + 0.4·(1 − e^−1.5); 0.5 is below the knee.
     let ic = InCamera {
         shoulder: 0.4,
         ..InCamera::NEUTRAL
     };
     let rolled = 0.6 + 0.4 * (1.0 - (-1.5f64).exp());
-    assert!((ic.tone(&ct, [1.2, 0.5, 0.0])[0] - enc(rolled)).abs() < 1e-5);
-    assert!((ic.tone(&ct, [1.2, 0.5, 0.0])[1] - enc(0.5)).abs() < 1e-5);
+    assert!((ic.rendering().encode(&ct, [1.2, 0.5, 0.0])[0] - enc(rolled)).abs() < 1e-5);
+    assert!((ic.rendering().encode(&ct, [1.2, 0.5, 0.0])[1] - enc(0.5)).abs() < 1e-5);
     // Gamma 2 on linear 0.3 → 0.09.
     let ic = InCamera {
         gamma: 2.0,
         ..InCamera::NEUTRAL
     };
-    assert!((ic.tone(&ct, [0.3; 3])[2] - enc(0.09)).abs() < 1e-5);
+    assert!((ic.rendering().encode(&ct, [0.3; 3])[2] - enc(0.09)).abs() < 1e-5);
     // Saturation 0 turns a colour into its luminance; greys are kept at any saturation.
     let ic = InCamera {
         saturation: 0.0,
         ..InCamera::NEUTRAL
     };
     let lum = 0.2126 * 0.8 + 0.7152 * 0.2 + 0.0722 * 0.1;
-    for v in ic.tone(&ct, [0.8, 0.2, 0.1]) {
+    for v in ic.rendering().encode(&ct, [0.8, 0.2, 0.1]) {
         assert!((v - enc(lum)).abs() < 1e-5);
     }
     // Incomplete adaptation: gains^a.
@@ -110,7 +112,7 @@ fn tone_stages_match_hand_computed_values() {
         adaptation: 0.5,
         ..InCamera::NEUTRAL
     };
-    let g = ic.adapt([2.0, 1.0, 0.25]);
+    let g = white_balance::adapt([2.0, 1.0, 0.25], ic.adaptation);
     assert!((g[0] - 2f32.sqrt()).abs() < 1e-6 && g[1] == 1.0 && (g[2] - 0.5).abs() < 1e-6);
     // Flare adds flare × the patch mean; auto exposure brings the mean green to the target.
     let ic = InCamera {
@@ -119,11 +121,14 @@ fn tone_stages_match_hand_computed_values() {
         ..InCamera::NEUTRAL
     };
     let mut raw = vec![[1.0, 2.0, 3.0], [3.0, 4.0, 5.0], [100.0, 100.0, 100.0]];
-    ic.add_flare(&mut raw, 2);
+    ic.glare().apply(&mut raw, 2);
     assert_eq!(raw[0], [2.0, 3.5, 5.0]);
     assert_eq!(raw[2], [101.0, 101.5, 102.0]);
     // Patch means were (2, 3, 4): patch 2 becomes (4, 5.5, 7), so the mean green is 4.5.
-    assert_eq!(ic.exposure_scale(&raw, 2), Some(0.2 / 4.5));
+    assert_eq!(
+        ic.auto_exposure().and_then(|e| e.scale(&raw, 2)),
+        Some(0.2 / 4.5)
+    );
     // JPEG at quality 50: DC steps 16/8 = 2 (luma) and 17/8 (chroma) levels; a grey of
     // 101 levels has Y = 101 → 102 (nearest multiple of 2), Cb = Cr = 0.
     let q = jpeg_quantise([101.0 / 255.0; 3], 50);
@@ -285,7 +290,7 @@ fn lighting_gradient_scales_patches_by_their_position() {
         ..InCamera::NEUTRAL
     };
     let mut raw = vec![[1.0f32, 2.0, 4.0]; 25];
-    ic.apply_gradient(&mut raw, &centres);
+    ic.uneven_lighting().apply(&mut raw, &centres);
     // Patch 0: 1 + 0.4·(−5/12) − 0.2·(−3/8) = 1 − 1/6 + 0.075.
     let g0 = 1.0 - 1.0 / 6.0 + 0.075;
     let g23 = 1.0 + 1.0 / 6.0 - 0.075;

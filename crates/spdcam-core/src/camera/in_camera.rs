@@ -1,24 +1,29 @@
-//! In-camera rendering of a JPEG camera, beyond the thesis's pipeline: uneven lighting
-//! across the chart (a scene effect that real photos carry), veiling glare,
-//! automatic exposure with sensor saturation, auto white balance with incomplete
-//! adaptation, colour saturation, a highlight shoulder, a tone curve beyond the sRGB gamma,
-//! and JPEG-like quantisation. Every stage is a parameter whose neutral value leaves the
-//! image unchanged; the whole stage is off unless [`crate::camera::CameraConfig::in_camera`]
-//! is set.
+//! The per-shot settings of a JPEG camera, beyond the thesis's pipeline, in one record:
+//! uneven lighting across the chart, veiling glare, automatic exposure with sensor
+//! saturation, auto white balance with incomplete adaptation, colour saturation, a
+//! highlight shoulder, a tone curve beyond the sRGB gamma, and JPEG-like quantisation.
+//! Each setting belongs to one stage of the chain and is carried out there:
 //!
-//! Order: raw ─► lighting gradient ─► flare ─► exposure (auto) ─► clip at full scale ─► white-balance gains raised
-//! to `adaptation` ─► colour matrix ─► saturation ─► shoulder ─► gamma ─► sRGB encode ─►
-//! contrast S-curve ─► JPEG quantisation.
+//! | settings | stage | module |
+//! |---|---|---|
+//! | `gradient` | scene: uneven lighting | [`super::scene`] |
+//! | `flare` | optics: veiling glare | [`super::optics`] |
+//! | `exposure_target` (+ clipping at full scale) | sensor: auto exposure | [`super::sensor`] |
+//! | `adaptation` | ISP: white balance | [`super::white_balance`] |
+//! | `saturation`, `shoulder`, `gamma`, `contrast`, `jpeg_quality` | ISP: rendering | [`super::tone`] |
 //!
-//! [`calibrate`] fits the parameters to a few real photos of the chart under known lights.
+//! The record is what calibration fits ([`calibrate`]), domain randomisation draws per
+//! sample and dataset manifests store. Every setting's neutral value leaves the image
+//! unchanged; the whole record is off unless [`crate::camera::CameraConfig::in_camera`] is
+//! set.
 
-use super::colour::ColourTransform;
+use super::optics::VeilingGlare;
+use super::scene::UnevenLighting;
+use super::sensor::AutoExposure;
+use super::tone::ToneRendering;
 use super::Camera;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
-
-/// Rec. 709 / sRGB luminance weights of linear R, G, B.
-const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
 /// The in-camera settings. [`InCamera::NEUTRAL`] changes nothing but the sensor clipping.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -150,110 +155,33 @@ impl InCamera {
         Ok(())
     }
 
-    /// Multiplies each region's raw value by the lighting gradient's gain at its centre;
-    /// `centres` holds each region's (x, y) position from −½ to ½ (the background sits at
-    /// the centre).
-    pub fn apply_gradient(&self, raw: &mut [[f32; 3]], centres: &[[f32; 2]]) {
-        if self.gradient == [0.0, 0.0] {
-            return;
-        }
-        let [gx, gy] = self.gradient.map(|g| g as f32);
-        for (v, [x, y]) in raw.iter_mut().zip(centres) {
-            let gain = (1.0 + gx * x + gy * y).max(0.0);
-            *v = v.map(|c| c * gain);
+    /// The scene stage's setting: the lighting gradient across the chart.
+    pub fn uneven_lighting(&self) -> UnevenLighting {
+        UnevenLighting {
+            gradient: self.gradient,
         }
     }
 
-    /// Adds the veiling glare to the raw region values in place; `patches` is the number
-    /// of chart patches (the regions before the background).
-    pub fn add_flare(&self, raw: &mut [[f32; 3]], patches: usize) {
-        if self.flare > 0.0 {
-            let mean = patch_mean(raw, patches);
-            let f = self.flare as f32;
-            raw.iter_mut()
-                .for_each(|v| *v = std::array::from_fn(|c| v[c] + f * mean[c]));
-        }
+    /// The optics stage's setting: the veiling glare.
+    pub fn glare(&self) -> VeilingGlare {
+        VeilingGlare { share: self.flare }
     }
 
-    /// The automatic exposure scale: brings the mean green raw value of the `patches` to
-    /// `exposure_target` of full scale; `None` when auto exposure is off or there is no
-    /// green signal.
-    pub fn exposure_scale(&self, raw: &[[f32; 3]], patches: usize) -> Option<f32> {
-        let target = self.exposure_target?;
-        let green = patch_mean(raw, patches)[1];
-        (green > 0.0).then(|| target as f32 / green)
+    /// The sensor stage's automatic exposure, when it is on.
+    pub fn auto_exposure(&self) -> Option<AutoExposure> {
+        self.exposure_target.map(|target| AutoExposure { target })
     }
 
-    /// The white-balance gains with incomplete adaptation: `gain^adaptation`.
-    pub fn adapt(&self, gains: [f32; 3]) -> [f32; 3] {
-        if self.adaptation == 1.0 {
-            return gains;
-        }
-        let a = self.adaptation as f32;
-        gains.map(|g| if g > 0.0 { g.powf(a) } else { g })
-    }
-
-    /// Linear sRGB (from the colour matrix) → encoded sRGB on 0…1, unquantised.
-    pub fn tone(&self, colour: &ColourTransform, linear: [f32; 3]) -> [f32; 3] {
-        let mut v = linear;
-        if self.saturation != 1.0 {
-            let y = LUMA[0] * v[0] + LUMA[1] * v[1] + LUMA[2] * v[2];
-            let s = self.saturation as f32;
-            v = v.map(|x| y + s * (x - y));
-        }
-        let knee = 1.0 - self.shoulder as f32;
-        let width = self.shoulder as f32;
-        let gamma = self.gamma as f32;
-        let c = self.contrast as f32;
-        let encoded = v.map(|x| {
-            let mut x = x.max(0.0);
-            if width > 0.0 && x > knee {
-                x = knee + width * (1.0 - (-(x - knee) / width).exp());
-            }
-            x = x.min(1.0);
-            if gamma != 1.0 {
-                x = x.powf(gamma);
-            }
-            let y = colour.encode(x);
-            (y + c * y * (1.0 - y) * (2.0 * y - 1.0)).clamp(0.0, 1.0)
-        });
-        match self.jpeg_quality {
-            Some(q) => jpeg_quantise(encoded, q),
-            None => encoded,
+    /// The ISP's rendering after the colour matrix.
+    pub fn rendering(&self) -> ToneRendering {
+        ToneRendering {
+            saturation: self.saturation,
+            shoulder: self.shoulder,
+            gamma: self.gamma,
+            contrast: self.contrast,
+            jpeg_quality: self.jpeg_quality,
         }
     }
-}
-
-/// Mean raw value of the first `patches` regions.
-fn patch_mean(raw: &[[f32; 3]], patches: usize) -> [f32; 3] {
-    let n = patches.min(raw.len()).max(1);
-    std::array::from_fn(|c| raw[..n].iter().map(|v| v[c]).sum::<f32>() / n as f32)
-}
-
-/// libjpeg's quality scaling of a base table entry: the quantisation step.
-fn jpeg_step(base: u32, quality: u8) -> f32 {
-    let q = u32::from(quality.clamp(1, 100));
-    let scale = if q < 50 { 5000 / q } else { 200 - 2 * q };
-    ((base * scale + 50) / 100).clamp(1, 255) as f32
-}
-
-/// Rounds an encoded pixel's JFIF Y, Cb, Cr (8-bit units) to the DC quantisation steps of
-/// `quality` divided by 8 (the DC coefficient of an 8×8 block is 8 × its mean), then back.
-pub fn jpeg_quantise(rgb: [f32; 3], quality: u8) -> [f32; 3] {
-    // Standard tables' DC entries: luminance 16, chrominance 17.
-    let (sy, sc) = (jpeg_step(16, quality) / 8.0, jpeg_step(17, quality) / 8.0);
-    let [r, g, b] = rgb.map(|v| v * 255.0);
-    let y = 0.299 * r + 0.587 * g + 0.114 * b;
-    let cb = -0.168_736 * r - 0.331_264 * g + 0.5 * b;
-    let cr = 0.5 * r - 0.418_688 * g - 0.081_312 * b;
-    let round = |v: f32, s: f32| (v / s).round() * s;
-    let (y, cb, cr) = (round(y, sy), round(cb, sc), round(cr, sc));
-    [
-        y + 1.402 * cr,
-        y - 0.344_136 * cb - 0.714_136 * cr,
-        y + 1.772 * cb,
-    ]
-    .map(|v| (v / 255.0).clamp(0.0, 1.0))
 }
 
 /// One real photo of the chart: its features (0–255, the camera's feature order) and the
@@ -433,13 +361,5 @@ mod tests {
             "{x:?}"
         );
         assert!(v < 1e-6);
-    }
-
-    #[test]
-    fn jpeg_steps_follow_libjpeg_scaling() {
-        assert_eq!(jpeg_step(16, 50), 16.0);
-        assert_eq!(jpeg_step(16, 75), 8.0);
-        assert_eq!(jpeg_step(16, 100), 1.0);
-        assert_eq!(jpeg_step(17, 10), 85.0);
     }
 }

@@ -1,6 +1,18 @@
-//! The virtual camera (thesis chapter 3): sensor ─► noise ─► demosaic ─► white balance ─►
-//! aberration ─► colour, each stage switchable, then the patch features by the sampler
-//! photos use too ([`crate::sampler`]).
+//! The virtual camera (thesis chapter 3, and the JPEG camera beyond it), one module per box
+//! of the chain, each switchable, then the patch features by the sampler photos use too
+//! ([`crate::sampler`]):
+//!
+//! ```text
+//! light × chart ─► scene ─► optics ─► sensor ─────────────────► ISP ───────────────────────────► features
+//!  (sensor:        (uneven   (veiling  (exposure, clipping,      (demosaic, white_balance
+//!   spectral        lighting) glare)    mosaic, noise)            with adaptation, aberration,
+//!   response)                                                     colour matrix, tone, JPEG)
+//! ```
+//!
+//! `scene.rs`, `optics.rs`, `sensor.rs` + `noise.rs`, `demosaic.rs`, `white_balance.rs`,
+//! `aberration.rs` (lateral chromatic aberration, an optical effect the thesis applies to the
+//! white-balanced image), `colour.rs`, `tone.rs`. The per-shot settings of the stages beyond
+//! the thesis come as one record, [`in_camera::InCamera`], which each stage reads its part of.
 //!
 //! [`Camera::render`] runs the whole image pipeline; [`Camera::features_fast`] gives the
 //! noise-free features straight from patch-level values, without an image, for very large
@@ -11,7 +23,10 @@ pub mod colour;
 pub mod demosaic;
 pub mod in_camera;
 pub mod noise;
+pub mod optics;
+pub mod scene;
 pub mod sensor;
+pub mod tone;
 pub mod white_balance;
 
 use crate::chart::Chart;
@@ -27,8 +42,11 @@ use colour::{ColourConfig, ColourTransform};
 use demosaic::DemosaicMethod;
 use in_camera::InCamera;
 use noise::NoiseParams;
-use sensor::{Sensitivities, SensorConfig, SensorMode, SpectralResponse};
+use optics::VeilingGlare;
+use scene::UnevenLighting;
+use sensor::{AutoExposure, Sensitivities, SensorConfig, SensorMode, SpectralResponse};
 use serde::{Deserialize, Serialize};
+use tone::ToneRendering;
 use white_balance::{RegionGeometry, WhiteBalance};
 
 /// Every setting of the camera, one field per stage; `None` switches a stage off.
@@ -197,7 +215,7 @@ impl Camera {
         let light = self.light(&d65)?;
         let mut balanced = Vec::new();
         // The matrix is the factory calibration: fitted without the in-camera rendering.
-        self.balanced_regions(None, &light, &mut balanced);
+        self.balanced_regions(&Shot::of(None), &light, &mut balanced);
         let observer = Observer::cie1931(&self.grid)?;
         let patches = self.chart.reflectances.len();
         let rgb: Vec<[f64; 3]> = balanced[..patches]
@@ -290,17 +308,17 @@ impl Camera {
         }
     }
 
-    /// Exposed raw values of every region under `light` (into `raw`); with an in-camera
-    /// stage, flare, auto exposure and clipping at full scale too.
-    fn exposed_regions(&self, ic: Option<&InCamera>, light: &[f32], raw: &mut Vec<[f32; 3]>) {
+    /// Exposed raw values of every region under `light` (into `raw`): the spectral
+    /// response, the scene's uneven lighting, the optics' glare, and the sensor's exposure
+    /// (with clipping at full scale when the shot meters automatically).
+    fn exposed_regions(&self, shot: &Shot, light: &[f32], raw: &mut Vec<[f32; 3]>) {
         self.response.raw_into(light, raw);
         let patches = self.chart.reflectances.len();
-        if let Some(ic) = ic {
-            ic.apply_gradient(raw, &self.region_centres);
-            ic.add_flare(raw, patches);
-        }
-        let scale = ic
-            .and_then(|ic| ic.exposure_scale(raw, patches))
+        shot.lighting.apply(raw, &self.region_centres);
+        shot.glare.apply(raw, patches);
+        let scale = shot
+            .auto_exposure
+            .and_then(|exposure| exposure.scale(raw, patches))
             .unwrap_or_else(|| {
                 sensor::exposure_scale(
                     raw,
@@ -308,33 +326,31 @@ impl Camera {
                     self.config.sensor.exposure,
                 )
             });
-        let full_scale = if ic.is_some() { 1.0 } else { f32::INFINITY };
+        let full_scale = shot.full_scale;
         raw.iter_mut()
             .for_each(|v| *v = v.map(|x| (x * scale).min(full_scale)));
     }
 
     /// Patch-level white-balanced values (noise-free) into `raw`, used by the D65 fit and
     /// the fast path.
-    fn balanced_regions(&self, ic: Option<&InCamera>, light: &[f32], raw: &mut Vec<[f32; 3]>) {
-        self.exposed_regions(ic, light, raw);
-        let mut gains = self
+    fn balanced_regions(&self, shot: &Shot, light: &[f32], raw: &mut Vec<[f32; 3]>) {
+        self.exposed_regions(shot, light, raw);
+        let estimated = self
             .config
             .white_balance
             .gains_for_regions(raw, &self.geometry);
-        if let Some(ic) = ic {
-            gains = ic.adapt(gains);
-        }
+        let gains = white_balance::adapt(estimated, shot.adaptation);
         raw.iter_mut()
             .for_each(|v| *v = std::array::from_fn(|c| v[c] * gains[c]));
     }
 
-    /// White-balanced camera RGB → encoded sRGB (0…1, unquantised), through the in-camera
-    /// tone stages when `ic` is given.
+    /// White-balanced camera RGB → encoded sRGB (0…1, unquantised): the colour matrix and
+    /// the sRGB curve, through the shot's tone rendering when it has one.
     #[inline]
-    fn finish_pixel(&self, ic: Option<&InCamera>, rgb: [f32; 3]) -> [f32; 3] {
-        match ic {
+    fn finish_pixel(&self, shot: &Shot, rgb: [f32; 3]) -> [f32; 3] {
+        match &shot.rendering {
             None => self.colour.encode_pixel(rgb),
-            Some(ic) => ic.tone(&self.colour, self.colour.to_linear_srgb(rgb)),
+            Some(tone) => tone.encode(&self.colour, self.colour.to_linear_srgb(rgb)),
         }
     }
 
@@ -367,21 +383,21 @@ impl Camera {
         buffers: &mut RenderBuffers,
         mut stages: Option<&mut Stages>,
     ) -> [f32; 3] {
-        let ic = self.config.in_camera.as_ref();
-        let gains = self.capture_balanced(ic, light, seed, buffers, stages.as_deref_mut());
+        let shot = Shot::of(self.config.in_camera.as_ref());
+        let gains = self.capture_balanced(&shot, light, seed, buffers, stages.as_deref_mut());
         if let Some(ab) = &self.config.aberration {
             ab.apply(&mut buffers.image, &mut buffers.scratch);
         }
         if let Some(s) = stages {
             s.aberrated = Some(buffers.image.clone());
         }
-        match ic {
+        match shot.rendering {
             None => self.colour.apply(&mut buffers.image),
             Some(_) => {
                 let [r, g, b] = &mut buffers.image.planes;
                 for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
                     let v = self
-                        .finish_pixel(ic, [*r, *g, *b])
+                        .finish_pixel(&shot, [*r, *g, *b])
                         .map(|v| self.colour.quantise(v));
                     (*r, *g, *b) = (v[0], v[1], v[2]);
                 }
@@ -413,7 +429,8 @@ impl Camera {
         buffers: &mut RenderBuffers,
         out: &mut Vec<f32>,
     ) {
-        self.capture_balanced(ic, light, seed, buffers, None);
+        let shot = Shot::of(ic);
+        self.capture_balanced(&shot, light, seed, buffers, None);
         let RenderBuffers {
             image,
             region,
@@ -446,7 +463,7 @@ impl Camera {
             samples
                 .pixels
                 .extend(r.iter().zip(g).zip(b).map(|((&r, &g), &b)| {
-                    self.finish_pixel(ic, [r, g, b])
+                    self.finish_pixel(&shot, [r, g, b])
                         .map(|v| self.colour.quantise(v))
                 }));
             let (mean, _) = sampler::robust_mean(samples);
@@ -457,7 +474,7 @@ impl Camera {
     /// Sensor, noise, demosaicing and white balance into `buffers.image`; returns the gains.
     fn capture_balanced(
         &self,
-        ic: Option<&InCamera>,
+        shot: &Shot,
         light: &[f32],
         seed: u64,
         buffers: &mut RenderBuffers,
@@ -471,7 +488,7 @@ impl Camera {
             ..
         } = buffers;
         let mut from_raw = false;
-        self.exposed_regions(ic, light, raw);
+        self.exposed_regions(shot, light, raw);
         match self.config.sensor.mode {
             SensorMode::SingleSensor(_) => {
                 sensor::form_mosaic(&self.region_map, raw, mosaic);
@@ -499,13 +516,11 @@ impl Camera {
         if let Some(s) = stages.as_deref_mut() {
             s.demosaiced = Some(image.clone());
         }
-        let mut gains = self
+        let estimated = self
             .config
             .white_balance
             .gains(if from_raw { binned } else { image });
-        if let Some(ic) = ic {
-            gains = ic.adapt(gains);
-        }
+        let gains = white_balance::adapt(estimated, shot.adaptation);
         white_balance::apply_gains(image, gains);
         if let Some(s) = stages {
             s.white_balanced = Some(image.clone());
@@ -556,12 +571,59 @@ impl Camera {
         raw: &mut Vec<[f32; 3]>,
         out: &mut Vec<f32>,
     ) {
-        self.balanced_regions(ic, light, raw);
+        let shot = Shot::of(ic);
+        self.balanced_regions(&shot, light, raw);
         for &p in &self.chart.feature_patches {
-            let encoded = self.finish_pixel(ic, raw[p]);
+            let encoded = self.finish_pixel(&shot, raw[p]);
             out.extend(encoded.map(|v| 255.0 * v));
         }
     }
+}
+
+/// The stages' settings for one shot, resolved from the camera's in-camera record (or one
+/// drawn for this sample); without a record, the thesis's camera.
+#[derive(Debug, Clone, Copy)]
+struct Shot {
+    lighting: UnevenLighting,
+    glare: VeilingGlare,
+    auto_exposure: Option<AutoExposure>,
+    /// Raw values clip here: full scale (1) for a metering JPEG camera; the thesis's camera
+    /// normalises to the brightest value and never clips.
+    full_scale: f32,
+    adaptation: f64,
+    rendering: Option<ToneRendering>,
+}
+
+impl Shot {
+    fn of(in_camera: Option<&InCamera>) -> Shot {
+        match in_camera {
+            None => Shot {
+                lighting: UnevenLighting {
+                    gradient: [0.0, 0.0],
+                },
+                glare: VeilingGlare { share: 0.0 },
+                auto_exposure: None,
+                full_scale: f32::INFINITY,
+                adaptation: 1.0,
+                rendering: None,
+            },
+            Some(ic) => Shot {
+                lighting: ic.uneven_lighting(),
+                glare: ic.glare(),
+                auto_exposure: ic.auto_exposure(),
+                full_scale: 1.0,
+                adaptation: ic.adaptation,
+                rendering: Some(ic.rendering()),
+            },
+        }
+    }
+}
+
+/// Mean raw value of the first `patches` regions (the chart's patches, before the
+/// background).
+fn patch_mean(raw: &[[f32; 3]], patches: usize) -> [f32; 3] {
+    let n = patches.min(raw.len()).max(1);
+    std::array::from_fn(|c| raw[..n].iter().map(|v| v[c]).sum::<f32>() / n as f32)
 }
 
 /// Bins a mosaic into 2×2 cells, each giving (R, mean of the two G, B); odd edges dropped.

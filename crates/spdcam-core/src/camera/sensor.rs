@@ -213,6 +213,24 @@ fn dot(a: &[f32], b: &[f32]) -> f32 {
     acc.iter().sum::<f32>() + tail
 }
 
+/// Automatic exposure, as a JPEG camera meters: the mean green raw value of the chart's
+/// patches is brought to `target` of full scale; raw values above full scale then clip
+/// (the sensor saturates).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AutoExposure {
+    /// The metered level, a fraction of full scale.
+    pub target: f64,
+}
+
+impl AutoExposure {
+    /// The exposure scale for the first `patches` regions of `raw`; `None` when they have
+    /// no green signal.
+    pub fn scale(&self, raw: &[[f32; 3]], patches: usize) -> Option<f32> {
+        let green = super::patch_mean(raw, patches)[1];
+        (green > 0.0).then(|| self.target as f32 / green)
+    }
+}
+
 /// The exposure scale: maps the brightest visible raw value to `exposure` of full scale.
 pub fn exposure_scale(raw: &[[f32; 3]], shows_background: bool, exposure: f64) -> f32 {
     let visible = if shows_background {

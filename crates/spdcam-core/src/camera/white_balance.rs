@@ -208,6 +208,17 @@ fn power(x: f64, p: f64) -> f64 {
     }
 }
 
+/// Incomplete adaptation (a camera that keeps some of the light's cast, as people prefer
+/// under warm light): each gain raised to the power `adaptation` (1 = full correction,
+/// 0 = none).
+pub fn adapt(gains: [f32; 3], adaptation: f64) -> [f32; 3] {
+    if adaptation == 1.0 {
+        return gains;
+    }
+    let a = adaptation as f32;
+    gains.map(|g| if g > 0.0 { g.powf(a) } else { g })
+}
+
 /// Multiplies each channel by its gain.
 pub fn apply_gains(image: &mut RgbImage, gains: [f32; 3]) {
     for (plane, g) in image.planes.iter_mut().zip(gains) {
