@@ -331,9 +331,9 @@ fn render<'py>(
                     let set = SpectralSet::new(w, vec![spd.to_string()], vec![v])?;
                     let (set, _) =
                         set.resample(&grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
-                    set.item(0).to_vec()
+                    set.spd(0)?
                 }
-                _ => light::resolve_spd(spd, &data_dir, &grid)?.values,
+                _ => light::resolve_spd(spd, &data_dir, &grid)?.spd,
             };
             let chart = grid_chart(chart, patch_px, &data_dir, &grid)?;
             let sensitivities = Sensitivities::resolve(camera, &data_dir, &grid)?;

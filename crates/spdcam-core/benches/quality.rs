@@ -45,8 +45,12 @@ fn spds(grid: &Grid) -> Vec<Vec<f64>> {
     let mut state = 0x5eed_u64;
     (0..COUNT)
         .map(|i| match i % 4 {
-            0 => planck(2000.0 + 6000.0 * next(&mut state), grid).unwrap(),
-            1 => daylight(4000.0 + 16000.0 * next(&mut state), grid).unwrap(),
+            0 => planck(2000.0 + 6000.0 * next(&mut state), grid)
+                .unwrap()
+                .into_values(),
+            1 => daylight(4000.0 + 16000.0 * next(&mut state), grid)
+                .unwrap()
+                .into_values(),
             2 => {
                 let mut s = gaussian(grid, 445.0 + 15.0 * next(&mut state), 20.0);
                 let phosphor = gaussian(grid, 550.0 + 70.0 * next(&mut state), 110.0);

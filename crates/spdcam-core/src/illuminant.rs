@@ -8,7 +8,7 @@
 //! and the CIE formula for A, shipped as `data/illuminants_cie.csv` (see `data/PROVENANCE.md`).
 
 use crate::error::{Error, Result};
-use crate::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use crate::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
 
@@ -35,7 +35,7 @@ pub(crate) fn planck_radiance(lambda_nm: f64, t_kelvin: f64) -> f64 {
 /// W·sr⁻¹·m⁻²·nm⁻¹ (absolute; the same as colour-science's `sd_blackbody`, with
 /// [`PLANCK_C1`] and [`PLANCK_C2`], refractive index 1). Errors on a temperature that is not a
 /// positive finite number, or a grid reaching 0 nm or below.
-pub fn planck(t_kelvin: f64, grid: &Grid) -> Result<Vec<f64>> {
+pub fn planck(t_kelvin: f64, grid: &Grid) -> Result<Spd> {
     if !(t_kelvin.is_finite() && t_kelvin > 0.0) {
         return Err(Error::invalid(format!(
             "blackbody temperature {t_kelvin} K is not a positive number"
@@ -47,11 +47,12 @@ pub fn planck(t_kelvin: f64, grid: &Grid) -> Result<Vec<f64>> {
             grid.start_nm
         )));
     }
-    Ok(grid
+    let values = grid
         .wavelengths()
         .iter()
         .map(|&w| planck_radiance(w, t_kelvin))
-        .collect())
+        .collect();
+    Spd::new(*grid, values)
 }
 
 /// Chromaticity (x_D, y_D) of CIE daylight at correlated colour temperature `cct` in kelvin,
@@ -79,13 +80,13 @@ pub fn daylight_xy(cct: f64) -> Result<[f64; 2]> {
 ///
 /// The standard illuminants are defined at nominal temperatures scaled by the 1968 change of
 /// c2: D65 is daylight at 6500 × 1.4388/1.4380 ≈ 6504 K and D50 at ≈ 5003 K.
-pub fn daylight(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
+pub fn daylight(cct: f64, grid: &Grid) -> Result<Spd> {
     daylight_from_xy(daylight_xy(cct)?, grid)
 }
 
 /// The CIE D-series SPD of daylight chromaticity `xy` on `grid` (CIE 015:2018):
 /// `DaylightBasis::on_grid(grid)?.spd(xy)`; see [`DaylightBasis`].
-pub fn daylight_from_xy(xy: [f64; 2], grid: &Grid) -> Result<Vec<f64>> {
+pub fn daylight_from_xy(xy: [f64; 2], grid: &Grid) -> Result<Spd> {
     DaylightBasis::on_grid(grid)?.spd(xy)
 }
 
@@ -97,6 +98,7 @@ pub fn daylight_from_xy(xy: [f64; 2], grid: &Grid) -> Result<Vec<f64>> {
 /// the interpolation CIE 015 recommends for it, and is zero outside 300–830 nm.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DaylightBasis {
+    grid: Grid,
     basis: [Vec<f64>; 3],
     /// S0, S1, S2 at 560 nm, where the SPDs are normalised to 100.
     at_560: [f64; 3],
@@ -113,6 +115,7 @@ impl DaylightBasis {
             .expect("the shipped daylight basis has a 560 nm row");
         let (set, _) = native.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
         Ok(DaylightBasis {
+            grid: *grid,
             basis: [0, 1, 2].map(|i| set.item(i).to_vec()),
             at_560: [0, 1, 2].map(|i| native.item(i)[i560]),
         })
@@ -123,7 +126,7 @@ impl DaylightBasis {
     /// M1 = (−1.3515 − 1.7703x + 5.9114y)/M, M2 = (0.0300 − 31.4424x + 30.0717y)/M, M1 and M2
     /// rounded to three decimals as CIE 015 prescribes (and colour-science does by default),
     /// normalised to 100 at 560 nm.
-    pub fn spd(&self, xy: [f64; 2]) -> Result<Vec<f64>> {
+    pub fn spd(&self, xy: [f64; 2]) -> Result<Spd> {
         let [x, y] = xy;
         let m = 0.0241 + 0.2562 * x - 0.7341 * y;
         if !(x.is_finite() && y.is_finite()) || m.abs() < 1e-6 {
@@ -136,12 +139,13 @@ impl DaylightBasis {
         let m2 = round3((0.0300 - 31.4424 * x + 30.0717 * y) / m);
         let [s0, s1, s2] = &self.basis;
         let scale = 100.0 / (self.at_560[0] + m1 * self.at_560[1] + m2 * self.at_560[2]);
-        Ok(s0
+        let values = s0
             .iter()
             .zip(s1)
             .zip(s2)
             .map(|((a, b), c)| scale * (a + m1 * b + m2 * c))
-            .collect())
+            .collect();
+        Spd::new(self.grid, values)
     }
 }
 
@@ -215,7 +219,7 @@ impl StandardIlluminant {
 
     /// The relative SPD (100 at 560 nm) on `grid`: the table resampled with Sprague (1880)
     /// interpolation (CIE 167:2005; exact at the 5 nm table points), zero outside 300–780 nm.
-    pub fn spd(&self, grid: &Grid) -> Result<Vec<f64>> {
+    pub fn spd(&self, grid: &Grid) -> Result<Spd> {
         let table = standard_table();
         let column = table
             .position(self.name())
@@ -224,7 +228,7 @@ impl StandardIlluminant {
             table
                 .select(&[column])
                 .resample(grid, Interpolation::Auto, Extrapolation::Zero)?;
-        Ok(set.item(0).to_vec())
+        Spd::new(*grid, set.item(0).to_vec())
     }
 }
 
@@ -277,7 +281,7 @@ mod tests {
         let grid = Grid::new(300.0, 780.0, 10.0).unwrap();
         let model = daylight(6500.0 * 1.4388 / 1.4380, &grid).unwrap();
         let table = StandardIlluminant::D65.spd(&grid).unwrap();
-        for (i, (m, t)) in model.iter().zip(&table).enumerate() {
+        for (i, (m, t)) in model.iter().zip(table.iter()).enumerate() {
             assert!(
                 (m - t).abs() <= 5.0001e-4,
                 "{} nm: {m} vs {t}",

@@ -4,7 +4,7 @@
 use crate::builtin::{self, DataDir};
 use crate::error::{Error, Result};
 use crate::illuminant::{self, StandardIlluminant};
-use crate::spectral::{Extrapolation, Grid, Interpolation, ResampleReport};
+use crate::spectral::{Extrapolation, Grid, Interpolation, ResampleReport, Spd};
 
 /// The forms an SPD may be named in, for help and error messages.
 pub const SPD_FORMS: &str = "D65, A, D50, daylight:CCT (4000–25000 K), planck:CCT, \
@@ -17,7 +17,7 @@ pub struct ResolvedSpd {
     /// A name for the light: the illuminant, `planck:CCT`, or the file (and column).
     pub name: String,
     /// Relative spectral power on the grid it was resolved to.
-    pub values: Vec<f64>,
+    pub spd: Spd,
     /// Present when the light came from a file: how it was resampled.
     pub resampling: Option<ResampleReport>,
 }
@@ -27,7 +27,7 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
     if let Ok(ill) = StandardIlluminant::parse(spec) {
         return Ok(ResolvedSpd {
             name: ill.name().to_string(),
-            values: ill.spd(grid)?,
+            spd: ill.spd(grid)?,
             resampling: None,
         });
     }
@@ -39,7 +39,7 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
                     "'{spec}': '{value}' is not a temperature in kelvin"
                 ))
             })?;
-            let values = match kind_lc.as_str() {
+            let spd = match kind_lc.as_str() {
                 "daylight" => illuminant::daylight(t, grid)?,
                 "planck" => illuminant::planck(t, grid)?,
                 _ if t < 5000.0 => illuminant::planck(t, grid)?,
@@ -47,7 +47,7 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
             };
             return Ok(ResolvedSpd {
                 name: spec.to_string(),
-                values,
+                spd,
                 resampling: None,
             });
         }
@@ -82,8 +82,8 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
     };
     let one = set.select(&[index]).require_non_negative("SPD", 0.01)?;
     let (resampled, report) = one.resample(grid, Interpolation::Auto, Extrapolation::Zero)?;
-    let values = resampled.item(0).to_vec();
-    if values.iter().all(|&v| v == 0.0) {
+    let spd = Spd::new(*grid, resampled.item(0).to_vec())?;
+    if spd.iter().all(|&v| v == 0.0) {
         return Err(Error::invalid(format!(
             "SPD '{}' in {file} is zero everywhere on {grid}",
             one.names()[0]
@@ -91,7 +91,7 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
     }
     Ok(ResolvedSpd {
         name: format!("{name}:{}", one.names()[0]),
-        values,
+        spd,
         resampling: Some(report),
     })
 }
@@ -113,8 +113,8 @@ mod tests {
             "planck:2856K",
         ] {
             let spd = resolve_spd(spec, &d, &g).unwrap();
-            assert_eq!(spd.values.len(), g.count, "{spec}");
-            assert!(spd.values.iter().all(|v| *v >= 0.0));
+            assert_eq!(spd.spd.grid(), &g, "{spec}");
+            assert!(spd.spd.iter().all(|v| *v >= 0.0));
         }
         let e = resolve_spd("moonlight", &d, &g).unwrap_err().to_string();
         assert!(e.contains("D65") && e.contains("moonlight"), "{e}");

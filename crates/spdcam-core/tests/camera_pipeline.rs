@@ -118,8 +118,8 @@ fn fast_features_match_the_noise_free_image_pipeline() {
         let camera = Camera::new(&nikon(), chart, config, &GRID).unwrap();
         for spd in ["A", "cct:9000", "D50"] {
             let spd = spdcam_core::light::resolve_spd(spd, &DataDir::default(), &GRID).unwrap();
-            let full = camera.render(&spd.values, 0, false).unwrap().features;
-            let light = camera.light(&spd.values).unwrap();
+            let full = camera.render(&spd.spd, 0, false).unwrap().features;
+            let light = camera.light(&spd.spd).unwrap();
             let mut fast = Vec::new();
             camera.features_fast(&light, &mut Vec::new(), &mut fast);
             assert_eq!(full.len(), fast.len());

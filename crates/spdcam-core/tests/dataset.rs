@@ -15,7 +15,7 @@ use spdcam_core::dataset::{
 };
 use spdcam_core::lighting::Lighting;
 use spdcam_core::seed;
-use spdcam_core::spectral::Grid;
+use spdcam_core::spectral::{Grid, Spd};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -172,7 +172,7 @@ fn generated_samples_are_the_camera_renders_of_their_lights() {
         let batch = generator.samples(0..12, None, &|_| {}).unwrap();
         for i in [0usize, 5, 11] {
             let draw = light.draw(seed, i as u64).unwrap();
-            assert_eq!(batch.spd_of(i), draw.spd.as_slice());
+            assert_eq!(batch.spd_of(i), draw.spd.values());
             assert_eq!(batch.families[i], draw.family);
             assert_eq!(batch.attempts[i], draw.attempts);
             assert_eq!(
@@ -626,7 +626,8 @@ fn generated_sets_are_compressed_float32_and_old_float64_files_still_read() {
     for i in 0..stored.len() {
         features.clear();
         cam.features_fast(
-            &cam.light(stored.spd_of(i)).unwrap(),
+            &cam.light(&Spd::new(GRID, stored.spd_of(i).to_vec()).unwrap())
+                .unwrap(),
             &mut raw,
             &mut features,
         );

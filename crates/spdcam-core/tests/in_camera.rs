@@ -15,7 +15,7 @@ use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation
 use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
 use spdcam_core::illuminant::StandardIlluminant;
 use spdcam_core::lighting::Lighting;
-use spdcam_core::spectral::Grid;
+use spdcam_core::spectral::{Grid, Spd};
 
 const GRID: Grid = Grid::SIMULATION;
 
@@ -39,7 +39,7 @@ fn camera(in_camera: Option<InCamera>) -> Camera {
     .unwrap()
 }
 
-fn fast(camera: &Camera, ic: Option<&InCamera>, spd: &[f64]) -> Vec<f32> {
+fn fast(camera: &Camera, ic: Option<&InCamera>, spd: &Spd) -> Vec<f32> {
     let light = camera.light(spd).unwrap();
     let (mut raw, mut out) = (Vec::new(), Vec::new());
     camera.features_fast_with(ic, &light, &mut raw, &mut out);
@@ -197,10 +197,11 @@ fn calibration_recovers_known_parameters() {
         })
         .collect();
     // A bluish light too: D65 with its red end attenuated.
-    let mut blue = StandardIlluminant::D65.spd(&GRID).unwrap();
+    let mut blue = StandardIlluminant::D65.spd(&GRID).unwrap().into_values();
     for (k, v) in blue.iter_mut().enumerate() {
         *v *= 1.5 - k as f64 / GRID.count as f64;
     }
+    let blue = Spd::new(GRID, blue).unwrap();
     photos.push(CalibrationPhoto {
         features: fast(&cam, Some(&truth), &blue)
             .iter()

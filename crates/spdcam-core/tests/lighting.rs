@@ -57,7 +57,7 @@ fn seven_of_seventeen_leaves_uv_and_ir_dark() {
         assert!((max - 1.0).abs() < 1e-12);
         // The SPD is the weighted sum of the channels, normalised.
         let channels = lighting.channels().unwrap();
-        assert_eq!(channels.combine(&w).unwrap(), draw.spd);
+        assert_eq!(channels.combine(&w).unwrap(), draw.spd.values());
     }
 }
 

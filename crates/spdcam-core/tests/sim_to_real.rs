@@ -95,7 +95,7 @@ fn agreement(chart_name: &str) -> f64 {
     let total: f64 = (0..photos)
         .map(|i| {
             rendered.clear();
-            let light = camera.light(set.item(i)).unwrap();
+            let light = camera.light(&set.spd(i).unwrap()).unwrap();
             camera.features_fast(&light, &mut raw, &mut rendered);
             let green = |v: &[f32]| {
                 v.iter()

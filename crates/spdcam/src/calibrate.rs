@@ -11,7 +11,7 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::Camera;
 use spdcam_core::chart::Chart;
 use spdcam_core::fsio::write_atomic;
-use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use std::path::{Path, PathBuf};
 
 /// Options of `spdcam calibrate`.
@@ -40,7 +40,7 @@ pub struct CalibrateArgs {
 /// Real photos: features (0–255) per row, and SPDs on the simulation grid per row.
 pub struct Measured {
     pub features: Vec<Vec<f64>>,
-    pub spds: Vec<Vec<f64>>,
+    pub spds: Vec<Spd>,
 }
 
 fn read_rows(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
@@ -97,7 +97,9 @@ pub fn read_measured(features: &Path, spds: &Path, grid: &Grid) -> Result<Measur
     let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
     Ok(Measured {
         features: features_rows,
-        spds: (0..set.len()).map(|i| set.item(i).to_vec()).collect(),
+        spds: (0..set.len())
+            .map(|i| Spd::new(*grid, set.item(i).to_vec()))
+            .collect::<spdcam_core::Result<_>>()?,
     })
 }
 

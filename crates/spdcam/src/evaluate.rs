@@ -9,7 +9,7 @@ use spdcam_core::chart::Chart;
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::imageio::write_png;
 use spdcam_core::raster::RgbImage;
-use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use spdcam_learn::evaluate::{
     band_mae_svg, best_median_worst_svg, boxplots_svg, evaluate, Evaluation,
 };
@@ -172,7 +172,9 @@ fn worst_case_image(model: &Model, e: &Evaluation, data_dir: &DataDir) -> Result
     let render = |spd: &[f64]| -> Result<RgbImage> {
         let set = SpectralSet::on_grid(&e.grid, vec!["spd".into()], vec![spd.to_vec()])?;
         let (set, _) = set.resample(&grid, Interpolation::Linear, Extrapolation::Zero)?;
-        Ok(camera.render(set.item(0), 0, false)?.image)
+        Ok(camera
+            .render(&Spd::new(grid, set.item(0).to_vec())?, 0, false)?
+            .image)
     };
     let truth = render(&e.truths[worst * d..(worst + 1) * d])?;
     let estimate = render(&e.estimates[worst * d..(worst + 1) * d])?;

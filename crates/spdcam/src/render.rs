@@ -14,7 +14,7 @@ use spdcam_core::lighting::Lighting;
 use spdcam_core::photo::scene::{self, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::raster::CfaPattern;
-use spdcam_core::spectral::{Grid, SpectralSet};
+use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_core::{fsio, imageio, light};
 use std::path::{Path, PathBuf};
 
@@ -276,7 +276,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
             let draw = Lighting::parse(recipe, data_dir, &grid)?.draw(args.seed, index)?;
             light::ResolvedSpd {
                 name: format!("{recipe} draw {index} (seed {})", args.seed),
-                values: draw.spd,
+                spd: draw.spd,
                 resampling: None,
             }
         }
@@ -289,19 +289,15 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         );
     }
     if let Some(path) = &args.spd_out {
-        let mut values = spd.values.clone();
-        let max = values.iter().cloned().fold(0.0f64, f64::max);
-        if max > 0.0 {
-            values.iter_mut().for_each(|v| *v /= max);
-        }
+        let values = spd.spd.normalised_by_max().into_values();
         SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?.write_csv(path)?;
         println!("light SPD: {}", path.display());
     }
     if let Some((width, height)) = scene {
-        return render_scene(&args, &spd.values, &spd.name, (width, height), data_dir);
+        return render_scene(&args, &spd.spd, &spd.name, (width, height), data_dir);
     }
     let camera = args.camera.camera(data_dir, &grid)?;
-    let rendering = camera.render(&spd.values, args.seed, args.stages.is_some())?;
+    let rendering = camera.render(&spd.spd, args.seed, args.stages.is_some())?;
     let depth = camera.config().colour.bit_depth;
     if let Some(dir) = &args.stages {
         write_stages(dir, &rendering.stages)?;
@@ -336,7 +332,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
 /// `render --scene`: the chart rendered at the scene pitch and photographed in a scene.
 fn render_scene(
     args: &RenderArgs,
-    spd: &[f64],
+    spd: &Spd,
     light_name: &str,
     (width, height): (usize, usize),
     data_dir: &DataDir,

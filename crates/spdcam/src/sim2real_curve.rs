@@ -54,7 +54,7 @@ fn training_set(set: &Measured, indices: &[usize], names: &[String], grid: &Grid
         samples.samples.push(k as u64);
         samples.families.push("measured".into());
         samples.features.extend(&set.features[i]);
-        samples.spds.extend(&set.spds[i]);
+        samples.spds.extend(set.spds[i].iter());
         samples.attempts.push(1);
     }
     TrainingSet {

@@ -911,7 +911,7 @@ fn real_sets(thesis: &Path, grid: &Grid) -> Result<Vec<(&'static str, Rows)>> {
                 let dir = thesis.join("measured").join(name);
                 let m = read_measured(&dir.join("features.csv"), &dir.join("spds.csv"), &GRID)?;
                 let names = (0..m.spds.len()).map(|i| format!("s{i}")).collect();
-                let (set, _) = SpectralSet::on_grid(&GRID, names, m.spds)?.resample(
+                let (set, _) = SpectralSet::from_spds(names, &m.spds)?.resample(
                     grid,
                     Interpolation::Linear,
                     Extrapolation::Zero,

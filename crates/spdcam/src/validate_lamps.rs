@@ -236,7 +236,7 @@ pub(crate) fn held_out_cameras(
 
 /// Every lamp of the library on `grid` (linear interpolation), normalised by its maximum.
 pub(crate) fn on_grid(library: &LampLibrary, grid: &Grid) -> Result<Vec<Vec<f64>>> {
-    let set = SpectralSet::on_grid(&library.grid, library.names.clone(), library.spds.clone())?;
+    let set = SpectralSet::from_spds(library.names.clone(), &library.spds)?;
     let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
     Ok(set
         .items()
@@ -378,7 +378,7 @@ fn real_scores(args: &ValidateArgs, model: &Model, data_dir: &DataDir) -> Result
         let rows: Vec<f64> = set.features.iter().flatten().copied().collect();
         let estimates = model.estimate_rows(&rows)?;
         let names = (0..set.spds.len()).map(|i| format!("s{i}")).collect();
-        let truth = SpectralSet::on_grid(&GRID, names, set.spds.clone())?
+        let truth = SpectralSet::from_spds(names, &set.spds)?
             .resample(&grid, Interpolation::Linear, Extrapolation::Zero)?
             .0;
         let d = grid.count;

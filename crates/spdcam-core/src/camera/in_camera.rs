@@ -23,6 +23,7 @@ use super::sensor::AutoExposure;
 use super::tone::ToneRendering;
 use super::Camera;
 use crate::error::{Error, Result};
+use crate::spectral::Spd;
 use serde::{Deserialize, Serialize};
 
 /// The in-camera settings. [`InCamera::NEUTRAL`] changes nothing but the sensor clipping.
@@ -191,7 +192,7 @@ pub struct CalibrationPhoto {
     /// The photo's chart features (0–255).
     pub features: Vec<f64>,
     /// The light's measured SPD on the camera's simulation grid.
-    pub spd: Vec<f64>,
+    pub spd: Spd,
 }
 
 /// The result of [`calibrate`].

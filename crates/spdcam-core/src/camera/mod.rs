@@ -36,7 +36,7 @@ use crate::illuminant::StandardIlluminant;
 use crate::raster::{Mosaic, RgbImage};
 use crate::sampler::{self, SampleBuffers};
 use crate::seed;
-use crate::spectral::Grid;
+use crate::spectral::{Grid, Spd};
 use aberration::LateralAberration;
 use colour::{ColourConfig, ColourTransform};
 use demosaic::DemosaicMethod;
@@ -253,17 +253,10 @@ impl Camera {
         self.camera_to_xyz
     }
 
-    /// Checks an SPD on the simulation grid and converts it for rendering: it must be
+    /// Checks an SPD and converts it for rendering: it must be on the simulation grid,
     /// finite, non-negative and give the camera a signal.
-    pub fn light(&self, spd: &[f64]) -> Result<Vec<f32>> {
-        if spd.len() != self.grid.count {
-            return Err(Error::invalid(format!(
-                "the SPD has {} values; the simulation grid {} needs {}",
-                spd.len(),
-                self.grid,
-                self.grid.count
-            )));
-        }
+    pub fn light(&self, spd: &Spd) -> Result<Vec<f32>> {
+        let spd = spd.on(&self.grid, "the camera")?;
         if let Some((i, v)) = spd
             .iter()
             .enumerate()
@@ -355,7 +348,7 @@ impl Camera {
     }
 
     /// Runs the full pipeline for one light and returns the image, features and stages.
-    pub fn render(&self, spd: &[f64], seed: u64, keep_stages: bool) -> Result<Rendering> {
+    pub fn render(&self, spd: &Spd, seed: u64, keep_stages: bool) -> Result<Rendering> {
         let light = self.light(spd)?;
         let mut buffers = self.buffers();
         let mut stages = Stages::default();

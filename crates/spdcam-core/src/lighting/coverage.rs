@@ -4,6 +4,7 @@
 
 use super::Lighting;
 use crate::error::{Error, Result};
+use crate::spectral::Spd;
 use rayon::prelude::*;
 
 /// The wavelengths GFC is taken over, as indices of the lighting's grid.
@@ -23,19 +24,15 @@ fn unit(spd: &[f64], keep: &[usize]) -> Option<Vec<f64>> {
 
 /// For each of `targets` (SPDs on the lighting's grid), the best GFC over draws `0..n` of
 /// `lighting` under `seed`. Dark targets score 0.
-pub fn best_gfc(lighting: &Lighting, seed: u64, n: u64, targets: &[Vec<f64>]) -> Result<Vec<f64>> {
+pub fn best_gfc(lighting: &Lighting, seed: u64, n: u64, targets: &[Spd]) -> Result<Vec<f64>> {
     if n == 0 {
         return Err(Error::invalid("coverage needs at least one draw"));
     }
     let keep = visible(lighting);
-    let count = lighting.grid().count;
-    if let Some(t) = targets.iter().find(|t| t.len() != count) {
-        return Err(Error::invalid(format!(
-            "a target SPD has {} values; the lighting's grid has {count}",
-            t.len()
-        )));
-    }
-    let targets: Vec<Option<Vec<f64>>> = targets.iter().map(|t| unit(t, &keep)).collect();
+    let targets = targets
+        .iter()
+        .map(|t| Ok(unit(t.on(lighting.grid(), "the lighting")?, &keep)))
+        .collect::<Result<Vec<Option<Vec<f64>>>>>()?;
     let draws = (0..n)
         .into_par_iter()
         .map(|i| Ok(unit(&lighting.draw(seed, i)?.spd, &keep)))
@@ -57,7 +54,7 @@ pub fn best_gfc(lighting: &Lighting, seed: u64, n: u64, targets: &[Vec<f64>]) ->
 mod tests {
     use super::*;
     use crate::builtin::DataDir;
-    use crate::spectral::Grid;
+    use crate::spectral::{Grid, Spd};
 
     #[test]
     fn a_recipe_covers_its_own_members_and_not_a_line() {
@@ -73,7 +70,8 @@ mod tests {
                 }
             })
             .collect();
-        let dark = vec![0.0; grid.count];
+        let line = Spd::new(grid, line).unwrap();
+        let dark = Spd::new(grid, vec![0.0; grid.count]).unwrap();
         let best = best_gfc(&lighting, 9, 50, &[member, line, dark]).unwrap();
         assert!((best[0] - 1.0).abs() < 1e-12, "{best:?}");
         // A line at 450 nm against a 2,000–3,000 K Planckian: its share of the

@@ -5,7 +5,7 @@
 
 use super::channels::normalise_by_max;
 use crate::error::{Error, Result};
-use crate::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use crate::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -83,7 +83,7 @@ pub struct LampLibrary {
     /// Each lamp's type (LED, fluorescent, …), in [`LampLibrary::names`] order.
     pub types: Vec<LampType>,
     /// One SPD per lamp on [`LampLibrary::grid`], maximum 1.
-    pub spds: Vec<Vec<f64>>,
+    pub spds: Vec<Spd>,
     /// The wavelengths of every SPD.
     pub grid: Grid,
 }
@@ -106,7 +106,7 @@ impl LampLibrary {
                     "{source}: SPD '{name}' is dark on {grid}"
                 )));
             }
-            out.push(spd);
+            out.push(Spd::new(*grid, spd)?);
         }
         let types = match info {
             Some(path) => read_types(path, &names)?,

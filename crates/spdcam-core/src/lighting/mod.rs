@@ -18,7 +18,7 @@ pub use lamp_families::{LampDraws, LampFamily, LampFits};
 pub use lamp_library::{LampLibrary, LampType};
 pub use luminaire::{Luminaire, PowerBudget, TELELUMEN_BUDGET, TELELUMEN_FILE};
 pub use measured::MeasuredSpds;
-pub use parametric::{daylight, fluorescent, planck, CctRange, PhosphorLeds};
+pub use parametric::{fluorescent, normalised_daylight, normalised_planck, CctRange, PhosphorLeds};
 pub use validation_split::ValidationSplit;
 
 use crate::builtin::DataDir;
@@ -26,7 +26,7 @@ use crate::colorimetry::Observer;
 use crate::error::{Error, Result};
 use crate::illuminant::{DAYLIGHT_CCT_MAX_K, DAYLIGHT_CCT_MIN_K};
 use crate::seed;
-use crate::spectral::Grid;
+use crate::spectral::{Grid, Spd};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 
@@ -34,7 +34,7 @@ use rand::{Rng, SeedableRng};
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightDraw {
     /// The SPD on the lighting's grid, maximum 1.
-    pub spd: Vec<f64>,
+    pub spd: Spd,
     /// The family it came from (`gaussian`, `leds`, `daylight`, …).
     pub family: String,
     /// The channel weights, for families that have them (in [`Lighting::weight_names`] order).
@@ -277,17 +277,20 @@ impl Lighting {
     }
 
     fn draw_with(&self, rng: &mut SmallRng) -> Result<LightDraw> {
-        let simple = |family: &str, spd: Vec<f64>| LightDraw {
-            spd,
-            family: family.to_string(),
-            weights: None,
-            attempts: 1,
+        let grid = self.grid;
+        let simple = |family: &str, spd: Vec<f64>| -> Result<LightDraw> {
+            Ok(LightDraw {
+                spd: Spd::new(grid, spd)?,
+                family: family.to_string(),
+                weights: None,
+                attempts: 1,
+            })
         };
         Ok(match &self.family {
             Family::Gaussian(channels) => {
                 let weights = WeightRule::all(channels.len()).draw(channels.len(), rng);
                 LightDraw {
-                    spd: channels.combine(&weights)?,
+                    spd: Spd::new(grid, channels.combine(&weights)?)?,
                     family: "gaussian".to_string(),
                     weights: Some(weights),
                     attempts: 1,
@@ -296,18 +299,20 @@ impl Lighting {
             Family::Leds(luminaire) => {
                 let (weights, attempts) = luminaire.draw(rng, &self.spec)?;
                 LightDraw {
-                    spd: luminaire.channels.combine(&weights)?,
+                    spd: Spd::new(grid, luminaire.channels.combine(&weights)?)?,
                     family: "leds".to_string(),
                     weights: Some(weights),
                     attempts,
                 }
             }
-            Family::Daylight(range) => simple("daylight", daylight(range.draw(rng), &self.grid)?),
-            Family::Planck(range) => simple("planck", planck(range.draw(rng), &self.grid)?),
-            Family::Phosphor(leds) => simple("phosphor", leds.draw(rng)?),
-            Family::Fluorescent => simple("fluorescent", fluorescent(&self.grid, rng)?),
-            Family::Measured(set) => simple("spds", set.draw(rng)),
-            Family::Lamp(draws) => simple(draws.family().name(), draws.draw(rng)),
+            Family::Daylight(range) => {
+                simple("daylight", normalised_daylight(range.draw(rng), &grid)?)?
+            }
+            Family::Planck(range) => simple("planck", normalised_planck(range.draw(rng), &grid)?)?,
+            Family::Phosphor(leds) => simple("phosphor", leds.draw(rng)?)?,
+            Family::Fluorescent => simple("fluorescent", fluorescent(&grid, rng)?)?,
+            Family::Measured(set) => simple("spds", set.draw(rng))?,
+            Family::Lamp(draws) => simple(draws.family().name(), draws.draw(rng))?,
             Family::Blend(b) => {
                 let first = b.first.draw_with(rng)?;
                 let second = b.second.draw_with(rng)?;
@@ -317,12 +322,12 @@ impl Lighting {
                 let mut spd: Vec<f64> = first
                     .spd
                     .iter()
-                    .zip(&second.spd)
+                    .zip(second.spd.iter())
                     .map(|(x, y)| share * x / ya + (1.0 - share) * y / yb)
                     .collect();
                 channels::normalise_by_max(&mut spd);
                 LightDraw {
-                    spd,
+                    spd: Spd::new(grid, spd)?,
                     family: "blend".to_string(),
                     weights: None,
                     attempts: first.attempts + second.attempts,

@@ -62,16 +62,18 @@ impl CctRange {
     }
 }
 
-/// CIE daylight (D series) at `cct`, normalised by its maximum.
-pub fn daylight(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
-    let mut spd = illuminant::daylight(cct, grid)?;
+/// CIE daylight (D series) at `cct`, normalised by its maximum (the absolute-scaled one,
+/// 100 at 560 nm, is [`illuminant::daylight`]).
+pub fn normalised_daylight(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
+    let mut spd = illuminant::daylight(cct, grid)?.into_values();
     normalise_by_max(&mut spd);
     Ok(spd)
 }
 
-/// Planck's law at `cct`, normalised by its maximum.
-pub fn planck(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
-    let mut spd = illuminant::planck(cct, grid)?;
+/// Planck's law at `cct`, normalised by its maximum (the absolute radiance is
+/// [`illuminant::planck`]).
+pub fn normalised_planck(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
+    let mut spd = illuminant::planck(cct, grid)?.into_values();
     normalise_by_max(&mut spd);
     Ok(spd)
 }
@@ -188,7 +190,7 @@ impl PhosphorLeds {
 pub fn fluorescent(grid: &Grid, rng: &mut SmallRng) -> Result<Vec<f64>> {
     let u = |rng: &mut SmallRng, a: f64, b: f64| a + (b - a) * rng.random::<f64>();
     let base_cct = u(rng, 2700.0, 6500.0);
-    let mut spd = planck(base_cct, grid)?;
+    let mut spd = normalised_planck(base_cct, grid)?;
     let level = u(rng, 0.05, 0.4);
     spd.iter_mut().for_each(|v| *v *= level);
     for (centre, sigma, lo, hi) in [
@@ -217,12 +219,14 @@ mod tests {
     #[test]
     fn daylight_at_6504_is_d65() {
         let grid = Grid::SIMULATION;
-        let ours = daylight(6504.0, &grid).unwrap();
-        let mut d65 = StandardIlluminant::D65.spd(&grid).unwrap();
-        normalise_by_max(&mut d65);
+        let ours = normalised_daylight(6504.0, &grid).unwrap();
+        let d65 = StandardIlluminant::D65
+            .spd(&grid)
+            .unwrap()
+            .normalised_by_max();
         let worst = ours
             .iter()
-            .zip(&d65)
+            .zip(d65.iter())
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         // The CIE tabulates D65 from rounded basis weights: the two agree to about 1 %.

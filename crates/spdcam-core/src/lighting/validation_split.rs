@@ -263,7 +263,7 @@ fn lamp_groups(library: &LampLibrary) -> Vec<Vec<usize>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spectral::Grid;
+    use crate::spectral::{Grid, Spd};
 
     /// A toy library: per type, lamps with distinct peaks; two settings of one product and
     /// one re-measurement.
@@ -275,11 +275,10 @@ mod tests {
         let mut add = |name: &str, kind: LampType, peak: f64| {
             names.push(name.to_string());
             types.push(kind);
-            spds.push(
-                (0..grid.count)
-                    .map(|k| (-((grid.wavelength(k) - peak) / 15.0).powi(2)).exp() + 1e-3)
-                    .collect(),
-            );
+            let values = (0..grid.count)
+                .map(|k| (-((grid.wavelength(k) - peak) / 15.0).powi(2)).exp() + 1e-3)
+                .collect();
+            spds.push(Spd::new(grid, values).unwrap());
         };
         for k in 0..12 {
             add(

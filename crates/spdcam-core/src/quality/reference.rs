@@ -3,7 +3,7 @@
 use crate::colorimetry::Observer;
 use crate::error::Result;
 use crate::illuminant::{daylight_xy, planck, DaylightBasis};
-use crate::spectral::Grid;
+use crate::spectral::{Grid, Spd};
 
 /// Planckian and CIE daylight references on one grid, with what they need prepared once.
 #[derive(Debug, Clone)]
@@ -24,14 +24,14 @@ impl ReferenceIlluminants {
     }
 
     /// CIE daylight (D-series, CIE 015:2018) at `cct`; errors outside 4000–25,000 K.
-    fn daylight(&self, cct: f64) -> Result<Vec<f64>> {
+    fn daylight(&self, cct: f64) -> Result<Spd> {
         self.daylight.spd(daylight_xy(cct)?)
     }
 
     /// The CIE 13.3-1995 reference illuminant at correlated colour temperature `cct`
     /// (CIE 13.3-1995 §5.1): a Planckian radiator below 5000 K, CIE daylight from 5000 K.
     /// Errors above 25,000 K, where CIE daylight is not defined.
-    pub fn cie1995(&self, cct: f64) -> Result<Vec<f64>> {
+    pub fn cie1995(&self, cct: f64) -> Result<Spd> {
         if cct < 5000.0 {
             planck(cct, &self.grid)
         } else {
@@ -43,7 +43,7 @@ impl ReferenceIlluminants {
     /// §4.1): Planckian below 4000 K, CIE daylight above 5000 K, and between them the mixture
     /// (1 − m)·P/Y_P + m·D/Y_D with m = (T − 4000)/1000, each part normalised to its luminance
     /// Y with the CIE 1931 2° observer. Errors above 25,000 K.
-    pub fn cie2017(&self, cct: f64) -> Result<Vec<f64>> {
+    pub fn cie2017(&self, cct: f64) -> Result<Spd> {
         if cct < 4000.0 {
             return planck(cct, &self.grid);
         }
@@ -57,10 +57,12 @@ impl ReferenceIlluminants {
             self.observer.spd_to_xyz(&d)[1],
         );
         let m = (cct - 4000.0) / 1000.0;
-        Ok(p.iter()
-            .zip(&d)
+        let mix = p
+            .iter()
+            .zip(d.iter())
             .map(|(p, d)| (1.0 - m) * p / yp + m * d / yd)
-            .collect())
+            .collect();
+        Spd::new(self.grid, mix)
     }
 }
 

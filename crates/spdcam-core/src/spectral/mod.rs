@@ -1,9 +1,12 @@
-//! Wavelength grids, named spectral sets, the spectral CSV layout and resampling.
+//! Wavelength grids, single spectra with their grid ([`Spd`]), named spectral sets, the
+//! spectral CSV layout and resampling.
 
 mod grid;
 mod resample;
 mod set;
+mod spd;
 
 pub use grid::Grid;
 pub use resample::{Extrapolation, Interpolation, ResampleReport};
 pub use set::SpectralSet;
+pub use spd::Spd;

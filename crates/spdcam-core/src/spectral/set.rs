@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::fsio;
-use crate::spectral::Grid;
+use crate::spectral::{Grid, Spd};
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -75,6 +75,19 @@ impl SpectralSet {
     /// A set on a regular grid.
     pub fn on_grid(grid: &Grid, names: Vec<String>, values: Vec<Vec<f64>>) -> Result<Self> {
         SpectralSet::new(grid.wavelengths(), names, values)
+    }
+
+    /// A set of `spds`, which must all be on one grid, named `names`.
+    pub fn from_spds(names: Vec<String>, spds: &[Spd]) -> Result<Self> {
+        let Some(first) = spds.first() else {
+            return Err(Error::invalid("a spectral set needs at least one spectrum"));
+        };
+        let grid = *first.grid();
+        let values = spds
+            .iter()
+            .map(|s| s.on(&grid, "a spectral set").map(<[f64]>::to_vec))
+            .collect::<Result<Vec<_>>>()?;
+        SpectralSet::on_grid(&grid, names, values)
     }
 
     /// Parses spectral CSV text; `source_name` (a path or built-in name) is used in errors.
@@ -211,6 +224,15 @@ impl SpectralSet {
     /// The values of item `i`, one per wavelength.
     pub fn item(&self, i: usize) -> &[f64] {
         &self.values[i]
+    }
+
+    /// Item `i` as a spectrum with its grid; an error when the wavelengths are not a
+    /// regular grid.
+    pub fn spd(&self, i: usize) -> Result<Spd> {
+        let grid = self
+            .grid()
+            .ok_or_else(|| Error::invalid("the spectra are not on a regular wavelength grid"))?;
+        Spd::new(grid, self.values[i].clone())
     }
 
     /// All items, `[item][sample]`.

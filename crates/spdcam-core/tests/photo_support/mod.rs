@@ -15,7 +15,7 @@ use spdcam_core::colorimetry::{self, srgb_decode, srgb_encode};
 use spdcam_core::light;
 use spdcam_core::photo::scene::{self, SceneOptions};
 use spdcam_core::photo::{decode_photo, ChartTemplate, Photo};
-use spdcam_core::spectral::Grid;
+use spdcam_core::spectral::{Grid, Spd};
 
 const GRID: Grid = Grid::SIMULATION;
 
@@ -89,13 +89,13 @@ pub struct SceneSize {
 }
 
 /// A random light: a colour temperature, or one to three narrow bands (strongly coloured).
-fn random_light(rng: &mut SmallRng) -> (String, Vec<f64>) {
+fn random_light(rng: &mut SmallRng) -> (String, Spd) {
     if rng.random_bool(0.5) {
         let cct = rng.random_range(2500.0..10000.0f64).round();
         let spec = format!("cct:{cct}");
         let spd = light::resolve_spd(&spec, &DataDir::new(None), &GRID)
             .unwrap()
-            .values;
+            .spd;
         (spec, spd)
     } else {
         let bands = rng.random_range(1..=3);
@@ -111,7 +111,7 @@ fn random_light(rng: &mut SmallRng) -> (String, Vec<f64>) {
                 *v += power * (-0.5 * ((l - centre) / width).powi(2)).exp();
             }
         }
-        (name, spd)
+        (name, Spd::new(GRID, spd).unwrap())
     }
 }
 

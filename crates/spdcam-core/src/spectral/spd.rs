@@ -1,0 +1,121 @@
+//! One spectral power distribution with the grid it is sampled on.
+
+use super::{Extrapolation, Grid, Interpolation, SpectralSet};
+use crate::error::{Error, Result};
+
+/// A spectrum (an SPD, absolute or relative) on a uniform wavelength grid. The grid travels
+/// with the values, so a function taking an `Spd` can check it got values on the grid it
+/// works on, rather than trusting a bare slice's length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spd {
+    grid: Grid,
+    values: Vec<f64>,
+}
+
+impl Spd {
+    /// The spectrum of `values` on `grid`; an error when their counts differ.
+    pub fn new(grid: Grid, values: Vec<f64>) -> Result<Spd> {
+        if values.len() != grid.count {
+            return Err(Error::invalid(format!(
+                "a spectrum on {grid} needs {} values, got {}",
+                grid.count,
+                values.len()
+            )));
+        }
+        Ok(Spd { grid, values })
+    }
+
+    /// The grid the values are sampled on.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The values, one per wavelength of [`Spd::grid`].
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// The values, giving up the grid.
+    pub fn into_values(self) -> Vec<f64> {
+        self.values
+    }
+
+    /// The values, after checking the spectrum is on `grid`; the error names `what` needs
+    /// it and both grids.
+    pub fn on(&self, grid: &Grid, what: &str) -> Result<&[f64]> {
+        if self.grid != *grid {
+            return Err(Error::invalid(format!(
+                "{what} works on {grid}; the spectrum is on {}",
+                self.grid
+            )));
+        }
+        Ok(&self.values)
+    }
+
+    /// The spectrum divided by its maximum (peak 1), negative values set to 0: the
+    /// normalisation every comparison of SPD shapes uses (thesis section 4.3). A spectrum
+    /// whose maximum is not a positive number comes back as zeros.
+    pub fn normalised_by_max(&self) -> Spd {
+        Spd {
+            grid: self.grid,
+            values: crate::metrics::normalise_by_max(&self.values),
+        }
+    }
+
+    /// The spectrum resampled onto `grid` (Sprague 1880 interpolation where the spectrum
+    /// has six or more samples, else linear; zero outside its range).
+    pub fn resampled(&self, grid: &Grid) -> Result<Spd> {
+        if self.grid == *grid {
+            return Ok(self.clone());
+        }
+        let set = SpectralSet::on_grid(&self.grid, vec!["spd".into()], vec![self.values.clone()])?;
+        let (set, _) = set.resample(grid, Interpolation::Auto, Extrapolation::Zero)?;
+        Spd::new(*grid, set.item(0).to_vec())
+    }
+}
+
+/// Reading an `Spd` as its values (indexing, iterating, slice functions), the way a `String`
+/// reads as a `str`; the grid stays with the `Spd`.
+impl std::ops::Deref for Spd {
+    type Target = [f64];
+
+    fn deref(&self) -> &[f64] {
+        &self.values
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_values_must_fill_the_grid() {
+        let grid = Grid::new(400.0, 700.0, 100.0).unwrap();
+        assert!(Spd::new(grid, vec![1.0, 2.0, 3.0, 4.0]).is_ok());
+        let err = Spd::new(grid, vec![1.0; 3]).unwrap_err().to_string();
+        assert!(err.contains("needs 4 values, got 3"), "{err}");
+    }
+
+    #[test]
+    fn a_spectrum_on_another_grid_is_refused_by_name() {
+        let grid = Grid::new(400.0, 700.0, 100.0).unwrap();
+        let other = Grid::new(400.0, 700.0, 50.0).unwrap();
+        let spd = Spd::new(grid, vec![1.0; 4]).unwrap();
+        assert_eq!(spd.on(&grid, "the camera").unwrap(), &[1.0; 4]);
+        let err = spd.on(&other, "the camera").unwrap_err().to_string();
+        assert!(err.starts_with("the camera works on"), "{err}");
+    }
+
+    #[test]
+    fn peak_normalisation_and_resampling_of_a_line() {
+        let grid = Grid::new(400.0, 700.0, 100.0).unwrap();
+        let spd = Spd::new(grid, vec![-1.0, 2.0, 4.0, 1.0]).unwrap();
+        assert_eq!(spd.normalised_by_max().values(), &[0.0, 0.5, 1.0, 0.25]);
+        // Linear interpolation (four samples) halfway between the points.
+        let fine = spd
+            .resampled(&Grid::new(400.0, 700.0, 50.0).unwrap())
+            .unwrap();
+        assert_eq!(fine.values(), &[-1.0, 0.5, 2.0, 3.0, 4.0, 2.5, 1.0]);
+        assert_eq!(spd.resampled(&grid).unwrap(), spd);
+    }
+}
