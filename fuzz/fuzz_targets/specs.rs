@@ -20,10 +20,10 @@ fuzz_target!(|data: &[u8]| {
     };
     let grid = Grid::SIMULATION;
     let _ = Grid::parse(text);
-    let _ = WhiteBalance::parse(text);
+    let _ = text.parse::<WhiteBalance>();
     let _ = Shard::parse(text);
-    let _ = CfaPattern::parse(text);
-    let _ = DemosaicMethod::parse(text);
+    let _ = text.parse::<CfaPattern>();
+    let _ = text.parse::<DemosaicMethod>();
     let _ = NoiseParams::preset(text);
     // Specs may name files; the fuzzer must not read the machine's files (/dev/zero), so
     // anything that could name one is left out. An empty data directory holds no names.

@@ -35,15 +35,23 @@ impl CfaPattern {
         };
         block[(y & 1) * 2 + (x & 1)]
     }
+}
+
+impl std::str::FromStr for CfaPattern {
+    type Err = crate::Error;
 
     /// Parses `RGGB`, `BGGR`, `GRBG` or `GBRG` (any case).
-    pub fn parse(text: &str) -> Option<CfaPattern> {
+    fn from_str(text: &str) -> crate::Result<CfaPattern> {
         match text.to_ascii_uppercase().as_str() {
-            "RGGB" => Some(CfaPattern::Rggb),
-            "BGGR" => Some(CfaPattern::Bggr),
-            "GRBG" => Some(CfaPattern::Grbg),
-            "GBRG" => Some(CfaPattern::Gbrg),
-            _ => None,
+            "RGGB" => Ok(CfaPattern::Rggb),
+            "BGGR" => Ok(CfaPattern::Bggr),
+            "GRBG" => Ok(CfaPattern::Grbg),
+            "GBRG" => Ok(CfaPattern::Gbrg),
+            _ => Err(crate::Error::UnknownName {
+                kind: "Bayer pattern",
+                name: text.to_string(),
+                valid: "rggb, bggr, grbg, gbrg".into(),
+            }),
         }
     }
 }
@@ -142,7 +150,7 @@ mod tests {
             let block: Vec<usize> = (0..4).map(|k| p.channel_at(k % 2, k / 2)).collect();
             assert_eq!(block.iter().filter(|&&c| c == 1).count(), 2, "{p:?}");
             assert_eq!(block.iter().filter(|&&c| c == 0).count(), 1);
-            assert_eq!(CfaPattern::parse(&format!("{p:?}")), Some(p));
+            assert_eq!(format!("{p:?}").parse::<CfaPattern>().unwrap(), p);
         }
         assert_eq!(CfaPattern::Rggb.channel_at(0, 0), 0);
         assert_eq!(CfaPattern::Rggb.channel_at(1, 1), 2);

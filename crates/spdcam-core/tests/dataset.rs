@@ -699,3 +699,37 @@ fn files_written_by_pandas_read_back() {
     }
     assert_eq!(read, expected);
 }
+
+#[test]
+fn measured_photos_are_read_and_their_spds_resampled_linearly() {
+    let dir = scratch("measured-photos");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (f, s) = (dir.join("features.csv"), dir.join("spds.csv"));
+    std::fs::write(&f, "p01_r,p01_g\n10,20\n\n30.5, 40\n").unwrap();
+    std::fs::write(&s, "400,410nm,420\n1,3,5\n2,2,0\n").unwrap();
+    let grid = Grid::new(395.0, 425.0, 5.0).unwrap();
+    let m = dataset::MeasuredPhotos::read(&f, &s, &grid).unwrap();
+    assert_eq!(m.features, vec![vec![10.0, 20.0], vec![30.5, 40.0]]);
+    // Linear between the file's wavelengths, zero outside 400–420 nm.
+    assert_eq!(m.spds[0].values(), &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 0.0]);
+    assert_eq!(m.spds[1].values(), &[0.0, 2.0, 2.0, 2.0, 1.0, 0.0, 0.0]);
+    assert_eq!(m.spds[1].grid(), &grid);
+    // One SPD short, and a cell that is not a number: errors name the files and line.
+    std::fs::write(&s, "400,410,420\n1,3,5\n").unwrap();
+    let e = dataset::MeasuredPhotos::read(&f, &s, &grid)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("has 2 photos but") && e.contains("has 1 SPDs"),
+        "{e}"
+    );
+    std::fs::write(&f, "p01_r,p01_g\n10,x\n").unwrap();
+    let e = dataset::MeasuredPhotos::read(&f, &s, &grid)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("features.csv") && e.contains("line 2") && e.contains("'x'"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

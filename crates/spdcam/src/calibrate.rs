@@ -10,8 +10,9 @@ use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::Camera;
 use spdcam_core::chart::Chart;
+use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::fsio::write_atomic;
-use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
+use spdcam_core::spectral::Grid;
 use std::path::{Path, PathBuf};
 
 /// Options of `spdcam calibrate`.
@@ -37,72 +38,6 @@ pub struct CalibrateArgs {
     camera: CameraArgs,
 }
 
-/// Real photos: features (0–255) per row, and SPDs on the simulation grid per row.
-pub struct Measured {
-    pub features: Vec<Vec<f64>>,
-    pub spds: Vec<Spd>,
-}
-
-fn read_rows(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-    let header: Vec<String> = lines
-        .next()
-        .with_context(|| format!("{} is empty", path.display()))?
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
-    let mut rows = Vec::new();
-    for (k, line) in lines.enumerate() {
-        let row = line
-            .split(',')
-            .map(|c| c.trim().parse::<f64>())
-            .collect::<std::result::Result<Vec<f64>, _>>()
-            .with_context(|| format!("{} line {}: not all numbers", path.display(), k + 2))?;
-        if row.len() != header.len() {
-            bail!(
-                "{} line {}: {} values for {} columns",
-                path.display(),
-                k + 2,
-                row.len(),
-                header.len()
-            );
-        }
-        rows.push(row);
-    }
-    Ok((header, rows))
-}
-
-/// Reads a measured set (features + SPDs), the SPDs resampled onto `grid` (zero outside).
-pub fn read_measured(features: &Path, spds: &Path, grid: &Grid) -> Result<Measured> {
-    let (_, features_rows) = read_rows(features)?;
-    let (header, spd_rows) = read_rows(spds)?;
-    if features_rows.len() != spd_rows.len() {
-        bail!(
-            "{} has {} photos but {} has {} SPDs",
-            features.display(),
-            features_rows.len(),
-            spds.display(),
-            spd_rows.len()
-        );
-    }
-    let wavelengths = header
-        .iter()
-        .map(|h| h.parse::<f64>())
-        .collect::<std::result::Result<Vec<f64>, _>>()
-        .with_context(|| format!("{}: the header must be wavelengths in nm", spds.display()))?;
-    let names = (0..spd_rows.len()).map(|i| format!("s{i}")).collect();
-    let set = SpectralSet::new(wavelengths, names, spd_rows)?;
-    let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
-    Ok(Measured {
-        features: features_rows,
-        spds: (0..set.len())
-            .map(|i| Spd::new(*grid, set.item(i).to_vec()))
-            .collect::<spdcam_core::Result<_>>()?,
-    })
-}
-
 /// Every camera sensitivity CSV in `dir`, sorted by file name; a file that is not a valid
 /// sensitivity set is skipped with a warning naming it and why.
 pub fn sensitivities_in(dir: &Path, data_dir: &DataDir, grid: &Grid) -> Result<Vec<Sensitivities>> {
@@ -120,7 +55,7 @@ pub fn warn_skipped(path: &Path, error: &spdcam_core::Error) {
 }
 
 /// The photos `indices` of a measured set as calibration photos.
-pub fn photos(measured: &Measured, indices: &[usize]) -> Vec<CalibrationPhoto> {
+pub fn photos(measured: &MeasuredPhotos, indices: &[usize]) -> Vec<CalibrationPhoto> {
     indices
         .iter()
         .map(|&i| CalibrationPhoto {
@@ -149,7 +84,7 @@ pub fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
     let chart: Chart = args.camera.chart(data_dir, &grid)?;
     let sens = Sensitivities::resolve(&args.camera.camera, data_dir, &grid)?;
     let camera = Camera::new(&sens, chart, args.camera.config()?, &grid)?;
-    let measured = read_measured(&args.features, &args.spds, &grid)?;
+    let measured = MeasuredPhotos::read(&args.features, &args.spds, &grid)?;
     if args.photos == 0 {
         bail!("--photos must be at least 1");
     }

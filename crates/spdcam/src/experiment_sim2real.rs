@@ -3,7 +3,7 @@
 //! on or off, and scored (mean GFC) on the real measured sets; steps that use real photos
 //! (calibration) are cross-validated: calibrated on a few photos outside the test fold.
 
-use crate::calibrate::{photos, read_measured, sensitivities_in, Measured};
+use crate::calibrate::{photos, sensitivities_in};
 use crate::sim2real_curve::{learning_curve, CurveOptions};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -13,6 +13,7 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
+use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::Lighting;
@@ -77,7 +78,7 @@ fn target(spd: &[f64]) -> Vec<f64> {
 }
 
 /// Mean GFC of `model` on the photos `indices`.
-fn score(model: &Ridge, set: &Measured, indices: &[usize]) -> Result<f64> {
+fn score(model: &Ridge, set: &MeasuredPhotos, indices: &[usize]) -> Result<f64> {
     let mut total = 0.0;
     for &i in indices {
         let truth = target(&set.spds[i]);
@@ -111,7 +112,7 @@ fn train_virtual(
 
 /// Ridge trained and tested on real photos (k-fold; the penalty chosen by an inner
 /// cross-validation on the training folds), the reference.
-fn real_to_real(set: &Measured, folds: usize) -> Result<f64> {
+fn real_to_real(set: &MeasuredPhotos, folds: usize) -> Result<f64> {
     let n = set.features.len();
     let mut total = 0.0;
     for f in 0..folds {
@@ -133,11 +134,15 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
             .join("thesis"),
     };
     let folds = args.folds.max(2);
-    let load = |name: &str| -> Result<Measured> {
+    let load = |name: &str| -> Result<MeasuredPhotos> {
         let dir = thesis.join("measured").join(name);
-        read_measured(&dir.join("features.csv"), &dir.join("spds.csv"), &GRID)
+        Ok(MeasuredPhotos::read(
+            &dir.join("features.csv"),
+            &dir.join("spds.csv"),
+            &GRID,
+        )?)
     };
-    let join = |mut a: Measured, b: Measured| {
+    let join = |mut a: MeasuredPhotos, b: MeasuredPhotos| {
         a.features.extend(b.features);
         a.spds.extend(b.spds);
         a
@@ -213,7 +218,7 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
     )?;
 
     let mut rows: Vec<(String, Vec<f64>)> = Vec::new();
-    let all = |set: &Measured| (0..set.features.len()).collect::<Vec<usize>>();
+    let all = |set: &MeasuredPhotos| (0..set.features.len()).collect::<Vec<usize>>();
     let mut fixed_row = |label: &str, camera: &Camera, r: Option<&Randomisation>| -> Result<()> {
         let model = train_virtual(camera, r, &lighting, args.count, args.ridge)?;
         let scores = sets
@@ -322,7 +327,7 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
 fn curve_table(
     args: &Sim2realArgs,
     path: &Path,
-    sets: &[(&str, Measured)],
+    sets: &[(&str, MeasuredPhotos)],
     prior: &Ridge,
 ) -> Result<()> {
     let model = Model::load(path)?;

@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use spdcam_core::builtin::{self, DataDir};
+use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::aberration::LateralAberration;
 use spdcam_core::camera::demosaic::DemosaicMethod;
 use spdcam_core::camera::noise::NoiseParams;
@@ -13,7 +13,6 @@ use spdcam_core::chart::{Chart, Layout};
 use spdcam_core::lighting::Lighting;
 use spdcam_core::photo::scene::{self, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
-use spdcam_core::raster::CfaPattern;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_core::{fsio, imageio, light};
 use std::path::{Path, PathBuf};
@@ -44,7 +43,7 @@ pub struct CameraArgs {
     pub size: Option<String>,
     /// Sensor: a Bayer pattern (rggb, bggr, grbg, gbrg) or `three` for three sensors.
     #[arg(long, default_value = "rggb")]
-    pub sensor: String,
+    pub sensor: SensorMode,
     /// Brightest raw value as a fraction of full scale (> 0; above 1 clips).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub exposure: f64,
@@ -53,14 +52,14 @@ pub struct CameraArgs {
     pub noise: String,
     /// Demosaicing: menon2007, malvar2004, bilinear.
     #[arg(long, default_value = "menon2007")]
-    pub demosaic: String,
+    pub demosaic: DemosaicMethod,
     /// White balance: none, grey-world, white-patch, shades-of-grey[:p], grey-edge[:p[:sigma]].
     #[arg(long, default_value = "shades-of-grey:6")]
-    pub white_balance: String,
+    pub white_balance: WhiteBalance,
     /// White-balance statistics from the 2×2-binned raw mosaic (`raw`, as camera ISPs) or
     /// the demosaiced image (`demosaiced`, as the thesis).
     #[arg(long, default_value = "raw")]
-    pub white_balance_statistics: String,
+    pub white_balance_statistics: WhiteBalanceStatistics,
     /// Lateral chromatic aberration strength, or `off` (the thesis: 0.005 = 20/4000).
     #[arg(long, default_value = "0.005")]
     pub aberration: String,
@@ -99,26 +98,10 @@ impl CameraArgs {
                 self.exposure
             );
         }
-        let mode = if self.sensor.eq_ignore_ascii_case("three") {
-            SensorMode::ThreeSensor
-        } else {
-            SensorMode::SingleSensor(CfaPattern::parse(&self.sensor).with_context(|| {
-                format!(
-                    "unknown sensor '{}'; valid: rggb, bggr, grbg, gbrg, three",
-                    self.sensor
-                )
-            })?)
-        };
         let noise = match self.noise.as_str() {
             "off" | "none" => None,
             name => Some(NoiseParams::preset(name)?),
         };
-        let demosaic = DemosaicMethod::parse(&self.demosaic).with_context(|| {
-            format!(
-                "unknown demosaicing method '{}'; valid: menon2007, malvar2004, bilinear",
-                self.demosaic
-            )
-        })?;
         let aberration = match self.aberration.as_str() {
             "off" | "none" => None,
             s => {
@@ -132,20 +115,15 @@ impl CameraArgs {
                 Some(LateralAberration { strength })
             }
         };
-        let white_balance_statistics = match self.white_balance_statistics.as_str() {
-            "raw" => WhiteBalanceStatistics::BinnedRaw,
-            "demosaiced" => WhiteBalanceStatistics::Demosaiced,
-            other => bail!("unknown white-balance statistics '{other}'; valid: raw, demosaiced"),
-        };
         let mut config = CameraConfig {
             noise,
-            demosaic,
-            white_balance: WhiteBalance::parse(&self.white_balance)?,
-            white_balance_statistics,
+            demosaic: self.demosaic,
+            white_balance: self.white_balance,
+            white_balance_statistics: self.white_balance_statistics,
             aberration,
             ..CameraConfig::default()
         };
-        config.sensor.mode = mode;
+        config.sensor.mode = self.sensor;
         config.sensor.exposure = self.exposure;
         config.colour.correction = !self.no_colour_correction;
         config.colour.bit_depth = self.bit_depth;
@@ -178,14 +156,7 @@ impl CameraArgs {
 
     /// The camera with these sensitivities and settings, photographing `chart`.
     pub fn camera_for(&self, chart: Chart, data_dir: &DataDir, grid: &Grid) -> Result<Camera> {
-        let (name, measured) = builtin::resolve_table(
-            &self.camera,
-            "camera",
-            builtin::CAMERAS,
-            data_dir,
-            &["cameras", "thesis"],
-        )?;
-        let sensitivities = Sensitivities::new(&name, &measured, grid)?;
+        let sensitivities = Sensitivities::resolve(&self.camera, data_dir, grid)?;
         Ok(Camera::new(&sensitivities, chart, self.config()?, grid)?)
     }
 }

@@ -3,11 +3,11 @@
 //! k-fold cross-validated on each real set (the photos come from the folds outside the test
 //! fold), beside baselines trained on the same photos.
 
-use crate::calibrate::Measured;
 use anyhow::Result;
 use rand::rngs::SmallRng;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
+use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::dataset::{Columns, Precision, SampleBatch};
 use spdcam_core::metrics;
 use spdcam_core::spectral::Grid;
@@ -44,7 +44,12 @@ pub struct Curve {
 }
 
 /// The photos `indices` of `set` as a training set on `grid` (the grid of the set's SPDs).
-fn training_set(set: &Measured, indices: &[usize], names: &[String], grid: &Grid) -> TrainingSet {
+fn training_set(
+    set: &MeasuredPhotos,
+    indices: &[usize],
+    names: &[String],
+    grid: &Grid,
+) -> TrainingSet {
     let mut samples = SampleBatch {
         feature_count: names.len(),
         spd_len: grid.count,
@@ -77,7 +82,7 @@ fn training_set(set: &Measured, indices: &[usize], names: &[String], grid: &Grid
 }
 
 /// The truth of photo `i` on the model's grid, peak-normalised.
-fn truth_on(set: &Measured, i: usize, set_grid: &Grid, model_grid: &Grid) -> Vec<f64> {
+fn truth_on(set: &MeasuredPhotos, i: usize, set_grid: &Grid, model_grid: &Grid) -> Vec<f64> {
     let values: Vec<f64> = model_grid
         .wavelengths()
         .iter()
@@ -87,7 +92,7 @@ fn truth_on(set: &Measured, i: usize, set_grid: &Grid, model_grid: &Grid) -> Vec
 }
 
 /// Mean GFC of `model` on the photos `test`.
-fn model_gfc(model: &Model, set: &Measured, test: &[usize], set_grid: &Grid) -> Result<f64> {
+fn model_gfc(model: &Model, set: &MeasuredPhotos, test: &[usize], set_grid: &Grid) -> Result<f64> {
     let features: Vec<f64> = test.iter().flat_map(|&i| set.features[i].clone()).collect();
     let spds = model.estimate_rows(&features)?;
     let grid = model.grid();
@@ -116,7 +121,7 @@ pub type Baselines<'a> = dyn Fn(&[usize], &[usize]) -> Result<Vec<f64>> + 'a;
 /// baselines on (train, test) photo indices.
 pub fn learning_curve(
     model: &Model,
-    set: &Measured,
+    set: &MeasuredPhotos,
     set_grid: &Grid,
     options: &CurveOptions,
     baselines: &Baselines,

@@ -3,7 +3,6 @@
 //! (`report`: the split's test lamps, the real photo sets, photos made bad on purpose →
 //! docs/trust.md).
 
-use crate::calibrate::read_measured;
 use crate::lamps::in_data_dir;
 use crate::validate_lamps::{held_out_cameras, on_grid, HeldOutPhotos};
 use anyhow::{bail, Context, Result};
@@ -17,6 +16,7 @@ use spdcam_core::camera::CameraConfig;
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
+use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::lighting::{LampLibrary, ValidationSplit};
@@ -909,7 +909,8 @@ fn real_sets(thesis: &Path, grid: &Grid) -> Result<Vec<(&'static str, Rows)>> {
             };
             for name in *dirs {
                 let dir = thesis.join("measured").join(name);
-                let m = read_measured(&dir.join("features.csv"), &dir.join("spds.csv"), &GRID)?;
+                let m =
+                    MeasuredPhotos::read(&dir.join("features.csv"), &dir.join("spds.csv"), &GRID)?;
                 let names = (0..m.spds.len()).map(|i| format!("s{i}")).collect();
                 let (set, _) = SpectralSet::from_spds(names, &m.spds)?.resample(
                     grid,

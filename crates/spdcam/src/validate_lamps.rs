@@ -5,7 +5,6 @@
 //! the average-SPD baseline, for the validation lamps (choose on these) and the test lamps
 //! (report only). (c) The real photo sets of the thesis (SG 96 models only).
 
-use crate::calibrate::{read_measured, Measured};
 use crate::lamps::{camera_names, in_data_dir, LibraryArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -16,6 +15,7 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
+use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::lighting::{LampLibrary, LampType, ValidationSplit};
@@ -351,14 +351,14 @@ fn real_scores(args: &ValidateArgs, model: &Model, data_dir: &DataDir) -> Result
         Some(p) => p.clone(),
         None => in_data_dir(None, "thesis", data_dir)?,
     };
-    let load = |names: &[&str]| -> Result<Measured> {
-        let mut all = Measured {
+    let load = |names: &[&str]| -> Result<MeasuredPhotos> {
+        let mut all = MeasuredPhotos {
             features: Vec::new(),
             spds: Vec::new(),
         };
         for name in names {
             let dir = thesis.join("measured").join(name);
-            let m = read_measured(&dir.join("features.csv"), &dir.join("spds.csv"), &GRID)?;
+            let m = MeasuredPhotos::read(&dir.join("features.csv"), &dir.join("spds.csv"), &GRID)?;
             all.features.extend(m.features);
             all.spds.extend(m.spds);
         }

@@ -57,12 +57,21 @@ impl DemosaicMethod {
             DemosaicMethod::Menon2007 => "menon2007",
         }
     }
+}
+
+impl std::str::FromStr for DemosaicMethod {
+    type Err = crate::Error;
 
     /// Parses a short name as [`DemosaicMethod::name`] gives it, in any case.
-    pub fn parse(text: &str) -> Option<DemosaicMethod> {
+    fn from_str(text: &str) -> crate::Result<DemosaicMethod> {
         DemosaicMethod::ALL
             .into_iter()
             .find(|method| method.name().eq_ignore_ascii_case(text))
+            .ok_or_else(|| crate::Error::UnknownName {
+                kind: "demosaicing method",
+                name: text.to_string(),
+                valid: DemosaicMethod::ALL.map(|m| m.name()).join(", "),
+            })
     }
 }
 
@@ -928,11 +937,12 @@ mod tests {
     #[test]
     fn names_round_trip() {
         for method in DemosaicMethod::ALL {
-            assert_eq!(DemosaicMethod::parse(method.name()), Some(method));
+            assert_eq!(method.name().parse::<DemosaicMethod>().unwrap(), method);
             let upper = method.name().to_ascii_uppercase();
-            assert_eq!(DemosaicMethod::parse(&upper), Some(method));
+            assert_eq!(upper.parse::<DemosaicMethod>().unwrap(), method);
         }
-        assert_eq!(DemosaicMethod::parse("menon"), None);
+        let e = "menon".parse::<DemosaicMethod>().unwrap_err().to_string();
+        assert!(e.contains("'menon'") && e.contains("menon2007"), "{e}");
     }
 
     #[test]

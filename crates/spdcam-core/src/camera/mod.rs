@@ -86,6 +86,23 @@ pub enum WhiteBalanceStatistics {
     Demosaiced,
 }
 
+impl std::str::FromStr for WhiteBalanceStatistics {
+    type Err = Error;
+
+    /// Parses `raw` ([`WhiteBalanceStatistics::BinnedRaw`]) or `demosaiced`.
+    fn from_str(text: &str) -> Result<WhiteBalanceStatistics> {
+        match text.to_ascii_lowercase().as_str() {
+            "raw" => Ok(WhiteBalanceStatistics::BinnedRaw),
+            "demosaiced" => Ok(WhiteBalanceStatistics::Demosaiced),
+            _ => Err(Error::UnknownName {
+                kind: "white-balance statistics",
+                name: text.to_string(),
+                valid: "raw, demosaiced".into(),
+            }),
+        }
+    }
+}
+
 impl Default for CameraConfig {
     /// The thesis's camera: RGGB, thesis noise, Menon 2007, shades of grey (p = 6),
     /// aberration 20/4000, D65-fitted colour matrix, 8-bit sRGB.

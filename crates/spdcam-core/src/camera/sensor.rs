@@ -119,6 +119,24 @@ pub enum SensorMode {
     ThreeSensor,
 }
 
+impl std::str::FromStr for SensorMode {
+    type Err = Error;
+
+    /// Parses a Bayer pattern (`rggb`, `bggr`, `grbg`, `gbrg`, any case) or `three`.
+    fn from_str(text: &str) -> Result<SensorMode> {
+        if text.eq_ignore_ascii_case("three") {
+            return Ok(SensorMode::ThreeSensor);
+        }
+        text.parse::<CfaPattern>()
+            .map(SensorMode::SingleSensor)
+            .map_err(|_| Error::UnknownName {
+                kind: "sensor",
+                name: text.to_string(),
+                valid: "rggb, bggr, grbg, gbrg, three".into(),
+            })
+    }
+}
+
 /// Sensor settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SensorConfig {

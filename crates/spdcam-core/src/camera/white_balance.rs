@@ -78,9 +78,11 @@ impl RegionGeometry {
     }
 }
 
-impl WhiteBalance {
+impl std::str::FromStr for WhiteBalance {
+    type Err = Error;
+
     /// Parses `none`, `grey-world`, `white-patch`, `shades-of-grey[:p]`, `grey-edge[:p[:sigma]]`.
-    pub fn parse(text: &str) -> Result<WhiteBalance> {
+    fn from_str(text: &str) -> Result<WhiteBalance> {
         let mut parts = text.split(':');
         let name = parts
             .next()
@@ -121,7 +123,9 @@ impl WhiteBalance {
         };
         Ok(wb)
     }
+}
 
+impl WhiteBalance {
     /// Gains that turn the estimated light colour `estimate` grey, green fixed.
     fn gains_from_estimate(estimate: [f64; 3]) -> [f32; 3] {
         let g = estimate[1];
@@ -314,6 +318,7 @@ fn gradient_magnitude(plane: &[f32], width: usize, height: usize, sigma: f64) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::str::FromStr;
 
     /// A 2×2 image: pixels (R,G,B) = (1,2,4), (3,2,0), (1,1,1), (3,3,3).
     fn tiny() -> RgbImage {
@@ -419,20 +424,20 @@ mod tests {
     #[test]
     fn parse_names_and_errors() {
         assert_eq!(
-            WhiteBalance::parse("shades-of-grey:4").unwrap(),
+            WhiteBalance::from_str("shades-of-grey:4").unwrap(),
             WhiteBalance::ShadesOfGrey { p: 4.0 }
         );
         assert_eq!(
-            WhiteBalance::parse("grey-world").unwrap(),
+            WhiteBalance::from_str("grey-world").unwrap(),
             WhiteBalance::GreyWorld
         );
-        assert!(WhiteBalance::parse("magic").is_err());
-        assert!(WhiteBalance::parse("shades-of-grey:-1").is_err());
+        assert!(WhiteBalance::from_str("magic").is_err());
+        assert!(WhiteBalance::from_str("shades-of-grey:-1").is_err());
         // Issue 15: `grey-edge:1:1e9` ran for minutes with gigabytes.
-        let e = WhiteBalance::parse("grey-edge:1:1e9")
+        let e = WhiteBalance::from_str("grey-edge:1:1e9")
             .unwrap_err()
             .to_string();
         assert!(e.contains("SPDCAM_MAX_FILTER_SIGMA"), "{e}");
-        assert!(WhiteBalance::parse("grey-edge:1:2").is_ok());
+        assert!(WhiteBalance::from_str("grey-edge:1:2").is_ok());
     }
 }

@@ -1,5 +1,6 @@
 //! The thesis's CSV layout in and out: `features.csv` (one row per sample, columns
-//! `p01_r,p01_g,…`) and `spds.csv` (one row per sample, header = wavelengths in nm).
+//! `p01_r,p01_g,…`) and `spds.csv` (one row per sample, header = wavelengths in nm), for
+//! datasets and for measured photos ([`MeasuredPhotos`]).
 
 use super::batch::{Columns, Precision, SampleBatch, SampleRow};
 use super::manifest::{ImportSource, Manifest, Origin, FEATURE_SCALE};
@@ -9,7 +10,7 @@ use super::writer::{prepare_output, DatasetWriter};
 use crate::error::{Error, Result};
 use crate::fsio;
 use crate::lighting::Lighting;
-use crate::spectral::Grid;
+use crate::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -82,6 +83,55 @@ fn numbers(record: &csv::StringRecord, names: &[String], path: &Path) -> Result<
                 .ok_or_else(|| err(format!("column '{name}': '{cell}' is not a number")))
         })
         .collect()
+}
+
+/// Photos measured in the thesis's CSV layout: the chart features of each photo and the
+/// SPD of its light, measured beside it.
+#[derive(Debug, Clone)]
+pub struct MeasuredPhotos {
+    /// Each photo's features (0–255), in the file's column order.
+    pub features: Vec<Vec<f64>>,
+    /// Each photo's measured SPD, on the grid it was read onto.
+    pub spds: Vec<Spd>,
+}
+
+impl MeasuredPhotos {
+    /// Reads `features` (one row per photo) and `spds` (one row per photo, the header the
+    /// wavelengths in nm); the SPDs are resampled onto `grid` by linear interpolation, zero
+    /// outside their range. Errors name the file and line.
+    pub fn read(features: &Path, spds: &Path, grid: &Grid) -> Result<MeasuredPhotos> {
+        let (_, feature_rows) = read_rows(features)?;
+        let (header, spd_rows) = read_rows(spds)?;
+        if feature_rows.len() != spd_rows.len() {
+            return Err(Error::invalid(format!(
+                "{} has {} photos but {} has {} SPDs",
+                features.display(),
+                feature_rows.len(),
+                spds.display(),
+                spd_rows.len()
+            )));
+        }
+        let wavelengths = wavelength_columns(&header, spds)?;
+        let names = (0..spd_rows.len()).map(|i| format!("s{i}")).collect();
+        let set = SpectralSet::new(wavelengths, names, spd_rows)?;
+        let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
+        Ok(MeasuredPhotos {
+            features: feature_rows,
+            spds: (0..set.len()).map(|i| set.spd(i)).collect::<Result<_>>()?,
+        })
+    }
+}
+
+/// Every row of a numeric CSV file with a header: the header's names and the rows.
+fn read_rows(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
+    let mut reader = reader(path)?;
+    let names = header(&mut reader, path)?;
+    let mut rows = Vec::new();
+    for record in reader.records() {
+        let record = record.map_err(|e| Error::parse(path.display().to_string(), e.to_string()))?;
+        rows.push(numbers(&record, &names, path)?);
+    }
+    Ok((names, rows))
 }
 
 /// Imports samples from a features CSV and an SPDs CSV (same rows) into the dataset

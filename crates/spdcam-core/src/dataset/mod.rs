@@ -36,7 +36,9 @@ mod split;
 mod writer;
 
 pub use batch::{Columns, Counts, Precision, SampleBatch, SampleRow};
-pub use csv_io::{export_csv, import_csv, ExportOptions, ImportOptions, ImportReport};
+pub use csv_io::{
+    export_csv, import_csv, ExportOptions, ImportOptions, ImportReport, MeasuredPhotos,
+};
 pub use file::{encode_parquet, encode_parquet_as, Compression, FileFormat, ZSTD_LEVEL};
 pub use generate::{GenerateEvent, GenerateOptions, GenerateRequest, Generator, Plan};
 pub use lock::{DirLock, LockOwner, LOCK_FILE};
