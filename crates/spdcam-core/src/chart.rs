@@ -191,22 +191,72 @@ pub const NEUTRAL_VARIATION: f64 = 0.1;
 /// Reflectance of a chart's matte black body, shown in gaps and borders.
 pub const DEFAULT_BACKGROUND: f64 = 0.04;
 
-/// The chart names `Chart::resolve` knows, with what they are.
-pub const CHART_NAMES: &[(&str, &str)] = &[
-    ("colorchecker24", "ColorChecker Classic 24, 4×6, built in"),
-    (
-        "colorchecker_sg96",
-        "ColorChecker Digital SG, the 96 centre patches (the thesis's i1Pro2 set) where they sit on the chart, 8×12, features row by row as in photos; data directory",
-    ),
-    (
-        "colorchecker_sg96_thesis",
-        "the same 96 patches in file order, 12 per row, as the thesis rendered them; data directory",
-    ),
-    (
-        "colorchecker_sg140",
-        "ColorChecker Digital SG, all 140 patches, 10×14, the 96 centre patches are features; data directory",
-    ),
-];
+/// The charts [`Chart::resolve`] knows by name; any other chart is a reflectance CSV.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KnownChart {
+    /// The ColorChecker Classic 24 (built in).
+    ColorChecker24,
+    /// The Digital SG's 96 centre patches where they sit on the chart, row by row.
+    Sg96,
+    /// The same 96 patches in the thesis's file order.
+    Sg96Thesis,
+    /// The whole Digital SG, 140 patches.
+    Sg140,
+}
+
+impl KnownChart {
+    /// Every known chart.
+    pub const ALL: [KnownChart; 4] = [
+        KnownChart::ColorChecker24,
+        KnownChart::Sg96,
+        KnownChart::Sg96Thesis,
+        KnownChart::Sg140,
+    ];
+
+    /// The name on the command line, in model files and in [`Chart::name`].
+    pub const fn name(self) -> &'static str {
+        match self {
+            KnownChart::ColorChecker24 => "colorchecker24",
+            KnownChart::Sg96 => "colorchecker_sg96",
+            KnownChart::Sg96Thesis => "colorchecker_sg96_thesis",
+            KnownChart::Sg140 => "colorchecker_sg140",
+        }
+    }
+
+    /// What the chart is and where its reflectances come from.
+    pub fn description(self) -> &'static str {
+        match self {
+            KnownChart::ColorChecker24 => "ColorChecker Classic 24, 4×6, built in",
+            KnownChart::Sg96 => {
+                "ColorChecker Digital SG, the 96 centre patches (the thesis's i1Pro2 set) where \
+                 they sit on the chart, 8×12, features row by row as in photos; data directory"
+            }
+            KnownChart::Sg96Thesis => {
+                "the same 96 patches in file order, 12 per row, as the thesis rendered them; \
+                 data directory"
+            }
+            KnownChart::Sg140 => {
+                "ColorChecker Digital SG, all 140 patches, 10×14, the 96 centre patches are \
+                 features; data directory"
+            }
+        }
+    }
+
+    /// The known chart called `name` (exactly), if any.
+    pub fn from_name(name: &str) -> Option<KnownChart> {
+        KnownChart::ALL.into_iter().find(|c| c.name() == name)
+    }
+
+    /// The physical chart a photo shows when features come from this one: the whole SG for
+    /// its 96 centre patches; `None` for the thesis's file order, which no photo shows.
+    pub fn physical(self) -> Option<KnownChart> {
+        match self {
+            KnownChart::ColorChecker24 => Some(KnownChart::ColorChecker24),
+            KnownChart::Sg96 | KnownChart::Sg140 => Some(KnownChart::Sg140),
+            KnownChart::Sg96Thesis => None,
+        }
+    }
+}
 
 impl Chart {
     /// Centre of each feature patch on the chart, in chart widths and heights from the
@@ -303,7 +353,7 @@ impl Chart {
     /// The built-in ColorChecker 24 on `grid`.
     pub fn colorchecker24(grid: &Grid) -> Result<Chart> {
         Chart::from_reflectances(
-            "colorchecker24",
+            KnownChart::ColorChecker24.name(),
             &builtin::COLORCHECKER24.load()?,
             4,
             6,
@@ -327,7 +377,7 @@ impl Chart {
             }
         }
         let mut chart = Chart::from_reflectances(
-            "colorchecker_sg140",
+            KnownChart::Sg140.name(),
             &reflectances.select(&order),
             10,
             14,
@@ -339,7 +389,7 @@ impl Chart {
         Ok(chart)
     }
 
-    /// Resolves a chart by name or file: the names of [`CHART_NAMES`], or a reflectance CSV
+    /// Resolves a chart by name or file: a [`KnownChart`]'s name, or a reflectance CSV
     /// (path or data-directory name) with `layout` rows × cols (needed unless the file has
     /// 24, 96 or 140 patches, whose layouts are known).
     pub fn resolve(
@@ -348,9 +398,9 @@ impl Chart {
         data_dir: &DataDir,
         grid: &Grid,
     ) -> Result<Chart> {
-        let (name, set) = match spec {
-            "colorchecker24" => return Chart::colorchecker24(grid),
-            "colorchecker_sg96" | "colorchecker_sg96_thesis" => {
+        let (name, set) = match KnownChart::from_name(spec) {
+            Some(KnownChart::ColorChecker24) => return Chart::colorchecker24(grid),
+            Some(known @ (KnownChart::Sg96 | KnownChart::Sg96Thesis)) => {
                 let (_, set) = builtin::resolve_table(
                     "colorchecker_digital_sg_96_i1pro2",
                     "chart",
@@ -358,7 +408,7 @@ impl Chart {
                     data_dir,
                     &["thesis"],
                 )?;
-                if spec == "colorchecker_sg96" {
+                if known == KnownChart::Sg96 {
                     // The file lists the SG's centre patches column by column (B2…B9,
                     // C2…C9, …, M2…M9): position (row r, column c) holds file patch c·8 + r.
                     let order: Vec<usize> = (0..8)
@@ -368,11 +418,11 @@ impl Chart {
                 }
                 (spec.to_string(), set)
             }
-            "colorchecker_sg140" => (
+            Some(KnownChart::Sg140) => (
                 spec.to_string(),
                 builtin::resolve_table("colorchecker_sg", "chart", &[], data_dir, &["charts"])?.1,
             ),
-            _ => builtin::resolve_table(
+            None => builtin::resolve_table(
                 spec,
                 "chart",
                 &[builtin::COLORCHECKER24],
@@ -383,11 +433,7 @@ impl Chart {
                 Error::UnknownName { name, .. } => Error::UnknownName {
                     kind: "chart",
                     name,
-                    valid: CHART_NAMES
-                        .iter()
-                        .map(|(n, _)| *n)
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                    valid: KnownChart::ALL.map(KnownChart::name).join(", ")
                         + ", or a reflectance CSV with --layout ROWSxCOLS",
                 },
                 other => other,
@@ -449,6 +495,24 @@ impl Chart {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn known_charts_round_trip_their_names_and_map_to_the_chart_photographed() {
+        for chart in KnownChart::ALL {
+            assert_eq!(KnownChart::from_name(chart.name()), Some(chart));
+            assert!(!chart.description().is_empty());
+        }
+        assert_eq!(KnownChart::from_name("ColorChecker24"), None);
+        assert_eq!(KnownChart::Sg96.physical(), Some(KnownChart::Sg140));
+        assert_eq!(KnownChart::Sg96Thesis.physical(), None);
+        let cc = Chart::resolve(
+            "colorchecker24",
+            None,
+            &DataDir::new(None),
+            &Grid::SIMULATION,
+        );
+        assert_eq!(cc.unwrap().name, KnownChart::ColorChecker24.name());
+    }
 
     #[test]
     fn colorchecker24_thesis_layout() {

@@ -14,7 +14,7 @@ use crate::shipped::ModelSet;
 use crate::trust::{self, PhotoFlags, Trust};
 use serde::Serialize;
 use spdcam_core::builtin::DataDir;
-use spdcam_core::chart::Chart;
+use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
 use spdcam_core::feature_check;
 use spdcam_core::metrics;
@@ -447,7 +447,7 @@ pub fn chart_templates(
     };
     if names.is_empty() {
         let mut out = vec![ChartTemplate::from_chart(&Chart::colorchecker24(&grid)?)?];
-        if let Ok(sg) = Chart::resolve("colorchecker_sg140", None, data_dir, &grid) {
+        if let Ok(sg) = Chart::resolve(KnownChart::Sg140.name(), None, data_dir, &grid) {
             out.push(ChartTemplate::from_chart(&sg)?);
         }
         return Ok(out);

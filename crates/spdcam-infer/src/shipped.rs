@@ -3,16 +3,17 @@
 
 use crate::error::{InferError, Result};
 use crate::model::Model;
+use spdcam_core::chart::KnownChart;
 
 /// The shipped models: chart name and `.spdm` bytes (`models/<chart>.spdm`, each made by the
 /// seeded commands in the README).
 const SHIPPED: &[(&str, &[u8])] = &[
     (
-        "colorchecker_sg96",
+        KnownChart::Sg96.name(),
         include_bytes!("../../../models/colorchecker_sg96.spdm"),
     ),
     (
-        "colorchecker24",
+        KnownChart::ColorChecker24.name(),
         include_bytes!("../../../models/colorchecker24.spdm"),
     ),
 ];

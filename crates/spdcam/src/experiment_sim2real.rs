@@ -11,7 +11,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::in_camera::{calibrate, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
-use spdcam_core::chart::Chart;
+use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
 use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
@@ -184,7 +184,7 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
     };
     let thesis_cam = "canon_eos_5d_mark_ii_mod_bw486";
     let plain_cam = "canon_eos_5d_mark_ii";
-    let sg = "colorchecker_sg96";
+    let sg = KnownChart::Sg96.name();
     // The domain-randomisation pool: every camera of the data directory's cameras/.
     let chart = Chart::resolve(sg, None, data_dir, &GRID)?;
     let mut sens = match data_dir.root().map(|p| p.join("cameras")) {

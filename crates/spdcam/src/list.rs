@@ -4,7 +4,7 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use spdcam_core::builtin::{self, DataDir};
 use spdcam_core::camera::noise::NoiseParams;
-use spdcam_core::chart::CHART_NAMES;
+use spdcam_core::chart::KnownChart;
 use spdcam_core::illuminant::StandardIlluminant;
 use spdcam_core::light::SPD_FORMS;
 use spdcam_core::lighting;
@@ -45,8 +45,8 @@ pub fn run(args: ListArgs, data_dir: &DataDir) -> Result<()> {
     }
     if want(Topic::Charts) {
         println!("charts:");
-        for (name, what) in CHART_NAMES {
-            println!("  {name:<28} {what}");
+        for chart in KnownChart::ALL {
+            println!("  {:<28} {}", chart.name(), chart.description());
         }
         println!(
             "  {:<28} a reflectance CSV with --layout ROWSxCOLS",

@@ -13,7 +13,7 @@ use rand::SeedableRng;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::CameraConfig;
-use spdcam_core::chart::Chart;
+use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
 use spdcam_core::dataset::MeasuredPhotos;
@@ -502,10 +502,9 @@ const SCENES: usize = 20;
 /// The chart as photos show it for `model_chart` (the SG's 96 patches are read from the
 /// whole 140-patch chart).
 fn photo_chart(model_chart: &str) -> &str {
-    if model_chart == "colorchecker_sg96" {
-        "colorchecker_sg140"
-    } else {
-        model_chart
+    match KnownChart::from_name(model_chart).and_then(KnownChart::physical) {
+        Some(physical) => physical.name(),
+        None => model_chart,
     }
 }
 
@@ -1027,7 +1026,7 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
             &shots.clean.features,
             &shots.clean.truths,
         )?;
-        if chart_name == "colorchecker_sg96" {
+        if KnownChart::from_name(chart_name) == Some(KnownChart::Sg96) {
             let thesis = match &args.thesis_data {
                 Some(p) => p.clone(),
                 None => in_data_dir(None, "thesis", data_dir)?,

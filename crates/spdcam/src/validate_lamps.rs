@@ -13,7 +13,7 @@ use rand::{Rng, SeedableRng};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
-use spdcam_core::chart::Chart;
+use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
 use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::fsio::write_atomic;
@@ -165,7 +165,7 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
             );
         }
         md.push('\n');
-        if !args.no_real && chart_name == "colorchecker_sg96" {
+        if !args.no_real && KnownChart::from_name(&chart_name) == Some(KnownChart::Sg96) {
             real_rows.push((path.clone(), real_scores(&args, model, data_dir)?));
         }
         eprintln!("{}: done", path.display());

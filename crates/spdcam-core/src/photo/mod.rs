@@ -36,7 +36,7 @@ pub use overlay::{analysis_overlay_jpeg, debug_overlay, write_overlay, OVERLAY_S
 pub use sample::{sample, PatchSample};
 
 use crate::builtin::DataDir;
-use crate::chart::Chart;
+use crate::chart::{Chart, KnownChart};
 use crate::error::{Error, Result};
 use crate::spectral::Grid;
 
@@ -81,9 +81,9 @@ impl ChartTemplate {
     /// different lightness exist, since then nothing fixes the orientation.
     pub fn from_chart(chart: &Chart) -> Result<ChartTemplate> {
         let layout = &chart.layout;
-        let patch_fraction = match chart.name.as_str() {
-            "colorchecker24" => COLORCHECKER24_PATCH_FRACTION,
-            "colorchecker_sg140" => COLORCHECKER_SG_PATCH_FRACTION,
+        let patch_fraction = match KnownChart::from_name(&chart.name) {
+            Some(KnownChart::ColorChecker24) => COLORCHECKER24_PATCH_FRACTION,
+            Some(KnownChart::Sg140) => COLORCHECKER_SG_PATCH_FRACTION,
             _ if layout.gap_px > 0 => {
                 layout.patch_px as f64 / (layout.patch_px + layout.gap_px) as f64
             }
@@ -129,10 +129,9 @@ impl ChartTemplate {
     /// `colorchecker_sg140`; any other chart as itself. `None` for a chart no photo shows
     /// in that order (`colorchecker_sg96_thesis`, the file order) or that has no template.
     pub fn for_chart(chart: &str, data_dir: &DataDir, grid: &Grid) -> Option<ChartTemplate> {
-        let physical = match chart {
-            "colorchecker_sg96_thesis" => return None,
-            "colorchecker_sg96" | "colorchecker_sg140" => "colorchecker_sg140",
-            other => other,
+        let physical = match KnownChart::from_name(chart) {
+            Some(known) => known.physical()?.name(),
+            None => chart,
         };
         let chart = Chart::resolve(physical, None, data_dir, grid).ok()?;
         ChartTemplate::from_chart(&chart).ok()
