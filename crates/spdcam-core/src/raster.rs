@@ -140,6 +140,47 @@ impl RgbImage {
     }
 }
 
+/// Separable Gaussian blur of one plane (row-major, `width` wide) in place, edges clamped,
+/// the kernel truncated at ⌈3σ⌉ (at least 1) and normalised to sum 1; `scratch` is reused
+/// between calls. Used by the lens's point spread and by edge-based white balance.
+pub fn gaussian_blur(
+    plane: &mut [f32],
+    width: usize,
+    height: usize,
+    sigma: f64,
+    scratch: &mut Vec<f32>,
+) {
+    let radius = (3.0 * sigma).ceil().max(1.0) as isize;
+    let kernel: Vec<f32> = (-radius..=radius)
+        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp() as f32)
+        .collect();
+    let sum: f32 = kernel.iter().sum();
+    let kernel: Vec<f32> = kernel.iter().map(|k| k / sum).collect();
+    let clamp = |v: isize, n: usize| v.clamp(0, n as isize - 1) as usize;
+    scratch.clear();
+    scratch.resize(plane.len(), 0.0);
+    for y in 0..height {
+        for x in 0..width {
+            scratch[y * width + x] = kernel
+                .iter()
+                .enumerate()
+                .map(|(k, w)| w * plane[y * width + clamp(x as isize + k as isize - radius, width)])
+                .sum();
+        }
+    }
+    for y in 0..height {
+        for x in 0..width {
+            plane[y * width + x] = kernel
+                .iter()
+                .enumerate()
+                .map(|(k, w)| {
+                    w * scratch[clamp(y as isize + k as isize - radius, height) * width + x]
+                })
+                .sum();
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,6 +1,8 @@
 //! Chart detection, rectification and sampling on seeded synthetic photos (see
 //! `photo_support`): the chart must be found, its corners placed within a small share of a
-//! patch, its orientation right, and its features equal to the unwarped render's.
+//! patch, its orientation right, and its features equal to what an ideal camera shows of
+//! the chart's flat patches; and photos by the full camera (mosaic, noise, aberration) must
+//! be found and sampled close to it.
 
 mod photo_support;
 #[cfg(feature = "measured-data")]
@@ -242,4 +244,51 @@ fn exif_orientation_is_honoured() {
         let d = (a.corners[k][0] - s.corners[k][0]).hypot(a.corners[k][1] - s.corners[k][1]);
         assert!(d < 0.1 * s.patch_px, "corner {k} is {d:.1} px off");
     }
+}
+
+/// The full camera chain (Bayer mosaic, thesis noise, Menon demosaicing, aberration) under
+/// daylight and tungsten: every chart is found and its features stay close to the
+/// noise-free flat-patch truth (demosaicing and noise move them a little, never far).
+#[test]
+fn photos_by_the_full_camera_are_found_and_sampled_close_to_the_truth() {
+    use spdcam_core::camera::{Camera, CameraConfig};
+    use spdcam_core::chart::Chart;
+    use spdcam_core::illuminant::StandardIlluminant;
+    use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
+    use spdcam_core::spectral::Grid;
+    let grid = Grid::SIMULATION;
+    let chart = Chart::colorchecker24(&grid).unwrap();
+    let template = ChartTemplate::from_chart(&chart).unwrap();
+    let chart = chart.with_layout(scene::scene_layout(&template)).unwrap();
+    let set = spdcam_core::builtin::CAMERAS[0].load().unwrap();
+    let sens =
+        spdcam_core::camera::sensor::Sensitivities::new("nikon_d5100_npl", &set, &grid).unwrap();
+    let camera = Camera::new(&sens, chart, CameraConfig::default(), &grid).unwrap();
+    let options = SceneOptions {
+        width: SIZE.width,
+        height: SIZE.height,
+        width_share: (0.3, 0.6),
+        ..SceneOptions::default()
+    };
+    let analyse_options = AnalyseOptions {
+        templates: vec![template],
+        ..AnalyseOptions::default()
+    };
+    let lights = [StandardIlluminant::D65, StandardIlluminant::A].map(|l| l.spd(&grid).unwrap());
+    let errors: Vec<f64> = (0..8u64)
+        .into_par_iter()
+        .map(|seed| {
+            let spd = &lights[seed as usize % 2];
+            let shot = scene::photograph(&camera, SceneLight::single(spd), seed, &options).unwrap();
+            let photo = decode_photo(&shot.jpeg, "full.jpg").unwrap();
+            let a = analyse(&photo, &analyse_options).unwrap();
+            let f = |v: &[f32], p: usize| [v[3 * p], v[3 * p + 1], v[3 * p + 2]];
+            (0..a.features.len() / 3)
+                .map(|p| delta_e(f(&a.features, p), f(&shot.expected_features, p)))
+                .sum::<f64>()
+                / (a.features.len() / 3) as f64
+        })
+        .collect();
+    println!("mean ΔE2000 per photo: {errors:.2?}");
+    assert!(errors.iter().all(|&e| e < 1.5), "{errors:.2?}");
 }

@@ -11,7 +11,7 @@ use spdcam_core::camera::white_balance::WhiteBalance;
 use spdcam_core::camera::{Camera, CameraConfig, WhiteBalanceStatistics};
 use spdcam_core::chart::{Chart, Layout};
 use spdcam_core::lighting::Lighting;
-use spdcam_core::photo::scene::{self, SceneOptions};
+use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_core::{fsio, imageio, light};
@@ -313,21 +313,13 @@ fn render_scene(
     let template = ChartTemplate::from_chart(&chart)?;
     let chart = chart.with_layout(scene::scene_layout(&template))?;
     let camera = args.camera.camera_for(chart, data_dir, &grid)?;
-    let rendering = camera.render(spd, args.seed, false)?;
     let options = SceneOptions {
         width,
         height,
         ..SceneOptions::default()
     };
+    let shot = scene::photograph(&camera, SceneLight::single(spd), args.seed, &options)?;
     let chart = camera.chart();
-    let shot = scene::photograph(
-        &rendering.image,
-        &chart.layout,
-        &template,
-        &chart.feature_patches,
-        args.seed,
-        &options,
-    )?;
     fsio::write_output(&args.output, &shot.jpeg)?;
     if fsio::is_stdout(&args.output) {
         return Ok(());

@@ -11,6 +11,7 @@ use rand::rngs::SmallRng;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::optics::Glow;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::CameraConfig;
 use spdcam_core::chart::{Chart, KnownChart};
@@ -20,7 +21,7 @@ use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::lighting::{LampLibrary, ValidationSplit};
-use spdcam_core::photo::scene::{self, SceneOptions};
+use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
@@ -557,56 +558,31 @@ fn scene_verdicts(
         let other = ids[(i * ids.len() / SCENES + ids.len() / 2) % ids.len()];
         let k = i % pool.len();
         let shot_seed = seed::derive(seed, i as u64);
-        let clean = pool[k]
-            .render(&setup.library.spds[lamp], shot_seed, false)?
-            .image;
-        let lit_b = pool[k]
-            .render(&setup.library.spds[other], shot_seed, false)?
-            .image;
-        let mut half = clean.clone();
-        for plane in 0..3 {
-            for y in 0..half.height {
-                for x in half.width / 2..half.width {
-                    half.planes[plane][y * half.width + x] =
-                        lit_b.planes[plane][y * half.width + x];
-                }
-            }
-        }
-        let mut glared = clean.clone();
-        let mean = clean
-            .planes
-            .iter()
-            .flatten()
-            .map(|&v| srgb_decode(f64::from(v)))
-            .sum::<f64>()
-            / (3 * clean.width * clean.height) as f64;
-        let side = clean.width as f64;
-        for plane in 0..3 {
-            for y in 0..glared.height {
-                for x in 0..glared.width {
-                    let d2 = ((x * x + y * y) as f64) / (side * side);
-                    let add = GLARE_LEVEL * mean * (-d2 / (2.0 * GLARE_WIDTH * GLARE_WIDTH)).exp();
-                    let v = &mut glared.planes[plane][y * glared.width + x];
-                    *v = srgb_encode((srgb_decode(f64::from(*v)) + add).min(1.0)) as f32;
-                }
-            }
-        }
-        let other_chart = wrong_pool[k]
-            .render(&setup.library.spds[lamp], shot_seed, false)?
-            .image;
-        for (kind, image) in [clean, other_chart, half, glared].iter().enumerate() {
-            let shot = scene::photograph(
-                image,
-                &chart.layout,
-                &template,
-                &chart.feature_patches,
-                shot_seed,
-                &SceneOptions {
-                    width: 1200,
-                    height: 900,
-                    ..SceneOptions::default()
-                },
-            )?;
+        let (spd, other_spd) = (&setup.library.spds[lamp], &setup.library.spds[other]);
+        let plain = SceneOptions {
+            width: 1200,
+            height: 900,
+            ..SceneOptions::default()
+        };
+        let glare = SceneOptions {
+            glow: Some(Glow {
+                level: GLARE_LEVEL,
+                width: GLARE_WIDTH,
+            }),
+            ..plain.clone()
+        };
+        let half = SceneLight {
+            spd,
+            right_half: Some(other_spd),
+        };
+        let shots = [
+            (&pool[k], SceneLight::single(spd), &plain),
+            (&wrong_pool[k], SceneLight::single(spd), &plain),
+            (&pool[k], half, &plain),
+            (&pool[k], SceneLight::single(spd), &glare),
+        ];
+        for (kind, (camera, light, scene_options)) in shots.into_iter().enumerate() {
+            let shot = scene::photograph(camera, light, shot_seed, scene_options)?;
             match estimate_photo_bytes(
                 &shot.jpeg,
                 "scene.jpg",

@@ -16,7 +16,8 @@
 //!
 //! [`Camera::render`] runs the whole image pipeline; [`Camera::features_fast`] gives the
 //! noise-free features straight from patch-level values, without an image, for very large
-//! datasets.
+//! datasets; [`Camera::exposed_chart`] and [`Camera::develop`] let a scene photo
+//! ([`crate::photo::scene`]) run the same stages on a chart placed in a scene.
 
 pub mod aberration;
 pub mod colour;
@@ -303,16 +304,21 @@ impl Camera {
     /// Fresh buffers sized for this camera's images.
     pub fn buffers(&self) -> RenderBuffers {
         let l = &self.chart.layout;
+        self.buffers_sized(l.width, l.height)
+    }
+
+    /// Fresh buffers for images of `width × height` pixels.
+    fn buffers_sized(&self, width: usize, height: usize) -> RenderBuffers {
         let pattern = match self.config.sensor.mode {
             SensorMode::SingleSensor(p) => p,
             SensorMode::ThreeSensor => crate::raster::CfaPattern::Rggb,
         };
         RenderBuffers {
             raw: Vec::new(),
-            mosaic: Mosaic::new(l.width, l.height, pattern),
-            image: RgbImage::new(l.width, l.height),
+            mosaic: Mosaic::new(width, height, pattern),
+            image: RgbImage::new(width, height),
             scratch: Vec::new(),
-            binned: RgbImage::new(l.width / 2, l.height / 2),
+            binned: RgbImage::new(width / 2, height / 2),
             region: aberration::RegionPlanes::default(),
             samples: SampleBuffers::default(),
         }
@@ -322,12 +328,25 @@ impl Camera {
     /// response, the scene's uneven lighting, the optics' glare, and the sensor's exposure
     /// (with clipping at full scale when the shot meters automatically).
     fn exposed_regions(&self, shot: &Shot, light: &[f32], raw: &mut Vec<[f32; 3]>) {
+        self.lit_regions(shot, light, raw);
+        let scale = self.exposure_scale(shot, raw);
+        expose(raw, scale, shot.full_scale);
+    }
+
+    /// Raw values of every region under `light` before exposure (into `raw`): the
+    /// spectral response, the scene's uneven lighting and the optics' glare.
+    fn lit_regions(&self, shot: &Shot, light: &[f32], raw: &mut Vec<[f32; 3]>) {
         self.response.raw_into(light, raw);
         let patches = self.chart.reflectances.len();
         shot.lighting.apply(raw, &self.region_centres);
         shot.glare.apply(raw, patches);
-        let scale = shot
-            .auto_exposure
+    }
+
+    /// The exposure's scale for lit region values: the shot's metering, or the camera's
+    /// fixed exposure of the brightest value.
+    fn exposure_scale(&self, shot: &Shot, raw: &[[f32; 3]]) -> f32 {
+        let patches = self.chart.reflectances.len();
+        shot.auto_exposure
             .and_then(|exposure| exposure.scale(raw, patches))
             .unwrap_or_else(|| {
                 sensor::exposure_scale(
@@ -335,10 +354,80 @@ impl Camera {
                     self.chart.layout.shows_background(),
                     self.config.sensor.exposure,
                 )
-            });
+            })
+    }
+
+    /// The chart's exposed raw values per region (patches, then the background; 1 = full
+    /// scale) under each of `spds`, all at the exposure the first light gives: the scene a
+    /// photo of the chart is composed from ([`crate::photo::scene`]), a second light lighting
+    /// part of the chart as the camera metered the first.
+    pub fn exposed_chart(&self, spds: &[&Spd]) -> Result<Vec<Vec<[f32; 3]>>> {
+        let shot = Shot::of(self.config.in_camera.as_ref());
+        let mut out: Vec<Vec<[f32; 3]>> = Vec::with_capacity(spds.len());
+        for spd in spds {
+            let light = self.light(spd)?;
+            let mut raw = Vec::new();
+            self.lit_regions(&shot, &light, &mut raw);
+            out.push(raw);
+        }
+        if let Some(first) = out.first() {
+            let scale = self.exposure_scale(&shot, first);
+            out.iter_mut()
+                .for_each(|raw| expose(raw, scale, shot.full_scale));
+        }
+        Ok(out)
+    }
+
+    /// Photographs a scene given as linear raw camera RGB at the sensor (exposed, 1 = full
+    /// scale; any size): the sensor (mosaic and noise), demosaicing, white balance from the
+    /// whole image with the shot's adaptation, aberration, the colour matrix and tone
+    /// rendering, quantised at the camera's bit depth. The stages are those of
+    /// [`Camera::render`]; the patch-level JPEG model is left out, for a scene photo is
+    /// encoded by a real JPEG encoder afterwards.
+    pub fn develop(&self, scene: &RgbImage, seed: u64) -> Rendering {
+        let shot = self.scene_shot();
+        let mut buffers = self.buffers_sized(scene.width, scene.height);
         let full_scale = shot.full_scale;
-        raw.iter_mut()
-            .for_each(|v| *v = v.map(|x| (x * scale).min(full_scale)));
+        match self.config.sensor.mode {
+            SensorMode::SingleSensor(_) => {
+                sensor::sample_mosaic(scene, full_scale, &mut buffers.mosaic)
+            }
+            SensorMode::ThreeSensor => {
+                for (plane, src) in buffers.image.planes.iter_mut().zip(&scene.planes) {
+                    plane
+                        .iter_mut()
+                        .zip(src)
+                        .for_each(|(v, &s)| *v = s.min(full_scale));
+                }
+            }
+        }
+        let gains = self.sense_and_balance(&shot, seed, &mut buffers, None);
+        self.finish_image(&shot, &mut buffers, None);
+        Rendering {
+            features: Vec::new(),
+            image: buffers.image,
+            stages: Stages::default(),
+            white_balance_gains: gains,
+        }
+    }
+
+    /// An exposed raw value as [`Camera::develop`] encodes it with white-balance `gains`
+    /// (clipped at full scale, balanced, encoded sRGB on 0…1, unquantised): what a flat,
+    /// noise-free patch of a scene photo shows.
+    pub fn encode_exposed(&self, raw: [f32; 3], gains: [f32; 3]) -> [f32; 3] {
+        let shot = self.scene_shot();
+        let balanced = std::array::from_fn(|c| raw[c].min(shot.full_scale) * gains[c]);
+        self.finish_pixel(&shot, balanced)
+    }
+
+    /// The configured shot without the patch-level JPEG model (scene photos are encoded by
+    /// a real encoder).
+    fn scene_shot(&self) -> Shot {
+        let mut shot = Shot::of(self.config.in_camera.as_ref());
+        if let Some(rendering) = &mut shot.rendering {
+            rendering.jpeg_quality = None;
+        }
+        shot
     }
 
     /// Patch-level white-balanced values (noise-free) into `raw`, used by the D65 fit and
@@ -395,6 +484,13 @@ impl Camera {
     ) -> [f32; 3] {
         let shot = Shot::of(self.config.in_camera.as_ref());
         let gains = self.capture_balanced(&shot, light, seed, buffers, stages.as_deref_mut());
+        self.finish_image(&shot, buffers, stages);
+        gains
+    }
+
+    /// The white-balanced image in `buffers.image` → aberration, the colour matrix and tone
+    /// rendering, quantised.
+    fn finish_image(&self, shot: &Shot, buffers: &mut RenderBuffers, stages: Option<&mut Stages>) {
         if let Some(ab) = &self.config.aberration {
             ab.apply(&mut buffers.image, &mut buffers.scratch);
         }
@@ -407,13 +503,12 @@ impl Camera {
                 let [r, g, b] = &mut buffers.image.planes;
                 for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
                     let v = self
-                        .finish_pixel(&shot, [*r, *g, *b])
+                        .finish_pixel(shot, [*r, *g, *b])
                         .map(|v| self.colour.quantise(v));
                     (*r, *g, *b) = (v[0], v[1], v[2]);
                 }
             }
         }
-        gains
     }
 
     /// The features [`Camera::render_into`] followed by [`Camera::features`] give, computed
@@ -488,20 +583,38 @@ impl Camera {
         light: &[f32],
         seed: u64,
         buffers: &mut RenderBuffers,
+        stages: Option<&mut Stages>,
+    ) -> [f32; 3] {
+        self.exposed_regions(shot, light, &mut buffers.raw);
+        match self.config.sensor.mode {
+            SensorMode::SingleSensor(_) => {
+                sensor::form_mosaic(&self.region_map, &buffers.raw, &mut buffers.mosaic)
+            }
+            SensorMode::ThreeSensor => {
+                sensor::form_three_sensor(&self.region_map, &buffers.raw, &mut buffers.image)
+            }
+        }
+        self.sense_and_balance(shot, seed, buffers, stages)
+    }
+
+    /// The exposed signal in `buffers.mosaic` (one sensor) or `buffers.image` (three) →
+    /// noise, demosaicing and white balance into `buffers.image`; returns the gains.
+    fn sense_and_balance(
+        &self,
+        shot: &Shot,
+        seed: u64,
+        buffers: &mut RenderBuffers,
         mut stages: Option<&mut Stages>,
     ) -> [f32; 3] {
         let RenderBuffers {
-            raw,
             mosaic,
             image,
             binned,
             ..
         } = buffers;
         let mut from_raw = false;
-        self.exposed_regions(shot, light, raw);
         match self.config.sensor.mode {
             SensorMode::SingleSensor(_) => {
-                sensor::form_mosaic(&self.region_map, raw, mosaic);
                 if let Some(noise) = &self.config.noise {
                     noise::add_noise(&mut mosaic.data, mosaic.width, noise, seed);
                 }
@@ -515,7 +628,6 @@ impl Camera {
                 demosaic::demosaic_into(mosaic, self.config.demosaic, image);
             }
             SensorMode::ThreeSensor => {
-                sensor::form_three_sensor(&self.region_map, raw, image);
                 if let Some(noise) = &self.config.noise {
                     for (c, plane) in image.planes.iter_mut().enumerate() {
                         noise::add_noise(plane, mosaic.width, noise, seed::derive(seed, c as u64));
@@ -627,6 +739,12 @@ impl Shot {
             },
         }
     }
+}
+
+/// Scales raw values by the exposure's `scale` and clips them at `full_scale`.
+fn expose(raw: &mut [[f32; 3]], scale: f32, full_scale: f32) {
+    raw.iter_mut()
+        .for_each(|v| *v = v.map(|x| (x * scale).min(full_scale)));
 }
 
 /// Mean raw value of the first `patches` regions (the chart's patches, before the

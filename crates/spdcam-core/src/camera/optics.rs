@@ -1,8 +1,10 @@
-//! The optics stage: what the lens does to the light before the sensor. Veiling glare is
+//! The optics stage: what the lens does to the light before the sensor. Veiling glare,
+//! vignetting, the lens's blur and the glow of a bright light just outside the frame are
 //! here; lateral chromatic aberration ([`super::aberration`]) belongs to the same box but
 //! runs on the white-balanced image, where the thesis put it (section 3.1.5).
 
 use super::patch_mean;
+use crate::raster::{gaussian_blur, RgbImage};
 
 /// Veiling glare (ISO 18844): stray light scattered inside the lens adds a share of the
 /// scene's mean level to every region, lifting dark patches most.
@@ -26,6 +28,94 @@ impl VeilingGlare {
     }
 }
 
+/// Vignetting: light falls off towards the frame's corners, as the gain `1 − strength·r²`
+/// with r the distance from the frame's centre relative to the half-diagonal (the leading
+/// term of the cos⁴ law; Ray, *Applied Photographic Optics*, 3rd ed., §43.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Vignetting {
+    /// Light lost at the corners (0 = none, < 1).
+    pub strength: f64,
+}
+
+impl Vignetting {
+    /// The gain at point (x, y) of a `width × height` frame.
+    pub fn gain(&self, [x, y]: [f64; 2], width: usize, height: usize) -> f64 {
+        let (mx, my) = (width as f64 / 2.0, height as f64 / 2.0);
+        1.0 - self.strength * ((x - mx).powi(2) + (y - my).powi(2)) / (mx * mx + my * my)
+    }
+
+    /// Multiplies every pixel of `image` by the gain at its centre.
+    pub fn apply(&self, image: &mut RgbImage) {
+        if self.strength == 0.0 {
+            return;
+        }
+        let (w, h) = (image.width, image.height);
+        for y in 0..h {
+            for x in 0..w {
+                let g = self.gain([x as f64 + 0.5, y as f64 + 0.5], w, h) as f32;
+                for plane in image.planes.iter_mut() {
+                    plane[y * w + x] *= g;
+                }
+            }
+        }
+    }
+}
+
+/// The lens's blur: a Gaussian point spread of `sigma` pixels (below 0.2 px, none).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LensBlur {
+    /// Standard deviation of the point spread (pixels).
+    pub sigma: f64,
+}
+
+impl LensBlur {
+    /// Blurs every plane of `image` in place.
+    pub fn apply(&self, image: &mut RgbImage) {
+        if self.sigma < 0.2 {
+            return;
+        }
+        let mut scratch = Vec::new();
+        let (w, h) = (image.width, image.height);
+        for plane in image.planes.iter_mut() {
+            gaussian_blur(plane, w, h, self.sigma, &mut scratch);
+        }
+    }
+}
+
+/// Glow from a bright light just outside the frame, scattered by the lens onto part of the
+/// image: light of the scene's colour added with a Gaussian fall-off from a point (a local
+/// form of veiling glare, ISO 18844's glare spread function in its simplest shape).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Glow {
+    /// At its centre the glow adds this share of the scene's mean level.
+    pub level: f64,
+    /// The fall-off's standard deviation, as a share of a reference length the caller
+    /// gives (the chart's width for a scene photo).
+    pub width: f64,
+}
+
+impl Glow {
+    /// Adds the glow centred at `centre` (pixels) to `image`; `mean` is the scene's mean
+    /// raw value (R, G, B) and `length` the reference length in pixels.
+    pub fn apply(&self, image: &mut RgbImage, centre: [f64; 2], mean: [f32; 3], length: f64) {
+        let s = self.width * length;
+        if self.level <= 0.0 || s <= 0.0 {
+            return;
+        }
+        let w = image.width;
+        for y in 0..image.height {
+            for x in 0..w {
+                let d2 =
+                    (x as f64 + 0.5 - centre[0]).powi(2) + (y as f64 + 0.5 - centre[1]).powi(2);
+                let g = (self.level * (-d2 / (2.0 * s * s)).exp()) as f32;
+                for (plane, m) in image.planes.iter_mut().zip(mean) {
+                    plane[y * w + x] += g * m;
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -39,5 +129,51 @@ mod tests {
             raw,
             [[0.25, 1.5, 0.625], [1.25, 1.5, 0.125], [0.45, 0.7, 0.325]]
         );
+    }
+
+    #[test]
+    fn vignetting_is_one_at_the_centre_and_loses_strength_at_the_corners() {
+        let v = Vignetting { strength: 0.25 };
+        assert_eq!(v.gain([50.0, 30.0], 100, 60), 1.0);
+        assert!((v.gain([0.0, 0.0], 100, 60) - 0.75).abs() < 1e-12);
+        assert!((v.gain([100.0, 30.0], 100, 60) - (1.0 - 0.25 * 2500.0 / 3400.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_lens_blur_keeps_a_flat_image_and_the_sum_of_a_point() {
+        let mut flat = RgbImage::new(9, 7);
+        flat.planes.iter_mut().for_each(|p| p.fill(0.5));
+        LensBlur { sigma: 1.0 }.apply(&mut flat);
+        assert!(flat
+            .planes
+            .iter()
+            .flatten()
+            .all(|&v| (v - 0.5).abs() < 1e-6));
+        let mut point = RgbImage::new(15, 15);
+        point.planes[1][7 * 15 + 7] = 1.0;
+        LensBlur { sigma: 1.0 }.apply(&mut point);
+        let sum: f32 = point.planes[1].iter().sum();
+        assert!((sum - 1.0).abs() < 1e-5, "{sum}");
+        assert!(point.planes[1][7 * 15 + 7] < 0.2 && point.planes[1][7 * 15 + 8] > 0.05);
+    }
+
+    #[test]
+    fn glow_adds_its_level_of_the_mean_at_its_centre_and_fades_with_distance() {
+        let mut image = RgbImage::new(200, 10);
+        Glow {
+            level: 0.5,
+            width: 0.1,
+        }
+        .apply(&mut image, [0.5, 0.5], [1.0, 2.0, 0.0], 100.0);
+        assert!((image.planes[0][0] - 0.5).abs() < 1e-6);
+        assert!((image.planes[1][0] - 1.0).abs() < 1e-6);
+        assert_eq!(image.planes[2][0], 0.0);
+        // 10 px (one σ) away: e^(−½) of the centre.
+        let at_sigma = image.planes[0][10];
+        assert!(
+            (at_sigma - 0.5 * (-0.5f32).exp()).abs() < 1e-6,
+            "{at_sigma}"
+        );
+        assert!(image.planes[0][199] < 1e-30);
     }
 }

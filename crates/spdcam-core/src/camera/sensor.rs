@@ -281,6 +281,17 @@ pub fn form_mosaic(region_map: &[u16], region_rgb: &[[f32; 3]], mosaic: &mut Mos
     }
 }
 
+/// Fills the mosaic from a raw image of its size: each pixel takes the value of the channel
+/// its filter passes, clipped at `full_scale`.
+pub fn sample_mosaic(image: &RgbImage, full_scale: f32, mosaic: &mut Mosaic) {
+    let (w, pattern) = (mosaic.width, mosaic.pattern);
+    for (y, row) in mosaic.data.chunks_exact_mut(w).enumerate() {
+        for (x, v) in row.iter_mut().enumerate() {
+            *v = image.planes[pattern.channel_at(x, y)][y * w + x].min(full_scale);
+        }
+    }
+}
+
 /// Fills a three-sensor image: every pixel takes its region's full (R, G, B).
 pub fn form_three_sensor(region_map: &[u16], region_rgb: &[[f32; 3]], image: &mut RgbImage) {
     for (c, plane) in image.planes.iter_mut().enumerate() {
@@ -345,6 +356,29 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_sampled_mosaic_matches_the_region_mosaic_and_clips_at_full_scale() {
+        let layout = Layout::grid(2, 2, 3, 1, 1);
+        let map = layout.region_map();
+        let rgb = [
+            [1.0, 2.0, 3.0],
+            [0.5, 0.25, 0.125],
+            [4.0, 5.0, 6.0],
+            [0.1, 0.2, 0.3],
+            [0.0, 0.01, 0.02],
+        ];
+        let mut image = RgbImage::new(layout.width, layout.height);
+        form_three_sensor(&map, &rgb, &mut image);
+        let mut from_regions = Mosaic::new(layout.width, layout.height, CfaPattern::Grbg);
+        form_mosaic(&map, &rgb, &mut from_regions);
+        let mut sampled = Mosaic::new(layout.width, layout.height, CfaPattern::Grbg);
+        sample_mosaic(&image, f32::INFINITY, &mut sampled);
+        assert_eq!(sampled.data, from_regions.data);
+        sample_mosaic(&image, 1.0, &mut sampled);
+        let clipped: Vec<f32> = from_regions.data.iter().map(|v| v.min(1.0)).collect();
+        assert_eq!(sampled.data, clipped);
     }
 
     #[test]

@@ -274,33 +274,9 @@ fn minkowski(values: &[f32], p: f64) -> f64 {
 
 /// |∇(G_σ * f)| with a separable Gaussian and central differences, edges clamped.
 fn gradient_magnitude(plane: &[f32], width: usize, height: usize, sigma: f64) -> Vec<f32> {
-    let radius = (3.0 * sigma).ceil().max(1.0) as isize;
-    let kernel: Vec<f32> = (-radius..=radius)
-        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp() as f32)
-        .collect();
-    let sum: f32 = kernel.iter().sum();
-    let kernel: Vec<f32> = kernel.iter().map(|k| k / sum).collect();
+    let mut smooth = plane.to_vec();
+    crate::raster::gaussian_blur(&mut smooth, width, height, sigma, &mut Vec::new());
     let clamp = |v: isize, n: usize| v.clamp(0, n as isize - 1) as usize;
-    let mut tmp = vec![0.0f32; plane.len()];
-    for y in 0..height {
-        for x in 0..width {
-            tmp[y * width + x] = kernel
-                .iter()
-                .enumerate()
-                .map(|(k, w)| w * plane[y * width + clamp(x as isize + k as isize - radius, width)])
-                .sum();
-        }
-    }
-    let mut smooth = vec![0.0f32; plane.len()];
-    for y in 0..height {
-        for x in 0..width {
-            smooth[y * width + x] = kernel
-                .iter()
-                .enumerate()
-                .map(|(k, w)| w * tmp[clamp(y as isize + k as isize - radius, height) * width + x])
-                .sum();
-        }
-    }
     let mut out = vec![0.0f32; plane.len()];
     for y in 0..height {
         for x in 0..width {

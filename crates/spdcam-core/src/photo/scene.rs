@@ -1,24 +1,31 @@
-//! Synthetic photos: a rendered chart placed in a scene the way a person photographs it —
+//! Synthetic photos: a chart photographed in a scene the way a person photographs it. The
+//! chart's exposed raw values under the light (the camera's scene and sensor response) are
 //! warped by a random homography onto a cluttered, textured background lit by the same
-//! light, then blurred, vignetted, made noisy and JPEG-compressed. Every random choice comes
-//! from the seed. Used to make example photos and to test detection against known truth.
+//! light; the lens blurs and vignettes the image (and a bright light outside the frame may
+//! glow into it); then the camera develops it through the same stages as a rendered chart
+//! — mosaic, sensor noise, demosaicing, white balance, aberration, colour matrix, tone — and
+//! a real JPEG encoder writes it. Every random choice comes from the seed. Used to make
+//! example photos, to test detection against known truth and to test the self-check.
 
 use super::geometry::Homography;
 use super::ChartTemplate;
+use crate::camera::optics::{Glow, LensBlur, Vignetting};
+use crate::camera::Camera;
 use crate::chart::Layout;
-use crate::colorimetry::{srgb_decode, srgb_encode};
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::raster::RgbImage;
+use crate::seed;
+use crate::spectral::Spd;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use rand_distr::{Distribution, Normal};
 use std::io::Cursor;
 
 /// Pixels per patch pitch a chart is rendered at before it is placed in a scene.
 pub const SCENE_PITCH_PX: usize = 50;
 
-/// How a scene is photographed; each range is drawn uniformly per scene.
+/// How a scene is photographed; each range is drawn uniformly per scene. The sensor's noise
+/// is the camera's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneOptions {
     /// Photo width in pixels.
@@ -30,14 +37,16 @@ pub struct SceneOptions {
     /// Random displacement of each chart corner, as a share of the chart's smaller side
     /// (perspective).
     pub perspective: f64,
-    /// Gaussian blur σ in pixels.
+    /// The lens's Gaussian blur σ in pixels.
     pub blur_sigma: (f64, f64),
     /// Light fall-off at the photo's corners (0 = none).
     pub vignetting: (f64, f64),
-    /// Noise σ in 8-bit levels.
-    pub noise_sigma: (f64, f64),
     /// JPEG quality, 1–100.
     pub jpeg_quality: (u8, u8),
+    /// A bright light just outside the frame glowing into the lens at the chart's first
+    /// corner (top left of its patch grid), its width a share of the grid's width; `None`:
+    /// none.
+    pub glow: Option<Glow>,
 }
 
 impl Default for SceneOptions {
@@ -49,8 +58,28 @@ impl Default for SceneOptions {
             perspective: 0.12,
             blur_sigma: (0.0, 1.2),
             vignetting: (0.0, 0.25),
-            noise_sigma: (0.0, 2.0),
             jpeg_quality: (80, 95),
+            glow: None,
+        }
+    }
+}
+
+/// The light on the chart: one spectrum, or a second one lighting the right half of the
+/// chart (mixed light, which a photo must not be trusted with).
+#[derive(Debug, Clone, Copy)]
+pub struct SceneLight<'a> {
+    /// The light on the chart (on the whole chart without `right_half`).
+    pub spd: &'a Spd,
+    /// The light on the right half of the chart, at the exposure of the first.
+    pub right_half: Option<&'a Spd>,
+}
+
+impl<'a> SceneLight<'a> {
+    /// One light on the whole chart.
+    pub fn single(spd: &'a Spd) -> SceneLight<'a> {
+        SceneLight {
+            spd,
+            right_half: None,
         }
     }
 }
@@ -78,8 +107,10 @@ pub struct ScenePhoto {
     pub corners: [[f64; 2]; 4],
     /// Patch side in photo pixels (the mean over the chart).
     pub patch_px: f64,
-    /// The vignetting gain (≤ 1, linear light) at each feature patch's centre.
-    pub vignetting_at_features: Vec<f64>,
+    /// Each feature patch as a flat, noise-free, unblurred patch would show at its centre,
+    /// vignetting and glow included (encoded sRGB, 0–255, `p01_r, p01_g, …`): the features
+    /// a perfect sampler would read.
+    pub expected_features: Vec<f32>,
 }
 
 /// Checks that a scene of `width × height` px is large enough to show a chart and within
@@ -96,12 +127,11 @@ pub fn check_scene_size(width: usize, height: usize) -> Result<()> {
     )
 }
 
-/// Places `chart` (encoded sRGB on 0…1, rendered with `layout`) into scene `seed`.
+/// Photographs `camera`'s chart (laid out by [`scene_layout`]) under `light` in scene
+/// `seed`.
 pub fn photograph(
-    chart: &RgbImage,
-    layout: &Layout,
-    template: &ChartTemplate,
-    feature_patches: &[usize],
+    camera: &Camera,
+    light: SceneLight,
     seed: u64,
     options: &SceneOptions,
 ) -> Result<ScenePhoto> {
@@ -116,8 +146,11 @@ pub fn photograph(
             options.width_share
         )));
     }
+    let chart = camera.chart();
+    let template = ChartTemplate::from_chart(chart)?;
+    let layout = &chart.layout;
     let mut rng = SmallRng::seed_from_u64(seed);
-    let (cw, ch) = (chart.width, chart.height);
+    let (cw, ch) = (layout.width, layout.height);
     let grid_w = (layout.cols * layout.patch_px + (layout.cols - 1) * layout.gap_px) as f64;
     let grid_h = (layout.rows * layout.patch_px + (layout.rows - 1) * layout.gap_px) as f64;
     let placed = placement(&mut rng, (cw as f64, ch as f64), grid_w, options)?;
@@ -149,19 +182,20 @@ pub fn photograph(
     let (tw, th) = template.size();
     let patch_px = template.patch_fraction * (area / (tw * th)).sqrt();
 
+    let spds: Vec<&Spd> = std::iter::once(light.spd).chain(light.right_half).collect();
+    let exposed = camera.exposed_chart(&spds)?;
+    let patches = chart.reflectances.len();
     // The light's colour on the chart's whitest surface tints the background.
     let white = [0, 1, 2].map(|c| {
-        let best = chart.planes[c].iter().cloned().fold(0.0f32, f32::max);
-        srgb_decode(f64::from(best)) as f32
-    });
-    let brightest = white.iter().cloned().fold(1e-6, f32::max);
-    let mut planes = background(&mut rng, w, h, white.map(|v| v / brightest));
-    let chart_linear: [Vec<f32>; 3] = std::array::from_fn(|c| {
-        chart.planes[c]
+        exposed[0][..patches]
             .iter()
-            .map(|&v| srgb_decode(f64::from(v)) as f32)
-            .collect()
+            .map(|v| v[c])
+            .fold(0.0, f32::max)
     });
+    let mut scene = RgbImage::new(w, h);
+    scene.planes = background(&mut rng, w, h, white);
+    let region_map = layout.region_map();
+    let half = cw as f64 / 2.0;
     for y in 0..h {
         for x in 0..w {
             let q = inverse.apply([x as f64 + 0.5, y as f64 + 0.5]);
@@ -172,34 +206,56 @@ pub fn photograph(
             let (x0, y0) = (u as usize, v as usize);
             let (x1, y1) = ((x0 + 1).min(cw - 1), (y0 + 1).min(ch - 1));
             let (fx, fy) = ((u - x0 as f64) as f32, (v - y0 as f64) as f32);
-            for (plane, p) in planes.iter_mut().zip(&chart_linear) {
-                let top = p[y0 * cw + x0] * (1.0 - fx) + p[y0 * cw + x1] * fx;
-                let bottom = p[y1 * cw + x0] * (1.0 - fx) + p[y1 * cw + x1] * fx;
+            let at = |cx: usize, cy: usize| {
+                let lit = if cx as f64 + 0.5 >= half {
+                    exposed.len() - 1
+                } else {
+                    0
+                };
+                exposed[lit][usize::from(region_map[cy * cw + cx])]
+            };
+            let (a, b, c, d) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
+            for (k, plane) in scene.planes.iter_mut().enumerate() {
+                let top = a[k] * (1.0 - fx) + b[k] * fx;
+                let bottom = c[k] * (1.0 - fx) + d[k] * fx;
                 plane[y * w + x] = top * (1.0 - fy) + bottom * fy;
             }
         }
     }
-    let sigma = draw(&mut rng, options.blur_sigma);
-    let mut scratch = Vec::new();
-    for p in planes.iter_mut() {
-        gaussian_blur(p, w, h, sigma, &mut scratch);
-    }
-    let strength = draw(&mut rng, options.vignetting);
-    let (mx, my) = (w as f64 / 2.0, h as f64 / 2.0);
-    let vignette = |x: f64, y: f64| {
-        1.0 - strength * ((x - mx).powi(2) + (y - my).powi(2)) / (mx * mx + my * my)
-    };
-    let noise = Normal::new(0.0, draw(&mut rng, options.noise_sigma).max(1e-9))
-        .map_err(|e| Error::invalid(format!("noise: {e}")))?;
-    let mut rgb8 = vec![0u8; w * h * 3];
-    for y in 0..h {
-        for x in 0..w {
-            let g = vignette(x as f64 + 0.5, y as f64 + 0.5);
-            for (c, plane) in planes.iter().enumerate() {
-                let linear = f64::from(plane[y * w + x]) * g;
-                let encoded = 255.0 * srgb_encode(linear.clamp(0.0, 1.0)) + noise.sample(&mut rng);
-                rgb8[3 * (y * w + x) + c] = encoded.round().clamp(0.0, 255.0) as u8;
+    let patch_mean: [f32; 3] = std::array::from_fn(|c| {
+        exposed[0][..patches].iter().map(|v| v[c]).sum::<f32>() / patches.max(1) as f32
+    });
+    let grid_width_px =
+        ((corners[1][0] - corners[0][0]).powi(2) + (corners[1][1] - corners[0][1]).powi(2)).sqrt();
+    let glow_at = |p: [f64; 2]| -> f64 {
+        options.glow.map_or(0.0, |g| {
+            let s = g.width * grid_width_px;
+            let d2 = (p[0] - corners[0][0]).powi(2) + (p[1] - corners[0][1]).powi(2);
+            if s > 0.0 {
+                g.level * (-d2 / (2.0 * s * s)).exp()
+            } else {
+                0.0
             }
+        })
+    };
+    if let Some(glow) = &options.glow {
+        glow.apply(&mut scene, corners[0], patch_mean, grid_width_px);
+    }
+    let blur = LensBlur {
+        sigma: draw(&mut rng, options.blur_sigma),
+    };
+    blur.apply(&mut scene);
+    let vignetting = Vignetting {
+        strength: draw(&mut rng, options.vignetting),
+    };
+    vignetting.apply(&mut scene);
+    let developed = camera.develop(&scene, seed::derive(seed, 1));
+    let mut rgb8 = vec![0u8; w * h * 3];
+    for (i, pixel) in rgb8.chunks_exact_mut(3).enumerate() {
+        for (c, v) in pixel.iter_mut().enumerate() {
+            *v = (255.0 * developed.image.planes[c][i])
+                .round()
+                .clamp(0.0, 255.0) as u8;
         }
     }
     let (q0, q1) = options.jpeg_quality;
@@ -211,20 +267,32 @@ pub fn photograph(
             context: "synthetic photo".into(),
             message: e.to_string(),
         })?;
-    let vignetting_at_features = feature_patches
+    let gains = developed.white_balance_gains;
+    let expected_features = chart
+        .feature_patches
         .iter()
-        .map(|&p| {
+        .flat_map(|&p| {
             let (px, py) = layout.patch_origin(p);
-            let half = layout.patch_px as f64 / 2.0;
-            let [x, y] = homography.apply([px as f64 + half, py as f64 + half]);
-            vignette(x, y)
+            let centre = layout.patch_px as f64 / 2.0;
+            let canvas_centre = [px as f64 + centre, py as f64 + centre];
+            let at = homography.apply(canvas_centre);
+            let lit = if canvas_centre[0] >= half {
+                exposed.len() - 1
+            } else {
+                0
+            };
+            let g = vignetting.gain(at, w, h) as f32;
+            let glow = glow_at(at) as f32;
+            let raw: [f32; 3] =
+                std::array::from_fn(|c| (exposed[lit][p][c] + glow * patch_mean[c]) * g);
+            camera.encode_exposed(raw, gains).map(|v| 255.0 * v)
         })
         .collect();
     Ok(ScenePhoto {
         jpeg,
         corners,
         patch_px,
-        vignetting_at_features,
+        expected_features,
     })
 }
 
@@ -294,9 +362,10 @@ fn value_noise(rng: &mut SmallRng, w: usize, h: usize, cell: usize) -> Vec<f32> 
     out
 }
 
-/// Linear-light background: two octaves of value noise in colour, with clutter (random
-/// rectangles, some of them square tiles, and discs), all tinted by `tint`.
-fn background(rng: &mut SmallRng, w: usize, h: usize, tint: [f32; 3]) -> [Vec<f32>; 3] {
+/// Raw background: two octaves of value noise in colour, with clutter (random rectangles,
+/// some of them square tiles, and discs), reflecting 1–70 % of `white`, the raw value of a
+/// white surface under the scene's light.
+fn background(rng: &mut SmallRng, w: usize, h: usize, white: [f32; 3]) -> [Vec<f32>; 3] {
     let mut planes: [Vec<f32>; 3] = std::array::from_fn(|_| {
         let (coarse, fine) = (rng.random_range(40..200), rng.random_range(5..20));
         let a = value_noise(rng, w, h, coarse);
@@ -336,41 +405,8 @@ fn background(rng: &mut SmallRng, w: usize, h: usize, tint: [f32; 3]) -> [Vec<f3
             }
         }
     }
-    for (plane, t) in planes.iter_mut().zip(tint) {
+    for (plane, t) in planes.iter_mut().zip(white) {
         plane.iter_mut().for_each(|v| *v *= t);
     }
     planes
-}
-
-/// Separable Gaussian blur with clamped edges; no-op below σ = 0.2.
-fn gaussian_blur(plane: &mut [f32], w: usize, h: usize, sigma: f64, scratch: &mut Vec<f32>) {
-    if sigma < 0.2 {
-        return;
-    }
-    let r = (3.0 * sigma).ceil() as isize;
-    let kernel: Vec<f32> = (-r..=r)
-        .map(|i| (-0.5 * (i as f64 / sigma).powi(2)).exp() as f32)
-        .collect();
-    let sum: f32 = kernel.iter().sum();
-    let kernel: Vec<f32> = kernel.iter().map(|k| k / sum).collect();
-    scratch.resize(w * h, 0.0);
-    let at = |i: isize, n: usize| i.clamp(0, n as isize - 1) as usize;
-    for y in 0..h {
-        for x in 0..w {
-            scratch[y * w + x] = kernel
-                .iter()
-                .enumerate()
-                .map(|(k, kv)| kv * plane[y * w + at(x as isize + k as isize - r, w)])
-                .sum();
-        }
-    }
-    for y in 0..h {
-        for x in 0..w {
-            plane[y * w + x] = kernel
-                .iter()
-                .enumerate()
-                .map(|(k, kv)| kv * scratch[at(y as isize + k as isize - r, h) * w + x])
-                .sum();
-        }
-    }
 }
