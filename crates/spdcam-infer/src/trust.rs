@@ -545,6 +545,16 @@ pub const UNUSABLE_CLIPPED_SHARE: f64 = 0.5;
 pub const DOUBTFUL_DARK_SHARE: f64 = 0.25;
 
 impl Calibration {
+    /// Whether the self-check `check` exceeds any of this calibration's doubtful levels:
+    /// the residual, the half-to-half residual or the colour gradient.
+    pub fn flags(&self, check: &SelfCheck) -> bool {
+        let above =
+            |value: Option<f64>, level: Option<f64>| value.zip(level).is_some_and(|(v, l)| v > l);
+        above(Some(check.mean), self.self_check_doubtful)
+            || above(Some(check.split), self.split_doubtful)
+            || above(check.colour_gradient, self.colour_gradient_doubtful)
+    }
+
     /// Reads a calibration from JSON (`shown` names it in errors), its arrays checked to
     /// agree in length.
     pub fn from_json(text: &str, shown: &str) -> Result<Calibration> {

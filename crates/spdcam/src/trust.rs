@@ -29,8 +29,8 @@ use spdcam_core::uneven_light::{Corrections, UnevenLight};
 use spdcam_core::{metrics, seed};
 use spdcam_infer::estimate::{estimate_photo_bytes, PhotoOptions};
 use spdcam_infer::trust::{
-    self, assess, Calibration, ChartCheck, MetricCalibration, Perturbed, PhotoFlags, Verdict,
-    JITTER_COPIES, JITTER_SIGMA,
+    self, assess, Calibration, ChartCheck, MetricCalibration, Perturbed, PhotoFlags, SelfCheck,
+    Verdict, JITTER_COPIES, JITTER_SIGMA,
 };
 use spdcam_infer::{Model, ModelSet};
 use std::collections::BTreeMap;
@@ -256,8 +256,8 @@ struct Judged {
     spd: Vec<f64>,
     truth: Option<Vec<f64>>,
     spread: Vec<f64>,
-    /// The self-check's mean and split residuals and colour gradient.
-    self_check: Option<(f64, f64, Option<f64>)>,
+    /// The self-check.
+    self_check: Option<SelfCheck>,
     metric_spread: BTreeMap<String, f64>,
     metric_error: BTreeMap<String, f64>,
 }
@@ -280,8 +280,7 @@ fn judge_rows(
             let self_check = match check {
                 Some(c) => c
                     .check(&spd, row, scale, &trust::flag_patches(row, scale))
-                    .ok()
-                    .map(|s| (s.mean, s.split, s.colour_gradient)),
+                    .ok(),
                 None => None,
             };
             let perturbed = Perturbed::of(model, row)?;
@@ -391,18 +390,15 @@ fn fit_calibration(
         .map(|b| b[b.len() - 1].0)
         .collect();
     let mut difficulties: Vec<f64> = by_difficulty.iter().map(|x| x.0).collect();
-    let mut checks: Vec<f64> = judged
-        .iter()
-        .filter_map(|j| j.self_check.map(|s| s.0))
-        .collect();
-    let mut splits: Vec<f64> = judged
-        .iter()
-        .filter_map(|j| j.self_check.map(|s| s.1))
-        .collect();
-    let mut gradients: Vec<f64> = judged
-        .iter()
-        .filter_map(|j| j.self_check.and_then(|s| s.2))
-        .collect();
+    let checks_of = |value: fn(&SelfCheck) -> Option<f64>| -> Vec<f64> {
+        judged
+            .iter()
+            .filter_map(|j| j.self_check.as_ref().and_then(value))
+            .collect()
+    };
+    let mut checks = checks_of(|s| Some(s.mean));
+    let mut splits = checks_of(|s| Some(s.split));
+    let mut gradients = checks_of(|s| s.colour_gradient);
     let (scale68, scale95) = (scale(0.68), scale(0.95));
     let metric_calibrations = SCALAR_KEYS
         .iter()
@@ -594,13 +590,7 @@ fn scene_verdicts(
                 Ok(e) => {
                     let t = e.trust.context("an estimate without a verdict")?;
                     counts[kind].0 += usize::from(t.verdict != Verdict::Ok);
-                    let flagged = t.self_check.as_ref().is_some_and(|s| {
-                        cal.self_check_doubtful.is_some_and(|l| s.mean > l)
-                            || cal.split_doubtful.is_some_and(|l| s.split > l)
-                            || s.colour_gradient
-                                .zip(cal.colour_gradient_doubtful)
-                                .is_some_and(|(g, l)| g > l)
-                    });
+                    let flagged = t.self_check.as_ref().is_some_and(|s| cal.flags(s));
                     counts[kind].1 += usize::from(flagged);
                 }
                 Err(_) => {
@@ -935,11 +925,16 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
     let mut scenes = format!(
         "## Scene photos\n\n\
          Photos made with the code of `spdcam render --scene` ({SCENES} test lamps, one photo each \
-         per kind, 1200×900, by the held-out cameras with the default camera stage, noise \
-         included), found, sampled and estimated like a user's photo. Share not `ok` (in \
-         brackets: flagged by the self-check); a photo in which no chart is found counts as \
-         both. Another chart: the non-grey patches in another order. Half-lit: the right half \
-         of the chart image lit by another test lamp. Glare: as above, on the chart image.\n\n\
+         per kind, 1200×900, by the held-out cameras with the default camera stage: the chart \
+         placed in a cluttered scene, the lens's blur and vignetting, Bayer mosaic, sensor \
+         noise, demosaicing, white balance over the whole frame, JPEG), found, sampled and \
+         estimated like a user's photo. Share not `ok` (in brackets: flagged by the \
+         self-check); a photo in which no chart is found counts as both. Another chart: the \
+         non-grey patches in another order. Half-lit: the right half of the chart lit by \
+         another test lamp in the scene, at one exposure and white balance. Glare: a bright \
+         light beside the chart glowing into the lens, adding 40 % of the chart's mean raw \
+         level at the grid's top-left corner and falling off as a Gaussian of 0.35 grid \
+         widths.\n\n\
          | model | photos per kind | clean | another chart | half-lit | glare |\n\
          |---|---:|---:|---:|---:|---:|\n"
     );
@@ -1029,24 +1024,17 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
         }
         metrics_md += &metric_table(&name, &metric_sets);
         metrics_md.push('\n');
-        let (Some(level), Some(split_level)) = (cal.self_check_doubtful, cal.split_doubtful) else {
+        if cal.self_check_doubtful.is_none() {
             flags += &format!(
                 "| `{name}` | – | no self-check without the chart's reflectances | | | | | |\n"
             );
             continue;
-        };
+        }
         let flagged = |rows: &[Vec<f64>]| -> Result<f64> {
             let judged = judge_rows(model, check.as_ref(), rows, None)?;
             Ok(judged
                 .iter()
-                .filter(|j| {
-                    j.self_check.is_none_or(|(m, s, g)| {
-                        m > level
-                            || s > split_level
-                            || g.zip(cal.colour_gradient_doubtful)
-                                .is_some_and(|(g, l)| g > l)
-                    })
-                })
+                .filter(|j| j.self_check.as_ref().is_none_or(|s| cal.flags(s)))
                 .count() as f64
                 / judged.len() as f64)
         };
