@@ -733,3 +733,34 @@ fn measured_photos_are_read_and_their_spds_resampled_linearly() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The real photo sets load from the data directory, each folder's photos joined: 640
+/// Telelumen photos by the Canon, 800 of the Hue lamps, 61 by the tablet, 96 SG features
+/// each, one measured SPD per photo.
+#[cfg(feature = "measured-data")]
+#[test]
+fn the_real_photo_sets_load_and_join_their_folders() {
+    let thesis = shared_data::data_dir().join("thesis");
+    let grid = Grid::SIMULATION;
+    let counts: Vec<usize> = dataset::REAL_PHOTO_SETS
+        .iter()
+        .map(|set| {
+            let m = set.load(&thesis, &grid).unwrap();
+            assert_eq!(m.features.len(), m.spds.len(), "{}", set.label);
+            assert!(
+                m.features.iter().all(|f| f.len() == 3 * 96),
+                "{}",
+                set.label
+            );
+            m.features.len()
+        })
+        .collect();
+    assert_eq!(counts, [640, 800, 61]);
+    let missing = dataset::REAL_PHOTO_SETS[0]
+        .load(Path::new("no-such-dir"), &grid)
+        .unwrap_err();
+    assert!(
+        missing.to_string().contains("telelumen_canon5d4_dev"),
+        "{missing}"
+    );
+}

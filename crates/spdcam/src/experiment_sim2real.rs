@@ -13,8 +13,8 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
-use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
+use spdcam_core::dataset::{MeasuredPhotos, REAL_PHOTO_SETS};
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::Lighting;
 use spdcam_core::metrics;
@@ -134,36 +134,10 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
             .join("thesis"),
     };
     let folds = args.folds.max(2);
-    let load = |name: &str| -> Result<MeasuredPhotos> {
-        let dir = thesis.join("measured").join(name);
-        Ok(MeasuredPhotos::read(
-            &dir.join("features.csv"),
-            &dir.join("spds.csv"),
-            &GRID,
-        )?)
-    };
-    let join = |mut a: MeasuredPhotos, b: MeasuredPhotos| {
-        a.features.extend(b.features);
-        a.spds.extend(b.spds);
-        a
-    };
-    let sets = [
-        (
-            "Telelumen, Canon 5D IV (dev)",
-            load("telelumen_canon5d4_dev")?,
-        ),
-        (
-            "Hue, Canon 5D IV",
-            join(load("hue_canon5d4_train")?, load("hue_canon5d4_val")?),
-        ),
-        (
-            "Telelumen, Galaxy Tab S7",
-            join(
-                load("telelumen_galaxy_tab_s7_train")?,
-                load("telelumen_galaxy_tab_s7_val")?,
-            ),
-        ),
-    ];
+    let sets = REAL_PHOTO_SETS
+        .iter()
+        .map(|set| Ok((set.label, set.load(&thesis, &GRID)?)))
+        .collect::<Result<Vec<_>>>()?;
     let lighting = Lighting::parse(LIGHTING, data_dir, &GRID)?;
     let config = CameraConfig {
         noise: None,

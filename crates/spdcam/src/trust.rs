@@ -17,7 +17,7 @@ use spdcam_core::camera::CameraConfig;
 use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
-use spdcam_core::dataset::MeasuredPhotos;
+use spdcam_core::dataset::REAL_PHOTO_SETS;
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::lighting::{LampLibrary, ValidationSplit};
@@ -852,41 +852,25 @@ fn significant(v: f64) -> String {
 
 /// The real photo sets of the thesis: name, features, true SPDs on `grid` (peak 1).
 fn real_sets(thesis: &Path, grid: &Grid) -> Result<Vec<(&'static str, Rows)>> {
-    let sets: [(&str, &[&str]); 3] = [
-        ("Telelumen, Canon 5D IV (dev)", &["telelumen_canon5d4_dev"]),
-        (
-            "Philips Hue, Canon 5D IV",
-            &["hue_canon5d4_train", "hue_canon5d4_val"],
-        ),
-        (
-            "Telelumen, Galaxy Tab S7",
-            &[
-                "telelumen_galaxy_tab_s7_train",
-                "telelumen_galaxy_tab_s7_val",
-            ],
-        ),
-    ];
-    sets.iter()
-        .map(|(label, dirs)| {
-            let mut rows = Rows {
-                features: Vec::new(),
-                truths: Vec::new(),
+    REAL_PHOTO_SETS
+        .iter()
+        .map(|set| {
+            let m = set.load(thesis, &GRID)?;
+            let names = (0..m.spds.len()).map(|i| format!("s{i}")).collect();
+            let (truths, _) = SpectralSet::from_spds(names, &m.spds)?.resample(
+                grid,
+                Interpolation::Linear,
+                Extrapolation::Zero,
+            )?;
+            let rows = Rows {
+                features: m.features,
+                truths: truths
+                    .items()
+                    .iter()
+                    .map(|s| metrics::normalise_by_max(s))
+                    .collect(),
             };
-            for name in *dirs {
-                let dir = thesis.join("measured").join(name);
-                let m =
-                    MeasuredPhotos::read(&dir.join("features.csv"), &dir.join("spds.csv"), &GRID)?;
-                let names = (0..m.spds.len()).map(|i| format!("s{i}")).collect();
-                let (set, _) = SpectralSet::from_spds(names, &m.spds)?.resample(
-                    grid,
-                    Interpolation::Linear,
-                    Extrapolation::Zero,
-                )?;
-                rows.features.extend(m.features);
-                rows.truths
-                    .extend(set.items().iter().map(|s| metrics::normalise_by_max(s)));
-            }
-            Ok((*label, rows))
+            Ok((set.label, rows))
         })
         .collect()
 }

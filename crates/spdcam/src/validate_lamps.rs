@@ -15,7 +15,7 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
-use spdcam_core::dataset::MeasuredPhotos;
+use spdcam_core::dataset::REAL_PHOTO_SETS;
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::lighting::{LampLibrary, LampType, ValidationSplit};
@@ -351,27 +351,10 @@ fn real_scores(args: &ValidateArgs, model: &Model, data_dir: &DataDir) -> Result
         Some(p) => p.clone(),
         None => in_data_dir(None, "thesis", data_dir)?,
     };
-    let load = |names: &[&str]| -> Result<MeasuredPhotos> {
-        let mut all = MeasuredPhotos {
-            features: Vec::new(),
-            spds: Vec::new(),
-        };
-        for name in names {
-            let dir = thesis.join("measured").join(name);
-            let m = MeasuredPhotos::read(&dir.join("features.csv"), &dir.join("spds.csv"), &GRID)?;
-            all.features.extend(m.features);
-            all.spds.extend(m.spds);
-        }
-        Ok(all)
-    };
-    let sets = [
-        load(&["telelumen_canon5d4_dev"])?,
-        load(&["hue_canon5d4_train", "hue_canon5d4_val"])?,
-        load(&[
-            "telelumen_galaxy_tab_s7_train",
-            "telelumen_galaxy_tab_s7_val",
-        ])?,
-    ];
+    let sets = REAL_PHOTO_SETS
+        .iter()
+        .map(|set| set.load(&thesis, &GRID))
+        .collect::<spdcam_core::Result<Vec<_>>>()?;
     let grid = model.grid();
     let mut out = [0.0; 3];
     for (k, set) in sets.iter().enumerate() {

@@ -122,6 +122,55 @@ impl MeasuredPhotos {
     }
 }
 
+/// One of the thesis's real photo sets (data directory `thesis/measured/…`, thesis chapter
+/// 5): a label for tables and the measured folders it joins (a set's training and
+/// validation halves are scored together when no model was fitted on them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RealPhotoSet {
+    /// How tables name the set.
+    pub label: &'static str,
+    /// Folders of `thesis/measured/`, each holding `features.csv` and `spds.csv`.
+    pub folders: &'static [&'static str],
+}
+
+/// The three real photo sets every evaluation scores on: the Telelumen development set by a
+/// Canon 5D IV, Philips Hue lamps by the same camera, and Telelumen lights by a Galaxy Tab S7.
+pub const REAL_PHOTO_SETS: [RealPhotoSet; 3] = [
+    RealPhotoSet {
+        label: "Telelumen, Canon 5D IV (dev)",
+        folders: &["telelumen_canon5d4_dev"],
+    },
+    RealPhotoSet {
+        label: "Philips Hue, Canon 5D IV",
+        folders: &["hue_canon5d4_train", "hue_canon5d4_val"],
+    },
+    RealPhotoSet {
+        label: "Telelumen, Galaxy Tab S7",
+        folders: &[
+            "telelumen_galaxy_tab_s7_train",
+            "telelumen_galaxy_tab_s7_val",
+        ],
+    },
+];
+
+impl RealPhotoSet {
+    /// Reads the set's folders under `thesis` (the data directory's `thesis/`) and joins
+    /// them, the SPDs on `grid` ([`MeasuredPhotos::read`]).
+    pub fn load(&self, thesis: &Path, grid: &Grid) -> Result<MeasuredPhotos> {
+        let mut all = MeasuredPhotos {
+            features: Vec::new(),
+            spds: Vec::new(),
+        };
+        for folder in self.folders {
+            let dir = thesis.join("measured").join(folder);
+            let m = MeasuredPhotos::read(&dir.join("features.csv"), &dir.join("spds.csv"), grid)?;
+            all.features.extend(m.features);
+            all.spds.extend(m.spds);
+        }
+        Ok(all)
+    }
+}
+
 /// Every row of a numeric CSV file with a header: the header's names and the rows.
 fn read_rows(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
     let mut reader = reader(path)?;

@@ -38,6 +38,7 @@ mod writer;
 pub use batch::{Columns, Counts, Precision, SampleBatch, SampleRow};
 pub use csv_io::{
     export_csv, import_csv, ExportOptions, ImportOptions, ImportReport, MeasuredPhotos,
+    RealPhotoSet, REAL_PHOTO_SETS,
 };
 pub use file::{encode_parquet, encode_parquet_as, Compression, FileFormat, ZSTD_LEVEL};
 pub use generate::{GenerateEvent, GenerateOptions, GenerateRequest, Generator, Plan};
