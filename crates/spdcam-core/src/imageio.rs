@@ -1,4 +1,4 @@
-//! Writing rendered images as PNG, atomically.
+//! Writing rendered images as PNG (atomically) or JPEG.
 
 use crate::error::{Error, Result};
 use crate::fsio;
@@ -6,20 +6,28 @@ use crate::raster::{Mosaic, RgbImage};
 use image::{ImageBuffer, ImageEncoder, Luma, Rgb};
 use std::path::Path;
 
+/// An RGB image with values on 0…1 (clipped) as 8-bit RGB.
+fn to_rgb8(image: &RgbImage) -> ImageBuffer<Rgb<u8>, Vec<u8>> {
+    let (w, h) = (image.width as u32, image.height as u32);
+    ImageBuffer::from_fn(w, h, |x, y| {
+        Rgb(image
+            .pixel(x as usize, y as usize)
+            .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8))
+    })
+}
+
 /// Encodes an RGB image with values on 0…1 (clipped) as an 8- or 16-bit PNG.
 pub fn encode_png(image: &RgbImage, bit_depth: u32) -> Result<Vec<u8>> {
     let (w, h) = (image.width as u32, image.height as u32);
     let mut bytes = Vec::new();
     let encoder = image::codecs::png::PngEncoder::new(&mut bytes);
     let result = match bit_depth {
-        8 => {
-            let buf = ImageBuffer::<Rgb<u8>, _>::from_fn(w, h, |x, y| {
-                Rgb(image
-                    .pixel(x as usize, y as usize)
-                    .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8))
-            });
-            encoder.write_image(buf.as_raw(), w, h, image::ExtendedColorType::Rgb8)
-        }
+        8 => encoder.write_image(
+            to_rgb8(image).as_raw(),
+            w,
+            h,
+            image::ExtendedColorType::Rgb8,
+        ),
         16 => {
             let buf = ImageBuffer::<Rgb<u16>, _>::from_fn(w, h, |x, y| {
                 Rgb(image
@@ -39,6 +47,23 @@ pub fn encode_png(image: &RgbImage, bit_depth: u32) -> Result<Vec<u8>> {
         context: "PNG encoding".into(),
         message: e.to_string(),
     })?;
+    Ok(bytes)
+}
+
+/// Encodes an RGB image with values on 0…1 (clipped) as an 8-bit JPEG of `quality` (1–100).
+pub fn encode_jpeg(image: &RgbImage, quality: u8) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut bytes, quality.clamp(1, 100))
+        .write_image(
+            to_rgb8(image).as_raw(),
+            image.width as u32,
+            image.height as u32,
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(|e| Error::Image {
+            context: "JPEG encoding".into(),
+            message: e.to_string(),
+        })?;
     Ok(bytes)
 }
 

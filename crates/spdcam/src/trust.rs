@@ -548,6 +548,18 @@ fn scene_verdicts(
         chart: Some(name.to_string()),
         ..PhotoOptions::default()
     };
+    let plain = SceneOptions {
+        width: 1200,
+        height: 900,
+        ..SceneOptions::default()
+    };
+    let glare = SceneOptions {
+        glow: Some(Glow {
+            level: GLARE_LEVEL,
+            width: GLARE_WIDTH,
+        }),
+        ..plain.clone()
+    };
     let mut counts = [(0usize, 0usize); 4];
     for i in 0..SCENES {
         let lamp = ids[i * ids.len() / SCENES];
@@ -555,18 +567,6 @@ fn scene_verdicts(
         let k = i % pool.len();
         let shot_seed = seed::derive(seed, i as u64);
         let (spd, other_spd) = (&setup.library.spds[lamp], &setup.library.spds[other]);
-        let plain = SceneOptions {
-            width: 1200,
-            height: 900,
-            ..SceneOptions::default()
-        };
-        let glare = SceneOptions {
-            glow: Some(Glow {
-                level: GLARE_LEVEL,
-                width: GLARE_WIDTH,
-            }),
-            ..plain.clone()
-        };
         let half = SceneLight {
             spd,
             right_half: Some(other_spd),

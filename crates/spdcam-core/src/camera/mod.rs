@@ -177,6 +177,15 @@ pub struct Rendering {
     pub white_balance_gains: [f32; 3],
 }
 
+/// A scene photographed by [`Camera::develop`].
+#[derive(Debug, Clone)]
+pub struct Developed {
+    /// The final image: encoded sRGB, quantised, on 0…1.
+    pub image: RgbImage,
+    /// The gains (R, G, B) white balance applied to the camera signal.
+    pub white_balance_gains: [f32; 3],
+}
+
 impl Camera {
     /// Builds a camera for `chart` (reflectances on `grid`) from `sensitivities` (on `grid`).
     /// Fits the colour matrix under CIE D65 on the chart's patches (noise-free, patch level).
@@ -384,7 +393,7 @@ impl Camera {
     /// rendering, quantised at the camera's bit depth. The stages are those of
     /// [`Camera::render`]; the patch-level JPEG model is left out, for a scene photo is
     /// encoded by a real JPEG encoder afterwards.
-    pub fn develop(&self, scene: &RgbImage, seed: u64) -> Rendering {
+    pub fn develop(&self, scene: &RgbImage, seed: u64) -> Developed {
         let shot = self.scene_shot();
         let mut buffers = self.buffers_sized(scene.width, scene.height);
         let full_scale = shot.full_scale;
@@ -403,10 +412,8 @@ impl Camera {
         }
         let gains = self.sense_and_balance(&shot, seed, &mut buffers, None);
         self.finish_image(&shot, &mut buffers, None);
-        Rendering {
-            features: Vec::new(),
+        Developed {
             image: buffers.image,
-            stages: Stages::default(),
             white_balance_gains: gains,
         }
     }
@@ -749,7 +756,7 @@ fn expose(raw: &mut [[f32; 3]], scale: f32, full_scale: f32) {
 
 /// Mean raw value of the first `patches` regions (the chart's patches, before the
 /// background).
-fn patch_mean(raw: &[[f32; 3]], patches: usize) -> [f32; 3] {
+pub(crate) fn patch_mean(raw: &[[f32; 3]], patches: usize) -> [f32; 3] {
     let n = patches.min(raw.len()).max(1);
     std::array::from_fn(|c| raw[..n].iter().map(|v| v[c]).sum::<f32>() / n as f32)
 }

@@ -95,19 +95,27 @@ pub struct Glow {
 }
 
 impl Glow {
+    /// The share of the scene's mean level the glow centred at `centre` adds at `point`
+    /// (pixels; `length` is the reference length in pixels).
+    pub fn share_at(&self, point: [f64; 2], centre: [f64; 2], length: f64) -> f64 {
+        let s = self.width * length;
+        if self.level <= 0.0 || s <= 0.0 {
+            return 0.0;
+        }
+        let d2 = (point[0] - centre[0]).powi(2) + (point[1] - centre[1]).powi(2);
+        self.level * (-d2 / (2.0 * s * s)).exp()
+    }
+
     /// Adds the glow centred at `centre` (pixels) to `image`; `mean` is the scene's mean
     /// raw value (R, G, B) and `length` the reference length in pixels.
     pub fn apply(&self, image: &mut RgbImage, centre: [f64; 2], mean: [f32; 3], length: f64) {
-        let s = self.width * length;
-        if self.level <= 0.0 || s <= 0.0 {
+        if self.level <= 0.0 || self.width * length <= 0.0 {
             return;
         }
         let w = image.width;
         for y in 0..image.height {
             for x in 0..w {
-                let d2 =
-                    (x as f64 + 0.5 - centre[0]).powi(2) + (y as f64 + 0.5 - centre[1]).powi(2);
-                let g = (self.level * (-d2 / (2.0 * s * s)).exp()) as f32;
+                let g = self.share_at([x as f64 + 0.5, y as f64 + 0.5], centre, length) as f32;
                 for (plane, m) in image.planes.iter_mut().zip(mean) {
                     plane[y * w + x] += g * m;
                 }

@@ -10,16 +10,16 @@
 use super::geometry::Homography;
 use super::ChartTemplate;
 use crate::camera::optics::{Glow, LensBlur, Vignetting};
-use crate::camera::Camera;
+use crate::camera::{self, Camera};
 use crate::chart::Layout;
 use crate::error::{Error, Result};
+use crate::imageio;
 use crate::limits;
 use crate::raster::RgbImage;
 use crate::seed;
 use crate::spectral::Spd;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use std::io::Cursor;
 
 /// Pixels per patch pitch a chart is rendered at before it is placed in a scene.
 pub const SCENE_PITCH_PX: usize = 50;
@@ -222,21 +222,13 @@ pub fn photograph(
             }
         }
     }
-    let patch_mean: [f32; 3] = std::array::from_fn(|c| {
-        exposed[0][..patches].iter().map(|v| v[c]).sum::<f32>() / patches.max(1) as f32
-    });
+    let patch_mean = camera::patch_mean(&exposed[0], patches);
     let grid_width_px =
         ((corners[1][0] - corners[0][0]).powi(2) + (corners[1][1] - corners[0][1]).powi(2)).sqrt();
-    let glow_at = |p: [f64; 2]| -> f64 {
-        options.glow.map_or(0.0, |g| {
-            let s = g.width * grid_width_px;
-            let d2 = (p[0] - corners[0][0]).powi(2) + (p[1] - corners[0][1]).powi(2);
-            if s > 0.0 {
-                g.level * (-d2 / (2.0 * s * s)).exp()
-            } else {
-                0.0
-            }
-        })
+    let glow_at = |p: [f64; 2]| {
+        options
+            .glow
+            .map_or(0.0, |g| g.share_at(p, corners[0], grid_width_px))
     };
     if let Some(glow) = &options.glow {
         glow.apply(&mut scene, corners[0], patch_mean, grid_width_px);
@@ -250,23 +242,9 @@ pub fn photograph(
     };
     vignetting.apply(&mut scene);
     let developed = camera.develop(&scene, seed::derive(seed, 1));
-    let mut rgb8 = vec![0u8; w * h * 3];
-    for (i, pixel) in rgb8.chunks_exact_mut(3).enumerate() {
-        for (c, v) in pixel.iter_mut().enumerate() {
-            *v = (255.0 * developed.image.planes[c][i])
-                .round()
-                .clamp(0.0, 255.0) as u8;
-        }
-    }
     let (q0, q1) = options.jpeg_quality;
     let quality = rng.random_range(q0.clamp(1, 100)..=q1.clamp(q0.clamp(1, 100), 100));
-    let mut jpeg = Vec::new();
-    image::codecs::jpeg::JpegEncoder::new_with_quality(Cursor::new(&mut jpeg), quality)
-        .encode(&rgb8, w as u32, h as u32, image::ExtendedColorType::Rgb8)
-        .map_err(|e| Error::Image {
-            context: "synthetic photo".into(),
-            message: e.to_string(),
-        })?;
+    let jpeg = imageio::encode_jpeg(&developed.image, quality)?;
     let gains = developed.white_balance_gains;
     let expected_features = chart
         .feature_patches
