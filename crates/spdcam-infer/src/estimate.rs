@@ -296,9 +296,10 @@ impl Estimate {
     /// `metrics` (every [`LightingMetrics`] key), `truth`, and for photos `photo` (chart, method, confidence, corners, homography, features and
     /// `features_by_name`, every patch with its statistics and flags, warnings). Judged
     /// estimates add `verdict`, `reasons`, `self_check` ({mean, worst, worst_patches} or
-    /// null), `expected_gfc`, `band68` and `band95` ({lower, upper} on the SPD's
-    /// wavelengths) and `metric_uncertainty` ({key: {half68, half95}} for the
-    /// single-number metrics), the last four null without a calibration. Photo estimates add
+    /// null), `expected_gfc`, `band_widening` (≥ 1: how much the bands were widened for a
+    /// photo the estimate explains worse than the calibration photos), `band68` and `band95`
+    /// ({lower, upper} on the SPD's wavelengths) and `metric_uncertainty` ({key: {half68,
+    /// half95}} for the single-number metrics), the last five null without a calibration. Photo estimates add
     /// `absolute` (approximate illuminance, PPFD, melanopic EDI and spectral irradiance from
     /// the EXIF exposure, see [`crate::absolute`]) or, when there is none, `absolute: null`
     /// and `absolute_reason`.
@@ -329,6 +330,7 @@ impl Estimate {
             v["reasons"] = serde_json::json!(t.reasons);
             v["self_check"] = serde_json::json!(t.self_check);
             v["expected_gfc"] = serde_json::json!(u.map(|u| u.expected_gfc));
+            v["band_widening"] = serde_json::json!(u.map(|u| u.widening));
             v["band68"] = serde_json::json!(u.map(|u| &u.band68));
             v["band95"] = serde_json::json!(u.map(|u| &u.band95));
             // Intervals of metrics the estimate defines only.

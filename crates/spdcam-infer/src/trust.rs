@@ -429,10 +429,14 @@ pub struct Uncertainty {
     pub band68: Band,
     /// The same at 95 %.
     pub band95: Band,
-    /// The GFC such estimates reach, in the median, on the calibration photos as hard.
+    /// The GFC such estimates reach, in the median: the calibration's [`GfcModel`].
     pub expected_gfc: f64,
     /// The mean spread of the perturbed estimates (see [`Perturbed::spread`]).
     pub difficulty: f64,
+    /// How many times the bands and intervals are widened because the estimated light
+    /// explains this photo worse than it explains a typical calibration photo
+    /// ([`Calibration::widening`]); 1 when it explains it as well or better.
+    pub widening: f64,
     /// Half-widths of the 68 % and 95 % intervals of the single-number metrics, by key
     /// ([`SCALAR_KEYS`]): "Ra 82 ± 4" is `cri_ra` ± `half95`. Only metrics the calibration
     /// measured and the perturbed copies define.
@@ -456,7 +460,7 @@ pub struct MetricCalibration {
     pub key: String,
     /// The median absolute error of the metric on the calibration photos.
     pub floor: f64,
-    /// The 68 % quantile of |error| / (floor + spread).
+    /// The 68 % quantile of |error| / ((floor + spread)·widening).
     pub scale68: f64,
     /// The 95 % quantile of the same.
     pub scale95: f64,
@@ -482,10 +486,13 @@ impl Band {
 ///
 /// The band is a scaled-residual conformal band (Lei et al. 2018, "Distribution-free
 /// predictive inference for regression", JASA 113: 1094–1111, section 5.2, locally weighted
-/// residuals): with the spread s(λ) of the perturbed estimates and a floor f(λ) (the median
-/// absolute error at λ), the q-quantile of |error(λ)| / (f(λ) + s(λ)) over the calibration
-/// photos times (f(λ) + s(λ)) is the band's half-width. The expected GFC is the median GFC of
-/// the calibration photos in the same difficulty bin (equal-count bins of the mean spread).
+/// residuals): with the spread s(λ) of the perturbed estimates, a floor f(λ) (the median
+/// absolute error at λ) and the widening w ≥ 1 of a photo the estimate explains worse than
+/// a typical calibration photo ([`Calibration::widening`]), the q-quantile of
+/// |error(λ)| / ((f(λ) + s(λ))·w) over the calibration photos times (f(λ) + s(λ))·w is the
+/// band's half-width. The expected GFC comes from [`GfcModel`] (not widened: on the real
+/// Telelumen dev photos scaling 1 − GFC by w or w² made it two to four times too
+/// pessimistic, while the estimate's shape alone came within 0.02 of their median GFC).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Calibration {
     /// The calibrated model's [`Model::fingerprint`].
@@ -502,10 +509,12 @@ pub struct Calibration {
     pub scale68: Vec<f64>,
     /// The 95 % quantile of the same.
     pub scale95: Vec<f64>,
-    /// Upper edges of the difficulty bins but the last (ascending).
-    pub difficulty_edges: Vec<f64>,
-    /// The median GFC per difficulty bin (one more than the edges).
-    pub expected_gfc: Vec<f64>,
+    /// The expected GFC of an estimate from its shape and difficulty.
+    pub gfc_model: GfcModel,
+    /// The median self-check residual ([`SelfCheck::mean`]) on the calibration photos, when
+    /// the chart's reflectances were at hand: the residual of a typical photo, against which
+    /// [`Calibration::widening`] measures a photo's.
+    pub residual_reference: Option<f64>,
     /// The 99th percentile of the difficulty on the calibration photos: harder photos are
     /// unlike the lights the model knows, or many lights give nearly the same photo.
     pub difficulty_doubtful: f64,
@@ -527,6 +536,70 @@ pub struct Calibration {
     /// photos (saturated colours clip a channel under narrow-band light, and the model was
     /// trained with them); more make the estimate doubtful.
     pub clipped_doubtful: usize,
+}
+
+/// The GFC to expect of an estimate, from the estimate itself: a ridge regression (Hoerl &
+/// Kennard 1970) of ln(1 − GFC) on ln(difficulty) and the estimate's coordinates on the
+/// first principal components of the calibration photos' estimates, fitted on those photos
+/// (`spdcam trust calibrate` chooses the number of components and the penalty by
+/// cross-validation over lamps). Narrow-band and spiky estimates come from lights that
+/// 96 broadband patches resolve poorly, so the shape says much of how far to trust it; the
+/// regression's value is the conditional median of ln(1 − GFC), hence of the GFC.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GfcModel {
+    /// The mean of the calibration photos' estimates (peak 1), per wavelength.
+    pub mean: Vec<f64>,
+    /// The principal components used, unit vectors on the model's wavelengths.
+    pub components: Vec<Vec<f64>>,
+    /// The weights of ln(difficulty), of each component's coordinate, and of a constant 1.
+    pub weights: Vec<f64>,
+}
+
+impl GfcModel {
+    /// The regression's inputs for `spd` (peak 1) of mean spread `difficulty`.
+    pub fn inputs(&self, spd: &[f64], difficulty: f64) -> Vec<f64> {
+        let mut x = Vec::with_capacity(self.components.len() + 2);
+        x.push(difficulty.max(f64::MIN_POSITIVE).ln());
+        for c in &self.components {
+            x.push(
+                c.iter()
+                    .zip(spd.iter().zip(&self.mean))
+                    .map(|(a, (v, m))| a * (v - m))
+                    .sum(),
+            );
+        }
+        x.push(1.0);
+        x
+    }
+
+    /// The median GFC of estimates like `spd` (peak 1) of mean spread `difficulty`.
+    pub fn expected(&self, spd: &[f64], difficulty: f64) -> f64 {
+        let z: f64 = self
+            .weights
+            .iter()
+            .zip(self.inputs(spd, difficulty))
+            .map(|(w, x)| w * x)
+            .sum();
+        (1.0 - z.exp()).clamp(0.0, 1.0)
+    }
+
+    /// Whether the model's arrays fit `d` wavelengths.
+    fn fits(&self, d: usize) -> bool {
+        self.mean.len() == d
+            && self.components.iter().all(|c| c.len() == d)
+            && self.weights.len() == self.components.len() + 2
+            && self.weights.iter().all(|w| w.is_finite())
+    }
+}
+
+/// The widening of a photo whose self-check residual is `residual` against the typical
+/// residual `reference` (see [`Calibration::widening`]): their ratio, at least 1; 1 when
+/// either is unknown.
+pub fn widening(residual: Option<f64>, reference: Option<f64>) -> f64 {
+    match (residual, reference) {
+        (Some(r), Some(reference)) if reference > 0.0 && r.is_finite() => (r / reference).max(1.0),
+        _ => 1.0,
+    }
 }
 
 /// Estimates above this detection confidence are placed surely; the photo analysis warns
@@ -565,7 +638,7 @@ impl Calibration {
             || c.floor.len() != d
             || c.scale68.len() != d
             || c.scale95.len() != d
-            || c.expected_gfc.len() != c.difficulty_edges.len() + 1
+            || !c.gfc_model.fits(d)
         {
             return Err(InferError::invalid(format!(
                 "{shown}: the calibration's arrays do not agree in length"
@@ -574,14 +647,25 @@ impl Calibration {
         Ok(c)
     }
 
+    /// How many times worse than a typical calibration photo the estimated light explains
+    /// a photo whose self-check residual is `residual`: the residual over the calibration's
+    /// median, at least 1 (and 1 without a self-check). A photo the light explains k times
+    /// worse (flare, uneven light, a camera unlike the calibration's) is taken to carry k
+    /// times the calibration's errors: its bands and intervals are k times as wide.
+    pub fn widening(&self, residual: Option<f64>) -> f64 {
+        widening(residual, self.residual_reference)
+    }
+
     /// The bands, expected GFC and metric intervals of `spd` (the model's peak-normalised
     /// estimate) whose perturbed estimates spread by `spread` per wavelength and by
-    /// `metric_spread` per metric ([`Perturbed`]).
+    /// `metric_spread` per metric ([`Perturbed`]), and whose self-check residual is
+    /// `residual` ([`SelfCheck::mean`]; `None` without a self-check).
     pub fn uncertainty(
         &self,
         spd: &[f64],
         spread: &[f64],
         metric_spread: &BTreeMap<String, f64>,
+        residual: Option<f64>,
     ) -> Result<Uncertainty> {
         let d = self.floor.len();
         if spd.len() != d || spread.len() != d {
@@ -590,25 +674,19 @@ impl Calibration {
                 spd.len()
             )));
         }
+        let widening = self.widening(residual);
+        let half = |scale: &[f64], k: usize| scale[k] * (self.floor[k] + spread[k]) * widening;
         let band = |scale: &[f64]| Band {
-            lower: (0..d)
-                .map(|k| (spd[k] - scale[k] * (self.floor[k] + spread[k])).max(0.0))
-                .collect(),
-            upper: (0..d)
-                .map(|k| spd[k] + scale[k] * (self.floor[k] + spread[k]))
-                .collect(),
+            lower: (0..d).map(|k| (spd[k] - half(scale, k)).max(0.0)).collect(),
+            upper: (0..d).map(|k| spd[k] + half(scale, k)).collect(),
         };
         let difficulty = spread.iter().sum::<f64>() / d as f64;
-        let bin = self
-            .difficulty_edges
-            .iter()
-            .take_while(|&&e| difficulty > e)
-            .count();
         Ok(Uncertainty {
             band68: band(&self.scale68),
             band95: band(&self.scale95),
-            expected_gfc: self.expected_gfc[bin],
+            expected_gfc: self.gfc_model.expected(spd, difficulty),
             difficulty,
+            widening,
             metrics: self
                 .metrics
                 .iter()
@@ -617,8 +695,8 @@ impl Calibration {
                     Some((
                         m.key.clone(),
                         MetricInterval {
-                            half68: m.scale68 * (m.floor + s),
-                            half95: m.scale95 * (m.floor + s),
+                            half68: m.scale68 * (m.floor + s) * widening,
+                            half95: m.scale95 * (m.floor + s) * widening,
                         },
                     ))
                 })
@@ -767,6 +845,7 @@ pub fn assess(
                 spd,
                 &perturbed.spread(),
                 &perturbed.metric_spread(&model.grid().wavelengths()),
+                self_check.as_ref().map(|s| s.mean),
             )?)
         }
         None => {
@@ -1068,8 +1147,9 @@ mod tests {
     #[test]
     fn a_calibration_whose_arrays_disagree_is_refused() {
         let text = r#"{"model":"0","chart":"c","method":"m","wavelength_nm":[400,410],
-            "floor":[0.1],"scale68":[1,1],"scale95":[2,2],"difficulty_edges":[],
-            "expected_gfc":[0.9],"difficulty_doubtful":0.1,"self_check_doubtful":null,"split_doubtful":null,
+            "floor":[0.1],"scale68":[1,1],"scale95":[2,2],
+            "gfc_model":{"mean":[0.5,0.5],"components":[],"weights":[0.0,-3.0]},
+            "residual_reference":null,"difficulty_doubtful":0.1,"self_check_doubtful":null,"split_doubtful":null,
             "clipped_doubtful":0}"#;
         let err = Calibration::from_json(text, "c.json")
             .unwrap_err()

@@ -709,10 +709,18 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
             println!("  {}", trust_line(t));
             if let (Some(u), false) = (&t.uncertainty, unusable) {
                 println!(
-                    "  expected GFC {:.3}; 95 % band {:.2} wide on average (68 %: {:.2}; SPD peak 1)",
+                    "  expected GFC {:.3}; 95 % band {:.2} wide on average (68 %: {:.2}; SPD peak 1){}",
                     u.expected_gfc,
                     u.band95.mean_width(),
-                    u.band68.mean_width()
+                    u.band68.mean_width(),
+                    if u.widening > 1.0 {
+                        format!(
+                            ", widened {:.1}× (the light found explains this photo {:.1}× worse than typical calibration photos)",
+                            u.widening, u.widening
+                        )
+                    } else {
+                        String::new()
+                    }
                 );
             }
         }

@@ -22,6 +22,8 @@ mod list;
 mod metrics;
 mod photo_args;
 mod plot_file;
+#[cfg(feature = "train")]
+mod reliability;
 mod render;
 mod serve;
 #[cfg(feature = "train")]
