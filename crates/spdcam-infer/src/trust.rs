@@ -60,6 +60,10 @@ pub struct SelfCheck {
     /// How much the light's colour changes across the chart, measured on its neutral
     /// patches ([`UnevenLight::colour_gradient`]); `None` with too few unclipped neutrals.
     pub colour_gradient: Option<f64>,
+    /// The share of the residual (0–1) that an additive light changing linearly across the
+    /// chart removes: large when glare, a reflection or flare from a light beside the chart
+    /// adds light to one side of it.
+    pub glare: f64,
 }
 
 /// The chart's feature patches seen by a reference camera, ready to be lit by an SPD.
@@ -132,7 +136,8 @@ impl ChartCheck {
     /// least squares (Hong, Luo & Rhodes 2001, "A study of digital camera colorimetric
     /// characterisation based on polynomial modelling", Color Res. Appl. 26: 76–84): a 3×3
     /// matrix (camera and white balance), an offset (flare) and a linear light gradient
-    /// across the chart. What the fit cannot explain is the residual.
+    /// across the chart. What the fit cannot explain is the residual; what share of it an
+    /// additive light changing across the chart would explain is the glare.
     pub fn check(
         &self,
         spd: &[f64],
@@ -211,7 +216,7 @@ impl ChartCheck {
             let p = predicted[i].map(|v| v / pl);
             let l = p.iter().sum::<f64>() / 3.0;
             let [x, y] = self.centres[i];
-            vec![p[0], p[1], p[2], 1.0, x * l, y * l]
+            vec![p[0], p[1], p[2], 1.0, x * l, y * l, x, y]
         };
         let target = |i: usize| observed[i].map(|v| v / ol);
         let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -227,6 +232,15 @@ impl ChartCheck {
         let mut residuals: Vec<(usize, f64)> =
             used.iter().map(|&i| (i, residual(i, &global, 6))).collect();
         let mean = residuals.iter().map(|r| r.1).sum::<f64>() / residuals.len() as f64;
+        // Glare: the same map with an additive light that changes linearly across the chart
+        // (two more columns per channel), compared with the map without it, a nested-model
+        // comparison (Seber & Lee 2003, "Linear Regression Analysis", section 4.3).
+        let with_glare = least_squares(used, 8, &design, &target)?;
+        let glare_mean = used
+            .iter()
+            .map(|&i| residual(i, &with_glare, 8))
+            .sum::<f64>()
+            / used.len() as f64;
         residuals.sort_by(|a, b| b.1.total_cmp(&a.1));
         // Halves: the colour map fitted to one half of the chart (the gradient fixed at the
         // whole chart's) predicts the other half (a Chow-type test for one map across the
@@ -263,6 +277,11 @@ impl ChartCheck {
             split = split.max(cross / used.len() as f64);
         }
         Ok(SelfCheck {
+            glare: if mean > 0.0 {
+                (1.0 - glare_mean / mean).max(0.0)
+            } else {
+                0.0
+            },
             colour_gradient: None,
             mean,
             split,
@@ -532,6 +551,10 @@ pub struct Calibration {
     /// doubtful (absent from older files).
     #[serde(default)]
     pub colour_gradient_doubtful: Option<f64>,
+    /// The 99th percentile of the self-check's glare ([`SelfCheck::glare`]) on the
+    /// calibration photos; above it the estimate is doubtful (absent from older files).
+    #[serde(default)]
+    pub glare_doubtful: Option<f64>,
     /// The 99th percentile of the number of clipped feature patches on the calibration
     /// photos (saturated colours clip a channel under narrow-band light, and the model was
     /// trained with them); more make the estimate doubtful.
@@ -619,13 +642,14 @@ pub const DOUBTFUL_DARK_SHARE: f64 = 0.25;
 
 impl Calibration {
     /// Whether the self-check `check` exceeds any of this calibration's doubtful levels:
-    /// the residual, the half-to-half residual or the colour gradient.
+    /// the residual, the half-to-half residual, the colour gradient or the glare.
     pub fn flags(&self, check: &SelfCheck) -> bool {
         let above =
             |value: Option<f64>, level: Option<f64>| value.zip(level).is_some_and(|(v, l)| v > l);
         above(Some(check.mean), self.self_check_doubtful)
             || above(Some(check.split), self.split_doubtful)
             || above(check.colour_gradient, self.colour_gradient_doubtful)
+            || above(Some(check.glare), self.glare_doubtful)
     }
 
     /// Reads a calibration from JSON (`shown` names it in errors), its arrays checked to
@@ -897,6 +921,19 @@ pub fn assess(
                 Verdict::Doubtful,
                 format!(
                     "the light's colour changes across the chart (two lights, or one light and a reflection): its neutral patches' colour gradient is {g:.2} (clean photos stay below {level:.2})"
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.glare_doubtful)) {
+        if s.glare > level {
+            lower(
+                Verdict::Doubtful,
+                format!(
+                    "light is added unevenly across the chart (glare, a reflection, or flare from a light beside it): an additive light changing across the chart explains {:.0} % of the self-check residual (clean photos stay below {:.0} %)",
+                    100.0 * s.glare,
+                    100.0 * level
                 ),
                 &mut reasons,
             );

@@ -405,6 +405,7 @@ fn fit_calibration(
     let mut difficulties: Vec<f64> = judged.iter().map(difficulty).collect();
     let mut splits = checks_of(|s| Some(s.split));
     let mut gradients = checks_of(|s| s.colour_gradient);
+    let mut glares = checks_of(|s| Some(s.glare));
     let (scale68, scale95) = (scale(0.68), scale(0.95));
     let metric_calibrations = SCALAR_KEYS
         .iter()
@@ -464,6 +465,8 @@ fn fit_calibration(
         // Measured where most photos had enough unclipped neutral patches.
         colour_gradient_doubtful: (10 * gradients.len() >= 9 * judged.len())
             .then(|| conformal_quantile(&mut gradients, 0.99)),
+        glare_doubtful: (glares.len() == judged.len())
+            .then(|| conformal_quantile(&mut glares, 0.99)),
         clipped_doubtful: conformal_quantile(&mut clipped, 0.99) as usize,
         metrics: metric_calibrations,
     })
@@ -744,7 +747,10 @@ linear RGB. `mean`/`worst`: the patch residuals relative to the chart's mean RGB
 `split`: the residual when each half of the chart (left/right, top/bottom) is predicted by \
 the other half's map; `colour_gradient`: how differently the three channels brighten across \
 the chart on its neutral patches (a linear gain and a flare per channel fitted there, \
-`spdcam_core::uneven_light`; one light falling off brightens all alike, two lights do not). \
+`spdcam_core::uneven_light`; one light falling off brightens all alike, two lights do not); \
+`glare`: the share of the residual that an additive light changing linearly across the chart \
+(two more columns of the map per channel) removes, a nested-model comparison: glare, a \
+reflection or flare from a light beside the chart adds light to one side of it. \
 The ColorChecker 24's reflectances are built in; the SG's come from the \
 data directory, so without it an SG estimate has no self-check (the reasons say so).\n\
 - **Bands.** The model is run on 16 copies of the features, each perturbed by 2 % \
@@ -773,7 +779,7 @@ widening (w or w², as 1 − GFC ≈ θ²/2 for an error angle θ) made the Tele
 median expected 1 − GFC 0.29 or 0.63 against an actual 0.15; without it, 0.13: not done.\n- **Verdict** (constants in `spdcam_infer::trust`, levels in the calibration file): `doubtful` \
 when the detection confidence is below 0.8, more feature patches are clipped than in 99 % of \
 the calibration photos, more than a quarter are nearly black, the self-check's mean or split \
-residual or colour gradient exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
+residual, colour gradient or glare exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
 99th percentile (many lights give nearly this photo, or it is unlike the training lights), \
 or the expected GFC is below 0.95; `unusable` when more than half the patches are clipped, \
 the self-check cannot be made (too few usable patches) or a self-check residual exceeds \
@@ -1080,8 +1086,8 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
     );
     let mut flags = String::from(
         "## The self-check on clean and bad photos\n\n\
-         Share of photos whose self-check residual or colour gradient exceeds the \
-         calibration's doubtful level \
+         Share of photos whose self-check residual, half-to-half residual, colour gradient or \
+         glare exceeds the calibration's doubtful level \
          (flagged), and share whose verdict is not `ok`. Clean: the test lamps' photos above. \
          Wrong chart: the same photos with the patches in a random order (a chart the model \
          does not read). Half-lit: the right half of the chart lit by the next lamp of the \
