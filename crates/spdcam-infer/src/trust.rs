@@ -1059,7 +1059,7 @@ mod tests {
     use super::*;
     use crate::estimate::{estimate_features, judge_estimate, FeatureRows};
     use crate::shipped::ModelSet;
-    use spdcam_core::colorimetry::srgb_encode;
+    use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
     use spdcam_core::illuminant::StandardIlluminant;
 
     fn cc24_check(grid: &Grid) -> ChartCheck {
@@ -1113,6 +1113,105 @@ mod tests {
         );
         assert_eq!(bad.worst_patches.len(), WORST_NAMED);
         assert!(bad.worst >= bad.mean);
+    }
+
+    #[test]
+    fn light_added_to_one_side_of_the_chart_reads_as_glare() {
+        let grid = Grid::parse("400-700:5").unwrap();
+        let check = cc24_check(&grid);
+        let spd = StandardIlluminant::D65.spd(&grid).unwrap();
+        let clean = features_of(&check, &spd);
+        // A light beside the chart adds up to a fifth of the white's level on its left side.
+        let glared: Vec<f64> = clean
+            .iter()
+            .enumerate()
+            .map(|(f, &v)| {
+                let x = check.centres[f / 3][0];
+                let lin = srgb_decode(v / 255.0) + 0.2 * (0.5 - x).powi(2);
+                255.0 * srgb_encode(lin.min(1.0))
+            })
+            .collect();
+        let skip = vec![false; check.patches()];
+        let a = check.check(&spd, &clean, 255.0, &skip).unwrap();
+        let b = check.check(&spd, &glared, 255.0, &skip).unwrap();
+        assert!((0.0..=1.0).contains(&a.glare) && (0.0..=1.0).contains(&b.glare));
+        assert!(a.glare < 0.1, "clean: {}", a.glare);
+        assert!(b.glare > 0.3, "glared: {} (clean {})", b.glare, a.glare);
+    }
+
+    #[test]
+    fn widening_is_the_residual_over_the_typical_one_and_never_narrows() {
+        assert_eq!(widening(Some(0.09), Some(0.03)), 3.0);
+        assert_eq!(widening(Some(0.01), Some(0.03)), 1.0);
+        assert_eq!(widening(None, Some(0.03)), 1.0);
+        assert_eq!(widening(Some(0.09), None), 1.0);
+        assert_eq!(widening(Some(f64::NAN), Some(0.03)), 1.0);
+        assert_eq!(widening(Some(0.09), Some(0.0)), 1.0);
+    }
+
+    #[test]
+    fn the_expected_gfc_follows_its_regression() {
+        // ln(1 − GFC) = −4 + 0.5·ln(difficulty) + 2·(coordinate on the one component).
+        let model = GfcModel {
+            mean: vec![0.5, 0.5],
+            components: vec![vec![0.6, 0.8]],
+            weights: vec![0.5, 2.0, -4.0],
+        };
+        let (spd, difficulty) = ([1.0, 0.25], 0.04);
+        let coordinate = 0.6 * 0.5 + 0.8 * -0.25;
+        let want = 1.0 - (-4.0 + 0.5 * 0.04f64.ln() + 2.0 * coordinate).exp();
+        assert!((model.expected(&spd, difficulty) - want).abs() < 1e-12);
+        assert_eq!(
+            model.inputs(&spd, difficulty),
+            vec![0.04f64.ln(), coordinate, 1.0]
+        );
+        // A regression that runs away stays a GFC.
+        let wild = GfcModel {
+            weights: vec![0.0, 0.0, 5.0],
+            ..model
+        };
+        assert_eq!(wild.expected(&spd, difficulty), 0.0);
+    }
+
+    #[test]
+    fn bands_widen_with_the_residual_and_the_expected_gfc_does_not_move() {
+        let d = 2;
+        let cal = Calibration {
+            model: "0".into(),
+            chart: "c".into(),
+            method: "m".into(),
+            wavelength_nm: vec![400.0, 410.0],
+            floor: vec![0.1; d],
+            scale68: vec![1.0; d],
+            scale95: vec![2.0; d],
+            gfc_model: GfcModel {
+                mean: vec![0.5; d],
+                components: Vec::new(),
+                weights: vec![0.0, -3.0],
+            },
+            residual_reference: Some(0.05),
+            difficulty_doubtful: 1.0,
+            self_check_doubtful: None,
+            metrics: Vec::new(),
+            split_doubtful: None,
+            colour_gradient_doubtful: None,
+            glare_doubtful: None,
+            clipped_doubtful: 0,
+        };
+        let (spd, spread) = ([1.0, 0.5], [0.05, 0.05]);
+        let plain = cal
+            .uncertainty(&spd, &spread, &BTreeMap::new(), Some(0.04))
+            .unwrap();
+        let wide = cal
+            .uncertainty(&spd, &spread, &BTreeMap::new(), Some(0.1))
+            .unwrap();
+        assert_eq!((plain.widening, wide.widening), (1.0, 2.0));
+        // Half-width 2 × (0.1 + 0.05) = 0.3, doubled by the widening.
+        assert!((plain.band95.upper[0] - 1.3).abs() < 1e-12);
+        assert!((wide.band95.upper[0] - 1.6).abs() < 1e-12);
+        assert_eq!(wide.band95.lower[1], 0.0);
+        assert_eq!(plain.expected_gfc, wide.expected_gfc);
+        assert!((plain.expected_gfc - (1.0 - (-3.0f64).exp())).abs() < 1e-12);
     }
 
     #[test]

@@ -507,7 +507,8 @@ fn fit_gfc_model(judged: &[Judged], shots: usize) -> Result<GfcModel> {
             .map(|j| m.inputs(&j.spd, difficulty(j)))
             .collect()
     };
-    // Per input, the penalty's unit: its centred sum of squares (0 for the constant).
+    // Per input, the penalty's unit: its centred sum of squares, at least a millionth per
+    // row so that an input without variance is shrunk to nothing (0 for the constant).
     let unit = |x: &[Vec<f64>], rows: &[usize]| -> Vec<f64> {
         let p = x[0].len();
         (0..p)
@@ -516,7 +517,10 @@ fn fit_gfc_model(judged: &[Judged], shots: usize) -> Result<GfcModel> {
                     return 0.0;
                 }
                 let mean = rows.iter().map(|&i| x[i][c]).sum::<f64>() / rows.len() as f64;
-                rows.iter().map(|&i| (x[i][c] - mean).powi(2)).sum::<f64>()
+                rows.iter()
+                    .map(|&i| (x[i][c] - mean).powi(2))
+                    .sum::<f64>()
+                    .max(1e-6 * rows.len() as f64)
             })
             .collect()
     };
@@ -1324,4 +1328,95 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A judged photo whose estimate `spd` has the GFC `gfc` against its truth and whose
+    /// perturbed estimates spread by `spread` at every wavelength.
+    fn judged(spd: &[f64], gfc: f64, spread: f64) -> Judged {
+        let norm = spd.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let u: Vec<f64> = spd.iter().map(|v| v / norm).collect();
+        // A unit vector orthogonal to u (Gram–Schmidt on (1, −1, 1, −1, …)).
+        let a: Vec<f64> = (0..spd.len()).map(|k| [1.0, -1.0][k % 2]).collect();
+        let along: f64 = a.iter().zip(&u).map(|(x, y)| x * y).sum();
+        let v: Vec<f64> = a.iter().zip(&u).map(|(x, y)| x - along * y).collect();
+        let vn = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let sin = (1.0 - gfc * gfc).sqrt();
+        Judged {
+            spd: spd.to_vec(),
+            truth: Some(
+                u.iter()
+                    .zip(&v)
+                    .map(|(x, y)| gfc * x + sin * y / vn)
+                    .collect(),
+            ),
+            spread: vec![spread; spd.len()],
+            self_check: None,
+            metric_spread: BTreeMap::new(),
+            metric_error: BTreeMap::new(),
+        }
+    }
+
+    #[test]
+    fn the_expected_gfc_regression_learns_how_the_gfc_falls_with_difficulty() {
+        // 1 − GFC = 0.2 · difficulty: ln(1 − GFC) = ln 0.2 + ln(difficulty); the shapes vary
+        // a little, unrelated to the GFC. 20 lamps of 4 photos.
+        let rows: Vec<Judged> = (0..80)
+            .map(|i| {
+                let difficulty = 0.01 * (1.0 + (i * 7 % 10) as f64);
+                let spd = [1.0, 0.5 + 0.02 * (i % 5) as f64, 0.6, 0.4, 0.3];
+                judged(&spd, 1.0 - 0.2 * difficulty, difficulty)
+            })
+            .collect();
+        for r in &rows {
+            let want = 1.0 - 0.2 * difficulty(r);
+            assert!((gfc(r) - want).abs() < 1e-9, "{} {want}", gfc(r));
+        }
+        let model = fit_gfc_model(&rows, 4).unwrap();
+        for r in &rows {
+            let gap = 1.0 - model.expected(&r.spd, difficulty(r));
+            let want = 0.2 * difficulty(r);
+            assert!(
+                (gap / want - 1.0).abs() < 0.05,
+                "expected 1 − GFC {gap}, true {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn band_scales_grow_with_the_level_and_hold_that_share_of_the_calibration() {
+        let cal_json = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../models/colorchecker24.trust.json"
+        ))
+        .unwrap();
+        let cal = Calibration::from_json(&cal_json, "cc24").unwrap();
+        let d = cal.floor.len();
+        let photos: Vec<Judged> = (0..200)
+            .map(|i| {
+                let spd: Vec<f64> = (0..d)
+                    .map(|k| 0.3 + 0.7 * ((k * 13 + i * 7) % 17) as f64 / 17.0)
+                    .collect();
+                judged(&spd, 0.9 + 0.0005 * i as f64, 0.02)
+            })
+            .collect();
+        let scales = level_scales(&cal, &photos);
+        assert_eq!(scales.len(), reliability::LEVELS.len());
+        for pair in scales.windows(2) {
+            assert!(pair[0].iter().zip(&pair[1]).all(|(a, b)| a <= b));
+        }
+        // The conformal quantile holds at least its level of the photos it was taken of.
+        for (level, scale) in reliability::LEVELS.iter().zip(&scales) {
+            let inside = photos
+                .iter()
+                .flat_map(|j| band_z(&cal, j).into_iter().zip(scale.clone()))
+                .filter(|(z, s)| z <= s)
+                .count() as f64
+                / (photos.len() * d) as f64;
+            assert!(inside >= *level - 1e-9, "level {level}: {inside}");
+        }
+    }
 }
