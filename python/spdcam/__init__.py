@@ -190,8 +190,11 @@ class Estimate:
     #: estimate); ``None`` where the estimate was not judged.
     verdict: Optional[str] = None
     reasons: list[str] = field(default_factory=list)
-    #: The GFC such photos reach, from the model's calibration.
+    #: The GFC estimates of this shape reach (median), from the model's calibration.
     expected_gfc: Optional[float] = None
+    #: How many times the bands and metric intervals were widened because the estimated
+    #: light explains this photo worse than a typical calibration photo (1: not widened).
+    band_widening: Optional[float] = None
     #: Half-widths of the calibrated 68 % and 95 % intervals of the single-number metrics,
     #: by key (``{"cri_ra": {"half68": 1.9, "half95": 4.0}, …}``: Ra 82 ± 4 at 95 %); empty
     #: without a calibration.
@@ -223,6 +226,7 @@ class Estimate:
             verdict=v.get("verdict"),
             reasons=list(v.get("reasons") or []),
             expected_gfc=v.get("expected_gfc"),
+            band_widening=v.get("band_widening"),
             metric_uncertainty=dict(v.get("metric_uncertainty") or {}),
             absolute=v.get("absolute"),
             json=v,

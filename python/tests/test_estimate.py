@@ -40,6 +40,7 @@ def test_the_example_photo_round_trip(example):
     # Judged, with bands around the SPD as the library's JSON gives them.
     assert e.verdict in ("ok", "doubtful", "unusable") and isinstance(e.reasons, list)
     assert 0.0 < e.expected_gfc <= 1.0
+    assert e.band_widening >= 1.0
     ra = e.metric_uncertainty["cri_ra"]
     assert 0.0 < ra["half68"] < ra["half95"] == e.json["metric_uncertainty"]["cri_ra"]["half95"]
     for lower, upper in (e.band, e.band68):

@@ -1257,6 +1257,7 @@ mod tests {
             "reasons",
             "self_check",
             "expected_gfc",
+            "band_widening",
             "band68",
             "band95",
         ] {
@@ -1266,8 +1267,10 @@ mod tests {
             json["band95"]["lower"].as_array().unwrap().len(),
             e.spd.len()
         );
+        assert!(json["self_check"]["glare"].as_f64().is_some());
         let u = e.trust.as_ref().unwrap().uncertainty.as_ref().unwrap();
         assert!((0.0..=1.0).contains(&u.expected_gfc));
+        assert!(u.widening >= 1.0);
         for k in 0..e.spd.len() {
             let (l95, l68, u68, u95) = (
                 u.band95.lower[k],
