@@ -26,6 +26,7 @@ BENCHES = [
     ("spdcam-core", "generate"),
     ("spdcam-learn", "speed"),
     ("spdcam", "estimate"),
+    ("spdcam", "photo_estimate"),
 ]
 
 
@@ -100,6 +101,10 @@ ROWS = [
     ("estimate --features: 1,000,000 SG rows → SPDs, the command, long CSV", "≤ 10 s", "estimate",
      ("{} s", r"^1,000,000 rows.*?long\): ([\d.]+) s"),
      ("peak memory {} MB", r"peak memory (\d+) MB"), ("", None)),
+    ("estimate: one 24-megapixel JPEG → judged SPD (bands, self-check, verdict)", "≤ 1 s", "photo_estimate",
+     ("{} ms", r"whole estimate +([\d.]+) ms"),
+     ("photo → features alone {} ms", r"baseline: photo → features +([\d.]+) ms"),
+     ("{}× the features alone", r"the whole is ([\d.]+)× it")),
     ("  20,000 rows in the process, streamed", "", "estimate",
      ("{} s", r"^20000 rows in the process: streamed ([\d.]+) s"),
      ("all in memory, colorimetry of every row, wide CSV {} s", r"wide CSV\): ([\d.]+) s"),

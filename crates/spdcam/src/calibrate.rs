@@ -40,6 +40,7 @@ pub struct CalibrateArgs {
 
 /// Every camera sensitivity CSV in `dir`, sorted by file name; a file that is not a valid
 /// sensitivity set is skipped with a warning naming it and why.
+#[cfg(feature = "train")]
 pub fn sensitivities_in(dir: &Path, data_dir: &DataDir, grid: &Grid) -> Result<Vec<Sensitivities>> {
     let (found, skipped) = Sensitivities::in_dir(dir, data_dir, grid)
         .with_context(|| format!("reading {}", dir.display()))?;

@@ -796,6 +796,18 @@ under narrow-band light although the model reads them well, that marked most pho
 unusable, so it became the calibration's 99th percentile (doubtful) and half the chart \
 (unusable).\n";
 
+/// Corrections measured once and left off, with their numbers (the shipped models and
+/// calibrations of this report, the same photos).
+const CORRECTIONS_TRIED: &str = "\nAlso tried, and left off: the self-check's own map (3×3 \
+matrix, flare, the light's gradient and an additive light changing linearly across the \
+chart, fitted to the estimate after undoing the best tone curve) with its spatially varying \
+parts taken out of the features, then estimated again. All of them: held-out virtual 0.9279 \
+(SG) and 0.9165 (CC24), Telelumen dev 0.8175, Hue 0.8846, tablet 0.7951. The additive part \
+alone (the glare): dev 0.8322, Hue 0.8769, tablet 0.8002; only where the self-check flags \
+glare: dev 0.8318, Hue 0.9012, tablet 0.8002, held-out virtual 0.9347 (SG) and 0.9294 \
+(CC24, at its own level). The gain alone: dev 0.7840, Hue 0.9174. Each helps one real set \
+and costs another, so none is switched on.\n";
+
 /// Spearman's rank correlation (Spearman 1904), ties given their mean rank.
 fn spearman(a: &[f64], b: &[f64]) -> f64 {
     fn ranks(v: &[f64]) -> Vec<f64> {
@@ -1299,6 +1311,7 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
     md.push('\n');
     md += &metrics_md;
     md += &corrections_md;
+    md += CORRECTIONS_TRIED;
     md.push('\n');
     md += &flags;
     md.push('\n');
