@@ -8,16 +8,15 @@
 
 #[path = "../tests/photo_support/mod.rs"]
 mod photo_support;
+mod support;
 
 use criterion::{criterion_group, Criterion};
 use spdcam_core::photo::{
     analyse, decode_photo, detect, detect_at, AnalyseOptions, ChartTemplate, Photo,
 };
 use std::hint::black_box;
-use std::time::{Duration, Instant};
-
-const WIDTH: u32 = 6000;
-const HEIGHT: u32 = 4000;
+use std::time::Duration;
+use support::median;
 
 struct Fixture {
     jpeg: Vec<u8>,
@@ -36,32 +35,13 @@ fn fixture() -> Fixture {
         },
     );
     let small = image::load_from_memory(&scene.jpeg).expect("scene decodes");
-    let big = small
-        .resize_exact(WIDTH, HEIGHT, image::imageops::FilterType::Triangle)
-        .to_rgb8();
-    let mut jpeg = Vec::new();
-    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 92)
-        .encode(big.as_raw(), WIDTH, HEIGHT, image::ExtendedColorType::Rgb8)
-        .expect("encode");
+    let jpeg = support::enlarged_jpeg(&small);
     let photo = decode_photo(&jpeg, "bench.jpg").expect("decode");
     Fixture {
         jpeg,
         photo,
         templates: vec![setup.template],
     }
-}
-
-fn median(runs: usize, mut f: impl FnMut()) -> Duration {
-    f();
-    let mut t: Vec<Duration> = (0..runs)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed()
-        })
-        .collect();
-    t.sort();
-    t[t.len() / 2]
 }
 
 fn summary(fx: &Fixture) {

@@ -18,34 +18,16 @@ use spdcam_infer::estimate::{
 use spdcam_infer::ModelSet;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use support::median;
 
-const WIDTH: u32 = 6000;
-const HEIGHT: u32 = 4000;
-
-fn median(runs: usize, mut f: impl FnMut()) -> Duration {
-    f();
-    let mut t: Vec<Duration> = (0..runs)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed()
-        })
-        .collect();
-    t.sort();
-    t[t.len() / 2]
-}
+#[path = "../../spdcam-core/benches/support/mod.rs"]
+mod support;
 
 fn main() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let example = image::open(repo.join("examples/sg-telelumen.jpg")).expect("the example photo");
-    let big = example
-        .resize_exact(WIDTH, HEIGHT, image::imageops::FilterType::Triangle)
-        .to_rgb8();
-    let mut jpeg = Vec::new();
-    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 92)
-        .encode(big.as_raw(), WIDTH, HEIGHT, image::ExtendedColorType::Rgb8)
-        .expect("encode");
+    let jpeg = support::enlarged_jpeg(&example);
     let data = std::env::var_os("SPDCAM_DATA")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo.join("../shared/data"));
