@@ -357,3 +357,38 @@ fn randomised_gradient_stays_in_its_range() {
     );
     assert_eq!(draws[7], randomisation.draw(9, 7).1.unwrap().gradient);
 }
+
+#[test]
+fn two_lights_meet_at_one_exposure_and_one_white_balance() {
+    let cam = camera(None);
+    let a = StandardIlluminant::D65.spd(&GRID).unwrap();
+    let b = StandardIlluminant::A.spd(&GRID).unwrap();
+    let (la, lb) = (cam.light(&a).unwrap(), cam.light(&b).unwrap());
+    let ic = InCamera {
+        exposure_target: Some(0.3),
+        ..InCamera::NEUTRAL
+    };
+    let two = |other: &[f32], second: &[bool]| {
+        let (mut raw, mut out) = (Vec::new(), Vec::new());
+        cam.features_fast_two_lights(Some(&ic), &la, other, second, &mut raw, &mut out);
+        out
+    };
+    let patches = 24;
+    let right: Vec<bool> = (0..patches).map(|p| p % 6 >= 3).collect();
+    let one = fast(&cam, Some(&ic), &a);
+    // The same light twice, or the second light nowhere, is the photo of one light.
+    assert_eq!(two(&la, &right), one);
+    assert_eq!(two(&lb, &vec![false; patches]), one);
+    // Tungsten on the right half: its patches warm against the daylit left, where a photo
+    // of each light alone balances each to neutral.
+    let mixed = two(&lb, &right);
+    let red_over_blue = |f: &[f32], p: usize| f[3 * p] / f[3 * p + 2].max(1.0);
+    // The neutral row: white (p18) on the left, neutral 3.5 (p22) on the right.
+    let (left, right_grey) = (red_over_blue(&mixed, 19), red_over_blue(&mixed, 22));
+    assert!(
+        right_grey > 1.3 * left,
+        "right {right_grey}, left {left}: {mixed:?}"
+    );
+    let alone = fast(&cam, Some(&ic), &b);
+    assert!(red_over_blue(&alone, 22) < 1.2 * red_over_blue(&alone, 19));
+}

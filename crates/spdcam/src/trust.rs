@@ -171,10 +171,8 @@ impl HeldOutPhotos {
         )?;
         let truth = on_grid(&setup.library, &model.grid())?;
         let cols = chart.layout.cols;
-        let right: Vec<bool> = chart
-            .feature_patches
-            .iter()
-            .map(|&p| 2 * (p % cols) >= cols)
+        let right: Vec<bool> = (0..chart.reflectances.len())
+            .map(|p| 2 * (p % cols) >= cols)
             .collect();
         let glare_gain = glare(chart);
         let mut rng = SmallRng::seed_from_u64(seed::derive(stream, 0x5752_4f4e_4700_0001));
@@ -194,25 +192,19 @@ impl HeldOutPhotos {
                 let (camera, ic) = randomisation.draw(stream, j as u64 * self.shots + k);
                 a.clear();
                 b.clear();
-                camera.features_fast_with(
+                let light = camera.light(&setup.library.spds[i])?;
+                camera.features_fast_with(ic.as_ref(), &light, &mut raw, &mut a);
+                camera.features_fast_two_lights(
                     ic.as_ref(),
-                    &camera.light(&setup.library.spds[i])?,
-                    &mut raw,
-                    &mut a,
-                );
-                camera.features_fast_with(
-                    ic.as_ref(),
+                    &light,
                     &camera.light(&setup.library.spds[other])?,
+                    &right,
                     &mut raw,
                     &mut b,
                 );
                 let clean: Vec<f64> = a.iter().map(|&v| f64::from(v)).collect();
-                let half: Vec<f64> = clean
-                    .iter()
-                    .enumerate()
-                    .map(|(f, &v)| if right[f / 3] { f64::from(b[f]) } else { v })
-                    .collect();
-                let mut order: Vec<usize> = (0..right.len()).collect();
+                let half: Vec<f64> = b.iter().map(|&v| f64::from(v)).collect();
+                let mut order: Vec<usize> = (0..chart.feature_patches.len()).collect();
                 order.shuffle(&mut rng);
                 let wrong: Vec<f64> = order
                     .iter()
@@ -1108,7 +1100,8 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
          (flagged), and share whose verdict is not `ok`. Clean: the test lamps' photos above. \
          Wrong chart: the same photos with the patches in a random order (a chart the model \
          does not read). Half-lit: the right half of the chart lit by the next lamp of the \
-         split, same camera and settings. Glare: veiling glare adding 40 % of the chart's mean \
+         split, same camera and settings, at the exposure the first lamp gives and one white \
+         balance from the chart as lit (as a camera takes two lights in one photo). Glare: veiling glare adding 40 % of the chart's mean \
          linear level at the top-left corner, falling off as a Gaussian of 0.35 chart widths. \
          All patch level (no scene photo), noise-free.\n\n\
          | model | photos | clean: flagged | clean: not ok | wrong chart: flagged | half-lit: flagged | glare: flagged | bad (all three): flagged |\n\

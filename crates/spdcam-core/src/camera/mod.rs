@@ -441,6 +441,12 @@ impl Camera {
     /// the fast path.
     fn balanced_regions(&self, shot: &Shot, light: &[f32], raw: &mut Vec<[f32; 3]>) {
         self.exposed_regions(shot, light, raw);
+        self.balance_regions(shot, raw);
+    }
+
+    /// White balance of exposed region values in place: the gains the camera estimates from
+    /// them, adapted as the shot adapts.
+    fn balance_regions(&self, shot: &Shot, raw: &mut [[f32; 3]]) {
         let estimated = self
             .config
             .white_balance
@@ -702,8 +708,43 @@ impl Camera {
     ) {
         let shot = Shot::of(ic);
         self.balanced_regions(&shot, light, raw);
+        self.finish_features(&shot, raw, out);
+    }
+
+    /// [`Camera::features_fast_with`] for a chart lit by `light` and, on the regions
+    /// `second` marks (the chart's patches in its order; unmarked and later regions keep
+    /// `light`), by `other`: one exposure, metered under the first light as in
+    /// [`Camera::exposed_chart`], and one white balance from the chart as lit. Two lights
+    /// in one photo, at patch level.
+    pub fn features_fast_two_lights(
+        &self,
+        ic: Option<&InCamera>,
+        light: &[f32],
+        other: &[f32],
+        second: &[bool],
+        raw: &mut Vec<[f32; 3]>,
+        out: &mut Vec<f32>,
+    ) {
+        let shot = Shot::of(ic);
+        self.lit_regions(&shot, light, raw);
+        let scale = self.exposure_scale(&shot, raw);
+        let mut by_other = Vec::new();
+        self.lit_regions(&shot, other, &mut by_other);
+        for ((v, o), &marked) in raw.iter_mut().zip(&by_other).zip(second) {
+            if marked {
+                *v = *o;
+            }
+        }
+        expose(raw, scale, shot.full_scale);
+        self.balance_regions(&shot, raw);
+        self.finish_features(&shot, raw, out);
+    }
+
+    /// The feature patches of white-balanced region values, encoded on 0–255, appended to
+    /// `out`.
+    fn finish_features(&self, shot: &Shot, raw: &[[f32; 3]], out: &mut Vec<f32>) {
         for &p in &self.chart.feature_patches {
-            let encoded = self.finish_pixel(&shot, raw[p]);
+            let encoded = self.finish_pixel(shot, raw[p]);
             out.extend(encoded.map(|v| 255.0 * v));
         }
     }
