@@ -463,6 +463,10 @@ function renderSummary() {
   row(table, 'CCT', c.cct != null ? `${fmt(c.cct, 0)} K` : 'none (far from the Planckian locus)', 'cct');
   row(table, 'Duv', c.duv != null ? (c.duv >= 0 ? '+' : '') + fmt(c.duv, 4) : '–', 'duv');
   if (typeof r.expected_gfc === 'number') row(table, 'expected GFC', fmt(r.expected_gfc, 3), 'expected-gfc');
+  if (typeof r.band_widening === 'number' && r.band_widening > 1) {
+    // The light found explains this photo worse than the calibration photos: wider bands.
+    row(table, 'bands widened', `${fmt(r.band_widening, 1)}×`, 'band-widening');
+  }
   if (r.absolute) {
     // Approximate absolute levels from the photo's EXIF exposure (see the JSON's note).
     row(table, 'illuminance (approx.)', `${fmt(r.absolute.illuminance_lux, 0)} lx`, 'illuminance');
