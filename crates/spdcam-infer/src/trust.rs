@@ -567,7 +567,9 @@ pub struct Calibration {
 /// (`spdcam trust calibrate` chooses the number of components and the penalty by
 /// cross-validation over lamps). Narrow-band and spiky estimates come from lights that
 /// 96 broadband patches resolve poorly, so the shape says much of how far to trust it; the
-/// regression's value is the conditional median of ln(1 − GFC), hence of the GFC.
+/// regression's value is the conditional median of ln(1 − GFC), hence of the GFC. It never
+/// extrapolates: each input is held within the range the calibration photos span, and the
+/// value within the range of their ln(1 − GFC).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GfcModel {
     /// The mean of the calibration photos' estimates (peak 1), per wavelength.
@@ -576,6 +578,12 @@ pub struct GfcModel {
     pub components: Vec<Vec<f64>>,
     /// The weights of ln(difficulty), of each component's coordinate, and of a constant 1.
     pub weights: Vec<f64>,
+    /// The smallest value of each input ([`GfcModel::inputs`]) on the calibration photos.
+    pub low: Vec<f64>,
+    /// The largest value of each input on the calibration photos.
+    pub high: Vec<f64>,
+    /// The smallest and largest ln(1 − GFC) of the calibration photos.
+    pub gap_range: [f64; 2],
 }
 
 impl GfcModel {
@@ -598,12 +606,14 @@ impl GfcModel {
     /// The median GFC of estimates like `spd` (peak 1) of mean spread `difficulty`.
     pub fn expected(&self, spd: &[f64], difficulty: f64) -> f64 {
         let z: f64 = self
-            .weights
+            .inputs(spd, difficulty)
             .iter()
-            .zip(self.inputs(spd, difficulty))
-            .map(|(w, x)| w * x)
+            .zip(self.low.iter().zip(&self.high))
+            .zip(&self.weights)
+            .map(|((x, (lo, hi)), w)| w * x.clamp(*lo, *hi))
             .sum();
-        (1.0 - z.exp()).clamp(0.0, 1.0)
+        let [lowest, highest] = self.gap_range;
+        (1.0 - z.clamp(lowest, highest).exp()).clamp(0.0, 1.0)
     }
 
     /// Whether the model's arrays fit `d` wavelengths.
@@ -611,6 +621,10 @@ impl GfcModel {
         self.mean.len() == d
             && self.components.iter().all(|c| c.len() == d)
             && self.weights.len() == self.components.len() + 2
+            && self.low.len() == self.weights.len()
+            && self.high.len() == self.weights.len()
+            && self.low.iter().zip(&self.high).all(|(l, h)| l <= h)
+            && self.gap_range[0] <= self.gap_range[1]
             && self.weights.iter().all(|w| w.is_finite())
     }
 }
@@ -1156,6 +1170,9 @@ mod tests {
             mean: vec![0.5, 0.5],
             components: vec![vec![0.6, 0.8]],
             weights: vec![0.5, 2.0, -4.0],
+            low: vec![-10.0, -1.0, 1.0],
+            high: vec![0.0, 1.0, 1.0],
+            gap_range: [-20.0, 0.0],
         };
         let (spd, difficulty) = ([1.0, 0.25], 0.04);
         let coordinate = 0.6 * 0.5 + 0.8 * -0.25;
@@ -1165,12 +1182,19 @@ mod tests {
             model.inputs(&spd, difficulty),
             vec![0.04f64.ln(), coordinate, 1.0]
         );
-        // A regression that runs away stays a GFC.
+        // Inputs beyond the calibration's range are held at its edge, and so is the value.
+        let narrow = GfcModel {
+            low: vec![-10.0, 0.2, 1.0],
+            ..model.clone()
+        };
+        let held = 1.0 - (-4.0 + 0.5 * 0.04f64.ln() + 2.0 * 0.2).exp();
+        assert!((narrow.expected(&spd, difficulty) - held).abs() < 1e-12);
         let wild = GfcModel {
             weights: vec![0.0, 0.0, 5.0],
+            gap_range: [-20.0, -3.0],
             ..model
         };
-        assert_eq!(wild.expected(&spd, difficulty), 0.0);
+        assert!((wild.expected(&spd, difficulty) - (1.0 - (-3.0f64).exp())).abs() < 1e-12);
     }
 
     #[test]
@@ -1188,6 +1212,9 @@ mod tests {
                 mean: vec![0.5; d],
                 components: Vec::new(),
                 weights: vec![0.0, -3.0],
+                low: vec![-10.0, 1.0],
+                high: vec![0.0, 1.0],
+                gap_range: [-10.0, 0.0],
             },
             residual_reference: Some(0.05),
             difficulty_doubtful: 1.0,
@@ -1287,7 +1314,8 @@ mod tests {
     fn a_calibration_whose_arrays_disagree_is_refused() {
         let text = r#"{"model":"0","chart":"c","method":"m","wavelength_nm":[400,410],
             "floor":[0.1],"scale68":[1,1],"scale95":[2,2],
-            "gfc_model":{"mean":[0.5,0.5],"components":[],"weights":[0.0,-3.0]},
+            "gfc_model":{"mean":[0.5,0.5],"components":[],"weights":[0.0,-3.0],
+                "low":[-9.0,1.0],"high":[0.0,1.0],"gap_range":[-9.0,0.0]},
             "residual_reference":null,"difficulty_doubtful":0.1,"self_check_doubtful":null,"split_doubtful":null,
             "clipped_doubtful":0}"#;
         let err = Calibration::from_json(text, "c.json")

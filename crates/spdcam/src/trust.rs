@@ -492,6 +492,9 @@ fn fit_gfc_model(judged: &[Judged], shots: usize) -> Result<GfcModel> {
         mean: pca.mean.clone(),
         components: pca.components[..k.min(pca.len())].to_vec(),
         weights: Vec::new(),
+        low: Vec::new(),
+        high: Vec::new(),
+        gap_range: [0.0; 2],
     };
     let inputs = |m: &GfcModel| -> Vec<Vec<f64>> {
         judged
@@ -550,6 +553,17 @@ fn fit_gfc_model(judged: &[Judged], shots: usize) -> Result<GfcModel> {
     let x = inputs(&model);
     let ridge = solve(&x, &(0..n).collect::<Vec<_>>(), penalty)?;
     model.weights = (0..ridge.inputs()).map(|j| ridge.weight(0, j)).collect();
+    let range = |values: &mut dyn Iterator<Item = f64>| {
+        values.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| {
+            [lo.min(v), hi.max(v)]
+        })
+    };
+    let input_ranges: Vec<[f64; 2]> = (0..model.weights.len())
+        .map(|c| range(&mut x.iter().map(|row| row[c])))
+        .collect();
+    model.low = input_ranges.iter().map(|r| r[0]).collect();
+    model.high = input_ranges.iter().map(|r| r[1]).collect();
+    model.gap_range = range(&mut target.iter().map(|t| t[0]));
     Ok(model)
 }
 
