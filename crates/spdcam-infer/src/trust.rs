@@ -169,7 +169,7 @@ impl ChartCheck {
             .iter()
             .map(|w| std::array::from_fn(|c| w[c].iter().zip(spd).map(|(a, b)| a * b).sum()))
             .collect();
-        let mut best: Option<SelfCheck> = None;
+        let mut best: Option<MapFit> = None;
         for &gamma in &TONE_GAMMAS {
             for &contrast in &TONE_CONTRASTS {
                 let observed: Vec<[f64; 3]> = features
@@ -180,14 +180,14 @@ impl ChartCheck {
                         })
                     })
                     .collect();
-                let s = self.fit(&predicted, &observed, &used)?;
-                if best.as_ref().is_none_or(|b| s.mean < b.mean) {
-                    best = Some(s);
+                let fitted = self.map_fit(&predicted, &observed, &used)?;
+                if best.as_ref().is_none_or(|b| fitted.mean < b.mean) {
+                    best = Some(fitted);
                 }
             }
         }
-        let mut best =
-            best.ok_or_else(|| InferError::invalid("self-check: no tone curve to try"))?;
+        let best = best.ok_or_else(|| InferError::invalid("self-check: no tone curve to try"))?;
+        let mut best = self.judge_fit(&best, &used)?;
         best.colour_gradient =
             UnevenLight::fit_neutrals(&self.neutrals, &self.centres, features, scale)
                 .ok()
@@ -195,14 +195,14 @@ impl ChartCheck {
         Ok(best)
     }
 
-    /// The self-check's fit of `predicted` raw RGB to `observed` linear RGB over the
-    /// patches `used` (see [`ChartCheck::check`]).
-    fn fit(
+    /// The per-photo map of `predicted` raw RGB to `observed` linear RGB over the patches
+    /// `used`, fitted by least squares, and its residual (see [`ChartCheck::check`]).
+    fn map_fit(
         &self,
         predicted: &[[f64; 3]],
         observed: &[[f64; 3]],
         used: &[usize],
-    ) -> Result<SelfCheck> {
+    ) -> Result<MapFit> {
         let level = |v: &[[f64; 3]]| {
             used.iter().map(|&i| v[i].iter().sum::<f64>()).sum::<f64>() / used.len() as f64
         };
@@ -212,46 +212,67 @@ impl ChartCheck {
                 "self-check: the chart or the light is black",
             ));
         }
-        let design = |i: usize| -> Vec<f64> {
-            let p = predicted[i].map(|v| v / pl);
-            let l = p.iter().sum::<f64>() / 3.0;
-            let [x, y] = self.centres[i];
-            vec![p[0], p[1], p[2], 1.0, x * l, y * l, x, y]
+        // Per patch: the predicted RGB, a constant (flare), the light's gradient and an
+        // additive light changing across the chart (the last two columns, for the glare).
+        let design: Vec<[f64; GLARE_COLUMNS]> = predicted
+            .iter()
+            .zip(&self.centres)
+            .map(|(p, &[x, y])| {
+                let p = p.map(|v| v / pl);
+                let l = p.iter().sum::<f64>() / 3.0;
+                [p[0], p[1], p[2], 1.0, x * l, y * l, x, y]
+            })
+            .collect();
+        let target: Vec<[f64; 3]> = observed.iter().map(|o| o.map(|v| v / ol)).collect();
+        let mean_length = used.iter().map(|&i| norm(target[i])).sum::<f64>() / used.len() as f64;
+        let mut fitted = MapFit {
+            design,
+            target,
+            mean_length,
+            global: DMatrix::zeros(0, 0),
+            residuals: Vec::new(),
+            mean: 0.0,
         };
-        let target = |i: usize| observed[i].map(|v| v / ol);
-        let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let mean_length = used.iter().map(|&i| norm(target(i))).sum::<f64>() / used.len() as f64;
-        let global = least_squares(used, 6, &design, &target)?;
-        let residual = |i: usize, solved: &DMatrix<f64>, columns: usize| -> f64 {
-            let d = design(i);
-            let t = target(i);
-            let fit: [f64; 3] =
-                std::array::from_fn(|c| (0..columns).map(|k| d[k] * solved[(k, c)]).sum());
-            norm(std::array::from_fn(|c| fit[c] - t[c])) / mean_length
-        };
-        let mut residuals: Vec<(usize, f64)> =
-            used.iter().map(|&i| (i, residual(i, &global, 6))).collect();
-        let mean = residuals.iter().map(|r| r.1).sum::<f64>() / residuals.len() as f64;
+        fitted.global = fitted.solve(used, MAP_COLUMNS)?;
+        fitted.residuals = used
+            .iter()
+            .map(|&i| (i, fitted.residual(i, &fitted.global, MAP_COLUMNS)))
+            .collect();
+        fitted.mean = fitted.residuals.iter().map(|r| r.1).sum::<f64>() / used.len() as f64;
+        fitted.residuals.sort_by(|a, b| b.1.total_cmp(&a.1));
+        Ok(fitted)
+    }
+
+    /// The self-check of the best-fitting map: its residual, the worst patches, the
+    /// half-to-half residual and the glare.
+    fn judge_fit(&self, fitted: &MapFit, used: &[usize]) -> Result<SelfCheck> {
         // Glare: the same map with an additive light that changes linearly across the chart
         // (two more columns per channel), compared with the map without it, a nested-model
         // comparison (Seber & Lee 2003, "Linear Regression Analysis", section 4.3).
-        let with_glare = least_squares(used, 8, &design, &target)?;
+        let with_glare = fitted.solve(used, GLARE_COLUMNS)?;
         let glare_mean = used
             .iter()
-            .map(|&i| residual(i, &with_glare, 8))
+            .map(|&i| fitted.residual(i, &with_glare, GLARE_COLUMNS))
             .sum::<f64>()
             / used.len() as f64;
-        residuals.sort_by(|a, b| b.1.total_cmp(&a.1));
         // Halves: the colour map fitted to one half of the chart (the gradient fixed at the
         // whole chart's) predicts the other half (a Chow-type test for one map across the
         // chart; Chow 1960, Econometrica 28: 591–605).
-        let gradient = |i: usize| -> [f64; 3] {
-            let d = design(i);
-            std::array::from_fn(|c| d[4] * global[(4, c)] + d[5] * global[(5, c)])
-        };
-        let flat = |i: usize| -> [f64; 3] {
-            let (t, g) = (target(i), gradient(i));
-            std::array::from_fn(|c| t[c] - g[c])
+        let flat = MapFit {
+            target: fitted
+                .target
+                .iter()
+                .zip(&fitted.design)
+                .map(|(t, d)| {
+                    std::array::from_fn(|c| {
+                        t[c] - (d[4] * fitted.global[(4, c)] + d[5] * fitted.global[(5, c)])
+                    })
+                })
+                .collect(),
+            design: fitted.design.clone(),
+            global: DMatrix::zeros(0, 0),
+            residuals: Vec::new(),
+            ..*fitted
         };
         let mut split = 0.0f64;
         for axis in 0..2 {
@@ -262,20 +283,15 @@ impl ChartCheck {
             }
             let mut cross = 0.0;
             for (fit_on, judged) in [(&a, &b), (&b, &a)] {
-                let solved = least_squares(fit_on, 4, &design, &flat)?;
+                let solved = flat.solve(fit_on, HALF_COLUMNS)?;
                 cross += judged
                     .iter()
-                    .map(|&i| {
-                        let d = design(i);
-                        let t = flat(i);
-                        let f: [f64; 3] =
-                            std::array::from_fn(|c| (0..4).map(|k| d[k] * solved[(k, c)]).sum());
-                        norm(std::array::from_fn(|c| f[c] - t[c])) / mean_length
-                    })
+                    .map(|&i| flat.residual(i, &solved, HALF_COLUMNS))
                     .sum::<f64>();
             }
             split = split.max(cross / used.len() as f64);
         }
+        let mean = fitted.mean;
         Ok(SelfCheck {
             glare: if mean > 0.0 {
                 (1.0 - glare_mean / mean).max(0.0)
@@ -285,14 +301,58 @@ impl ChartCheck {
             colour_gradient: None,
             mean,
             split,
-            worst: residuals[0].1,
-            worst_patches: residuals
+            worst: fitted.residuals[0].1,
+            worst_patches: fitted
+                .residuals
                 .iter()
                 .take(WORST_NAMED)
                 .map(|r| r.0 + 1)
                 .collect(),
         })
     }
+}
+
+/// Columns of the self-check's map: 3×3 matrix, flare, and the light's gradient in x and y.
+const MAP_COLUMNS: usize = 6;
+/// The map's columns with the additive light changing across the chart (glare).
+const GLARE_COLUMNS: usize = 8;
+/// The map's columns fitted on half the chart: matrix and flare.
+const HALF_COLUMNS: usize = 4;
+
+/// The self-check's map at one tone curve: per patch its design row and target (the
+/// photo's linear RGB over its mean level), the map's solution on the first
+/// [`MAP_COLUMNS`] columns and the patch residuals (worst first) with their mean.
+struct MapFit {
+    design: Vec<[f64; GLARE_COLUMNS]>,
+    target: Vec<[f64; 3]>,
+    /// The mean RGB length of the targets, the residuals' unit.
+    mean_length: f64,
+    global: DMatrix<f64>,
+    residuals: Vec<(usize, f64)>,
+    mean: f64,
+}
+
+impl MapFit {
+    /// The least-squares map on the first `columns` design columns over the patches `rows`.
+    fn solve(&self, rows: &[usize], columns: usize) -> Result<DMatrix<f64>> {
+        least_squares(rows, columns, &|i| self.design[i].to_vec(), &|i| {
+            self.target[i]
+        })
+    }
+
+    /// Patch `i`'s residual under the map `solved` on the first `columns` columns, relative
+    /// to the mean RGB length.
+    fn residual(&self, i: usize, solved: &DMatrix<f64>, columns: usize) -> f64 {
+        let (d, t) = (&self.design[i], self.target[i]);
+        let fit: [f64; 3] =
+            std::array::from_fn(|c| (0..columns).map(|k| d[k] * solved[(k, c)]).sum());
+        norm(std::array::from_fn(|c| fit[c] - t[c])) / self.mean_length
+    }
+}
+
+/// The Euclidean length of an RGB triple.
+fn norm(v: [f64; 3]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// Gammas of the tone curves the self-check tries (the virtual camera's range, 0.7–1.3).

@@ -371,47 +371,43 @@ fn fit_calibration(
     let mut checks = checks_of(|s| Some(s.mean));
     let all_checked = checks.len() == judged.len();
     let residual_reference = all_checked.then(|| median(&mut checks.clone()));
-    let widen = |j: &Judged| trust::widening(residual(j), residual_reference);
+    let widenings: Vec<f64> = judged
+        .iter()
+        .map(|j| trust::widening(residual(j), residual_reference))
+        .collect();
     let floor: Vec<f64> = (0..d)
         .map(|k| {
             median(
                 &mut judged
                     .iter()
-                    .map(|j| err(j, k) / widen(j))
+                    .zip(&widenings)
+                    .map(|(j, w)| err(j, k) / w)
                     .collect::<Vec<_>>(),
             )
             .max(1e-4)
         })
         .collect();
-    let scale = |q: f64| -> Vec<f64> {
-        (0..d)
-            .map(|k| {
-                let mut z: Vec<f64> = judged
-                    .iter()
-                    .map(|j| err(j, k) / ((floor[k] + j.spread[k]) * widen(j)))
-                    .collect();
-                conformal_quantile(&mut z, q)
-            })
-            .collect()
-    };
+    let z: Vec<Vec<f64>> = judged
+        .iter()
+        .zip(&widenings)
+        .map(|(j, &w)| band_z(&floor, w, j))
+        .collect();
+    let [scale68, scale95]: [Vec<f64>; 2] = quantile_scales(&z, &[0.68, 0.95])
+        .try_into()
+        .map_err(|_| anyhow::anyhow!("two band scales"))?;
     let mut difficulties: Vec<f64> = judged.iter().map(difficulty).collect();
     let mut splits = checks_of(|s| Some(s.split));
     let mut gradients = checks_of(|s| s.colour_gradient);
     let mut glares = checks_of(|s| Some(s.glare));
-    let (scale68, scale95) = (scale(0.68), scale(0.95));
     let metric_calibrations = SCALAR_KEYS
         .iter()
         .filter_map(|&key| {
             let pairs: Vec<(f64, f64)> = judged
                 .iter()
-                .filter_map(|j| {
-                    Some((
-                        *j.metric_error.get(key)?,
-                        *j.metric_spread.get(key)?,
-                        widen(j),
-                    ))
+                .zip(&widenings)
+                .filter_map(|(j, w)| {
+                    Some((*j.metric_error.get(key)? / w, *j.metric_spread.get(key)?))
                 })
-                .map(|(e, s, w)| (e / w, s))
                 .collect();
             if pairs.len() < MIN_METRIC_PHOTOS {
                 return None;
@@ -519,39 +515,46 @@ fn fit_gfc_model(judged: &[Judged], shots: usize) -> Result<GfcModel> {
             })
             .collect()
     };
-    let solve = |x: &[Vec<f64>], rows: &[usize], penalty: f64| -> Result<Ridge> {
+    // The Gram matrices of `rows` and their penalty units, solved for any penalty.
+    let gram = |x: &[Vec<f64>], rows: &[usize]| -> Result<(Gram, Vec<f64>)> {
         let xs: Vec<&[f64]> = rows.iter().map(|&i| x[i].as_slice()).collect();
         let ys: Vec<&[f64]> = rows.iter().map(|&i| target[i].as_slice()).collect();
-        let diagonal: Vec<f64> = unit(x, rows).iter().map(|u| penalty * u).collect();
-        Ok(Gram::from_rows(&xs, &ys)?.solve(&diagonal, None)?)
+        Ok((Gram::from_rows(&xs, &ys)?, unit(x, rows)))
+    };
+    let solve = |(gram, unit): &(Gram, Vec<f64>), penalty: f64| -> Result<Ridge> {
+        let diagonal: Vec<f64> = unit.iter().map(|u| penalty * u).collect();
+        Ok(gram.solve(&diagonal, None)?)
     };
     let lamp = |i: usize| i / shots.max(1);
+    let folds: Vec<(Vec<usize>, Vec<usize>)> = (0..GFC_FOLDS)
+        .map(|f| (0..n).partition(|&i| lamp(i) % GFC_FOLDS == f))
+        .filter(|(test, train): &(Vec<usize>, Vec<usize>)| !test.is_empty() && !train.is_empty())
+        .collect();
     let mut best: Option<(f64, usize, f64)> = None;
     for &k in GFC_COMPONENTS.iter().filter(|&&k| k <= pca.len()) {
         let x = inputs(&with(k));
-        for &penalty in GFC_PENALTIES.iter().rev() {
-            let mut sse = 0.0;
-            for f in 0..GFC_FOLDS {
-                let (test, train): (Vec<usize>, Vec<usize>) =
-                    (0..n).partition(|&i| lamp(i) % GFC_FOLDS == f);
-                if test.is_empty() || train.is_empty() {
-                    continue;
-                }
-                let ridge = solve(&x, &train, penalty)?;
-                sse += test
+        let mut sse = [0.0; GFC_PENALTIES.len()];
+        for (test, train) in &folds {
+            let fitted = gram(&x, train)?;
+            for (total, &penalty) in sse.iter_mut().zip(&GFC_PENALTIES) {
+                let ridge = solve(&fitted, penalty)?;
+                *total += test
                     .iter()
                     .map(|&i| (ridge.predict(&x[i])[0] - target[i][0]).powi(2))
                     .sum::<f64>();
             }
-            if best.is_none_or(|b| sse < b.0) {
-                best = Some((sse, k, penalty));
+        }
+        // The strongest penalty first, so that a tie keeps it.
+        for (&total, &penalty) in sse.iter().zip(&GFC_PENALTIES).rev() {
+            if best.is_none_or(|b| total < b.0) {
+                best = Some((total, k, penalty));
             }
         }
     }
     let (_, k, penalty) = best.context("no expected-GFC regression could be fitted")?;
     let mut model = with(k);
     let x = inputs(&model);
-    let ridge = solve(&x, &(0..n).collect::<Vec<_>>(), penalty)?;
+    let ridge = solve(&gram(&x, &(0..n).collect::<Vec<_>>())?, penalty)?;
     model.weights = (0..ridge.inputs()).map(|j| ridge.weight(0, j)).collect();
     let range = |values: &mut dyn Iterator<Item = f64>| {
         values.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| {
@@ -856,30 +859,39 @@ struct MetricCoverage {
 }
 
 /// A photo's band error in units of its calibrated scale: per wavelength
-/// |error(λ)| / ((f(λ) + s(λ))·widening), the quantity the calibration's conformal
-/// quantiles are taken of ([`Calibration`]).
-fn band_z(cal: &Calibration, judged: &Judged) -> Vec<f64> {
-    let w = cal.widening(residual(judged));
+/// |error(λ)| / ((f(λ) + s(λ))·w), the quantity the calibration's conformal quantiles are
+/// taken of ([`Calibration`]); `floor` is the calibration's f(λ) and `widening` the photo's w.
+fn band_z(floor: &[f64], widening: f64, judged: &Judged) -> Vec<f64> {
     let truth = judged.truth.as_deref().unwrap_or_default();
     truth
         .iter()
         .enumerate()
-        .map(|(k, t)| (judged.spd[k] - t).abs() / ((cal.floor[k] + judged.spread[k]) * w))
+        .map(|(k, t)| (judged.spd[k] - t).abs() / ((floor[k] + judged.spread[k]) * widening))
         .collect()
 }
 
-/// Per level of [`reliability::LEVELS`], per wavelength: the conformal quantile of the
-/// calibration photos' [`band_z`], the scale of the band of that level.
-fn level_scales(cal: &Calibration, calibration_photos: &[Judged]) -> Vec<Vec<f64>> {
-    let z: Vec<Vec<f64>> = calibration_photos.iter().map(|j| band_z(cal, j)).collect();
-    reliability::LEVELS
+/// Per level of `levels`, per wavelength: the conformal quantile of the photos' [`band_z`]
+/// rows `z`, the scale of the band of that level.
+fn quantile_scales(z: &[Vec<f64>], levels: &[f64]) -> Vec<Vec<f64>> {
+    let d = z.first().map_or(0, Vec::len);
+    levels
         .iter()
         .map(|&q| {
-            (0..cal.floor.len())
+            (0..d)
                 .map(|k| conformal_quantile(&mut z.iter().map(|r| r[k]).collect::<Vec<_>>(), q))
                 .collect()
         })
         .collect()
+}
+
+/// Per level of [`reliability::LEVELS`], the scales of `cal`'s bands measured on its
+/// calibration photos ([`quantile_scales`]).
+fn level_scales(cal: &Calibration, calibration_photos: &[Judged]) -> Vec<Vec<f64>> {
+    let z: Vec<Vec<f64>> = calibration_photos
+        .iter()
+        .map(|j| band_z(&cal.floor, cal.widening(residual(j)), j))
+        .collect();
+    quantile_scales(&z, &reliability::LEVELS)
 }
 
 /// What [`measure_row`] measured on one photo set.
@@ -929,12 +941,9 @@ fn measure_row(
             in95 += usize::from(u.band95.lower[k] <= t && t <= u.band95.upper[k]);
             total += 1;
         }
+        let z = band_z(&cal.floor, u.widening, j);
         for (count, scale) in in_level.iter_mut().zip(level_scales) {
-            *count += band_z(cal, j)
-                .iter()
-                .zip(scale)
-                .filter(|(z, s)| z <= s)
-                .count();
+            *count += z.iter().zip(scale).filter(|(z, s)| z <= s).count();
         }
         expected.push(u.expected_gfc);
         actual.push(gfc(j));
@@ -1433,7 +1442,11 @@ mod tests {
         for (level, scale) in reliability::LEVELS.iter().zip(&scales) {
             let inside = photos
                 .iter()
-                .flat_map(|j| band_z(&cal, j).into_iter().zip(scale.clone()))
+                .flat_map(|j| {
+                    band_z(&cal.floor, cal.widening(residual(j)), j)
+                        .into_iter()
+                        .zip(scale.clone())
+                })
                 .filter(|(z, s)| z <= s)
                 .count() as f64
                 / (photos.len() * d) as f64;
