@@ -106,8 +106,8 @@ def test_finetune_chooses_the_recipe_by_cross_validation(mlp, tmp_path):
     tuned = spdcam.finetune(path, few, tmp_path / "chosen.spdm",
                             progress=lambda d, t: calls.append((d, t)))
     assert tuned.feature_names[0][0] == "p01_r"
-    # 2 folds × 4 candidate recipes, then the chosen one on all the samples.
-    assert [d for d, _ in calls] == list(range(1, 10)) and {t for _, t in calls} == {9}
+    # 2 folds × 7 candidate recipes, then the chosen one on all the samples.
+    assert [d for d, _ in calls] == list(range(1, 16)) and {t for _, t in calls} == {15}
 
 
 def test_an_exception_of_the_callback_reaches_the_caller(data, tmp_path):

@@ -46,6 +46,7 @@
 mod burn_net;
 pub mod error;
 pub mod evaluate;
+pub mod real_cameras;
 pub mod recipe;
 pub mod ridge;
 pub mod synthetic;

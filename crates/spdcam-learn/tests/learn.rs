@@ -184,3 +184,39 @@ fn finetuning_adapts_to_a_new_camera() {
     );
     assert!(tuned.training().finetuned_from.is_some());
 }
+
+#[test]
+fn the_recipe_choice_weighs_ridge_on_the_photos_and_never_loses_to_it() {
+    // A model trained on one camera, a few photos of another: ridge on those photos alone
+    // is among the candidates, and the recipe chosen cross-validates at least as well as it.
+    let pretrained = trained_cnn(&gaussian_set(600, 24, 5, 2)).model;
+    let few = gaussian_set(40, 24, 6, 77);
+    let scored = spdcam_learn::recipe::choose(&pretrained, &few, 3, Backend::Cpu, &mut |_, _| {})
+        .expect("choose");
+    let ridge: Vec<_> = scored
+        .iter()
+        .filter(|s| matches!(s.recipe.fit, spdcam_learn::recipe::Fit::Ridge { .. }))
+        .collect();
+    assert_eq!(ridge.len(), 3, "three ridge candidates");
+    assert!(ridge.iter().all(|s| scored[0].cv_gfc >= s.cv_gfc));
+    // On a new camera the photos' own ridge beats the model as it is (GFC well above it).
+    let unchanged = scored
+        .iter()
+        .find(|s| matches!(s.recipe.fit, spdcam_learn::recipe::Fit::Unchanged))
+        .expect("the model unchanged is a candidate");
+    assert!(
+        ridge[0].cv_gfc > unchanged.cv_gfc,
+        "ridge {} vs unchanged {}",
+        ridge[0].cv_gfc,
+        unchanged.cv_gfc
+    );
+    // The ridge model keeps the grid and estimates photos of the new camera.
+    let model = ridge[0]
+        .recipe
+        .fit
+        .run(&pretrained, &few, 3)
+        .expect("ridge fit");
+    assert_eq!(model.grid(), pretrained.grid());
+    let test = gaussian_set(100, 24, 98, 77);
+    assert!(mean_gfc(&model, &test) > 0.9, "{}", mean_gfc(&model, &test));
+}

@@ -36,6 +36,9 @@ pub struct ExperimentArgs {
 enum ExperimentCommand {
     /// Train and test on the thesis's virtual datasets; compare with its Tables 4.2–4.4.
     Thesis(ThesisArgs),
+    /// Every way of estimating on the real photo sets' validation and test photos, beside a
+    /// constant guess and ridge on real photos (`docs/real-cameras-table.md`).
+    RealCameras(crate::experiment_real_cameras::RealCamerasArgs),
 }
 
 /// One of the thesis's virtual sets.
@@ -227,6 +230,7 @@ fn load_part(set: SetName, part: &str, root: &Path, ch: &[Vec<f64>]) -> Result<T
 pub fn run(args: ExperimentArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
     match args.command {
         ExperimentCommand::Thesis(a) => thesis(a, data_dir),
+        ExperimentCommand::RealCameras(a) => crate::experiment_real_cameras::run(a, data_dir),
     }
 }
 

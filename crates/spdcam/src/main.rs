@@ -13,6 +13,8 @@ mod evaluate;
 #[cfg(feature = "train")]
 mod experiment;
 #[cfg(feature = "train")]
+mod experiment_real_cameras;
+#[cfg(feature = "train")]
 mod experiment_sim2real;
 #[cfg(feature = "train")]
 mod finetune;

@@ -245,6 +245,8 @@ fn train_estimate_evaluate_finetune() {
         "the model unchanged",
         "all layers, about 150 steps",
         "output layer only",
+        "ridge on the photos alone, penalty 1e-4",
+        "ridge on the photos alone, penalty 1",
     ] {
         assert!(out.contains(name), "{name}: {out}");
     }
@@ -253,12 +255,12 @@ fn train_estimate_evaluate_finetune() {
         .filter_map(|l| l.split("cross-validated GFC ").nth(1))
         .map(|v| v.split([' ', ')']).next().unwrap().parse().unwrap())
         .collect();
-    assert_eq!(scores.len(), 5, "four candidates and the choice: {out}");
+    assert_eq!(scores.len(), 8, "seven candidates and the choice: {out}");
     assert!(
-        scores[..4].windows(2).all(|w| w[0] >= w[1]),
+        scores[..7].windows(2).all(|w| w[0] >= w[1]),
         "best first: {out}"
     );
-    assert_eq!(scores[4], scores[0], "the best is chosen: {out}");
+    assert_eq!(scores[7], scores[0], "the best is chosen: {out}");
     assert!(chosen.is_file());
 
     // Features of another chart, and a file that is not a model: clear errors.

@@ -51,7 +51,7 @@ pub struct InCameraRanges {
 
 impl InCameraRanges {
     /// Ranges for the named groups (`exposure`: exposure target and flare; `wb`:
-    /// adaptation; `tone`: saturation, shoulder, gamma, contrast; `jpeg`: JPEG quality;
+    /// adaptation from half to full; `wb-wide`: adaptation from none to full; `tone`: saturation, shoulder, gamma, contrast; `jpeg`: JPEG quality;
     /// `gradient`: uneven lighting across the chart), wide enough to cover the JPEG cameras
     /// and photo set-ups we know of.
     pub fn for_groups(groups: &[&str]) -> Result<InCameraRanges> {
@@ -63,6 +63,9 @@ impl InCameraRanges {
                     r.flare = Some([0.0, 0.3]);
                 }
                 "wb" => r.adaptation = Some([0.5, 1.0]),
+                // Real JPEG photos whose neutral patches keep most of the light's cast
+                // (a white-balance adaptation near 0.3 in the Telelumen sets).
+                "wb-wide" => r.adaptation = Some([0.0, 1.0]),
                 "tone" => {
                     r.saturation = Some([0.6, 1.3]);
                     r.shoulder = Some([0.0, 0.4]);
@@ -75,7 +78,7 @@ impl InCameraRanges {
                     return Err(Error::UnknownName {
                         kind: "randomisation group",
                         name: other.to_string(),
-                        valid: "camera, exposure, wb, tone, jpeg, gradient".into(),
+                        valid: "camera, exposure, wb, wb-wide, tone, jpeg, gradient".into(),
                     })
                 }
             }
