@@ -698,8 +698,8 @@ def finetune(
 
     With none of ``epochs``, ``freeze`` (train only the new output layer), ``refit_pca``
     (a new PCA on the new data) and ``keep_output`` (keep the trained output layer) the
-    recipe is chosen by cross-validation on the data, the model unchanged among the
-    candidates (at least 4 samples); with any of them, the thesis's transfer learning with
+    recipe is chosen by cross-validation on the data, the model unchanged and ridge
+    regression on the data alone among the candidates (at least 4 samples); with any of them, the thesis's transfer learning with
     those changes. Returns the model loaded from ``output``.
 
     ``progress`` is a callback ``(done, total)`` counting the cross-validation's fits, or
