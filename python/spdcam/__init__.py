@@ -260,12 +260,22 @@ class Estimates:
     cct: np.ndarray
     #: Duv; NaN with CCT: shape (rows,).
     duv: np.ndarray
+    #: Each row's judgement as ``spdcam estimate --features --json`` writes it (``verdict``,
+    #: ``reasons``, ``self_check``, ``expected_gfc``, ``band_widening``, ``band68``,
+    #: ``band95``, ``metric_uncertainty``): one dict per row.
+    judgements: list[dict[str, Any]] = field(default_factory=list, repr=False)
 
     def __len__(self) -> int:
         return self.spd.shape[0]
 
+    @property
+    def verdicts(self) -> list[Optional[str]]:
+        """Each row's verdict: ``"ok"``, ``"doubtful"`` or ``"unusable"``."""
+        return [j.get("verdict") for j in self.judgements]
+
     def __getitem__(self, i: int) -> Estimate:
         cct, duv = float(self.cct[i]), float(self.duv[i])
+        j = self.judgements[i] if self.judgements else {}
         return Estimate(
             name=f"estimate_{range(len(self))[i] + 1}",
             model=self.model,
@@ -274,6 +284,13 @@ class Estimates:
             xy=self.xy[i],
             cct=None if np.isnan(cct) else cct,
             duv=None if np.isnan(duv) else duv,
+            band=_band(j.get("band95")),
+            band68=_band(j.get("band68")),
+            verdict=j.get("verdict"),
+            reasons=list(j.get("reasons") or []),
+            expected_gfc=j.get("expected_gfc"),
+            band_widening=j.get("band_widening"),
+            metric_uncertainty=dict(j.get("metric_uncertainty") or {}),
         )
 
     def to_colour(self) -> Any:
@@ -461,7 +478,8 @@ def estimate_features(
     ``features`` is a 2-D array (rows × columns; one row is one estimate, values on any
     scale, e.g. 0–255), a 1-D array for one row, or a pandas DataFrame whose columns name
     the features. ``names`` are the columns (``p01_r, p01_g, …``); by default the columns of
-    the model that reads that many. Returns :class:`Estimates` (arrays over the rows).
+    the model that reads that many. Returns :class:`Estimates` (arrays over the rows), each
+    row judged as the command line judges it (verdict, reasons, bands, expected GFC).
     """
     if names is None and hasattr(features, "columns") and hasattr(features, "to_numpy"):
         names = [str(c) for c in features.columns]
@@ -479,7 +497,7 @@ def estimate_features(
         names = [str(n) for n in names]
         if len(names) != cols:
             raise SpdcamError(f"{source}: {len(names)} names for {cols} feature columns")
-    model_name, wl, spd, xy, cct, duv = _native.estimate_rows(
+    model_name, wl, spd, xy, cct, duv, judged = _native.estimate_rows(
         a.tobytes(), rows, _models(model), names, source, range
     )
     wavelengths = np.frombuffer(wl, dtype=np.float64)
@@ -490,6 +508,7 @@ def estimate_features(
         xy=np.frombuffer(xy, dtype=np.float64).reshape(rows, 2),
         cct=np.frombuffer(cct, dtype=np.float64),
         duv=np.frombuffer(duv, dtype=np.float64),
+        judgements=json.loads(judged),
     )
 
 

@@ -14,14 +14,11 @@ use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, Layout, THESIS_PATCH_PX};
 use spdcam_core::dataset::randomise::RandomiseRequest;
 use spdcam_core::dataset::{GenerateEvent, GenerateOptions, GenerateRequest, Pipeline};
-use spdcam_core::photo::{decode_photo, load_photo, Photo};
+use spdcam_core::photo::{load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
 use spdcam_core::{fsio, light};
-use spdcam_infer::estimate::estimate_decoded;
-use spdcam_infer::{
-    estimate_features, estimate_photo, Estimate, FeatureRows, Model, ModelSet, PhotoOptions,
-};
+use spdcam_infer::{Estimate, Estimator, FeatureRows, Model, ModelSet, PhotoOptions};
 use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
 use spdcam_learn::pca::Components;
 use spdcam_learn::recipe;
@@ -45,10 +42,27 @@ fn py_err(e: impl std::fmt::Display) -> PyErr {
     SpdcamError::new_err(e.to_string())
 }
 
-/// A set of models an estimate chooses from by the chart a photo shows.
+/// A set of models an estimate chooses from by the chart a photo shows, held by the
+/// estimator every estimate goes through (calibrations and chart checks made once, when the
+/// models are loaded).
 #[pyclass(module = "spdcam._native", frozen)]
 struct Models {
-    set: ModelSet,
+    estimator: Estimator,
+}
+
+impl Models {
+    /// The estimator of `set` on the default 400–700 nm grid (charts from `SPDCAM_DATA`).
+    fn of(set: ModelSet) -> spdcam_infer::Result<Models> {
+        Ok(Models {
+            estimator: Estimator::new(set, DataDir::new(None), Grid::ESTIMATION)?,
+        })
+    }
+
+    /// The estimator on the grid `range` names (the models shared).
+    fn on(&self, range: &str) -> PyResult<Estimator> {
+        let grid = Grid::parse(range).map_err(py_err)?;
+        self.estimator.on_grid(grid).map_err(py_err)
+    }
 }
 
 #[pymethods]
@@ -56,23 +70,20 @@ impl Models {
     /// The models shipped inside spdcam, one per chart.
     #[staticmethod]
     fn shipped() -> PyResult<Models> {
-        Ok(Models {
-            set: ModelSet::shipped().map_err(py_err)?,
-        })
+        Models::of(ModelSet::shipped().map_err(py_err)?).map_err(py_err)
     }
 
     /// One model from a `.spdm` file.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Models> {
         let model = Model::load(&path).map_err(py_err)?;
-        Ok(Models {
-            set: ModelSet::single(model, path.display().to_string()),
-        })
+        Models::of(ModelSet::single(model, path.display().to_string())).map_err(py_err)
     }
 
     /// `(name, chart, feature names, wavelength grid label)` of each model.
     fn describe(&self) -> Vec<(String, Option<String>, Vec<String>, String)> {
-        self.set
+        self.estimator
+            .models()
             .models()
             .iter()
             .map(|m| {
@@ -119,24 +130,20 @@ fn estimate_photo_json(
     corners: Option<Vec<[f64; 2]>>,
     range: &str,
 ) -> PyResult<String> {
-    let grid = Grid::parse(range).map_err(py_err)?;
+    let estimator = models.on(range)?;
     let options = PhotoOptions {
         chart,
         corners,
-        debug: None,
+        ..PhotoOptions::default()
     };
-    let data_dir = DataDir::new(None);
     let estimate = match photo {
         PhotoInput::Path(path) => py
-            .allow_threads(|| estimate_photo(&path, &models.set, &options, &data_dir, &grid))
+            .allow_threads(|| estimator.estimate_photo(&path, &options))
             .map_err(|e| py_err(format!("cannot use photo {}: {e}", path.display())))?,
         PhotoInput::Encoded(data) => {
             let data = data.as_bytes();
-            py.allow_threads(|| {
-                let photo = decode_photo(data, source)?;
-                estimate_decoded(&photo, &models.set, &options, &data_dir, &grid)
-            })
-            .map_err(py_err)?
+            py.allow_threads(|| estimator.estimate_photo_bytes(data, source, &options))
+                .map_err(py_err)?
         }
         PhotoInput::Pixels(pixels, width, height, bits) => {
             let pixels = pixels.as_bytes();
@@ -150,7 +157,7 @@ fn estimate_photo_json(
                 } else {
                     Photo::from_rgb8(source, width, height, pixels.to_vec())?
                 };
-                estimate_decoded(&photo, &models.set, &options, &data_dir, &grid)
+                estimator.estimate_decoded(&photo, &options)
             })
             .map_err(py_err)?
         }
@@ -177,7 +184,9 @@ fn f64_bytes<'py>(py: Python<'py>, values: impl Iterator<Item = f64>) -> Bound<'
 }
 
 /// What `estimate_rows` returns: the model's name, then as `f64` bytes the wavelengths,
-/// the SPDs (rows × wavelengths), xy (rows × 2), CCT and Duv (NaN where undefined).
+/// the SPDs (rows × wavelengths), xy (rows × 2), CCT and Duv (NaN where undefined), then
+/// the judgement of each row as JSON text (a list of objects with the keys of
+/// [`JUDGEMENT_KEYS`], as `spdcam estimate --json` writes them).
 type RowsResult<'py> = (
     String,
     Bound<'py, PyBytes>,
@@ -185,11 +194,39 @@ type RowsResult<'py> = (
     Bound<'py, PyBytes>,
     Bound<'py, PyBytes>,
     Bound<'py, PyBytes>,
+    String,
 );
 
-/// Estimates the light for feature rows: `values` native-endian `f64` bytes of `rows`
-/// rows, one column per name of `names` (default: the columns of the model that reads
-/// that many).
+/// The keys of an estimate's JSON that say how far it can be trusted.
+const JUDGEMENT_KEYS: [&str; 8] = [
+    "verdict",
+    "reasons",
+    "self_check",
+    "expected_gfc",
+    "band_widening",
+    "band68",
+    "band95",
+    "metric_uncertainty",
+];
+
+/// The judgements of `estimates` as a JSON list (see [`RowsResult`]).
+fn judgements_json(estimates: &[Estimate]) -> PyResult<String> {
+    let judged = estimates
+        .iter()
+        .map(|e| {
+            let v = e.to_json().map_err(py_err)?;
+            Ok(JUDGEMENT_KEYS
+                .iter()
+                .map(|&k| (k.to_string(), v[k].clone()))
+                .collect::<serde_json::Map<_, _>>())
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    serde_json::to_string(&judged).map_err(py_err)
+}
+
+/// Estimates the light for feature rows, each judged as `spdcam estimate --features`
+/// judges it: `values` native-endian `f64` bytes of `rows` rows, one column per name of
+/// `names` (default: the columns of the model that reads that many).
 #[pyfunction]
 #[pyo3(signature = (values, rows, models, names=None, source="features", range="400-700:5"))]
 fn estimate_rows<'py>(
@@ -201,11 +238,12 @@ fn estimate_rows<'py>(
     source: &str,
     range: &str,
 ) -> PyResult<RowsResult<'py>> {
-    let grid = Grid::parse(range).map_err(py_err)?;
-    let features = feature_rows(values, rows, &models.set, names, source)?;
+    let estimator = models.on(range)?;
+    let features = feature_rows(values, rows, estimator.models(), names, source)?;
     let estimates = py
-        .allow_threads(|| estimate_features(&models.set, &features, source, &grid))
+        .allow_threads(|| estimator.estimate_rows(&features, source))
         .map_err(py_err)?;
+    let grid = *estimator.grid();
     let model = estimates
         .first()
         .map(|e| e.model.clone())
@@ -224,6 +262,7 @@ fn estimate_rows<'py>(
             py,
             estimates.iter().map(|e| e.colorimetry.duv.unwrap_or(nan)),
         ),
+        judgements_json(&estimates)?,
     ))
 }
 
@@ -492,12 +531,12 @@ fn architecture(model: &str) -> PyResult<Architecture> {
 }
 
 /// Saves `model` at `path` and loads it back as a model set named by the path.
-fn saved(model: &Model, path: &Path) -> Result<ModelSet, spdcam_learn::LearnError> {
+fn saved(model: &Model, path: &Path) -> Result<Models, spdcam_learn::LearnError> {
     model.save(path)?;
-    Ok(ModelSet::single(
+    Ok(Models::of(ModelSet::single(
         Model::load(path)?,
         path.display().to_string(),
-    ))
+    ))?)
 }
 
 /// A training loop's progress as epochs done of `epochs`.
@@ -527,7 +566,7 @@ fn train(
 ) -> PyResult<Models> {
     let architecture = architecture(model)?;
     let reporter = Reporter::new(progress);
-    let set = py
+    let models = py
         .allow_threads(|| -> Result<_, spdcam_learn::LearnError> {
             fsio::check_writable(&output)?;
             let set = TrainingSet::load(&data)?;
@@ -549,7 +588,7 @@ fn train(
         })
         .map_err(py_err)?;
     reporter.finish()?;
-    Ok(Models { set })
+    Ok(models)
 }
 
 /// Fine-tunes the model file `model` on the dataset in `data` as `spdcam finetune` does:
@@ -572,7 +611,7 @@ fn finetune(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Models> {
     let reporter = Reporter::new(progress);
-    let set = py
+    let models = py
         .allow_threads(|| -> Result<_, spdcam_learn::LearnError> {
             fsio::check_writable(&output)?;
             let pretrained = Model::load(&model)?;
@@ -602,7 +641,7 @@ fn finetune(
         })
         .map_err(py_err)?;
     reporter.finish()?;
-    Ok(Models { set })
+    Ok(models)
 }
 
 /// Seconds the library alone takes for `repeats` estimates from the photo file at `path`
@@ -614,12 +653,11 @@ fn library_seconds_photo(
     models: &Models,
     repeats: usize,
 ) -> PyResult<f64> {
-    let grid = Grid::parse("400-700:5").map_err(py_err)?;
     let options = PhotoOptions::default();
     py.allow_threads(|| {
         let start = Instant::now();
         for _ in 0..repeats {
-            estimate_photo(&path, &models.set, &options, &DataDir::new(None), &grid)?;
+            models.estimator.estimate_photo(&path, &options)?;
         }
         Ok(start.elapsed().as_secs_f64())
     })
@@ -637,12 +675,11 @@ fn library_seconds_rows(
     models: &Models,
     repeats: usize,
 ) -> PyResult<f64> {
-    let grid = Grid::parse("400-700:5").map_err(py_err)?;
-    let features = feature_rows(values, rows, &models.set, None, "features")?;
+    let features = feature_rows(values, rows, models.estimator.models(), None, "features")?;
     py.allow_threads(|| {
         let start = Instant::now();
         for _ in 0..repeats {
-            estimate_features(&models.set, &features, "features", &grid)?;
+            models.estimator.estimate_rows(&features, "features")?;
         }
         Ok(start.elapsed().as_secs_f64())
     })

@@ -219,6 +219,17 @@ impl StandardIlluminant {
 
     /// The relative SPD (100 at 560 nm) on `grid`: the table resampled with Sprague (1880)
     /// interpolation (CIE 167:2005; exact at the 5 nm table points), zero outside 300–780 nm.
+    ///
+    /// ```
+    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::spectral::Grid;
+    ///
+    /// let grid = Grid::ESTIMATION;
+    /// let d65 = StandardIlluminant::parse("D65")?.spd(&grid)?;
+    /// assert_eq!(d65.grid(), &grid);
+    /// assert!((d65[grid.index_of(560.0).unwrap()] - 100.0).abs() < 1e-9);
+    /// # Ok::<(), spdcam_core::Error>(())
+    /// ```
     pub fn spd(&self, grid: &Grid) -> Result<Spd> {
         let table = standard_table();
         let column = table

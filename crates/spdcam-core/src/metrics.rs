@@ -15,6 +15,7 @@
 //! A spectrum that is zero everywhere has no direction: its GFC with anything is 0 (SAM π/2).
 
 use crate::error::{Error, Result};
+use crate::spectral::normalise_peak;
 use serde::{Deserialize, Serialize};
 
 /// Added to every band of a max-normalised spectrum before SID turns it into a distribution.
@@ -48,15 +49,22 @@ pub struct Summary {
     pub max: f64,
 }
 
-/// The spectrum divided by its maximum, with negative values clipped to 0. A spectrum whose
-/// maximum is not positive comes back as zeros.
+/// The spectrum divided by its maximum ([`normalise_peak`]), with negative values clipped
+/// to 0. A spectrum that cannot be normalised (a non-finite value, no positive one) comes
+/// back as zeros.
 pub fn normalise_by_max(spd: &[f64]) -> Vec<f64> {
-    let max = spd.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if max > 0.0 && max.is_finite() {
-        spd.iter().map(|v| (v / max).max(0.0)).collect()
-    } else {
-        vec![0.0; spd.len()]
+    let mut out = spd.to_vec();
+    clip_normalise(&mut out);
+    out
+}
+
+/// [`normalise_by_max`] in place.
+pub fn clip_normalise(spd: &mut [f64]) {
+    if normalise_peak(spd).is_err() {
+        spd.fill(0.0);
+        return;
     }
+    spd.iter_mut().for_each(|v| *v = v.max(0.0));
 }
 
 fn check_pair(truth: &[f64], estimate: &[f64]) -> Result<()> {
@@ -90,6 +98,15 @@ pub fn rmse(truth: &[f64], estimate: &[f64]) -> Result<f64> {
 }
 
 /// GFC of two spectra as they are (no normalisation; scale does not change it).
+///
+/// ```
+/// use spdcam_core::metrics::gfc;
+///
+/// assert_eq!(gfc(&[1.0, 2.0, 3.0], &[2.0, 4.0, 6.0])?, 1.0); // the same shape
+/// assert!(gfc(&[1.0, 0.0], &[0.0, 1.0])?.abs() < 1e-12); // nothing in common
+/// assert!(gfc(&[1.0, 2.0], &[1.0]).is_err());
+/// # Ok::<(), spdcam_core::Error>(())
+/// ```
 pub fn gfc(truth: &[f64], estimate: &[f64]) -> Result<f64> {
     check_pair(truth, estimate)?;
     let dot: f64 = truth.iter().zip(estimate).map(|(a, b)| a * b).sum();
@@ -125,6 +142,20 @@ pub fn sid(truth: &[f64], estimate: &[f64]) -> Result<f64> {
 }
 
 /// All four metrics, each spectrum normalised by its own maximum first (thesis section 4.3).
+///
+/// ```
+/// use spdcam_core::illuminant::StandardIlluminant;
+/// use spdcam_core::metrics::compare;
+/// use spdcam_core::spectral::Grid;
+///
+/// let grid = Grid::ESTIMATION;
+/// let (a, d65) = (StandardIlluminant::A.spd(&grid)?, StandardIlluminant::D65.spd(&grid)?);
+/// let same = compare(&a, &a)?;
+/// assert_eq!((same.gfc, same.rmse), (1.0, 0.0));
+/// let apart = compare(&a, &d65)?;
+/// assert!(apart.gfc < 0.95 && apart.sam > 0.0 && apart.sid > 0.0);
+/// # Ok::<(), spdcam_core::Error>(())
+/// ```
 pub fn compare(truth: &[f64], estimate: &[f64]) -> Result<SpectralMetrics> {
     check_pair(truth, estimate)?;
     let t = normalise_by_max(truth);
@@ -139,6 +170,16 @@ pub fn compare(truth: &[f64], estimate: &[f64]) -> Result<SpectralMetrics> {
 
 /// Mean, standard deviation, median, minimum and maximum of `values`; an error when empty
 /// or when a value is not finite.
+///
+/// ```
+/// use spdcam_core::metrics::summarise;
+///
+/// let s = summarise(&[0.99, 0.97, 0.95, 0.93])?;
+/// assert!((s.mean - 0.96).abs() < 1e-12 && (s.median - 0.96).abs() < 1e-12);
+/// assert_eq!((s.min, s.max), (0.93, 0.99));
+/// assert!(summarise(&[]).is_err());
+/// # Ok::<(), spdcam_core::Error>(())
+/// ```
 pub fn summarise(values: &[f64]) -> Result<Summary> {
     if values.is_empty() {
         return Err(Error::invalid("cannot summarise an empty set of values"));

@@ -16,13 +16,12 @@
 
 use crate::error::Result;
 use serde::Serialize;
-use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::srgb_decode;
 use spdcam_core::colorimetry::Observer;
 use spdcam_core::photo::{Exposure, PhotoAnalysis};
 use spdcam_core::quality::LightingMetrics;
-use spdcam_core::spectral::Grid;
+use spdcam_core::spectral::Spd;
 
 /// CIE 015:2018 maximum luminous efficacy K_m of photopic vision, lm/W.
 pub const LUMINOUS_EFFICACY_LM_PER_W: f64 = 683.002;
@@ -59,29 +58,33 @@ pub struct AbsoluteLevel {
     pub note: &'static str,
 }
 
-/// The absolute levels of the estimate `spd` (on `grid`, any scale) with `metrics`, from the
-/// photo `analysis` of `chart_name`'s feature patches (`clipped`/`dark` per feature patch);
-/// `Ok(None)` with the reason when they cannot be had (no EXIF exposure, chart reflectances
-/// not at hand, no usable neutral patch).
+/// The absolute levels of the estimate `spd` (any scale) with `metrics`, from the photo
+/// `analysis` of the feature patches (`unusable`: clipped or dark, per feature patch) of the
+/// chart `chart_name`, whose reflectances on the estimate's grid are `chart` (`None` when
+/// not at hand); the reason instead when they cannot be had (no EXIF exposure, chart
+/// reflectances not at hand, no usable neutral patch).
 pub fn absolute_level(
     analysis: &PhotoAnalysis,
     chart_name: &str,
-    spd: &[f64],
-    grid: &Grid,
+    chart: Option<&Chart>,
+    spd: &Spd,
     metrics: &LightingMetrics,
     unusable: &[bool],
-    data_dir: &DataDir,
 ) -> Result<Absolute> {
     let Some(exposure) = analysis.exposure else {
         return Ok(Err(
             "the photo's EXIF gives no aperture, exposure time and ISO".into(),
         ));
     };
-    let Ok(chart) = Chart::resolve(chart_name, None, data_dir, grid) else {
+    let Some(chart) = chart else {
         return Ok(Err(format!(
             "the reflectances of {chart_name} are not at hand (the data directory holds them)"
         )));
     };
+    let grid = spd.grid();
+    chart
+        .reflectances
+        .require_grid(grid, "the chart of the absolute levels")?;
     let observer = Observer::cie1931(grid)?;
     let patches = chart.feature_patches.len();
     if analysis.features.len() != 3 * patches {
@@ -127,7 +130,7 @@ pub fn absolute_level(
     let luminous: f64 = observer
         .cmf(1)
         .iter()
-        .zip(spd)
+        .zip(spd.iter())
         .map(|(v, s)| v * s)
         .sum::<f64>()
         * grid.step_nm

@@ -1,26 +1,26 @@
-//! From chart features, or from photos of a chart, to estimates of the light's SPD: the one
-//! path every front end (command line, Python, web app) calls.
+//! What an estimate is and what it is made from: feature rows ([`FeatureRows`]), how photos
+//! are analysed ([`PhotoOptions`], [`chart_templates`]), and the judged [`Estimate`] with its
+//! colorimetry and its score against a truth. The [`crate::Estimator`] makes every estimate.
 //!
 //! ```text
 //! photo ─► decode ─► detect chart ─► sample (spdcam-core::photo) ─┐
-//! features CSV ─► FeatureRows ──────────────────────────────────────┴─► model for the chart
-//!     (ModelSet) ─► SPD ─► Estimate (SPD, colorimetry, score against a truth, photo analysis)
+//! features CSV ─► FeatureRows ──────────────────────────────────────┴─► Estimator: model for
+//!     the chart ─► SPD ─► judged ─► Estimate (SPD, colorimetry, metrics, verdict, bands)
 //! ```
 
-use crate::absolute::{absolute_level, Absolute};
+use crate::absolute::Absolute;
 use crate::error::{InferError, Result};
-use crate::model::Model;
+use crate::estimator::Estimator;
 use crate::shipped::ModelSet;
-use crate::trust::{self, PhotoFlags, Trust};
+use crate::trust::Trust;
 use serde::Serialize;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
-use spdcam_core::feature_check;
 use spdcam_core::metrics;
-use spdcam_core::photo::{self, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis};
+use spdcam_core::photo::{ChartTemplate, PhotoAnalysis};
 use spdcam_core::quality::LightingMetrics;
-use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_core::spectral::{Grid, Spd};
 use std::path::{Path, PathBuf};
 
 /// CCT is defined only this near the Planckian locus (|Duv| in CIE 1960 uv).
@@ -46,6 +46,16 @@ impl FeatureRows {
     }
 
     /// Parses features CSV text (see [`FeatureRows::read_csv`]); `shown` names it in errors.
+    ///
+    /// ```
+    /// use spdcam_infer::FeatureRows;
+    ///
+    /// let rows = FeatureRows::from_csv_str("p01_r,p01_g\n12,34\n56,78\n", "f.csv")?;
+    /// assert_eq!((rows.rows, rows.values.as_slice()), (2, [12.0, 34.0, 56.0, 78.0].as_slice()));
+    /// let err = FeatureRows::from_csv_str("p01_r,p01_g\n12,x\n", "f.csv").unwrap_err();
+    /// assert_eq!(err.to_string(), "f.csv line 2, column p01_g: 'x' is not a number");
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
     pub fn from_csv_str(text: &str, shown: &str) -> Result<FeatureRows> {
         FeatureRows::from_reader(text.as_bytes(), shown)
     }
@@ -109,6 +119,16 @@ impl FeatureRows {
     /// Rows from values in memory (row-major, one column per name; e.g. a numpy array),
     /// checked like a CSV's: whole rows, at least one, every value finite. `source` names
     /// them in messages.
+    ///
+    /// ```
+    /// use spdcam_infer::FeatureRows;
+    ///
+    /// let names = vec!["p01_r".to_string(), "p01_g".to_string(), "p01_b".to_string()];
+    /// let rows = FeatureRows::from_values(names.clone(), vec![0.5; 6], "array")?;
+    /// assert_eq!(rows.rows, 2);
+    /// assert!(FeatureRows::from_values(names, vec![0.5; 4], "array").is_err());
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
     pub fn from_values(names: Vec<String>, values: Vec<f64>, source: &str) -> Result<FeatureRows> {
         let columns = names.len();
         if columns == 0 || values.is_empty() || values.len() % columns != 0 {
@@ -157,58 +177,6 @@ impl FeatureRows {
     }
 }
 
-/// SPD estimates for feature rows (checked against the model's columns), one set item per
-/// row named by `labels`, resampled to `grid` (within the model's grid).
-pub fn estimate_rows(
-    model: &Model,
-    features: &FeatureRows,
-    labels: Vec<String>,
-    source: &str,
-    grid: &Grid,
-) -> Result<SpectralSet> {
-    model.check_features(&features.names, source)?;
-    check_rows(features, source)?;
-    let mg = model.grid();
-    if grid.start_nm < mg.start_nm - 1e-9 || grid.end_nm() > mg.end_nm() + 1e-9 {
-        return Err(InferError::invalid(format!(
-            "the range {}: the model estimates {} nm only",
-            grid.label(),
-            mg.label()
-        )));
-    }
-    let spds = model.estimate_rows(&features.values)?;
-    let values = spds.chunks_exact(mg.count).map(<[f64]>::to_vec).collect();
-    let set = SpectralSet::on_grid(&mg, labels, values)?;
-    if *grid == mg {
-        return Ok(set);
-    }
-    let (resampled, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
-    Ok(resampled)
-}
-
-/// Refuses rows that say nothing about the light (values outside the encoding's range, a
-/// black chart, a chart without colour; see [`feature_check`]), naming the row when there
-/// are several. Rows on 0–1 are told from rows on 0–255 by their largest value.
-fn check_rows(features: &FeatureRows, source: &str) -> Result<()> {
-    let width = features.names.len().max(1);
-    for (i, row) in features.values.chunks(width).enumerate() {
-        let scale = if row.iter().any(|&v| v > 1.0) {
-            255.0
-        } else {
-            1.0
-        };
-        feature_check::check_feature_row(row, &features.names, scale).map_err(|e| {
-            let at = if features.rows > 1 {
-                format!(" row {}", i + 1)
-            } else {
-                String::new()
-            };
-            InferError::invalid(format!("{source}{at}: {e}"))
-        })?;
-    }
-    Ok(())
-}
-
 /// CIE 1931 xy, and CCT and Duv where the chromaticity is near enough the Planckian locus.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Colorimetry {
@@ -221,9 +189,21 @@ pub struct Colorimetry {
 }
 
 impl Colorimetry {
-    /// The colorimetry of `spd` on `grid` (CIE 1931 2° observer; CCT and Duv by Ohno 2014).
-    pub fn of(spd: &[f64], grid: &Grid) -> Result<Colorimetry> {
-        let xy = Observer::cie1931(grid)?.spd_to_xy(spd);
+    /// The colorimetry of `spd` (CIE 1931 2° observer; CCT and Duv by Ohno 2014).
+    ///
+    /// ```
+    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::spectral::Grid;
+    /// use spdcam_infer::estimate::Colorimetry;
+    ///
+    /// let d65 = StandardIlluminant::D65.spd(&Grid::ESTIMATION)?;
+    /// let c = Colorimetry::of(&d65)?;
+    /// assert!((c.cct.unwrap() - 6504.0).abs() < 30.0);
+    /// assert!(c.label().starts_with("xy (0.31"));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn of(spd: &Spd) -> Result<Colorimetry> {
+        let xy = Observer::cie1931(spd.grid())?.spd_to_xy(spd);
         let (cct, duv) = match uv_to_cct_duv(xy_to_uv1960(xy)) {
             Ok((cct, duv)) if duv.abs() <= MAX_CCT_DUV => (Some(cct), Some(duv)),
             _ => (None, None),
@@ -253,6 +233,15 @@ pub struct Score {
 
 impl Score {
     /// The score of `estimate` against `truth` (same grid).
+    ///
+    /// ```
+    /// use spdcam_infer::estimate::Score;
+    ///
+    /// // Peak-normalised first: a brighter copy of the same shape scores perfectly.
+    /// let score = Score::of(&[0.5, 1.0, 0.25], &[1.0, 2.0, 0.5])?;
+    /// assert_eq!((score.gfc, score.rmse), (1.0, 0.0));
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
     pub fn of(truth: &[f64], estimate: &[f64]) -> Result<Score> {
         let t = metrics::normalise_by_max(truth);
         let e = metrics::normalise_by_max(estimate);
@@ -270,10 +259,8 @@ pub struct Estimate {
     pub name: String,
     /// The model that made it.
     pub model: String,
-    /// The SPD's wavelengths (nm).
-    pub grid: Grid,
-    /// The relative SPD, peak 1.
-    pub spd: Vec<f64>,
+    /// The relative SPD, peak 1, on the estimator's wavelengths.
+    pub spd: Spd,
     /// xy, CCT, Duv of the SPD.
     pub colorimetry: Colorimetry,
     /// The lighting-quality metrics of the SPD (CRI, TM-30, α-opic, S/P, PPF, blue-light
@@ -307,8 +294,8 @@ impl Estimate {
         let mut v = serde_json::json!({
             "name": self.name,
             "model": self.model,
-            "wavelength_nm": self.grid.wavelengths(),
-            "spd": self.spd,
+            "wavelength_nm": self.spd.grid().wavelengths(),
+            "spd": self.spd.values(),
             "colorimetry": self.colorimetry,
             "metrics": self.metrics,
             "truth": self.truth,
@@ -344,7 +331,8 @@ impl Estimate {
     }
 
     /// Compares the estimate with `truth` (on the estimate's grid) and keeps the score.
-    pub fn score_against(&mut self, truth: &[f64]) -> Result<()> {
+    pub fn score_against(&mut self, truth: &Spd) -> Result<()> {
+        let truth = truth.on(self.spd.grid(), "scoring an estimate")?;
         self.truth = Some(Score::of(truth, &self.spd)?);
         Ok(())
     }
@@ -366,57 +354,6 @@ pub fn analysis_json(analysis: &PhotoAnalysis) -> Result<serde_json::Value> {
     Ok(v)
 }
 
-/// Estimates for feature rows: each row through the model for its columns, labelled
-/// `estimate_1…`, on `grid`; not judged (see [`judge_estimate`]), so many rows stay fast.
-pub fn estimate_features(
-    models: &ModelSet,
-    features: &FeatureRows,
-    source: &str,
-    grid: &Grid,
-) -> Result<Vec<Estimate>> {
-    let chosen = models.require(&features.names, source)?;
-    let labels: Vec<String> = (1..=features.rows)
-        .map(|i| format!("estimate_{i}"))
-        .collect();
-    let set = estimate_rows(&chosen.model, features, labels, source, grid)?;
-    (0..set.len())
-        .map(|i| {
-            Ok(Estimate {
-                name: set.names()[i].clone(),
-                model: chosen.name.clone(),
-                grid: *grid,
-                spd: set.item(i).to_vec(),
-                colorimetry: Colorimetry::of(set.item(i), grid)?,
-                metrics: LightingMetrics::from_samples(&grid.wavelengths(), set.item(i)),
-                truth: None,
-                photo: None,
-                trust: None,
-                absolute: None,
-            })
-        })
-        .collect()
-}
-
-/// Judges an estimate made from feature `row` (no photo) by the model of `models` for
-/// `names`, and keeps the verdict in it ([`trust::judge`]).
-pub fn judge_estimate(
-    estimate: &mut Estimate,
-    models: &ModelSet,
-    names: &[String],
-    row: &[f64],
-    data_dir: &DataDir,
-) -> Result<()> {
-    let chosen = models.require(names, &estimate.name)?;
-    estimate.trust = Some(trust::judge(
-        &chosen.model,
-        row,
-        &PhotoFlags::default(),
-        data_dir,
-        &estimate.grid,
-    )?);
-    Ok(())
-}
-
 /// How photos are analysed: which charts to look for, and optional corners or debug image.
 #[derive(Debug, Clone, Default)]
 pub struct PhotoOptions {
@@ -427,6 +364,10 @@ pub struct PhotoOptions {
     pub corners: Option<Vec<[f64; 2]>>,
     /// Where to write a debug image of each photo (see `spdcam_core::photo::debug_path`).
     pub debug: Option<PathBuf>,
+    /// Also draw the chart found on each photo, reduced to at most this many pixels wide
+    /// (a JPEG for a report; [`crate::estimator::AnalysedPhoto::overlay`]), while the
+    /// photo is decoded anyway.
+    pub overlay_width: Option<u32>,
 }
 
 /// The charts to look for in photos. With `chart`: that chart as photos show it (from a
@@ -485,150 +426,9 @@ pub fn chart_templates(
     Ok(out)
 }
 
-/// Analyses photos (in parallel) with `options` and the charts of `templates`; one result
-/// per photo, in order, so one bad photo does not cost the others.
-pub fn analyse_photos(
-    photos: &[PathBuf],
-    options: &PhotoOptions,
-    templates: Vec<ChartTemplate>,
-) -> Result<Vec<Result<PhotoAnalysis>>> {
-    if options.corners.is_some() && photos.len() > 1 {
-        return Err(InferError::invalid(format!(
-            "corners apply to one photo; {} were given",
-            photos.len()
-        )));
-    }
-    let analyse = AnalyseOptions {
-        templates,
-        corners: options.corners.clone(),
-        debug: options.debug.clone(),
-    };
-    Ok(photo::analyse_photos(photos, &analyse)
-        .into_iter()
-        .map(|r| r.map_err(InferError::from))
-        .collect())
-}
-
-/// The estimate for an analysed photo, with the model for its chart, labelled `name`,
-/// judged ([`trust::judge`]; the chart's reflectances from `data_dir` when it is not built
-/// in).
-pub fn estimate_analysis(
-    models: &ModelSet,
-    analysis: PhotoAnalysis,
-    name: String,
-    data_dir: &DataDir,
-    grid: &Grid,
-) -> Result<Estimate> {
-    let rows = FeatureRows::of_analyses(&[&analysis])?;
-    let chosen = models.require(&rows.names, &analysis.source).map_err(|_| {
-        InferError::invalid(format!(
-            "{}: no model for chart {}; the models are for {}",
-            analysis.source,
-            analysis.chart,
-            charts_of(models)
-        ))
-    })?;
-    let set = estimate_rows(
-        &chosen.model,
-        &rows,
-        vec![name.clone()],
-        &analysis.source,
-        grid,
-    )?;
-    let spd = set.item(0).to_vec();
-    let feature_patches = chosen
-        .model
-        .photo_chart()
-        .filter(|t| t.name == analysis.chart)
-        .map(|t| t.feature_patches.as_slice());
-    let flags = trust::photo_flags(&analysis, feature_patches);
-    let trust = trust::judge(&chosen.model, &rows.values, &flags, data_dir, grid)?;
-    let metrics = LightingMetrics::from_samples(&grid.wavelengths(), &spd);
-    let unusable: Vec<bool> = (0..flags.clipped.len())
-        .map(|k| flags.clipped[k] || flags.dark.get(k).copied().unwrap_or(false))
-        .collect();
-    let absolute = match chosen.model.header().chart.as_deref() {
-        Some(chart) => absolute_level(&analysis, chart, &spd, grid, &metrics, &unusable, data_dir)?,
-        None => Err("the model names no chart".into()),
-    };
-    Ok(Estimate {
-        name,
-        model: chosen.name.clone(),
-        grid: *grid,
-        colorimetry: Colorimetry::of(&spd, grid)?,
-        metrics,
-        spd,
-        truth: None,
-        photo: Some(analysis),
-        trust: Some(trust),
-        absolute: Some(absolute),
-    })
-}
-
-/// The estimate for one photo file: analysed with `options`, estimated with the model for
-/// the chart it shows, on `grid`.
-pub fn estimate_photo(
-    path: &Path,
-    models: &ModelSet,
-    options: &PhotoOptions,
-    data_dir: &DataDir,
-    grid: &Grid,
-) -> Result<Estimate> {
-    let templates = chart_templates(models, options.chart.as_deref(), data_dir)?;
-    let analysis = analyse_photos(&[path.to_path_buf()], options, templates)?
-        .pop()
-        .ok_or_else(|| InferError::invalid("no photo analysed"))??;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| path.display().to_string());
-    estimate_analysis(models, analysis, name, data_dir, grid)
-}
-
-/// Analyses a decoded photo: the chart found (or placed by `options.corners`) among the
-/// charts [`chart_templates`] gives, and sampled.
-pub fn analyse_decoded(
-    photo: &Photo,
-    models: &ModelSet,
-    options: &PhotoOptions,
-    data_dir: &DataDir,
-) -> Result<PhotoAnalysis> {
-    let analyse = AnalyseOptions {
-        templates: chart_templates(models, options.chart.as_deref(), data_dir)?,
-        corners: options.corners.clone(),
-        debug: options.debug.clone(),
-    };
-    Ok(photo::analyse(photo, &analyse)?)
-}
-
-/// Analyses a photo held in memory (an upload, never written to disk) named `name` in
-/// messages, decoded with the same limits as a file.
-pub fn analyse_photo_bytes(
-    bytes: &[u8],
-    name: &str,
-    models: &ModelSet,
-    options: &PhotoOptions,
-    data_dir: &DataDir,
-) -> Result<PhotoAnalysis> {
-    let decoded = photo::decode_photo(bytes, name)?;
-    analyse_decoded(&decoded, models, options, data_dir)
-}
-
-/// The estimate for a photo already decoded (from bytes or a pixel array, e.g. in Python),
-/// analysed with `options` and estimated with the model for its chart, labelled with the
-/// photo's source.
-pub fn estimate_decoded(
-    photo: &Photo,
-    models: &ModelSet,
-    options: &PhotoOptions,
-    data_dir: &DataDir,
-    grid: &Grid,
-) -> Result<Estimate> {
-    let analysis = analyse_decoded(photo, models, options, data_dir)?;
-    estimate_analysis(models, analysis, photo.source.clone(), data_dir, grid)
-}
-
-/// [`estimate_photo`] for a photo held in memory, labelled `name`.
+/// The estimate for one photo held in memory, labelled `name`: an [`Estimator`] built for
+/// this photo alone. Build the estimator once (and call [`Estimator::estimate_photo_bytes`])
+/// when estimating many.
 pub fn estimate_photo_bytes(
     bytes: &[u8],
     name: &str,
@@ -637,43 +437,13 @@ pub fn estimate_photo_bytes(
     data_dir: &DataDir,
     grid: &Grid,
 ) -> Result<Estimate> {
-    let analysis = analyse_photo_bytes(bytes, name, models, options, data_dir)?;
-    estimate_analysis(models, analysis, name.to_string(), data_dir, grid)
-}
-
-/// `colorchecker_sg96, colorchecker24`: the charts the set's models read.
-fn charts_of(models: &ModelSet) -> String {
-    models
-        .models()
-        .iter()
-        .map(|m| m.model.header().chart.as_deref().unwrap_or("unknown"))
-        .collect::<Vec<_>>()
-        .join(", ")
+    Estimator::new(models.clone(), data_dir.clone(), *grid)?
+        .estimate_photo_bytes(bytes, name, options)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn example_photo() -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/sg-telelumen.jpg")
-    }
-
-    #[test]
-    fn a_decoded_photo_gives_the_same_estimate_as_its_file() {
-        let models = ModelSet::shipped().unwrap();
-        let grid = Grid::parse("400-700:5").unwrap();
-        let options = PhotoOptions::default();
-        let data_dir = DataDir::new(None);
-        let path = example_photo();
-        let from_file = estimate_photo(&path, &models, &options, &data_dir, &grid).unwrap();
-        let bytes = std::fs::read(&path).unwrap();
-        let photo = photo::decode_photo(&bytes, "in memory").unwrap();
-        let decoded = estimate_decoded(&photo, &models, &options, &data_dir, &grid).unwrap();
-        assert_eq!(decoded.name, "in memory");
-        assert_eq!(decoded.spd, from_file.spd);
-        assert_eq!(decoded.colorimetry, from_file.colorimetry);
-    }
 
     #[test]
     fn rows_from_values_are_checked_like_a_csv() {
@@ -690,22 +460,5 @@ mod tests {
             err.to_string(),
             "x row 2, column b: NaN is not a finite number"
         );
-    }
-
-    #[test]
-    fn a_photo_without_a_chart_names_itself() {
-        let models = ModelSet::shipped().unwrap();
-        let grid = Grid::parse("400-700:5").unwrap();
-        let photo = Photo::from_rgb8("grey.png", 200, 150, vec![128; 200 * 150 * 3]).unwrap();
-        let err = estimate_decoded(
-            &photo,
-            &models,
-            &PhotoOptions::default(),
-            &DataDir::new(None),
-            &grid,
-        )
-        .unwrap_err()
-        .to_string();
-        assert!(err.contains("grey.png"), "{err}");
     }
 }

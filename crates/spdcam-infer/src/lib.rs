@@ -16,9 +16,12 @@
 //!   from; [`model`]: the `.spdm` file ([`record`]: how a model was trained).
 //! - [`scale`] (the feature and target scalings), [`network`] (the forward pass),
 //!   [`target`] and [`pca`] (from the network's outputs back to an SPD).
-//! - [`estimate`]: photo or feature rows → [`Estimate`] (SPD, colorimetry, lighting
-//!   metrics), the one path every front end calls; [`stream`]: any number of feature rows
-//!   in bounded memory.
+//! - [`estimator`]: the [`Estimator`], built once from the models, the data directory and
+//!   the output grid, the one path every front end (command line, web app, Python) takes
+//!   from a photo (file, bytes, decoded) or feature rows (in memory, streamed) to a judged
+//!   [`Estimate`]; [`estimate`]: what an estimate is (SPD, colorimetry, lighting metrics,
+//!   verdict, bands) and what it is made from; [`stream`]: feature rows read a block at a
+//!   time, and the CSV layouts of many SPDs.
 //! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
 //!   verdict); [`plot`] and [`report`]: SVG plots and the HTML report.
 //! - [`error`]: the crate's error type.
@@ -28,16 +31,15 @@
 //!
 //! ```
 //! use spdcam_core::builtin::DataDir;
-//! use spdcam_core::spectral::{Grid, SpectralSet};
-//! use spdcam_infer::{estimate_photo, ModelSet, PhotoOptions};
+//! use spdcam_core::spectral::{Grid, Spd, SpectralSet};
+//! use spdcam_infer::{Estimator, PhotoOptions};
 //! use std::path::Path;
 //!
 //! let examples = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
-//! let models = ModelSet::shipped()?;
 //! let grid = Grid::parse("400-700:5")?;
+//! let estimator = Estimator::shipped(DataDir::new(None), grid)?;
 //! let photo = Path::new(examples).join("sg-telelumen.jpg");
-//! let mut estimate =
-//!     estimate_photo(&photo, &models, &PhotoOptions::default(), &DataDir::new(None), &grid)?;
+//! let mut estimate = estimator.estimate_photo(&photo, &PhotoOptions::default())?;
 //! assert_eq!(estimate.spd.len(), grid.count);
 //! // This spiky LED mix lies far from the Planckian locus: no CCT, the label says so.
 //! match estimate.colorimetry.cct {
@@ -46,8 +48,7 @@
 //! }
 //! // The true SPD beside the photo (380–780 nm, 5 nm), on the estimate's wavelengths.
 //! let truth = SpectralSet::read_csv(&Path::new(examples).join("sg-telelumen.truth.csv"))?;
-//! let at = |nm: f64| truth.wavelengths().iter().position(|&w| w == nm).unwrap();
-//! let truth: Vec<f64> = grid.wavelengths().iter().map(|&nm| truth.item(0)[at(nm)]).collect();
+//! let truth = Spd::new(Grid::SIMULATION, truth.item(0).to_vec())?.resampled(&grid)?;
 //! estimate.score_against(&truth)?;
 //! let gfc = estimate.truth.unwrap().gfc;
 //! println!("GFC against the truth {gfc:.4}");
@@ -60,6 +61,7 @@
 pub mod absolute;
 pub mod error;
 pub mod estimate;
+pub mod estimator;
 pub mod model;
 pub mod network;
 pub mod pca;
@@ -73,9 +75,7 @@ pub mod target;
 pub mod trust;
 
 pub use error::{InferError, Result};
-pub use estimate::{
-    analyse_photo_bytes, estimate_decoded, estimate_features, estimate_photo, estimate_photo_bytes,
-    Estimate, FeatureRows, PhotoOptions,
-};
+pub use estimate::{estimate_photo_bytes, Estimate, FeatureRows, PhotoOptions};
+pub use estimator::{AnalysedPhoto, Estimator, RowStream};
 pub use model::Model;
 pub use shipped::ModelSet;

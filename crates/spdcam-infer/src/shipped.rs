@@ -35,6 +35,16 @@ pub struct ModelSet {
 
 impl ModelSet {
     /// The models shipped inside spdcam.
+    ///
+    /// ```
+    /// use spdcam_infer::ModelSet;
+    ///
+    /// let models = ModelSet::shipped()?;
+    /// let cc24 = models.for_chart("colorchecker24").unwrap();
+    /// assert_eq!(cc24.name, "the shipped colorchecker24 model");
+    /// assert_eq!(cc24.model.feature_names().len(), 72);
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
     pub fn shipped() -> Result<ModelSet> {
         let models = SHIPPED
             .iter()
@@ -82,6 +92,18 @@ impl ModelSet {
 
     /// The model for feature columns `names` (from `source`), or an error that names the
     /// charts and column counts the set's models read.
+    ///
+    /// ```
+    /// use spdcam_infer::ModelSet;
+    ///
+    /// let models = ModelSet::shipped()?;
+    /// let sg = models.for_chart("colorchecker_sg96").unwrap();
+    /// let chosen = models.require(sg.model.feature_names(), "photo.csv")?;
+    /// assert_eq!(chosen.name, sg.name);
+    /// let err = models.require(&["red".to_string()], "other.csv").unwrap_err();
+    /// assert!(err.to_string().starts_with("other.csv: no model reads these 1 feature columns"));
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
     pub fn require(&self, names: &[String], source: &str) -> Result<&NamedModel> {
         if let Some(m) = self.for_features(names) {
             return Ok(m);

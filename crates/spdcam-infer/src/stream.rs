@@ -2,12 +2,12 @@
 //! rows in bounded memory, in time linear in the rows, on every core.
 //!
 //! ```text
-//! features CSV ─► FeatureStream (blocks of lines parsed in parallel) ─► Model::estimate_rows
-//!     ─► GridMap (model grid → output grid) ─► long CSV rows (formatted in parallel) ─► file
+//! features CSV ─► FeatureStream (blocks of lines parsed in parallel) ─► the Estimator's
+//!     RowStream (Model::estimate_rows) ─► GridMap (model grid → output grid) ─► long CSV
+//!     rows (formatted in parallel) ─► file
 //! ```
 
 use crate::error::{InferError, Result};
-use crate::model::Model;
 use rayon::prelude::*;
 use spdcam_core::feature_check;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
@@ -282,33 +282,40 @@ impl GridMap {
     }
 }
 
-/// The SPDs of a block of feature rows (in the model's column order, named `names`) on
-/// `map`'s grid. Rows that say nothing about the light are refused first, as
-/// [`crate::estimate::estimate_features`] refuses them, naming the row (1-based in the file).
-pub fn estimate_block(
-    model: &Model,
-    block: &FeatureBlock,
+/// Refuses feature rows (row-major, named `names`) that say nothing about the light:
+/// values outside the encoding's range, a black chart, a chart without colour (see
+/// [`feature_check`]). The first bad row is named (`first_row` counts the rows before these,
+/// 1-based in the message) when `name_rows`. Rows on 0–1 are told from rows on 0–255 by
+/// their largest value.
+pub fn check_feature_rows(
+    values: &[f64],
     names: &[String],
     source: &str,
-    map: &GridMap,
-) -> Result<Vec<f64>> {
+    first_row: usize,
+    name_rows: bool,
+) -> Result<()> {
     let width = names.len().max(1);
-    block
-        .values
+    let bad = values
         .par_chunks(width)
         .enumerate()
-        .try_for_each(|(i, row)| {
-            // Rows on 0–1 are told from rows on 0–255 by their largest value.
+        .find_map_first(|(i, row)| {
             let scale = if row.iter().any(|&v| v > 1.0) {
                 255.0
             } else {
                 1.0
             };
-            feature_check::check_feature_row(row, names, scale).map_err(|e| {
-                InferError::invalid(format!("{source} row {}: {e}", block.first_row + i + 1))
-            })
-        })?;
-    Ok(map.apply(model.estimate_rows(&block.values)?))
+            feature_check::check_feature_row(row, names, scale)
+                .err()
+                .map(|e| (i, e))
+        });
+    match bad {
+        None => Ok(()),
+        Some((i, e)) if name_rows => Err(InferError::invalid(format!(
+            "{source} row {}: {e}",
+            first_row + i + 1
+        ))),
+        Some((_, e)) => Err(InferError::invalid(format!("{source}: {e}"))),
+    }
 }
 
 /// The name of feature row `row` (0-based): `estimate_1`, `estimate_2`, ….

@@ -6,6 +6,7 @@ use crate::error::{InferError, Result};
 use crate::pca::{Components, Pca};
 use faer::{linalg::solvers::Solve, Mat, Side};
 use serde::{Deserialize, Serialize};
+use spdcam_core::metrics;
 
 /// Which targets to train on.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -36,14 +37,6 @@ pub enum Target {
     Pca(Pca),
     /// Channel weights.
     Weights(Channels),
-}
-
-/// Divides by the maximum and clips negative values (an estimate is a relative SPD).
-pub fn normalise(spd: &mut [f64]) {
-    let max = spd.iter().copied().fold(0.0, f64::max);
-    for v in spd.iter_mut() {
-        *v = if max > 0.0 { (*v / max).max(0.0) } else { 0.0 };
-    }
 }
 
 impl Target {
@@ -81,7 +74,8 @@ impl Target {
                 }
             }
         }
-        normalise(spd);
+        // An estimate is a relative SPD: peak 1, nothing below 0.
+        metrics::clip_normalise(spd);
     }
 
     /// Checks the stored numbers (for a target read from a file).

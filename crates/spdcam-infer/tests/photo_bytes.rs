@@ -3,7 +3,7 @@
 
 use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::Grid;
-use spdcam_infer::{estimate_photo, estimate_photo_bytes, ModelSet, PhotoOptions};
+use spdcam_infer::{estimate_photo_bytes, Estimator, ModelSet, PhotoOptions};
 use std::path::PathBuf;
 
 fn example() -> PathBuf {
@@ -17,7 +17,10 @@ fn bytes_and_file_give_the_same_estimate() {
     let data = DataDir::new(None);
     let options = PhotoOptions::default();
     let path = example();
-    let from_file = estimate_photo(&path, &models, &options, &data, &grid).unwrap();
+    let from_file = Estimator::new(models.clone(), data.clone(), grid)
+        .unwrap()
+        .estimate_photo(&path, &options)
+        .unwrap();
     let bytes = std::fs::read(&path).unwrap();
     let from_bytes =
         estimate_photo_bytes(&bytes, "sg-telelumen.jpg", &models, &options, &data, &grid).unwrap();

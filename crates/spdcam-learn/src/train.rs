@@ -10,7 +10,7 @@ use crate::pca::Pca;
 use crate::record::{DataInfo, TrainingRecord};
 use crate::ridge::Gram;
 use crate::scale::{FeatureScaler, TargetScaler};
-use crate::target::{normalise, Channels, Target, TargetKind};
+use crate::target::{Channels, Target, TargetKind};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::seq::SliceRandom;
@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::dataset::{Columns, Dataset, SampleBatch};
+use spdcam_core::metrics;
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::Grid;
 pub use spdcam_infer::record::{Backend, Schedule, TrainOptions};
@@ -163,7 +164,7 @@ pub fn spds_on_grid(batch: &SampleBatch, columns: &Columns, grid: &Grid) -> Resu
         for (v, &j) in spd.iter_mut().zip(&indices) {
             *v = row[j];
         }
-        normalise(&mut spd);
+        metrics::clip_normalise(&mut spd);
         out.extend_from_slice(&spd);
     }
     Ok(out)

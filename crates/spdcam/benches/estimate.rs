@@ -4,15 +4,17 @@
 //!
 //! - the command itself on 1,000,000 rows (100,000 with `--quick`), long layout written to a
 //!   file, with its peak memory (Linux);
-//! - against the previous path in the same run, on 20,000 rows in the process: the whole file
-//!   read into memory, every estimate with its colorimetry (xy, CCT, Duv), one wide CSV —
-//!   beside the streamed path (blocks parsed in parallel, estimated, written as long rows).
+//! - against the in-memory path in the same run, on 2,000 rows in the process: the whole file
+//!   read into memory, every estimate judged with its colorimetry (xy, CCT, Duv) and metrics
+//!   (as the Python package estimates rows), one wide CSV — beside the streamed path (blocks
+//!   parsed in parallel, estimated, written as long rows).
 //!
 //! `cargo bench -p spdcam --bench estimate [-- --quick]`.
 
+use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::{Grid, SpectralSet};
-use spdcam_infer::stream::{estimate_block, long_header, long_rows, FeatureStream, GridMap};
-use spdcam_infer::{estimate_features, FeatureRows, ModelSet};
+use spdcam_infer::stream::{long_header, long_rows, FeatureStream};
+use spdcam_infer::{Estimator, FeatureRows, ModelSet};
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
@@ -64,41 +66,41 @@ fn main() {
         .expect("the shipped ColorChecker SG model");
     let names = model.model.feature_names().to_vec();
     let grid = Grid::ESTIMATION;
+    let estimator =
+        Estimator::new(models.clone(), DataDir::new(None), grid).expect("the estimator");
 
-    // The previous path against the streamed one, in the process, on the same rows.
-    let small = 20_000;
+    // The in-memory path against the streamed one, in the process, on the same rows.
+    let small = 2_000;
     let features = dir.join("small.csv");
     write_features(&features, &names, small);
     let t = Instant::now();
     let rows = FeatureRows::read_csv(&features).expect("features");
-    let estimates = estimate_features(&models, &rows, "bench", &grid).expect("estimates");
+    let estimates = estimator.estimate_rows(&rows, "bench").expect("estimates");
     let set = SpectralSet::on_grid(
         &grid,
         estimates.iter().map(|e| e.name.clone()).collect(),
-        estimates.iter().map(|e| e.spd.clone()).collect(),
+        estimates.iter().map(|e| e.spd.to_vec()).collect(),
     )
     .expect("set");
     std::fs::write(dir.join("wide.csv"), set.to_csv_string()).expect("write");
     let previous = t.elapsed().as_secs_f64();
     drop((rows, estimates, set));
     let t = Instant::now();
-    let mut stream = FeatureStream::open(&features).expect("stream");
-    let map = GridMap::new(&model.model.grid(), &grid).expect("grid map");
+    let mut stream = estimator
+        .stream(FeatureStream::open(&features).expect("features"), "bench")
+        .expect("stream");
     let mut out =
         std::io::BufWriter::new(std::fs::File::create(dir.join("long.csv")).expect("out"));
     out.write_all(long_header(&grid).as_bytes()).expect("write");
-    let mut done = 0;
-    while let Some(block) = stream.next_block(done).expect("block") {
-        let spds = estimate_block(&model.model, &block, &names, "bench", &map).expect("estimates");
-        out.write_all(&long_rows(&spds, grid.count, done))
+    while let Some(block) = stream.next_block().expect("block") {
+        out.write_all(&long_rows(&block.spds, grid.count, block.first_row))
             .expect("write");
-        done += block.rows;
     }
     out.flush().expect("flush");
     let streamed = t.elapsed().as_secs_f64();
     println!(
-        "{small} rows in the process: streamed {:.3} s ({:.1} µs a row); previous path (all in \
-         memory, colorimetry of every row, wide CSV): {previous:.3} s → {:.2}×",
+        "{small} rows in the process: streamed {:.3} s ({:.1} µs a row); in-memory path (all in \
+         memory, every row judged with its colorimetry, wide CSV): {previous:.3} s → {:.2}×",
         streamed,
         streamed / small as f64 * 1e6,
         previous / streamed

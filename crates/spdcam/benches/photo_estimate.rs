@@ -11,11 +11,9 @@
 //! `cargo bench -p spdcam --bench photo_estimate`.
 
 use spdcam_core::builtin::DataDir;
+use spdcam_core::photo::decode_photo;
 use spdcam_core::spectral::Grid;
-use spdcam_infer::estimate::{
-    analyse_photo_bytes, estimate_analysis, estimate_photo_bytes, PhotoOptions,
-};
-use spdcam_infer::ModelSet;
+use spdcam_infer::{Estimator, PhotoOptions};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -32,37 +30,36 @@ fn main() {
         .map(PathBuf::from)
         .unwrap_or_else(|| repo.join("../shared/data"));
     let data_dir = DataDir::new(data.is_dir().then_some(data));
-    let models = ModelSet::shipped().expect("shipped models");
+    let estimator = Estimator::shipped(data_dir, Grid::ESTIMATION).expect("the estimator");
     let options = PhotoOptions::default();
-    let grid = Grid::ESTIMATION;
 
-    let estimate = estimate_photo_bytes(&jpeg, "bench.jpg", &models, &options, &data_dir, &grid)
+    let estimate = estimator
+        .estimate_photo_bytes(&jpeg, "bench.jpg", &options)
         .expect("an estimate");
     let trust = estimate.trust.as_ref().expect("a judged estimate");
     let whole = median(5, || {
         black_box(
-            estimate_photo_bytes(&jpeg, "bench.jpg", &models, &options, &data_dir, &grid)
+            estimator
+                .estimate_photo_bytes(&jpeg, "bench.jpg", &options)
                 .expect("estimate"),
         );
     });
-    let analysis =
-        analyse_photo_bytes(&jpeg, "bench.jpg", &models, &options, &data_dir).expect("analysis");
+    let analyse = || {
+        let decoded = decode_photo(&jpeg, "bench.jpg").expect("decoded");
+        estimator
+            .analyse_decoded(&decoded, &options)
+            .expect("analysis")
+            .analysis
+    };
+    let analysis = analyse();
     let features = median(5, || {
-        black_box(
-            analyse_photo_bytes(&jpeg, "bench.jpg", &models, &options, &data_dir)
-                .expect("analysis"),
-        );
+        black_box(analyse());
     });
     let judged = median(9, || {
         black_box(
-            estimate_analysis(
-                &models,
-                analysis.clone(),
-                "bench.jpg".into(),
-                &data_dir,
-                &grid,
-            )
-            .expect("estimate"),
+            estimator
+                .estimate_analysis(analysis.clone(), "bench.jpg".into())
+                .expect("estimate"),
         );
     });
     let ms = |d: Duration| d.as_secs_f64() * 1e3;

@@ -10,20 +10,18 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
-use spdcam_core::metrics;
-use spdcam_core::photo::{self, ChartTemplate, PhotoAnalysis};
+use spdcam_core::photo::{self, PhotoAnalysis};
 use spdcam_core::quality::LightingMetrics;
-use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
-use spdcam_infer::estimate::{analyse_photos, chart_templates, estimate_analysis};
+use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use spdcam_infer::estimate::{Colorimetry, Score};
+use spdcam_infer::estimator::EstimatedBlock;
 use spdcam_infer::plot::spds_band_svg;
 use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
 use spdcam_infer::stream::{
-    estimate_block, long_header, long_rows, row_name, FeatureStream, GridMap, Layout,
-    WIDE_LAYOUT_MAX_ROWS,
+    long_header, long_rows, row_name, FeatureStream, Layout, WIDE_LAYOUT_MAX_ROWS,
 };
-use spdcam_infer::trust::{self, MetricInterval, PhotoFlags, Trust, Uncertainty, Verdict};
-use spdcam_infer::{Estimate, Model, ModelSet};
+use spdcam_infer::trust::{MetricInterval, Trust, Uncertainty, Verdict};
+use spdcam_infer::{Estimate, Estimator, Model, ModelSet, RowStream};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -85,12 +83,13 @@ enum LayoutArg {
     Long,
 }
 
-/// The model `--model` names, or the shipped ones.
-fn load_models(path: Option<&Path>) -> Result<ModelSet> {
-    match path {
-        Some(p) => Ok(ModelSet::single(Model::load(p)?, p.display().to_string())),
-        None => Ok(ModelSet::shipped()?),
-    }
+/// The estimator of the model `--model` names, or of the shipped ones, on `grid`.
+fn estimator(path: Option<&Path>, data_dir: &DataDir, grid: Grid) -> Result<Estimator> {
+    let models = match path {
+        Some(p) => ModelSet::single(Model::load(p)?, p.display().to_string()),
+        None => ModelSet::shipped()?,
+    };
+    Ok(Estimator::new(models, data_dir.clone(), grid)?)
 }
 
 /// Column labels for photos: their file names, or their paths where names repeat.
@@ -146,12 +145,13 @@ fn truths(
     photos: &[&Path],
     count: usize,
     grid: &Grid,
-) -> Result<Vec<Option<Vec<f64>>>> {
+) -> Result<Vec<Option<Spd>>> {
+    let item = |set: &SpectralSet, i: usize| Spd::new(*grid, set.item(i).to_vec());
     if let Some(path) = truth {
         let set = read_truths(path, grid)?;
         return match set.len() {
-            1 => Ok(vec![Some(set.item(0).to_vec()); count]),
-            n if n == count => Ok((0..n).map(|i| Some(set.item(i).to_vec())).collect()),
+            1 => Ok(vec![Some(item(&set, 0)?); count]),
+            n if n == count => (0..n).map(|i| Ok(Some(item(&set, i)?))).collect(),
             n => bail!(
                 "{}: {n} true SPDs for {count} estimates; give one, or one per estimate",
                 path.display()
@@ -179,41 +179,36 @@ fn truths(
                     set.len()
                 );
             }
-            Ok(Some(set.item(0).to_vec()))
+            Ok(Some(item(&set, 0)?))
         })
         .collect()
 }
 
-/// What [`estimate_from_photos`] gives: the estimates, their photos, the charts looked
-/// for, and how many photos gave none.
+/// What [`estimate_from_photos`] gives: the estimates, their photos, with `--report` each
+/// photo with the chart found drawn on it, and how many photos gave none.
 struct PhotoEstimates {
     estimates: Vec<Estimate>,
     photos: Vec<PathBuf>,
-    templates: Vec<ChartTemplate>,
+    overlays: Vec<Option<Vec<u8>>>,
     failed: usize,
 }
 
 /// Estimates from the photos, one per photo that could be used; the photos that could not
 /// (no chart found, no model for its chart, unreadable) are reported on stderr and counted.
-fn estimate_from_photos(
-    args: &EstimateArgs,
-    models: &ModelSet,
-    data_dir: &DataDir,
-    grid: &Grid,
-) -> Result<PhotoEstimates> {
-    let options = args.photo.options()?;
-    let templates = chart_templates(models, options.chart.as_deref(), data_dir)?;
-    let results = analyse_photos(&args.photos, &options, templates.clone())?;
+fn estimate_from_photos(args: &EstimateArgs, estimator: &Estimator) -> Result<PhotoEstimates> {
+    let mut options = args.photo.options()?;
+    options.overlay_width = args.report.is_some().then_some(REPORT_IMAGE_WIDTH);
+    let results = estimator.analyse_photos(&args.photos, &options)?;
     let labels = photo_labels(&args.photos);
-    let mut analyses: Vec<(PathBuf, String, PhotoAnalysis)> = Vec::new();
+    let mut analyses: Vec<(PathBuf, String, PhotoAnalysis, Option<Vec<u8>>)> = Vec::new();
     let mut failed = 0;
     for ((path, label), result) in args.photos.iter().zip(labels).zip(results) {
         match result {
             Ok(a) => {
-                for w in &a.warnings {
-                    eprintln!("warning: {}: {w}", a.source);
+                for w in &a.analysis.warnings {
+                    eprintln!("warning: {}: {w}", a.analysis.source);
                 }
-                analyses.push((path.clone(), label, a));
+                analyses.push((path.clone(), label, a.analysis, a.overlay));
             }
             Err(e) => {
                 eprintln!("error: cannot use photo {}: {e}", path.display());
@@ -222,7 +217,7 @@ fn estimate_from_photos(
         }
     }
     if let Some(out) = &args.photo.features_out {
-        let all: Vec<PhotoAnalysis> = analyses.iter().map(|(_, _, a)| a.clone()).collect();
+        let all: Vec<PhotoAnalysis> = analyses.iter().map(|(_, _, a, _)| a.clone()).collect();
         if !all.is_empty() {
             photo::write_features_csv(out, &all)?;
             eprintln!("features → {}", out.display());
@@ -230,14 +225,16 @@ fn estimate_from_photos(
     }
     let mut estimates = Vec::with_capacity(analyses.len());
     let mut paths = Vec::with_capacity(analyses.len());
-    for (path, label, analysis) in analyses {
+    let mut overlays = Vec::with_capacity(analyses.len());
+    for (path, label, analysis, overlay) in analyses {
         if !quiet(args) {
             println!("{}", photo_args::describe(&analysis));
         }
-        match estimate_analysis(models, analysis, label, data_dir, grid) {
+        match estimator.estimate_analysis(analysis, label) {
             Ok(e) => {
                 estimates.push(e);
                 paths.push(path);
+                overlays.push(overlay);
             }
             Err(e) => {
                 eprintln!("error: no estimate for {}: {e}", path.display());
@@ -248,7 +245,7 @@ fn estimate_from_photos(
     Ok(PhotoEstimates {
         estimates,
         photos: paths,
-        templates,
+        overlays,
         failed,
     })
 }
@@ -270,10 +267,10 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     if let Some(plot) = &args.plot {
         plot_is_png(plot)?;
     }
-    let models = load_models(args.model.as_deref())?;
     let grid = Grid::parse(&args.range)?;
+    let estimator = estimator(args.model.as_deref(), data_dir, grid)?;
     if let Some(path) = &args.features {
-        return run_features(&args, path, &models, data_dir, &grid);
+        return run_features(&args, path, &estimator);
     }
     if args.layout == Some(LayoutArg::Long) && args.output.is_some() {
         bail!("--layout long is for --features; estimates of photos are written wide");
@@ -281,9 +278,9 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     let PhotoEstimates {
         mut estimates,
         photos,
-        templates,
+        overlays,
         failed,
-    } = estimate_from_photos(&args, &models, data_dir, &grid)?;
+    } = estimate_from_photos(&args, &estimator)?;
     if estimates.is_empty() {
         bail!(
             "no estimate: none of the {} photo(s) could be used (see the errors above)",
@@ -300,7 +297,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     let set = SpectralSet::on_grid(
         &grid,
         estimates.iter().map(|e| e.name.clone()).collect(),
-        estimates.iter().map(|e| e.spd.clone()).collect(),
+        estimates.iter().map(|e| e.spd.to_vec()).collect(),
     )?;
     if let Some(out) = &args.output {
         fsio::write_output(
@@ -327,9 +324,9 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     if let Some(path) = &args.report {
         let items = estimates
             .iter()
-            .zip(&photos)
+            .zip(overlays)
             .zip(truths)
-            .map(|((e, photo), truth)| report_item(e, Some((photo, &templates)), truth))
+            .map(|((e, overlay), truth)| report_item(e, overlay, truth.map(Spd::into_values)))
             .collect::<Result<Vec<_>>>()?;
         let title = match estimates.as_slice() {
             [one] => format!("The light in {}", one.name),
@@ -364,8 +361,8 @@ struct FeatureRun {
     model: String,
     grid: Grid,
     truths: Option<SpectralSet>,
-    /// The first [`DETAILED_MAX`] estimates, without colorimetry until printed, judged.
-    first: Vec<(String, Vec<f64>, Option<Score>, Trust)>,
+    /// The first [`DETAILED_MAX`] estimates, judged.
+    first: Vec<Estimate>,
     rows: usize,
     /// (sum of GFC, sum of RMSE) over the scored estimates.
     score_sums: (f64, f64),
@@ -388,46 +385,21 @@ impl FeatureRun {
         }
     }
 
-    /// One full estimate (colorimetry and lighting metrics computed: they are asked for).
-    fn estimate(
-        &self,
-        name: String,
-        spd: Vec<f64>,
-        truth: Option<Score>,
-        trust: Option<Trust>,
-    ) -> Result<Estimate> {
-        Ok(Estimate {
-            colorimetry: Colorimetry::of(&spd, &self.grid)?,
-            metrics: LightingMetrics::from_samples(&self.grid.wavelengths(), &spd),
-            name,
-            model: self.model.clone(),
-            grid: self.grid,
-            spd,
-            truth,
-            photo: None,
-            trust,
-            absolute: None,
-        })
-    }
-
-    /// Takes the SPDs of the rows from `first_row` on: scores, keeps, prints JSON, writes.
-    /// `features` are the rows' features, `judge` judges one of them.
+    /// Takes a block of estimated rows: scores, keeps the first judged estimates, prints
+    /// JSON (every row judged), writes the SPDs.
     fn add(
         &mut self,
-        first_row: usize,
-        spds: Vec<f64>,
-        features: &[f64],
-        judge: &dyn Fn(&[f64]) -> Result<Trust>,
+        stream: &RowStream,
+        block: &EstimatedBlock,
         json: bool,
         out: &mut Option<&mut dyn Write>,
     ) -> Result<()> {
         let width = self.grid.count;
-        let columns = features.len() / (spds.len() / width).max(1);
-        let row = |k: usize| &features[k * columns..(k + 1) * columns];
+        let spds = &block.spds;
         let scores: Vec<Option<Score>> = spds
             .chunks_exact(width)
             .enumerate()
-            .map(|(k, spd)| match self.truth(first_row + k)? {
+            .map(|(k, spd)| match self.truth(block.first_row + k)? {
                 Some(t) => Ok(Some(Score::of(t, spd)?)),
                 None => Ok(None),
             })
@@ -436,36 +408,30 @@ impl FeatureRun {
             self.score_sums.0 += s.gfc;
             self.score_sums.1 += s.rmse;
         }
-        for (k, spd) in spds.chunks_exact(width).enumerate() {
-            if self.first.len() < DETAILED_MAX {
-                self.first.push((
-                    row_name(first_row + k),
-                    spd.to_vec(),
-                    scores[k],
-                    judge(row(k))?,
-                ));
+        let mut text = String::new();
+        for (k, score) in scores.iter().enumerate() {
+            let kept = self.first.len() < DETAILED_MAX;
+            if !kept && !json {
+                break;
             }
-        }
-        if json {
-            let mut text = String::new();
-            for (k, spd) in spds.chunks_exact(width).enumerate() {
-                let trust = judge(row(k))?;
-                let e = self.estimate(
-                    row_name(first_row + k),
-                    spd.to_vec(),
-                    scores[k],
-                    Some(trust),
-                )?;
+            let mut e = stream.estimate(block, k)?;
+            e.truth = *score;
+            if json {
                 text.push_str(if self.json_started { ",\n" } else { "[\n" });
                 self.json_started = true;
                 text.push_str(&serde_json::to_string_pretty(&e.to_json()?)?);
             }
+            if kept {
+                self.first.push(e);
+            }
+        }
+        if json {
             std::io::stdout().lock().write_all(text.as_bytes())?;
         }
-        self.rows += spds.len() / width;
+        self.rows += block.rows;
         if let Some(out) = out {
             if let Some(wide) = &mut self.wide {
-                wide.extend_from_slice(&spds);
+                wide.extend_from_slice(spds);
                 if self.layout.is_none() && self.rows > WIDE_LAYOUT_MAX_ROWS {
                     self.layout = Some(Layout::Long);
                     let held = std::mem::take(wide);
@@ -474,10 +440,10 @@ impl FeatureRun {
                     out.write_all(&long_rows(&held, width, 0))?;
                 }
             } else {
-                if first_row == 0 {
+                if block.first_row == 0 {
                     out.write_all(long_header(&self.grid).as_bytes())?;
                 }
-                out.write_all(&long_rows(&spds, width, first_row))?;
+                out.write_all(&long_rows(spds, width, block.first_row))?;
             }
         }
         Ok(())
@@ -499,37 +465,22 @@ impl FeatureRun {
 }
 
 /// `estimate --features`: the rows of the features CSV streamed through the model for their
-/// columns a block at a time, the SPDs written as they come (long layout), so that time is
-/// linear in the rows and memory bounded whatever their number. Colorimetry (xy, CCT, Duv)
-/// and the lighting metrics are computed only for what is printed: the estimates shown in
-/// full (up to 20), the plot's title, and every estimate of `--json`.
-fn run_features(
-    args: &EstimateArgs,
-    path: &Path,
-    models: &ModelSet,
-    data_dir: &DataDir,
-    grid: &Grid,
-) -> Result<()> {
-    let mut stream = FeatureStream::open(path)?;
+/// columns a block at a time by the estimator, the SPDs written as they come (long layout),
+/// so that time is linear in the rows and memory bounded whatever their number. The full
+/// judged estimates (colorimetry, lighting metrics, verdict, bands) are made only for what
+/// is printed: the estimates shown in full (up to 20), the plot's title, and every estimate
+/// of `--json`.
+fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimator) -> Result<()> {
     let source = path.display().to_string();
-    let chosen = models.require(stream.names(), &source)?;
-    let judge = |row: &[f64]| -> Result<Trust> {
-        Ok(trust::judge(
-            &chosen.model,
-            row,
-            &PhotoFlags::default(),
-            data_dir,
-            grid,
-        )?)
-    };
-    let map = GridMap::new(&chosen.model.grid(), grid)?;
+    let mut stream = estimator.stream(FeatureStream::open(path)?, &source)?;
+    let grid = *estimator.grid();
     let mut run = FeatureRun {
-        model: chosen.name.clone(),
-        grid: *grid,
+        model: stream.model_name().to_string(),
+        grid,
         truths: args
             .truth
             .as_deref()
-            .map(|t| read_truths(t, grid))
+            .map(|t| read_truths(t, &grid))
             .transpose()?,
         first: Vec::new(),
         rows: 0,
@@ -542,20 +493,10 @@ fn run_features(
         json_started: false,
     };
     let mut estimate_all = |out: &mut Option<&mut dyn Write>| -> Result<()> {
-        let mut rows = 0;
-        while let Some(block) = stream.next_block(rows)? {
-            let spds = estimate_block(&chosen.model, &block, stream.names(), &source, &map)?;
-            rows += block.rows;
-            run.add(
-                block.first_row,
-                spds,
-                &block.values,
-                &judge,
-                args.photo.json,
-                out,
-            )?;
+        while let Some(block) = stream.next_block()? {
+            run.add(&stream, &block, args.photo.json, out)?;
         }
-        if rows == 0 {
+        if run.rows == 0 {
             bail!("{source}: no rows of features below the header");
         }
         run.finish(out)
@@ -590,10 +531,7 @@ fn run_features(
             .first
             .iter()
             .enumerate()
-            .map(|(row, (name, spd, score, trust))| {
-                let e = run.estimate(name.clone(), spd.clone(), *score, Some(trust.clone()))?;
-                report_item(&e, None, run.truth(row)?.map(<[f64]>::to_vec))
-            })
+            .map(|(row, e)| report_item(e, None, run.truth(row)?.map(<[f64]>::to_vec)))
             .collect::<Result<Vec<_>>>()?;
         let title = if run.rows > items.len() {
             format!(
@@ -610,33 +548,25 @@ fn run_features(
         let series: Vec<(String, Vec<f64>)> = run
             .first
             .iter()
-            .map(|(n, spd, _, _)| (n.clone(), spd.clone()))
+            .map(|e| (e.name.clone(), e.spd.to_vec()))
             .collect();
         let title = if run.rows == 1 {
-            let (name, spd, _, _) = &run.first[0];
-            let e = run.estimate(name.clone(), spd.clone(), None, None)?;
-            format!("Estimated SPD: {}", e.colorimetry.label())
+            format!("Estimated SPD: {}", run.first[0].colorimetry.label())
         } else {
             format!("Estimated SPDs ({} of {})", series.len(), run.rows)
         };
-        let bands: Vec<Option<&Uncertainty>> =
-            run.first.iter().map(|f| f.3.uncertainty.as_ref()).collect();
-        write_plot(plot, &spds_band_svg(&title, grid, &series, &bands)?)?;
+        let bands: Vec<Option<&Uncertainty>> = run
+            .first
+            .iter()
+            .map(|e| e.trust.as_ref().and_then(|t| t.uncertainty.as_ref()))
+            .collect();
+        write_plot(plot, &spds_band_svg(&title, &grid, &series, &bands)?)?;
     }
     if quiet(args) {
         return Ok(());
     }
-    let shown = if detailed {
-        let first = std::mem::take(&mut run.first);
-        first
-            .into_iter()
-            .map(|(name, spd, score, trust)| run.estimate(name, spd, score, Some(trust)))
-            .collect::<Result<Vec<_>>>()?
-    } else {
-        Vec::new()
-    };
     if detailed {
-        print_estimates(&shown, args);
+        print_estimates(&run.first, args);
         return Ok(());
     }
     println!("{} estimates with {}", run.rows, run.model);
@@ -689,7 +619,7 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
                 e.name,
                 colorimetry_line(&e.colorimetry, intervals)
             );
-            println!("  relative SPD: {}", spd_line(&e.spd, &e.grid));
+            println!("  relative SPD: {}", spd_line(&e.spd));
             println!("  {}", metrics_line(&e.metrics, intervals));
             match (&e.absolute, e.photo.as_ref().and_then(|p| p.exposure)) {
                 (Some(Ok(a)), _) => println!(
@@ -743,8 +673,8 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
              PPF: µmol/s of 400–700 nm photons per klm; ± the 95 % interval when calibrated; \
              computed on the estimate's {}–{} nm only \
              (`spdcam metrics` on a wider SPD, `--json` for every number)",
-            estimates[0].grid.start_nm,
-            estimates[0].grid.end_nm()
+            estimates[0].spd.grid().start_nm,
+            estimates[0].spd.grid().end_nm()
         );
     }
     if estimates.iter().any(|e| e.trust.is_some()) {
@@ -774,42 +704,19 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     }
 }
 
-/// One estimate of the report: its JSON, for a photo the photo with the chart found
-/// (decoded again and drawn as `--debug` draws it, among the charts of `templates`), and
-/// its truth.
+/// One estimate of the report: its JSON, for a photo the photo with the chart found (the
+/// `overlay` drawn when it was analysed), and its truth.
 fn report_item(
     estimate: &Estimate,
-    photo: Option<(&PathBuf, &[ChartTemplate])>,
+    overlay: Option<Vec<u8>>,
     truth: Option<Vec<f64>>,
 ) -> Result<ReportItem> {
-    let image = match (photo, &estimate.photo) {
-        (Some((path, templates)), Some(analysis)) => {
-            let template = templates
-                .iter()
-                .find(|t| t.name == analysis.chart)
-                .with_context(|| {
-                    format!(
-                        "{}: no template of chart {}",
-                        path.display(),
-                        analysis.chart
-                    )
-                })?;
-            let decoded = photo::load_photo(path)?;
-            Some(ReportImage {
-                mime: "image/jpeg",
-                bytes: photo::analysis_overlay_jpeg(
-                    &decoded,
-                    template,
-                    analysis,
-                    REPORT_IMAGE_WIDTH,
-                )?,
-            })
-        }
-        _ => None,
-    };
     Ok(ReportItem {
         estimate: estimate.to_json()?,
-        image,
+        image: overlay.map(|bytes| ReportImage {
+            mime: "image/jpeg",
+            bytes,
+        }),
         truth_spd: truth,
     })
 }
@@ -836,13 +743,13 @@ fn with_bands(estimates: &[Estimate], grid: &Grid) -> Result<SpectralSet> {
     let mut values = Vec::new();
     for e in estimates {
         names.push(e.name.clone());
-        values.push(e.spd.clone());
+        values.push(e.spd.to_vec());
         if let Some(u) = e.trust.as_ref().and_then(|t| t.uncertainty.as_ref()) {
             for (band, level) in [(&u.band68, "68"), (&u.band95, "95")] {
                 names.push(format!("{}_lower{level}", e.name));
-                values.push(band.lower.clone());
+                values.push(band.lower.to_vec());
                 names.push(format!("{}_upper{level}", e.name));
-                values.push(band.upper.clone());
+                values.push(band.upper.to_vec());
             }
         }
     }
@@ -892,11 +799,12 @@ fn colorimetry_line(
 }
 
 /// The SPD every 25 nm, peak-normalised, on one terminal line: `400:0.12 425:0.40 …`.
-fn spd_line(spd: &[f64], grid: &Grid) -> String {
-    let spd = metrics::normalise_by_max(spd);
-    grid.wavelengths()
+fn spd_line(spd: &Spd) -> String {
+    let spd = spd.normalised_by_max();
+    spd.grid()
+        .wavelengths()
         .iter()
-        .zip(&spd)
+        .zip(spd.iter())
         .filter(|(w, _)| (*w % 25.0).abs() < 1e-9)
         .map(|(w, v)| format!("{w:.0}:{v:.2}"))
         .collect::<Vec<_>>()

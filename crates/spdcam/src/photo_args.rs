@@ -60,6 +60,7 @@ impl PhotoArgs {
             chart: self.chart.clone(),
             corners: self.corners.as_deref().map(parse_corners).transpose()?,
             debug: self.debug.clone(),
+            overlay_width: None,
         })
     }
 }

@@ -693,6 +693,31 @@ impl Camera {
     /// Noise-free features straight from patch-level values (no image, no demosaicing, no
     /// aberration, no quantisation): what [`Camera::render`] gives with noise off, up to
     /// quantisation, at a fraction of the cost. Appends to `out`.
+    ///
+    /// ```
+    /// use spdcam_core::builtin;
+    /// use spdcam_core::camera::sensor::Sensitivities;
+    /// use spdcam_core::camera::{Camera, CameraConfig};
+    /// use spdcam_core::chart::Chart;
+    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::spectral::Grid;
+    ///
+    /// let grid = Grid::SIMULATION;
+    /// let table = &builtin::CAMERAS[0];
+    /// let sensitivities = Sensitivities::new(table.name, &table.load()?, &grid)?;
+    /// let chart = Chart::colorchecker24(&grid)?;
+    /// let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid)?;
+    /// let (mut raw, mut warm, mut cool) = (Vec::new(), Vec::new(), Vec::new());
+    /// camera.features_fast(&camera.light(&StandardIlluminant::A.spd(&grid)?)?, &mut raw, &mut warm);
+    /// camera.features_fast(&camera.light(&StandardIlluminant::D65.spd(&grid)?)?, &mut raw, &mut cool);
+    /// assert_eq!(warm.len(), 72);
+    /// // White balanced: the white patch (19) is near neutral under both lights, while the
+    /// // blue patch (13) changes with the light.
+    /// let white = |f: &[f32]| (f[54] - f[56]).abs();
+    /// assert!(white(&warm) < 12.0 && white(&cool) < 12.0);
+    /// assert_ne!(warm[36..39], cool[36..39]);
+    /// # Ok::<(), spdcam_core::Error>(())
+    /// ```
     pub fn features_fast(&self, light: &[f32], raw: &mut Vec<[f32; 3]>, out: &mut Vec<f32>) {
         self.features_fast_with(self.config.in_camera.as_ref(), light, raw, out);
     }

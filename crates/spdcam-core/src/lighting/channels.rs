@@ -2,7 +2,7 @@
 //! channels of the thesis and the channels of a measured multi-channel LED luminaire.
 
 use crate::error::{Error, Result};
-use crate::spectral::Grid;
+use crate::spectral::{normalise_peak, Grid};
 use rand::rngs::SmallRng;
 use rand::seq::index;
 use rand::Rng;
@@ -104,20 +104,9 @@ impl Channels {
                 spd.iter_mut().zip(channel).for_each(|(s, c)| *s += w * c);
             }
         }
-        normalise_by_max(&mut spd)
-            .then_some(spd)
-            .ok_or_else(|| Error::invalid("the weights light no channel: the SPD is dark"))
-    }
-}
-
-/// Divides `spd` by its maximum; false when the maximum is not positive (a dark light).
-pub(crate) fn normalise_by_max(spd: &mut [f64]) -> bool {
-    let max = spd.iter().cloned().fold(0.0f64, f64::max);
-    if max > 0.0 && max.is_finite() {
-        spd.iter_mut().for_each(|v| *v /= max);
-        true
-    } else {
-        false
+        normalise_peak(&mut spd)
+            .map(|()| spd)
+            .map_err(|_| Error::invalid("the weights light no channel: the SPD is dark"))
     }
 }
 

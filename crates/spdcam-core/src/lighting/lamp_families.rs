@@ -15,12 +15,11 @@
 //! 1994, ch. 4 and 10).
 
 use super::bands::Shape;
-use super::channels::normalise_by_max;
 use super::fit::{levenberg_marquardt, nnls};
 use super::lamp_library::{LampLibrary, LampType};
 use crate::error::{Error, Result};
 use crate::metrics;
-use crate::spectral::Grid;
+use crate::spectral::{normalise_peak, Grid};
 use nalgebra::{DMatrix, DVector};
 use rand::rngs::SmallRng;
 use rand::Rng;
@@ -663,11 +662,11 @@ impl LampDraws {
             .map(|(&h, &bw)| h * (self.spread * bw * normal()).exp())
             .collect();
         let mut spd = model_spectrum(self.family, &theta, &heights, &self.wavelengths);
-        if !normalise_by_max(&mut spd) {
+        if normalise_peak(&mut spd).is_err() {
             // Every height of a fitted lamp is non-negative and one is positive, so the
             // spectrum is dark only if the lamp itself was; fall back to it unmoved.
             spd = model_spectrum(self.family, &lamp.theta, &lamp.heights, &self.wavelengths);
-            normalise_by_max(&mut spd);
+            normalise_peak(&mut spd).ok();
         }
         spd
     }

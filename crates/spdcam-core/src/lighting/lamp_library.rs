@@ -3,9 +3,8 @@
 //! The lamp families are fitted to such a library, and the coverage and validation commands
 //! score against it.
 
-use super::channels::normalise_by_max;
 use crate::error::{Error, Result};
-use crate::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
+use crate::spectral::{normalise_peak, Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -101,7 +100,7 @@ impl LampLibrary {
         let mut out = Vec::with_capacity(set.len());
         for (name, values) in names.iter().zip(set.items()) {
             let mut spd = values.clone();
-            if !normalise_by_max(&mut spd) {
+            if normalise_peak(&mut spd).is_err() {
                 return Err(Error::invalid(format!(
                     "{source}: SPD '{name}' is dark on {grid}"
                 )));

@@ -1,9 +1,8 @@
 //! Measured SPDs as a light family: one of a set at random, or a random mixture of two.
 
-use super::channels::normalise_by_max;
 use crate::builtin::{self, DataDir};
 use crate::error::{Error, Result};
-use crate::spectral::{Extrapolation, Grid, Interpolation};
+use crate::spectral::{normalise_peak, Extrapolation, Grid, Interpolation};
 use rand::rngs::SmallRng;
 use rand::Rng;
 
@@ -36,7 +35,7 @@ impl MeasuredSpds {
         let mut spds = Vec::with_capacity(set.len());
         for (item, values) in set.names().iter().zip(set.items()) {
             let mut spd = values.clone();
-            if !normalise_by_max(&mut spd) {
+            if normalise_peak(&mut spd).is_err() {
                 return Err(Error::invalid(format!(
                     "{name}: SPD '{item}' is dark on {grid}"
                 )));
@@ -71,7 +70,8 @@ impl MeasuredSpds {
             .zip(&self.spds[second])
             .map(|(x, y)| a * x + (1.0 - a) * y)
             .collect();
-        normalise_by_max(&mut spd);
+        // A mix of two lit spectra is lit: the normalisation cannot fail.
+        normalise_peak(&mut spd).ok();
         spd
     }
 

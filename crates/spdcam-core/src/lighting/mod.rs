@@ -26,7 +26,7 @@ use crate::colorimetry::Observer;
 use crate::error::{Error, Result};
 use crate::illuminant::{DAYLIGHT_CCT_MAX_K, DAYLIGHT_CCT_MIN_K};
 use crate::seed;
-use crate::spectral::{Grid, Spd};
+use crate::spectral::{normalise_peak, Grid, Spd};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 
@@ -96,6 +96,20 @@ struct Blend {
 impl Lighting {
     /// Parses a recipe (see [`catalogue`]) for lights on `grid`; files are paths or names
     /// under the data directory.
+    ///
+    /// ```
+    /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::lighting::Lighting;
+    /// use spdcam_core::spectral::Grid;
+    ///
+    /// let grid = Grid::SIMULATION;
+    /// let daylight = Lighting::parse("daylight:5000-6500", &DataDir::new(None), &grid)?;
+    /// let mixed = Lighting::parse("mix:planck=0.5,phosphor=0.5", &DataDir::new(None), &grid)?;
+    /// assert_eq!(mixed.mix_members().unwrap().len(), 2);
+    /// assert!(Lighting::parse("candles", &DataDir::new(None), &grid).is_err());
+    /// # let _ = daylight;
+    /// # Ok::<(), spdcam_core::Error>(())
+    /// ```
     pub fn parse(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Lighting> {
         let (head, rest) = spec.split_once(':').unwrap_or((spec, ""));
         let family = match head {
@@ -270,6 +284,21 @@ impl Lighting {
 
     /// Draw `index` of this recipe under `seed`: the same (seed, index) always gives the same
     /// light, whatever the order or the machine of the draws.
+    ///
+    /// ```
+    /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::lighting::Lighting;
+    /// use spdcam_core::spectral::Grid;
+    ///
+    /// let leds = Lighting::parse("gaussian:7", &DataDir::new(None), &Grid::SIMULATION)?;
+    /// let light = leds.draw(42, 3)?;
+    /// assert_eq!(light, leds.draw(42, 3)?); // reproducible
+    /// assert_ne!(light.spd, leds.draw(42, 4)?.spd);
+    /// // Peak 1, one weight per channel.
+    /// assert_eq!(light.spd.iter().copied().fold(0.0, f64::max), 1.0);
+    /// assert_eq!(light.weights.unwrap().len(), 7);
+    /// # Ok::<(), spdcam_core::Error>(())
+    /// ```
     pub fn draw(&self, seed: u64, index: u64) -> Result<LightDraw> {
         let mut rng =
             SmallRng::seed_from_u64(seed::derive(seed::derive(seed, index), LIGHT_STREAM));
@@ -325,7 +354,7 @@ impl Lighting {
                     .zip(second.spd.iter())
                     .map(|(x, y)| share * x / ya + (1.0 - share) * y / yb)
                     .collect();
-                channels::normalise_by_max(&mut spd);
+                normalise_peak(&mut spd)?;
                 LightDraw {
                     spd: Spd::new(grid, spd)?,
                     family: "blend".to_string(),

@@ -2,11 +2,10 @@
 //! a random colour temperature, phosphor-converted white LEDs and fluorescent-like line
 //! spectra. Every SPD is normalised by its maximum.
 
-use super::channels::normalise_by_max;
 use crate::colorimetry::{cct_duv_to_uv, Observer};
 use crate::error::{Error, Result};
 use crate::illuminant;
-use crate::spectral::Grid;
+use crate::spectral::{normalise_peak, Grid};
 use rand::rngs::SmallRng;
 use rand::Rng;
 
@@ -66,7 +65,7 @@ impl CctRange {
 /// 100 at 560 nm, is [`illuminant::daylight`]).
 pub fn normalised_daylight(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
     let mut spd = illuminant::daylight(cct, grid)?.into_values();
-    normalise_by_max(&mut spd);
+    normalise_peak(&mut spd)?;
     Ok(spd)
 }
 
@@ -74,7 +73,7 @@ pub fn normalised_daylight(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
 /// [`illuminant::planck`]).
 pub fn normalised_planck(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
     let mut spd = illuminant::planck(cct, grid)?.into_values();
-    normalise_by_max(&mut spd);
+    normalise_peak(&mut spd)?;
     Ok(spd)
 }
 
@@ -174,7 +173,7 @@ impl PhosphorLeds {
             let mut spd: Vec<f64> = (0..grid.count)
                 .map(|i| pump * bands[0][i] + bands[1][i] + red * bands[2][i])
                 .collect();
-            normalise_by_max(&mut spd);
+            normalise_peak(&mut spd)?;
             return Ok(spd);
         }
         Err(Error::invalid(format!(
@@ -205,7 +204,7 @@ pub fn fluorescent(grid: &Grid, rng: &mut SmallRng) -> Result<Vec<f64>> {
         let width = sigma * u(rng, 0.8, 1.5);
         add_band(&mut spd, grid, centre, width, u(rng, lo, hi));
     }
-    normalise_by_max(&mut spd);
+    normalise_peak(&mut spd)?;
     Ok(spd)
 }
 

@@ -34,6 +34,7 @@ pub use spectrum::{LightSpectrum, QUALITY_GRID};
 pub use tm30::{colour_fidelity_cie2017, ColourFidelity, HueBin};
 
 use crate::colorimetry::{uv_to_cct_duv, xyz_to_xy};
+use crate::spectral::Spd;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -165,6 +166,24 @@ impl LightingMetrics {
             reasons: BTreeMap::new(),
             warnings: Vec::new(),
         }
+    }
+
+    /// The metrics of `spd` on its wavelengths (see [`LightingMetrics::from_samples`]).
+    ///
+    /// ```
+    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::quality::LightingMetrics;
+    /// use spdcam_core::spectral::Grid;
+    ///
+    /// let a = StandardIlluminant::A.spd(&Grid::SIMULATION)?;
+    /// let m = LightingMetrics::of_spd(&a);
+    /// // Illuminant A is the CRI's own reference at its CCT: Ra 100.
+    /// assert!((m.cri_ra.unwrap() - 100.0).abs() < 0.5);
+    /// assert!(m.scalar("tm30_rf").unwrap() > 99.0);
+    /// # Ok::<(), spdcam_core::Error>(())
+    /// ```
+    pub fn of_spd(spd: &Spd) -> LightingMetrics {
+        LightingMetrics::from_samples(&spd.grid().wavelengths(), spd)
     }
 
     /// The metrics of a spectrum sampled at `wavelengths`; a spectrum the metrics cannot take

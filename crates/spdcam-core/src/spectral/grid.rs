@@ -75,6 +75,16 @@ impl Grid {
     }
 
     /// Parses `START-END:STEP` or `START-END` (5 nm step), e.g. `400-700:5`.
+    ///
+    /// ```
+    /// use spdcam_core::spectral::Grid;
+    ///
+    /// let grid = Grid::parse("400-700:5")?;
+    /// assert_eq!((grid.count, grid.end_nm()), (61, 700.0));
+    /// assert_eq!(grid, Grid::ESTIMATION);
+    /// assert!(Grid::parse("700-400").is_err());
+    /// # Ok::<(), spdcam_core::Error>(())
+    /// ```
     pub fn parse(text: &str) -> Result<Grid> {
         let bad = || {
             Error::invalid(format!(

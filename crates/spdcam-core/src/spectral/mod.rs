@@ -9,4 +9,4 @@ mod spd;
 pub use grid::Grid;
 pub use resample::{Extrapolation, Interpolation, ResampleReport};
 pub use set::SpectralSet;
-pub use spd::Spd;
+pub use spd::{normalise_peak, Spd};

@@ -14,6 +14,17 @@ pub struct Spd {
 
 impl Spd {
     /// The spectrum of `values` on `grid`; an error when their counts differ.
+    ///
+    /// ```
+    /// use spdcam_core::spectral::{Grid, Spd};
+    ///
+    /// let grid = Grid::parse("400-700:100")?;
+    /// let spd = Spd::new(grid, vec![0.2, 1.0, 0.6, 0.1])?;
+    /// assert_eq!(spd.grid().wavelengths(), [400.0, 500.0, 600.0, 700.0]);
+    /// assert_eq!(spd[1], 1.0); // reads as its values
+    /// assert!(Spd::new(grid, vec![1.0; 3]).is_err());
+    /// # Ok::<(), spdcam_core::Error>(())
+    /// ```
     pub fn new(grid: Grid, values: Vec<f64>) -> Result<Spd> {
         if values.len() != grid.count {
             return Err(Error::invalid(format!(
@@ -64,6 +75,18 @@ impl Spd {
 
     /// The spectrum resampled onto `grid` (Sprague 1880 interpolation where the spectrum
     /// has six or more samples, else linear; zero outside its range).
+    ///
+    /// ```
+    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::spectral::Grid;
+    ///
+    /// let a = StandardIlluminant::A.spd(&Grid::SIMULATION)?; // 380–780 nm, 5 nm
+    /// let coarse = a.resampled(&Grid::parse("400-700:10")?)?;
+    /// assert_eq!(coarse.len(), 31);
+    /// // Every 10 nm sample is one of the 5 nm samples.
+    /// assert_eq!(coarse[0], a[4]);
+    /// # Ok::<(), spdcam_core::Error>(())
+    /// ```
     pub fn resampled(&self, grid: &Grid) -> Result<Spd> {
         if self.grid == *grid {
             return Ok(self.clone());
@@ -72,6 +95,38 @@ impl Spd {
         let (set, _) = set.resample(grid, Interpolation::Auto, Extrapolation::Zero)?;
         Spd::new(*grid, set.item(0).to_vec())
     }
+}
+
+/// Divides `values` by their largest value so the peak is 1: the one peak normalisation of
+/// the workspace (relative SPDs of lights, decoded estimates, the spectra a comparison
+/// normalises first). An error, the values left as they were, when a value is not finite
+/// or none is positive (a dark spectrum has no shape to keep).
+///
+/// ```
+/// use spdcam_core::spectral::normalise_peak;
+///
+/// let mut spd = vec![1.0, 4.0, 2.0];
+/// normalise_peak(&mut spd)?;
+/// assert_eq!(spd, [0.25, 1.0, 0.5]);
+/// let mut dark = vec![0.0, -1.0];
+/// assert!(normalise_peak(&mut dark).is_err());
+/// assert!(normalise_peak(&mut [1.0, f64::NAN]).is_err());
+/// # Ok::<(), spdcam_core::Error>(())
+/// ```
+pub fn normalise_peak(values: &mut [f64]) -> Result<()> {
+    if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+        return Err(Error::invalid(format!(
+            "a spectrum holding the non-finite value {v} has no peak to normalise by"
+        )));
+    }
+    let peak = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(peak > 0.0) {
+        return Err(Error::invalid(
+            "a spectrum without a positive value (dark) has no peak to normalise by",
+        ));
+    }
+    values.iter_mut().for_each(|v| *v /= peak);
+    Ok(())
 }
 
 /// Reading an `Spd` as its values (indexing, iterating, slice functions), the way a `String`

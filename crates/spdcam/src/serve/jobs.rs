@@ -3,10 +3,8 @@
 //! once (memory stays bounded however many uploads arrive) and a page can poll its job's
 //! progress while a 24 MP photo is worked on.
 
-use spdcam_core::builtin::DataDir;
-use spdcam_core::spectral::Grid;
-use spdcam_infer::estimate::{analyse_photo_bytes, estimate_analysis};
-use spdcam_infer::{ModelSet, PhotoOptions};
+use spdcam_core::photo;
+use spdcam_infer::{Estimator, InferError, PhotoOptions};
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::Instant;
@@ -42,42 +40,33 @@ pub enum Progress {
     Finished(Outcome),
 }
 
-/// What estimates: the models, the data directory for charts, the output grid.
+/// What estimates: the estimator of the models, built once for every upload.
 pub struct Engine {
-    /// The models, one per chart.
-    pub models: ModelSet,
-    /// Where named charts are found.
-    pub data_dir: DataDir,
-    /// The wavelength grid of the estimates (that of `spdcam estimate`'s default).
-    pub grid: Grid,
+    /// The models with their calibrations and chart checks, and the output grid (that of
+    /// `spdcam estimate`'s default).
+    pub estimator: Estimator,
 }
 
 impl Engine {
-    /// The estimate of one upload, by the library path `spdcam estimate` takes: a photo
-    /// that cannot be read or shows no chart is a 400, one with no model for its chart 422.
+    /// The estimate of one upload, by the estimator `spdcam estimate` uses: a photo that
+    /// cannot be read or shows no chart is a 400, one with no model for its chart 422.
     pub fn estimate(&self, upload: Upload) -> Outcome {
         let options = PhotoOptions {
             corners: upload.corners,
             ..PhotoOptions::default()
         };
-        let analysis = match analyse_photo_bytes(
-            &upload.bytes,
-            &upload.name,
-            &self.models,
-            &options,
-            &self.data_dir,
-        ) {
+        let analysed = match photo::decode_photo(&upload.bytes, &upload.name)
+            .map_err(InferError::from)
+            .and_then(|decoded| self.estimator.analyse_decoded(&decoded, &options))
+        {
             Ok(a) => a,
             Err(e) => return Outcome::Failed(400, e.to_string()),
         };
         drop(upload.bytes);
-        let estimate = match estimate_analysis(
-            &self.models,
-            analysis,
-            upload.name,
-            &self.data_dir,
-            &self.grid,
-        ) {
+        let estimate = match self
+            .estimator
+            .estimate_analysis(analysed.analysis, upload.name)
+        {
             Ok(e) => e,
             Err(e) => return Outcome::Failed(422, e.to_string()),
         };

@@ -14,7 +14,7 @@ use clap::Args;
 use jobs::{Engine, Jobs};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::Grid;
-use spdcam_infer::ModelSet;
+use spdcam_infer::Estimator;
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -128,9 +128,7 @@ impl Server {
 /// (the default of `spdcam estimate`, so the answers equal its `--json`).
 pub fn shipped_engine(data_dir: &DataDir) -> Result<Engine> {
     Ok(Engine {
-        models: ModelSet::shipped()?,
-        data_dir: data_dir.clone(),
-        grid: Grid::parse("400-700:5")?,
+        estimator: Estimator::shipped(data_dir.clone(), Grid::parse("400-700:5")?)?,
     })
 }
 

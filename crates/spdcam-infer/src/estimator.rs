@@ -1,0 +1,795 @@
+//! The [`Estimator`]: built once from the models, the data directory and the output grid,
+//! it holds per model everything an estimate needs besides the input (the chart templates
+//! photos are searched for, the trust calibration parsed once, the chart check built once,
+//! the map from the model's wavelengths to the output's), and turns every kind of input into
+//! the same judged [`Estimate`].
+//!
+//! ```text
+//! photo path ─► decode ─┐
+//! photo bytes ─► decode ─┼─► find the chart, sample ─► PhotoAnalysis ─┐
+//! decoded photo ─────────┘                                            │
+//! feature rows (FeatureRows) ──────────────────────────────────────────┼─► the model for the
+//! a stream of rows (FeatureStream, a block at a time) ─────────────────┘   columns, once per
+//!     row ─► SPD ─► judged (the same SPD, trust::assess) ─► Estimate (one constructor)
+//! ```
+//!
+//! The command line, the web app and the Python package all estimate through it, so the
+//! same photo or row gives the same SPD and the same verdict in each.
+
+use crate::absolute::absolute_level;
+use crate::error::{InferError, Result};
+use crate::estimate::{chart_templates, Colorimetry, Estimate, FeatureRows, PhotoOptions};
+use crate::shipped::{ModelSet, NamedModel};
+use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
+use crate::trust::{self, Calibration, ChartCheck, PhotoFlags, Trust};
+use rayon::prelude::*;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::chart::Chart;
+use spdcam_core::photo::{
+    self, analysis_overlay_jpeg, debug_paths, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis,
+};
+use spdcam_core::quality::LightingMetrics;
+use spdcam_core::spectral::{Grid, Spd};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// What judging one model's estimates needs, made once per model.
+struct ModelTrust {
+    /// The shipped calibration measured on the model, parsed once.
+    calibration: Option<Calibration>,
+    /// The chart re-rendered under an estimate (the self-check), built once.
+    check: Option<ChartCheck>,
+}
+
+/// What does not depend on the output grid, shared by the estimators of every grid.
+struct Prepared {
+    models: ModelSet,
+    /// Per model of `models`, in order.
+    trust: Vec<ModelTrust>,
+    /// The charts photos are searched for without `PhotoOptions::chart`; `None` when they
+    /// cannot be made (the error is made again when a photo needs them).
+    templates: Option<Vec<ChartTemplate>>,
+    data_dir: DataDir,
+}
+
+/// What one model needs on the output grid.
+#[derive(Clone)]
+struct OnGrid {
+    /// The model's wavelengths to the output's; `None` when the output lies outside them
+    /// (the error is made again when an estimate needs the model).
+    map: Option<GridMap>,
+    /// The model's chart on the output grid, for the absolute levels; `None` when its
+    /// reflectances are not at hand.
+    chart: Option<Arc<Chart>>,
+}
+
+/// Turns photos and feature rows into judged estimates of the light (see the module's
+/// documentation). Cheap to clone; [`Estimator::on_grid`] gives one for other wavelengths
+/// sharing the models.
+///
+/// ```
+/// use spdcam_core::builtin::DataDir;
+/// use spdcam_core::spectral::Grid;
+/// use spdcam_infer::{Estimator, ModelSet, PhotoOptions};
+/// use std::path::Path;
+///
+/// let estimator = Estimator::new(ModelSet::shipped()?, DataDir::new(None), Grid::ESTIMATION)?;
+/// let photo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/sg-telelumen.jpg");
+/// let estimate = estimator.estimate_photo(&photo, &PhotoOptions::default())?;
+/// assert_eq!(estimate.name, "sg-telelumen.jpg");
+/// assert_eq!(estimate.spd.grid(), &Grid::ESTIMATION);
+/// // Judged: a verdict, and bands from the model's calibration.
+/// let trust = estimate.trust.as_ref().unwrap();
+/// println!("verdict {}", trust.verdict.label());
+/// assert!(trust.uncertainty.is_some());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone)]
+pub struct Estimator {
+    prepared: Arc<Prepared>,
+    grid: Grid,
+    /// Per model of the set, in order.
+    on_grid: Vec<OnGrid>,
+}
+
+impl Estimator {
+    /// The estimator of `models` (charts found in `data_dir` when not built in) whose
+    /// estimates lie on `grid`: each model's calibration parsed and chart check built here,
+    /// once.
+    pub fn new(models: ModelSet, data_dir: DataDir, grid: Grid) -> Result<Estimator> {
+        let trust = models
+            .models()
+            .iter()
+            .map(|m| {
+                Ok(ModelTrust {
+                    calibration: trust::calibration_for(&m.model)?,
+                    check: ChartCheck::for_model(&m.model, &data_dir)?,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let templates = chart_templates(&models, None, &data_dir).ok();
+        let prepared = Arc::new(Prepared {
+            models,
+            trust,
+            templates,
+            data_dir,
+        });
+        Estimator::with(prepared, grid)
+    }
+
+    /// The estimator of the shipped models (see [`ModelSet::shipped`]).
+    pub fn shipped(data_dir: DataDir, grid: Grid) -> Result<Estimator> {
+        Estimator::new(ModelSet::shipped()?, data_dir, grid)
+    }
+
+    fn with(prepared: Arc<Prepared>, grid: Grid) -> Result<Estimator> {
+        let on_grid = prepared
+            .models
+            .models()
+            .iter()
+            .map(|m| OnGrid {
+                map: GridMap::new(&m.model.grid(), &grid).ok(),
+                chart: m
+                    .model
+                    .header()
+                    .chart
+                    .as_deref()
+                    .and_then(|name| Chart::resolve(name, None, &prepared.data_dir, &grid).ok())
+                    .map(Arc::new),
+            })
+            .collect();
+        Ok(Estimator {
+            prepared,
+            grid,
+            on_grid,
+        })
+    }
+
+    /// The same models (calibrations and chart checks shared, not made again) estimating
+    /// on `grid`.
+    ///
+    /// ```
+    /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::spectral::Grid;
+    /// use spdcam_infer::Estimator;
+    ///
+    /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
+    /// let coarse = estimator.on_grid(Grid::parse("420-680:20")?)?;
+    /// assert_eq!(coarse.grid().count, 14);
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
+    pub fn on_grid(&self, grid: Grid) -> Result<Estimator> {
+        if grid == self.grid {
+            return Ok(self.clone());
+        }
+        Estimator::with(self.prepared.clone(), grid)
+    }
+
+    /// The wavelengths of the estimates.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The models estimates are made with.
+    pub fn models(&self) -> &ModelSet {
+        &self.prepared.models
+    }
+
+    /// The charts photos are searched for: those of the models (see
+    /// [`chart_templates`]), or the one `chart` names.
+    pub fn templates(&self, chart: Option<&str>) -> Result<Vec<ChartTemplate>> {
+        match (chart, &self.prepared.templates) {
+            (None, Some(templates)) => Ok(templates.clone()),
+            _ => chart_templates(&self.prepared.models, chart, &self.prepared.data_dir),
+        }
+    }
+
+    /// The estimate for the photo file at `path`, labelled with its file name.
+    pub fn estimate_photo(&self, path: &Path, options: &PhotoOptions) -> Result<Estimate> {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| path.display().to_string());
+        let analysed = self
+            .analyse_photos(&[path.to_path_buf()], options)?
+            .pop()
+            .ok_or_else(|| InferError::invalid("no photo analysed"))??;
+        self.estimate_analysis(analysed.analysis, name)
+    }
+
+    /// The estimate for a photo held in memory (an upload, never written to disk), decoded
+    /// with the same limits as a file and labelled `name`.
+    ///
+    /// ```
+    /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::spectral::Grid;
+    /// use spdcam_infer::{Estimator, PhotoOptions};
+    ///
+    /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
+    /// let jpeg = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/sg-telelumen.jpg"))?;
+    /// let estimate = estimator.estimate_photo_bytes(&jpeg, "upload.jpg", &PhotoOptions::default())?;
+    /// assert_eq!(estimate.photo.unwrap().chart, "colorchecker_sg140");
+    /// let err = estimator.estimate_photo_bytes(b"not a photo", "notes.txt", &PhotoOptions::default());
+    /// assert!(err.unwrap_err().to_string().contains("notes.txt"));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn estimate_photo_bytes(
+        &self,
+        bytes: &[u8],
+        name: &str,
+        options: &PhotoOptions,
+    ) -> Result<Estimate> {
+        let decoded = photo::decode_photo(bytes, name)?;
+        self.estimate_decoded(&decoded, options)
+    }
+
+    /// The estimate for a photo already decoded (from bytes, or a pixel array in Python),
+    /// labelled with the photo's source.
+    pub fn estimate_decoded(&self, photo: &Photo, options: &PhotoOptions) -> Result<Estimate> {
+        let analysed = self.analyse_decoded(photo, options)?;
+        self.estimate_analysis(analysed.analysis, photo.source.clone())
+    }
+
+    /// Analyses photo files in parallel with `options`: one result per photo, in order, so
+    /// one bad photo does not cost the others. Each photo is decoded once; the picture of
+    /// the chart found ([`AnalysedPhoto::overlay`]) is drawn while it is at hand when
+    /// `options.overlay_width` asks for it.
+    pub fn analyse_photos(
+        &self,
+        paths: &[PathBuf],
+        options: &PhotoOptions,
+    ) -> Result<Vec<Result<AnalysedPhoto>>> {
+        if options.corners.is_some() && paths.len() > 1 {
+            return Err(InferError::invalid(format!(
+                "corners apply to one photo; {} were given",
+                paths.len()
+            )));
+        }
+        let templates = self.templates(options.chart.as_deref())?;
+        let debug = options.debug.as_ref().map(|d| debug_paths(d, paths));
+        Ok(paths
+            .par_iter()
+            .enumerate()
+            .map(|(i, path)| {
+                let decoded = photo::load_photo(path)?;
+                let debug = debug.as_ref().map(|d| d[i].clone());
+                self.analyse_with(&decoded, options, templates.clone(), debug)
+            })
+            .collect())
+    }
+
+    /// Analyses a decoded photo with `options` (the chart found among the charts
+    /// [`Estimator::templates`] gives, or placed by `options.corners`, and sampled).
+    pub fn analyse_decoded(&self, photo: &Photo, options: &PhotoOptions) -> Result<AnalysedPhoto> {
+        let templates = self.templates(options.chart.as_deref())?;
+        self.analyse_with(photo, options, templates, options.debug.clone())
+    }
+
+    /// One decoded photo analysed with `options` among `templates`, its debug image (if
+    /// any) written to `debug`.
+    fn analyse_with(
+        &self,
+        photo: &Photo,
+        options: &PhotoOptions,
+        templates: Vec<ChartTemplate>,
+        debug: Option<PathBuf>,
+    ) -> Result<AnalysedPhoto> {
+        let analyse = AnalyseOptions {
+            templates,
+            corners: options.corners.clone(),
+            debug,
+        };
+        let analysis = photo::analyse(photo, &analyse)?;
+        let overlay = match options.overlay_width {
+            Some(width) => {
+                let template = analyse
+                    .templates
+                    .iter()
+                    .find(|t| t.name == analysis.chart)
+                    .ok_or_else(|| {
+                        InferError::invalid(format!(
+                            "{}: no template of chart {}",
+                            analysis.source, analysis.chart
+                        ))
+                    })?;
+                Some(analysis_overlay_jpeg(photo, template, &analysis, width)?)
+            }
+            None => None,
+        };
+        Ok(AnalysedPhoto { analysis, overlay })
+    }
+
+    /// The estimate for an analysed photo, by the model for the chart it shows, labelled
+    /// `name`, judged with what the analysis found (detection, clipped and dark patches).
+    pub fn estimate_analysis(&self, analysis: PhotoAnalysis, name: String) -> Result<Estimate> {
+        let rows = FeatureRows::of_analyses(&[&analysis])?;
+        let index = self.choose(&rows.names, &analysis.source).map_err(|_| {
+            InferError::invalid(format!(
+                "{}: no model for chart {}; the models are for {}",
+                analysis.source,
+                analysis.chart,
+                self.charts()
+            ))
+        })?;
+        let model_spds = self.run_model(index, &rows, &analysis.source)?;
+        let chosen = self.named(index);
+        let feature_patches = chosen
+            .model
+            .photo_chart()
+            .filter(|t| t.name == analysis.chart)
+            .map(|t| t.feature_patches.as_slice());
+        let flags = trust::photo_flags(&analysis, feature_patches);
+        self.judged(
+            index,
+            name,
+            model_spds,
+            &rows.values,
+            &flags,
+            Some(analysis),
+        )
+    }
+
+    /// Judged estimates for feature rows, each labelled `estimate_N` (1-based), by the
+    /// model for their columns; `source` names the rows in errors. The rows are judged in
+    /// parallel.
+    ///
+    /// ```
+    /// use spdcam_core::builtin::{self, DataDir};
+    /// use spdcam_core::camera::sensor::Sensitivities;
+    /// use spdcam_core::camera::{Camera, CameraConfig};
+    /// use spdcam_core::chart::Chart;
+    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::spectral::Grid;
+    /// use spdcam_infer::{Estimator, FeatureRows};
+    ///
+    /// // The ColorChecker 24 under illuminant A, through the virtual camera.
+    /// let grid = Grid::SIMULATION;
+    /// let table = &builtin::CAMERAS[0];
+    /// let sensitivities = Sensitivities::new(table.name, &table.load()?, &grid)?;
+    /// let chart = Chart::colorchecker24(&grid)?;
+    /// let names = chart.feature_names();
+    /// let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid)?;
+    /// let a = StandardIlluminant::A.spd(&grid)?;
+    /// let (mut raw, mut row) = (Vec::new(), Vec::new());
+    /// camera.features_fast(&camera.light(&a)?, &mut raw, &mut row);
+    /// let values = row.iter().map(|&v| f64::from(v)).collect();
+    ///
+    /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
+    /// let rows = FeatureRows::from_values(names, values, "rendered")?;
+    /// let estimate = &estimator.estimate_rows(&rows, "rendered")?[0];
+    /// assert_eq!(estimate.name, "estimate_1");
+    /// // A warm light: a CCT near illuminant A's 2856 K.
+    /// let cct = estimate.colorimetry.cct.unwrap();
+    /// assert!((2300.0..3500.0).contains(&cct), "{cct}");
+    /// assert!(estimate.trust.is_some());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn estimate_rows(&self, features: &FeatureRows, source: &str) -> Result<Vec<Estimate>> {
+        let index = self.choose(&features.names, source)?;
+        let model_spds = self.run_model(index, features, source)?;
+        let width = features.names.len();
+        let d = self.named(index).model.grid().count;
+        features
+            .values
+            .par_chunks(width)
+            .zip(model_spds.par_chunks(d))
+            .enumerate()
+            .map(|(i, (row, spd))| {
+                self.judged(
+                    index,
+                    row_name(i),
+                    spd.to_vec(),
+                    row,
+                    &PhotoFlags::default(),
+                    None,
+                )
+            })
+            .collect()
+    }
+
+    /// Feature rows from `stream`, estimated a block at a time (see [`RowStream`]); the
+    /// model is the one for the stream's columns.
+    ///
+    /// ```
+    /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::spectral::Grid;
+    /// use spdcam_infer::stream::FeatureStream;
+    /// use spdcam_infer::Estimator;
+    ///
+    /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
+    /// let names: Vec<String> = estimator.models().for_chart("colorchecker24").unwrap()
+    ///     .model.feature_names().to_vec();
+    /// // Two rows of a chart with colour: the patches' channels at different levels.
+    /// let row: Vec<String> = (0..names.len()).map(|i| format!("{}", 30 + (i * 37) % 200)).collect();
+    /// let text = format!("{}\n{}\n{}\n", names.join(","), row.join(","), row.join(","));
+    /// let file = FeatureStream::new(Box::new(std::io::Cursor::new(text)), "rows.csv")?;
+    /// let mut stream = estimator.stream(file, "rows.csv")?;
+    /// let block = stream.next_block()?.unwrap();
+    /// assert_eq!((block.rows, block.spds.len()), (2, 2 * 61));
+    /// // The full judged estimate of a row, only when it is wanted.
+    /// let second = stream.estimate(&block, 1)?;
+    /// assert_eq!(second.name, "estimate_2");
+    /// assert_eq!(second.spd.values(), &block.spds[61..]);
+    /// assert!(stream.next_block()?.is_none());
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
+    pub fn stream(&self, stream: FeatureStream, source: &str) -> Result<RowStream<'_>> {
+        let index = self.choose(stream.names(), source)?;
+        self.map(index)?;
+        Ok(RowStream {
+            estimator: self,
+            stream,
+            index,
+            source: source.to_string(),
+            rows: 0,
+        })
+    }
+
+    /// The index of the model for feature columns `names`.
+    fn choose(&self, names: &[String], source: &str) -> Result<usize> {
+        let chosen = self.prepared.models.require(names, source)?;
+        self.prepared
+            .models
+            .models()
+            .iter()
+            .position(|m| std::ptr::eq(m, chosen))
+            .ok_or_else(|| InferError::invalid("the chosen model is not of the set"))
+    }
+
+    fn named(&self, index: usize) -> &NamedModel {
+        &self.prepared.models.models()[index]
+    }
+
+    /// Model `index`'s wavelengths to the output's, or why there is no map.
+    fn map(&self, index: usize) -> Result<&GridMap> {
+        match &self.on_grid[index].map {
+            Some(map) => Ok(map),
+            None => Err(GridMap::new(&self.named(index).model.grid(), &self.grid)
+                .err()
+                .unwrap_or_else(|| {
+                    InferError::invalid("the output grid lies outside the model's")
+                })),
+        }
+    }
+
+    /// The model's SPDs (on its own grid, peak 1, row-major) for `features`, checked against
+    /// its columns first (rows that say nothing about the light are refused by name).
+    fn run_model(&self, index: usize, features: &FeatureRows, source: &str) -> Result<Vec<f64>> {
+        let model = &self.named(index).model;
+        model.check_features(&features.names, source)?;
+        self.map(index)?;
+        check_feature_rows(
+            &features.values,
+            &features.names,
+            source,
+            0,
+            features.rows > 1,
+        )?;
+        model.estimate_rows(&features.values)
+    }
+
+    /// THE constructor of every estimate: the model's SPD `model_spd` (on its grid, peak 1)
+    /// for `row`, judged (the self-check, the perturbed spread, the calibration; `flags`
+    /// what a photo analysis found), and everything read from it on the output grid.
+    fn judged(
+        &self,
+        index: usize,
+        name: String,
+        model_spd: Vec<f64>,
+        row: &[f64],
+        flags: &PhotoFlags,
+        photo: Option<PhotoAnalysis>,
+    ) -> Result<Estimate> {
+        let chosen = self.named(index);
+        let map = self.map(index)?;
+        let judge = &self.prepared.trust[index];
+        let mut trust = trust::assess(
+            &chosen.model,
+            judge.calibration.as_ref(),
+            judge.check.as_ref(),
+            row,
+            &model_spd,
+            flags,
+        )?;
+        self.bands_on_grid(&mut trust, map)?;
+        let spd = Spd::new(self.grid, map.apply(model_spd))?;
+        let metrics = LightingMetrics::of_spd(&spd);
+        let absolute = match &photo {
+            Some(analysis) => {
+                let unusable: Vec<bool> = (0..flags.clipped.len())
+                    .map(|k| flags.clipped[k] || flags.dark.get(k).copied().unwrap_or(false))
+                    .collect();
+                let chart = chosen.model.header().chart.as_deref();
+                Some(match chart {
+                    Some(chart) => absolute_level(
+                        analysis,
+                        chart,
+                        self.on_grid[index].chart.as_deref(),
+                        &spd,
+                        &metrics,
+                        &unusable,
+                    )?,
+                    None => Err("the model names no chart".into()),
+                })
+            }
+            None => None,
+        };
+        Ok(Estimate {
+            name,
+            model: chosen.name.clone(),
+            colorimetry: Colorimetry::of(&spd)?,
+            metrics,
+            spd,
+            truth: None,
+            photo,
+            trust: Some(trust),
+            absolute,
+        })
+    }
+
+    /// The bands of `trust` taken from the model's wavelengths to the output's by `map`,
+    /// their lower edges held at 0 or above.
+    fn bands_on_grid(&self, trust: &mut Trust, map: &GridMap) -> Result<()> {
+        if let Some(u) = &mut trust.uncertainty {
+            for band in [&mut u.band68, &mut u.band95] {
+                let lower = map.apply(band.lower.to_vec());
+                band.lower = Spd::new(self.grid, lower.into_iter().map(|v| v.max(0.0)).collect())?;
+                band.upper = Spd::new(self.grid, map.apply(band.upper.to_vec()))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// `colorchecker_sg96, colorchecker24`: the charts the set's models read.
+    fn charts(&self) -> String {
+        self.prepared
+            .models
+            .models()
+            .iter()
+            .map(|m| m.model.header().chart.as_deref().unwrap_or("unknown"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// A photo analysed by [`Estimator::analyse_photos`].
+#[derive(Debug, Clone)]
+pub struct AnalysedPhoto {
+    /// What the photo gave.
+    pub analysis: PhotoAnalysis,
+    /// The photo with the chart found drawn on it (as `--debug` draws it), reduced to
+    /// `PhotoOptions::overlay_width` and encoded as JPEG, when asked for.
+    pub overlay: Option<Vec<u8>>,
+}
+
+/// Feature rows read a block at a time and estimated by one model (see
+/// [`Estimator::stream`]): time linear in the rows, memory bounded whatever their number.
+/// The SPDs of a block come cheap; [`RowStream::estimate`] makes the full judged estimate
+/// of any row of it.
+pub struct RowStream<'a> {
+    estimator: &'a Estimator,
+    stream: FeatureStream,
+    index: usize,
+    source: String,
+    rows: usize,
+}
+
+/// One block of a [`RowStream`]: the rows' features and their SPDs.
+#[derive(Debug, Clone)]
+pub struct EstimatedBlock {
+    /// The number (0-based) of the block's first row among all rows.
+    pub first_row: usize,
+    /// Number of rows.
+    pub rows: usize,
+    /// The features, row-major.
+    pub features: Vec<f64>,
+    /// The SPDs on the estimator's grid, peak 1, row-major.
+    pub spds: Vec<f64>,
+    /// The SPDs on the model's grid, as the judge takes them.
+    model_spds: Vec<f64>,
+}
+
+impl RowStream<'_> {
+    /// The name of the model estimating the rows.
+    pub fn model_name(&self) -> &str {
+        &self.estimator.named(self.index).name
+    }
+
+    /// The next block of rows with their SPDs, or `None` after the last. Rows that say
+    /// nothing about the light are refused, naming the row (1-based in the file).
+    pub fn next_block(&mut self) -> Result<Option<EstimatedBlock>> {
+        let Some(block) = self.stream.next_block(self.rows)? else {
+            return Ok(None);
+        };
+        let names = self.stream.names();
+        check_feature_rows(&block.values, names, &self.source, block.first_row, true)?;
+        let model_spds = self
+            .estimator
+            .named(self.index)
+            .model
+            .estimate_rows(&block.values)?;
+        let spds = self.estimator.map(self.index)?.apply(model_spds.clone());
+        self.rows += block.rows;
+        Ok(Some(EstimatedBlock {
+            first_row: block.first_row,
+            rows: block.rows,
+            features: block.values,
+            spds,
+            model_spds,
+        }))
+    }
+
+    /// The full judged estimate of row `k` of `block`, named `estimate_N` after its place
+    /// among all rows: the SPD the block holds, not estimated again.
+    pub fn estimate(&self, block: &EstimatedBlock, k: usize) -> Result<Estimate> {
+        if k >= block.rows {
+            return Err(InferError::invalid(format!(
+                "row {k} of a block of {} rows",
+                block.rows
+            )));
+        }
+        let width = self.stream.names().len();
+        let d = self.estimator.named(self.index).model.grid().count;
+        self.estimator.judged(
+            self.index,
+            row_name(block.first_row + k),
+            block.model_spds[k * d..(k + 1) * d].to_vec(),
+            &block.features[k * width..(k + 1) * width],
+            &PhotoFlags::default(),
+            None,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use spdcam_core::photo::decode_photo;
+
+    fn example_photo() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/sg-telelumen.jpg")
+    }
+
+    fn shipped() -> Estimator {
+        Estimator::shipped(DataDir::new(None), Grid::ESTIMATION).unwrap()
+    }
+
+    #[test]
+    fn a_photo_its_bytes_its_pixels_and_its_row_give_one_estimate() {
+        let estimator = shipped();
+        let options = PhotoOptions::default();
+        let path = example_photo();
+        let from_file = estimator.estimate_photo(&path, &options).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let from_bytes = estimator
+            .estimate_photo_bytes(&bytes, "in memory", &options)
+            .unwrap();
+        let decoded = decode_photo(&bytes, "decoded").unwrap();
+        let from_pixels = estimator.estimate_decoded(&decoded, &options).unwrap();
+        assert_eq!(from_bytes.name, "in memory");
+        assert_eq!(from_pixels.name, "decoded");
+        let analysis = from_file.photo.as_ref().unwrap();
+        let rows = FeatureRows::of_analyses(&[analysis]).unwrap();
+        let from_row = estimator.estimate_rows(&rows, "row").unwrap().remove(0);
+        assert_eq!(from_row.name, "estimate_1");
+        for other in [&from_bytes, &from_pixels, &from_row] {
+            assert_eq!(other.spd, from_file.spd);
+            assert_eq!(other.colorimetry, from_file.colorimetry);
+        }
+        // The row carries no photo flags; the photo's own judgement is the same here, as
+        // the example photo has no clipped or dark feature patch and a sure detection.
+        let verdicts: Vec<_> = [&from_file, &from_bytes, &from_pixels, &from_row]
+            .iter()
+            .map(|e| e.trust.as_ref().unwrap().clone())
+            .collect();
+        assert!(verdicts.iter().all(|t| t.verdict == verdicts[0].verdict));
+        assert_eq!(verdicts[0].uncertainty, verdicts[3].uncertainty);
+        assert_eq!(verdicts[0].self_check, verdicts[3].self_check);
+    }
+
+    #[test]
+    fn another_grid_shares_the_models_and_resamples_spd_and_bands() {
+        let estimator = shipped();
+        let coarse = estimator
+            .on_grid(Grid::parse("400-700:10").unwrap())
+            .unwrap();
+        assert!(Arc::ptr_eq(&estimator.prepared, &coarse.prepared));
+        let path = example_photo();
+        let fine = estimator
+            .estimate_photo(&path, &PhotoOptions::default())
+            .unwrap();
+        let e = coarse
+            .estimate_photo(&path, &PhotoOptions::default())
+            .unwrap();
+        assert_eq!(e.spd.grid(), coarse.grid());
+        // Every other 5 nm sample is a 10 nm sample.
+        for (k, v) in e.spd.iter().enumerate() {
+            assert!((v - fine.spd[2 * k]).abs() < 1e-12, "at {k}");
+        }
+        let u = e.trust.unwrap().uncertainty.unwrap();
+        assert_eq!(u.band95.lower.grid(), coarse.grid());
+        assert_eq!(u.band68.upper.len(), 31);
+    }
+
+    #[test]
+    fn a_range_beyond_the_model_is_named_when_estimating() {
+        let wide = shipped()
+            .on_grid(Grid::parse("380-780:5").unwrap())
+            .unwrap();
+        let err = wide
+            .estimate_photo(&example_photo(), &PhotoOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("the model estimates"), "{err}");
+    }
+
+    #[test]
+    fn a_stream_gives_the_rows_estimates_and_judges_any_row_of_a_block() {
+        let estimator = shipped();
+        let photo = estimator
+            .estimate_photo(&example_photo(), &PhotoOptions::default())
+            .unwrap();
+        let analysis = photo.photo.as_ref().unwrap();
+        let mut text = analysis.feature_names.join(",") + "\n";
+        for scale in [1.0f32, 0.5, 0.25] {
+            let row: Vec<String> = analysis
+                .features
+                .iter()
+                .map(|v| format!("{}", v * scale))
+                .collect();
+            text.push_str(&row.join(","));
+            text.push('\n');
+        }
+        let rows = FeatureRows::from_csv_str(&text, "f.csv").unwrap();
+        let all = estimator.estimate_rows(&rows, "f.csv").unwrap();
+        let source =
+            FeatureStream::new(Box::new(std::io::Cursor::new(text.into_bytes())), "f.csv").unwrap();
+        let mut stream = estimator.stream(source, "f.csv").unwrap();
+        assert_eq!(stream.model_name(), "the shipped colorchecker_sg96 model");
+        let block = stream.next_block().unwrap().unwrap();
+        assert_eq!((block.first_row, block.rows), (0, 3));
+        assert!(stream.next_block().unwrap().is_none());
+        for (k, e) in all.iter().enumerate() {
+            let streamed = stream.estimate(&block, k).unwrap();
+            assert_eq!(streamed.name, e.name);
+            assert_eq!(streamed.spd.values(), &block.spds[k * 61..(k + 1) * 61]);
+            assert_eq!(streamed.trust, e.trust);
+        }
+        assert!(stream.estimate(&block, 3).is_err());
+    }
+
+    #[test]
+    fn a_photo_without_a_chart_names_itself() {
+        let photo = Photo::from_rgb8("grey.png", 200, 150, vec![128; 200 * 150 * 3]).unwrap();
+        let err = shipped()
+            .estimate_decoded(&photo, &PhotoOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("grey.png"), "{err}");
+    }
+
+    #[test]
+    fn the_report_picture_is_drawn_from_the_one_decoding() {
+        let options = PhotoOptions {
+            overlay_width: Some(320),
+            ..PhotoOptions::default()
+        };
+        let analysed = shipped()
+            .analyse_photos(&[example_photo()], &options)
+            .unwrap()
+            .pop()
+            .unwrap()
+            .unwrap();
+        let jpeg = analysed.overlay.unwrap();
+        let picture = decode_photo(&jpeg, "overlay.jpg").unwrap();
+        assert_eq!(picture.width, 320);
+        let plain = shipped()
+            .analyse_photos(&[example_photo()], &PhotoOptions::default())
+            .unwrap()
+            .pop()
+            .unwrap()
+            .unwrap();
+        assert!(plain.overlay.is_none());
+        assert_eq!(plain.analysis, analysed.analysis);
+    }
+}

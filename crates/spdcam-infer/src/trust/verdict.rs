@@ -1,0 +1,376 @@
+//! The verdict: what the photo analysis found (detection, clipped and dark patches), the
+//! self-check and the calibrated uncertainty weighed into ok, doubtful or unusable, with the
+//! reasons.
+
+use super::calibration::{Calibration, Uncertainty};
+use super::self_check::{ChartCheck, SelfCheck};
+use super::spread::{feature_scale, Perturbed};
+use crate::error::Result;
+use crate::model::Model;
+use serde::Serialize;
+use spdcam_core::photo::{PatchSample, PhotoAnalysis};
+
+/// Estimates above this detection confidence are placed surely; the photo analysis warns
+/// below the same level.
+pub const SURE_DETECTION: f64 = 0.8;
+/// Self-check residuals this many times the calibration's doubtful level make an estimate
+/// unusable: the light found does not explain the photo.
+pub const UNUSABLE_SELF_CHECK_FACTOR: f64 = 3.0;
+/// Below this expected GFC an estimate is doubtful (GFC 0.95 is the thesis's "acceptable"
+/// level of spectral match; Hernández-Andrés et al. 2001, JOSA A 18: 412–420).
+pub const DOUBTFUL_GFC: f64 = 0.95;
+/// A share of clipped feature patches above this makes an estimate unusable: half the
+/// chart says only that it is brighter than the camera records.
+pub const UNUSABLE_CLIPPED_SHARE: f64 = 0.5;
+/// A share of dark feature patches above this makes an estimate doubtful.
+pub const DOUBTFUL_DARK_SHARE: f64 = 0.25;
+
+/// Whether a patch's encoded RGB has a channel at the top of the scale.
+pub fn clipped_patch(rgb: &[f64], scale: f64) -> bool {
+    rgb.iter().any(|&v| v >= 0.995 * scale)
+}
+
+/// The number of clipped patches of a feature row (see [`clipped_patch`]).
+pub fn clipped_patches(row: &[f64]) -> usize {
+    let scale = feature_scale(row);
+    row.chunks_exact(3)
+        .filter(|p| clipped_patch(p, scale))
+        .count()
+}
+
+/// Patches to leave out of the self-check when no photo analysis flags them: a channel at
+/// the top of the scale (clipped) or every channel below 2 % of it (dark).
+pub fn flag_patches(row: &[f64], scale: f64) -> Vec<bool> {
+    row.chunks_exact(3)
+        .map(|p| clipped_patch(p, scale) || p.iter().all(|&v| v < 0.02 * scale))
+        .collect()
+}
+
+/// One word for how far an estimate can be trusted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// Nothing found against it.
+    Ok,
+    /// Use with care: see the reasons.
+    Doubtful,
+    /// Do not use the numbers: the photo does not say what the light is.
+    Unusable,
+}
+
+impl Verdict {
+    /// `ok`, `doubtful` or `unusable`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Ok => "ok",
+            Verdict::Doubtful => "doubtful",
+            Verdict::Unusable => "unusable",
+        }
+    }
+}
+
+/// How far an estimate can be trusted: the verdict, why, and the measurements behind it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trust {
+    /// The verdict.
+    pub verdict: Verdict,
+    /// What lowered it, and checks that could not be made.
+    pub reasons: Vec<String>,
+    /// The self-check, when the chart's reflectances were at hand.
+    pub self_check: Option<SelfCheck>,
+    /// Bands and expected GFC, when the model has a calibration.
+    pub uncertainty: Option<Uncertainty>,
+}
+
+/// What the photo analysis found that bears on trust (all `None`/empty for feature rows).
+#[derive(Debug, Clone, Default)]
+pub struct PhotoFlags {
+    /// The detection's confidence.
+    pub confidence: Option<f64>,
+    /// Per feature patch: clipped.
+    pub clipped: Vec<bool>,
+    /// Per feature patch: dark.
+    pub dark: Vec<bool>,
+}
+
+/// Judges one estimate: `row` the features, `spd` the model's estimate on its own grid
+/// (peak-normalised), `flags` what the photo analysis found. The thresholds are constants
+/// of this module and levels of the calibration, chosen before any result was seen
+/// (docs/trust.md).
+pub fn assess(
+    model: &Model,
+    calibration: Option<&Calibration>,
+    check: Option<&ChartCheck>,
+    row: &[f64],
+    spd: &[f64],
+    flags: &PhotoFlags,
+) -> Result<Trust> {
+    let mut verdict = Verdict::Ok;
+    let mut reasons = Vec::new();
+    let mut lower = |v: Verdict, reason: String, reasons: &mut Vec<String>| {
+        if v as u8 > verdict as u8 {
+            verdict = v;
+        }
+        reasons.push(reason);
+    };
+    if let Some(c) = flags.confidence.filter(|&c| c < SURE_DETECTION) {
+        lower(
+            Verdict::Doubtful,
+            format!("the chart was found with confidence {c:.2} only"),
+            &mut reasons,
+        );
+    }
+    let scale = feature_scale(row);
+    let patches = row.len() / 3;
+    let mut skip = flag_patches(row, scale);
+    for (i, s) in skip.iter_mut().enumerate() {
+        *s |= flags.clipped.get(i).copied().unwrap_or(false)
+            || flags.dark.get(i).copied().unwrap_or(false);
+    }
+    let clipped = (0..patches)
+        .filter(|&i| {
+            flags.clipped.get(i).copied().unwrap_or(false)
+                || clipped_patch(&row[3 * i..3 * i + 3], scale)
+        })
+        .count();
+    let clipped_doubtful = calibration.map_or(0, |c| c.clipped_doubtful);
+    if clipped as f64 > UNUSABLE_CLIPPED_SHARE * patches as f64 {
+        lower(
+            Verdict::Unusable,
+            format!("{clipped} of {patches} patches are clipped (overexposed)"),
+            &mut reasons,
+        );
+    } else if clipped > clipped_doubtful {
+        lower(
+            Verdict::Doubtful,
+            format!(
+                "{clipped} of {patches} patches are clipped (overexposed; at most {clipped_doubtful} in the calibration photos)"
+            ),
+            &mut reasons,
+        );
+    }
+    let dark = (0..patches)
+        .filter(|&i| {
+            flags.dark.get(i).copied().unwrap_or(false)
+                || row[3 * i..3 * i + 3].iter().all(|&v| v < 0.02 * scale)
+        })
+        .count();
+    if dark as f64 > DOUBTFUL_DARK_SHARE * patches as f64 {
+        lower(
+            Verdict::Doubtful,
+            format!("{dark} of {patches} patches are nearly black (underexposed)"),
+            &mut reasons,
+        );
+    }
+    let self_check = match check {
+        Some(c) => match c.check(spd, row, scale, &skip) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                lower(
+                    Verdict::Unusable,
+                    format!("no self-check: {e}"),
+                    &mut reasons,
+                );
+                None
+            }
+        },
+        None => {
+            reasons.push("no self-check: the chart's reflectances are not at hand (the data directory holds them)".into());
+            None
+        }
+    };
+    let uncertainty = match calibration {
+        Some(cal) => {
+            let perturbed = Perturbed::of(model, row)?;
+            Some(cal.uncertainty(
+                spd,
+                &perturbed.spread(),
+                &perturbed.metric_spread(&model.grid().wavelengths()),
+                self_check.as_ref().map(|s| s.mean),
+            )?)
+        }
+        None => {
+            reasons.push("no uncertainty: the model has no calibration".into());
+            None
+        }
+    };
+    if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.self_check_doubtful)) {
+        if s.mean > level {
+            let v = if s.mean > UNUSABLE_SELF_CHECK_FACTOR * level {
+                Verdict::Unusable
+            } else {
+                Verdict::Doubtful
+            };
+            lower(
+                v,
+                format!(
+                    "the estimated light does not explain the photo: self-check residual {:.3} (clean photos stay below {level:.3}; worst patches {})",
+                    s.mean,
+                    s.worst_patches.iter().map(|p| format!("p{p:02}")).collect::<Vec<_>>().join(", ")
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.split_doubtful)) {
+        if s.split > level {
+            let v = if s.split > UNUSABLE_SELF_CHECK_FACTOR * level {
+                Verdict::Unusable
+            } else {
+                Verdict::Doubtful
+            };
+            lower(
+                v,
+                format!(
+                    "the two halves of the chart look lit differently (two lights, glare): half-to-half residual {:.3} (clean photos stay below {level:.3})",
+                    s.split
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(g), Some(level)) = (
+        self_check.as_ref().and_then(|s| s.colour_gradient),
+        calibration.and_then(|c| c.colour_gradient_doubtful),
+    ) {
+        if g > level {
+            lower(
+                Verdict::Doubtful,
+                format!(
+                    "the light's colour changes across the chart (two lights, or one light and a reflection): its neutral patches' colour gradient is {g:.2} (clean photos stay below {level:.2})"
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.glare_doubtful)) {
+        if s.glare > level {
+            lower(
+                Verdict::Doubtful,
+                format!(
+                    "light is added unevenly across the chart (glare, a reflection, or flare from a light beside it): an additive light changing across the chart explains {:.0} % of the self-check residual (clean photos stay below {:.0} %)",
+                    100.0 * s.glare,
+                    100.0 * level
+                ),
+                &mut reasons,
+            );
+        }
+    }
+    if let (Some(u), Some(cal)) = (&uncertainty, calibration) {
+        if u.difficulty > cal.difficulty_doubtful {
+            lower(
+                Verdict::Doubtful,
+                "many lights give nearly this photo, or it is unlike the training lights: the SPD's shape is uncertain (wide band)".into(),
+                &mut reasons,
+            );
+        }
+        if u.expected_gfc < DOUBTFUL_GFC {
+            lower(
+                Verdict::Doubtful,
+                format!("expected GFC {:.3} is below {DOUBTFUL_GFC}", u.expected_gfc),
+                &mut reasons,
+            );
+        }
+    }
+    Ok(Trust {
+        verdict,
+        reasons,
+        self_check,
+        uncertainty,
+    })
+}
+
+/// The flags of an analysed photo's feature patches: `feature_patches` are their indices
+/// among the chart's patches (row-major) when the chart has patches that are not features.
+pub fn photo_flags(analysis: &PhotoAnalysis, feature_patches: Option<&[usize]>) -> PhotoFlags {
+    let count = analysis.features.len() / 3;
+    let indices: Vec<usize> = match feature_patches {
+        Some(f) if f.len() == count => f.to_vec(),
+        _ if analysis.patches.len() == count => (0..count).collect(),
+        _ => Vec::new(),
+    };
+    let flag = |get: fn(&PatchSample) -> bool| -> Vec<bool> {
+        indices
+            .iter()
+            .map(|&i| {
+                analysis
+                    .patches
+                    .iter()
+                    .find(|p| p.patch == i)
+                    .is_some_and(get)
+            })
+            .collect()
+    };
+    PhotoFlags {
+        confidence: Some(analysis.confidence),
+        clipped: flag(|p| p.clipped),
+        dark: flag(|p| p.dark),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::self_check::tests::{cc24_check, features_of};
+    use super::*;
+    use crate::estimate::FeatureRows;
+    use crate::estimator::Estimator;
+    use crate::shipped::ModelSet;
+    use spdcam_core::builtin::DataDir;
+    use spdcam_core::illuminant::StandardIlluminant;
+
+    #[test]
+    fn a_wrong_charts_features_are_not_ok_and_bands_hold_the_estimate() {
+        let models = ModelSet::shipped().unwrap();
+        let model = &models.for_chart("colorchecker24").unwrap().model;
+        let grid = model.grid();
+        let check = cc24_check(&grid);
+        let row = features_of(&check, &StandardIlluminant::D65.spd(&grid).unwrap());
+        let mut wrong = Vec::new();
+        for p in (0..check.patches()).rev() {
+            wrong.extend_from_slice(&row[3 * p..3 * p + 3]);
+        }
+        let rows = FeatureRows::from_values(
+            model.feature_names().to_vec(),
+            [row.clone(), wrong.clone()].concat(),
+            "test",
+        )
+        .unwrap();
+        let estimator = Estimator::new(models.clone(), DataDir::new(None), grid).unwrap();
+        let estimates = estimator.estimate_rows(&rows, "test").unwrap();
+        let t = estimates[1].trust.as_ref().unwrap();
+        assert_ne!(t.verdict, Verdict::Ok, "{:?}", t.reasons);
+        assert!(t.self_check.as_ref().unwrap().mean > 0.2);
+
+        let e = &estimates[0];
+        let json = e.to_json().unwrap();
+        for key in [
+            "verdict",
+            "reasons",
+            "self_check",
+            "expected_gfc",
+            "band_widening",
+            "band68",
+            "band95",
+        ] {
+            assert!(json.get(key).is_some_and(|v| !v.is_null()), "no {key}");
+        }
+        assert_eq!(
+            json["band95"]["lower"].as_array().unwrap().len(),
+            e.spd.len()
+        );
+        assert!(json["self_check"]["glare"].as_f64().is_some());
+        let u = e.trust.as_ref().unwrap().uncertainty.as_ref().unwrap();
+        assert!((0.0..=1.0).contains(&u.expected_gfc));
+        assert!(u.widening >= 1.0);
+        for k in 0..e.spd.len() {
+            let (l95, l68, u68, u95) = (
+                u.band95.lower[k],
+                u.band68.lower[k],
+                u.band68.upper[k],
+                u.band95.upper[k],
+            );
+            assert!(0.0 <= l95 && l95 <= l68 && l68 <= e.spd[k] + 1e-9, "at {k}");
+            assert!(e.spd[k] <= u68 + 1e-9 && u68 <= u95, "at {k}");
+        }
+    }
+}
