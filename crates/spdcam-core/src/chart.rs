@@ -191,6 +191,32 @@ pub const NEUTRAL_VARIATION: f64 = 0.1;
 /// Reflectance of a chart's matte black body, shown in gaps and borders.
 pub const DEFAULT_BACKGROUND: f64 = 0.04;
 
+/// The error for a known chart whose reflectances were not found in the data directory
+/// (`error` says they were not): it names the chart as the user did, the charts available
+/// without data, and how to set the data directory. Other errors (a damaged file) pass.
+fn needs_data(chart: KnownChart, error: Error, data_dir: &DataDir) -> Error {
+    if !matches!(error, Error::UnknownName { .. }) {
+        return error;
+    }
+    let without_data: Vec<&str> = KnownChart::ALL
+        .into_iter()
+        .filter(|c| !c.needs_data_dir())
+        .map(KnownChart::name)
+        .collect();
+    let place = match data_dir.root() {
+        Some(root) => format!("the data directory {} does not hold them", root.display()),
+        None => "no data directory is set".to_string(),
+    };
+    Error::invalid(format!(
+        "chart {} needs its measured reflectances from the data directory, and {place}; \
+         charts available without data: {} (or a reflectance CSV with --layout ROWSxCOLS); \
+         set the data directory with --data-dir DIR or {}",
+        chart.name(),
+        without_data.join(", "),
+        builtin::DATA_DIR_ENV
+    ))
+}
+
 /// The charts [`Chart::resolve`] knows by name; any other chart is a reflectance CSV.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum KnownChart {
@@ -221,6 +247,12 @@ impl KnownChart {
             KnownChart::Sg96Thesis => "colorchecker_sg96_thesis",
             KnownChart::Sg140 => "colorchecker_sg140",
         }
+    }
+
+    /// Whether the chart's reflectances come from the data directory (all but the built-in
+    /// ColorChecker 24).
+    pub const fn needs_data_dir(self) -> bool {
+        !matches!(self, KnownChart::ColorChecker24)
     }
 
     /// What the chart is and where its reflectances come from.
@@ -407,7 +439,8 @@ impl Chart {
                     &[],
                     data_dir,
                     &["thesis"],
-                )?;
+                )
+                .map_err(|e| needs_data(known, e, data_dir))?;
                 if known == KnownChart::Sg96 {
                     // The file lists the SG's centre patches column by column (B2…B9,
                     // C2…C9, …, M2…M9): position (row r, column c) holds file patch c·8 + r.
@@ -418,9 +451,11 @@ impl Chart {
                 }
                 (spec.to_string(), set)
             }
-            Some(KnownChart::Sg140) => (
+            Some(known @ KnownChart::Sg140) => (
                 spec.to_string(),
-                builtin::resolve_table("colorchecker_sg", "chart", &[], data_dir, &["charts"])?.1,
+                builtin::resolve_table("colorchecker_sg", "chart", &[], data_dir, &["charts"])
+                    .map_err(|e| needs_data(known, e, data_dir))?
+                    .1,
             ),
             None => builtin::resolve_table(
                 spec,

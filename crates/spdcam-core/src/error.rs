@@ -68,6 +68,18 @@ impl Error {
     }
 }
 
+/// A number for a message, short whatever its size: as written (`0.8`, `1500`) between
+/// 1e-4 and 1e6, else in scientific notation (`1e300`, `2.5e-320`), so that a huge value
+/// does not become a 300-digit line.
+pub fn short_number(value: f64) -> String {
+    let size = value.abs();
+    if value == 0.0 || !value.is_finite() || (1e-4..1e6).contains(&size) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
+}
+
 /// At most this many names are listed in one message.
 const LISTED_NAMES: usize = 10;
 

@@ -6,7 +6,7 @@
 //! without colour (a greyscale photo), whose patches are all the same mixture of R, G and B
 //! and so carry no information about the spectrum.
 
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 
 /// Below this share of the scale, a patch's largest channel difference is no colour: a
 /// greyscale JPEG saved as RGB keeps about one level of chroma noise on 0–255.
@@ -26,14 +26,16 @@ pub fn check_feature_row(values: &[f64], names: &[String], scale: f64) -> Result
     for (i, &v) in values.iter().enumerate() {
         if !v.is_finite() {
             return Err(Error::invalid(format!(
-                "feature {}: {v} is not a finite number",
-                name(i)
+                "feature {}: {} is not a finite number",
+                name(i),
+                short_number(v)
             )));
         }
         if v < 0.0 || v > scale * (1.0 + 1e-9) {
             return Err(Error::invalid(format!(
-                "feature {}: {v} is outside 0–{scale}, the range of encoded sRGB",
-                name(i)
+                "feature {}: {} is outside 0–{scale}, the range of encoded sRGB",
+                name(i),
+                short_number(v)
             )));
         }
     }

@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::limits;
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 /// Checks that the directory that will hold `path` exists, naming it if not.
@@ -20,13 +20,123 @@ pub fn check_parent_dir(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Reads a whole text file whose size is within [`limits::TEXT_FILE_BYTES`].
+/// Reads a whole text file whose size is within [`limits::TEXT_FILE_BYTES`] (a pipe or a
+/// device too, through the same cap).
 pub fn read_text(path: &Path) -> Result<String> {
-    let size = std::fs::metadata(path)
-        .map_err(|e| Error::io(path, e))?
-        .len();
-    limits::TEXT_FILE_BYTES.check(size, &path.display().to_string())?;
-    std::fs::read_to_string(path).map_err(|e| Error::io(path, e))
+    let bytes = read_limited(path, &limits::TEXT_FILE_BYTES)?;
+    String::from_utf8(bytes).map_err(|_| {
+        Error::io(
+            path,
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                "stream did not contain valid UTF-8",
+            ),
+        )
+    })
+}
+
+/// Reads all of `path` — a file, a pipe (`/dev/stdin`, `<(…)`) or a device — holding at
+/// most `limit` bytes: a regular file larger than that is refused from its size, anything
+/// else is read through a cap of `limit + 1` bytes and refused once it passes the limit, so
+/// that an endless stream (`/dev/zero`) costs no more memory than the limit.
+pub fn read_limited(path: &Path, limit: &limits::Limit) -> Result<Vec<u8>> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let meta = file.metadata().map_err(|e| Error::io(path, e))?;
+    if meta.is_dir() {
+        return Err(Error::invalid(format!(
+            "{}: is a directory; name a file",
+            path.display()
+        )));
+    }
+    let max = limit.value();
+    let context = path.display().to_string();
+    if meta.is_file() {
+        limit.check_against(meta.len(), max, &context)?;
+    }
+    let capped = max.saturating_add(1);
+    let mut reader = file.take(capped);
+    let hint = if meta.is_file() {
+        meta.len() + 1
+    } else {
+        1 << 16
+    };
+    let mut bytes = Vec::with_capacity(hint.min(capped) as usize);
+    let mut chunk = vec![0u8; 1 << 16];
+    loop {
+        let n = match reader.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(Error::io(path, e)),
+        };
+        if bytes.len() + n > bytes.capacity() {
+            // Grow by doubling, never past the cap: a stream just over the limit must not
+            // double the memory it takes.
+            let target = (bytes.capacity() as u64 * 2)
+                .max((bytes.len() + n) as u64)
+                .min(capped) as usize;
+            bytes.reserve_exact(target - bytes.len());
+        }
+        bytes.extend_from_slice(&chunk[..n]);
+    }
+    if bytes.len() as u64 > max {
+        return Err(limit.exceeded(&context));
+    }
+    Ok(bytes)
+}
+
+/// Refuses an output directory that is, contains or lies inside one of `inputs` (files or
+/// directories), before anything is written or removed: replacing the output would
+/// destroy the input it is read from. Paths are compared canonicalised (symbolic links
+/// and `..` resolved; an output that does not exist yet by its nearest existing ancestor).
+pub fn check_output_apart(output: &Path, inputs: &[&Path]) -> Result<()> {
+    let out = canonical_or_planned(output);
+    for input in inputs {
+        let Ok(input_path) = input.canonicalize() else {
+            continue;
+        };
+        let relation = if out == input_path {
+            "is"
+        } else if input_path.starts_with(&out) {
+            "contains"
+        } else if out.starts_with(&input_path) {
+            "lies inside"
+        } else {
+            continue;
+        };
+        return Err(Error::invalid(format!(
+            "the output {} {relation} the input {}: writing it would destroy what is read; \
+             choose an output directory apart from the inputs",
+            output.display(),
+            input.display()
+        )));
+    }
+    Ok(())
+}
+
+/// `path` canonicalised; when it does not exist yet, its nearest existing ancestor
+/// canonicalised with the rest of the path appended (`new/../ds` is `ds`).
+fn canonical_or_planned(path: &Path) -> PathBuf {
+    use std::path::Component;
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let parts: Vec<Component> = absolute.components().collect();
+    for found in (1..=parts.len()).rev() {
+        let Ok(mut planned) = parts[..found].iter().collect::<PathBuf>().canonicalize() else {
+            continue;
+        };
+        // The missing part holds no links: its `..` are resolved by name.
+        for part in &parts[found..] {
+            match part {
+                Component::ParentDir => {
+                    planned.pop();
+                }
+                Component::CurDir => {}
+                other => planned.push(other),
+            }
+        }
+        return planned;
+    }
+    absolute
 }
 
 /// Checks, before long work, that a file can later be written at `path`: its directory

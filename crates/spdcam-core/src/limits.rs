@@ -1,10 +1,11 @@
-//! Resource limits on what a file or an option may ask for, in one place.
+//! Resource limits on what a file, a pipe or an option may ask for, in one place.
 //!
-//! Every size a user can type or a file can declare (image pixels, rendered pixels,
-//! wavelength bands, sample counts, chunk sizes, filter widths) is checked against one of
-//! these limits before anything is allocated, so that no input makes spdcam allocate more
-//! than about 1 GiB or run for hours by mistake. Each limit can be raised for one run with
-//! its environment variable; the error says which one and to what value.
+//! Every size a user can type or an input can declare or hold (bytes read, image pixels,
+//! rendered pixels, wavelength bands, CSV columns and rows, sample counts, draws, chunk
+//! sizes, filter widths) is checked against one of these limits before anything is
+//! allocated, so that no input makes spdcam allocate more than about 1 GiB or run for hours
+//! by mistake. Each limit can be raised (or lowered) for one run with its environment
+//! variable; the error says which one and to what value. [`ALL`] lists them.
 
 use crate::error::{Error, Result};
 
@@ -64,6 +65,47 @@ pub const TEXT_FILE_BYTES: Limit = Limit {
     default: 256 << 20,
 };
 
+/// Bytes of a photo read from a file, a pipe or a device (`estimate /dev/stdin`): 1 GiB
+/// holds any photo within [`IMAGE_PIXELS`]. A pipe is read through this cap, so that an
+/// endless stream (`/dev/zero`) is refused instead of filling the memory.
+pub const PHOTO_BYTES: Limit = Limit {
+    what: "bytes of a photo",
+    env: "SPDCAM_MAX_PHOTO_BYTES",
+    default: 1 << 30,
+};
+
+/// Bytes of a model file (`.spdm`): the shipped ones are under 10 MB.
+pub const MODEL_BYTES: Limit = Limit {
+    what: "bytes of a model file",
+    env: "SPDCAM_MAX_MODEL_BYTES",
+    default: 256 << 20,
+};
+
+/// Columns of a CSV file (features, spectral sets, weights): a ColorChecker SG gives 288
+/// features, a spectral library a few thousand lamps. Checked on the header line as it is
+/// read, so that a header of millions of columns is refused at once.
+pub const CSV_COLUMNS: Limit = Limit {
+    what: "CSV columns",
+    env: "SPDCAM_MAX_CSV_COLUMNS",
+    default: 100_000,
+};
+
+/// Rows of a CSV table held whole in memory (spectral sets, imported features and SPDs);
+/// files streamed a block at a time (`estimate --features`) have no row limit.
+pub const CSV_ROWS: Limit = Limit {
+    what: "CSV rows",
+    env: "SPDCAM_MAX_CSV_ROWS",
+    default: 10_000_000,
+};
+
+/// Draws of one lighting recipe held in memory at once (`coverage --draws`): each holds
+/// its SPD (81 bands × 8 bytes), so the default takes about 650 MB.
+pub const DRAWS: Limit = Limit {
+    what: "draws",
+    env: "SPDCAM_MAX_DRAWS",
+    default: 1_000_000,
+};
+
 /// Width in pixels of a smoothing filter (`grey-edge:p:sigma`): the Gaussian spans
 /// ±3σ, so its cost per pixel grows with σ.
 pub const FILTER_SIGMA_PX: Limit = Limit {
@@ -71,6 +113,22 @@ pub const FILTER_SIGMA_PX: Limit = Limit {
     env: "SPDCAM_MAX_FILTER_SIGMA",
     default: 100,
 };
+
+/// Every limit, in the order of the README's table.
+pub const ALL: [Limit; 12] = [
+    PHOTO_BYTES,
+    TEXT_FILE_BYTES,
+    MODEL_BYTES,
+    IMAGE_PIXELS,
+    RENDER_PIXELS,
+    CSV_COLUMNS,
+    CSV_ROWS,
+    GRID_BANDS,
+    SAMPLES,
+    DRAWS,
+    CHUNK_BYTES,
+    FILTER_SIGMA_PX,
+];
 
 impl Limit {
     /// The limit in force: the environment variable's value when it is set to a whole
@@ -110,6 +168,18 @@ impl Limit {
         Ok(())
     }
 
+    /// The error for an input of unknown size (a pipe, a device, a header line still being
+    /// read) found to hold more than the limit: "{context}: more than N {what} …".
+    pub fn exceeded(&self, context: &str) -> Error {
+        Error::invalid(format!(
+            "{context}: more than {} {} (the limit; set {}=N to allow more, if the machine \
+             has the memory and time)",
+            group_digits(self.value()),
+            self.what,
+            self.env
+        ))
+    }
+
     fn error(&self, requested: &str, limit: u64, raise_to: f64, context: &str) -> Error {
         let raise = if raise_to.is_finite() && raise_to < u64::MAX as f64 {
             format!("{}={}", self.env, raise_to as u64)
@@ -123,6 +193,11 @@ impl Limit {
             group_digits(limit)
         ))
     }
+}
+
+/// Checks the number of columns of a CSV header (of `source`) against [`CSV_COLUMNS`].
+pub fn check_csv_columns(columns: usize, source: &str) -> Result<()> {
+    CSV_COLUMNS.check(columns as u64, &format!("{source}, line 1"))
 }
 
 /// `1234567` as `1,234,567`.
@@ -178,6 +253,17 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("SPDCAM_MAX_RENDER_PIXELS=N"));
+    }
+
+    #[test]
+    fn every_limit_has_its_own_variable() {
+        let mut names: Vec<&str> = ALL.iter().map(|l| l.env).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), ALL.len());
+        assert!(names.iter().all(|n| n.starts_with("SPDCAM_MAX_")));
+        let e = DRAWS.exceeded("coverage").to_string();
+        assert!(e.contains("more than 1,000,000 draws") && e.contains("SPDCAM_MAX_DRAWS=N"));
     }
 
     #[test]

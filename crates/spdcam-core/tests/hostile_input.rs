@@ -323,3 +323,165 @@ fn manifests_naming_files_outside_the_dataset_are_refused() {
     assert!(e.contains("not a path inside"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn writers_refuse_an_output_that_is_holds_or_lies_inside_an_input() {
+    // Issue 29, item 1: split and export with --force emptied their input first.
+    let dir = scratch("apart");
+    let data = dir.join("ds");
+    generate(&data, 16, 3);
+    let input = Dataset::open(&data).unwrap();
+    let export = ExportOptions {
+        feature_scale: 255.0,
+        spd_grid: None,
+    };
+    for (out, relation) in [
+        (data.clone(), "is"),
+        (data.join("samples"), "lies inside"),
+        (dir.clone(), "contains"),
+    ] {
+        let errors = [
+            dataset::split(&input, &out, [0.5, 0.25, 0.25], 1, true, &|_| {}).map(|_| ()),
+            dataset::export_csv(&input, &out, &export, true).map(|_| ()),
+            dataset::merge(std::slice::from_ref(&input), &out, true, &|_| {}).map(|_| ()),
+        ];
+        for e in errors {
+            let e = e.unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("{relation} the input {}", data.display())),
+                "{}: {e}",
+                out.display()
+            );
+        }
+        let again = Dataset::open(&data).unwrap();
+        assert!(again.verify(&|_| {}).problems.is_empty());
+        assert_eq!(again.len(), 16);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_dataset_and_its_copy_are_not_merged() {
+    // Issue 29, item 9.
+    let dir = scratch("merge-copy");
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    generate(&a, 16, 4);
+    std::fs::create_dir_all(b.join("samples")).unwrap();
+    for name in [
+        "manifest.json",
+        "samples/part-00000.parquet",
+        "samples/part-00001.parquet",
+    ] {
+        std::fs::copy(a.join(name), b.join(name)).unwrap();
+    }
+    let inputs = [Dataset::open(&a).unwrap(), Dataset::open(&b).unwrap()];
+    let e = dataset::merge(&inputs, &dir.join("m"), false, &|_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("hold the same samples"), "{e}");
+    assert!(!dir.join("m").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn endless_streams_are_read_only_up_to_the_limit() {
+    // Issue 29, item 4: `estimate /dev/zero` reached 15.7 GB.
+    let limit = spdcam_core::limits::Limit {
+        what: "bytes of a test stream",
+        env: "SPDCAM_TEST_UNSET_LIMIT",
+        default: 4096,
+    };
+    let e = spdcam_core::fsio::read_limited(Path::new("/dev/zero"), &limit)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("/dev/zero: more than 4,096 bytes of a test stream"),
+        "{e}"
+    );
+    let dir = scratch("limited-read");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("exact"), vec![7u8; 4096]).unwrap();
+    std::fs::write(dir.join("over"), vec![7u8; 4097]).unwrap();
+    let read = spdcam_core::fsio::read_limited(&dir.join("exact"), &limit).unwrap();
+    assert_eq!(read.len(), 4096);
+    let e = spdcam_core::fsio::read_limited(&dir.join("over"), &limit)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("4,097 bytes of a test stream exceed the limit of 4,096"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_cut_jpeg_is_truncated_and_a_flipped_bit_is_corrupt() {
+    // Issue 29, item 10.
+    use spdcam_core::photo::{decode_photo, jpeg_end, JpegEnd};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/sg-telelumen.jpg");
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(jpeg_end(&bytes), JpegEnd::Complete);
+    let half = &bytes[..bytes.len() / 2];
+    assert_eq!(jpeg_end(half), JpegEnd::Truncated);
+    match decode_photo(half, "half.jpg") {
+        Ok(p) => assert!(
+            p.warnings.iter().any(|w| w.contains("truncated")),
+            "{:?}",
+            p.warnings
+        ),
+        Err(e) => assert!(e.to_string().contains("truncated"), "{e}"),
+    }
+    let mut corrupt = 0;
+    for k in 1..16 {
+        let mut damaged = bytes.clone();
+        let at = damaged.len() * k / 16;
+        damaged[at] ^= 0x04;
+        let end = jpeg_end(&damaged);
+        assert_ne!(end, JpegEnd::Truncated, "bit at {at}");
+        corrupt += usize::from(end == JpegEnd::Corrupt);
+        let said = match decode_photo(&damaged, "flipped.jpg") {
+            Ok(p) => p.warnings.join("; "),
+            Err(e) => e.to_string(),
+        };
+        assert!(!said.contains("truncated"), "bit at {at}: {said}");
+        if end == JpegEnd::Corrupt {
+            assert!(said.contains("corrupt"), "bit at {at}: {said}");
+        }
+    }
+    // A bit that makes a marker out of entropy-coded data: FF followed by a marker code.
+    let mut marker = bytes.clone();
+    let at = (bytes.len() / 2..bytes.len() - 4)
+        .find(|&i| bytes[i] == 0xFE && !matches!(bytes[i + 1], 0x00 | 0xD0..=0xD9 | 0xFF))
+        .unwrap();
+    marker[at] = 0xFF;
+    assert_eq!(jpeg_end(&marker), JpegEnd::Corrupt);
+    assert!(corrupt > 0 || jpeg_end(&marker) == JpegEnd::Corrupt);
+}
+
+#[test]
+fn spds_at_the_ends_of_double_precision_give_the_unscaled_metrics() {
+    // Issue 29, item 11.
+    use spdcam_core::quality::LightingMetrics;
+    let grid = Grid::new(380.0, 780.0, 5.0).unwrap();
+    let base: Vec<f64> = grid
+        .wavelengths()
+        .iter()
+        .map(|w| ((w / 780.0).powi(4) + 0.4 * (-((w - 450.0) / 20.0).powi(2)).exp()) / 1.01)
+        .collect();
+    let reference = LightingMetrics::from_samples(&grid.wavelengths(), &base);
+    assert!(reference.reasons.is_empty(), "{:?}", reference.reasons);
+    for scale in [1e-300, 1e300, 1e308, f64::MAX / 2.0] {
+        let scaled: Vec<f64> = base.iter().map(|v| v * scale).collect();
+        let m = LightingMetrics::from_samples(&grid.wavelengths(), &scaled);
+        assert!(m.reasons.is_empty(), "{scale:e}: {:?}", m.reasons);
+        for key in [
+            "cct_k", "cri_ra", "cri_r9", "tm30_rf", "tm30_rg", "mel_der", "sp_ratio",
+        ] {
+            let (a, b) = (reference.scalar(key).unwrap(), m.scalar(key).unwrap());
+            assert!(
+                (a - b).abs() <= 1e-9 * a.abs().max(1.0),
+                "{scale:e} {key}: {a} vs {b}"
+            );
+        }
+    }
+}

@@ -19,15 +19,6 @@ pub enum InferError {
         /// What is wrong with it.
         message: String,
     },
-    /// A file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        #[source]
-        source: std::io::Error,
-    },
     /// A numerical step (SVD, a linear solve) failed.
     #[error("{0}")]
     Numerical(String),

@@ -65,12 +65,12 @@ impl FeatureRows {
             .trim(csv::Trim::All)
             .flexible(true)
             .from_reader(input);
-        let names: Vec<String> = reader
+        let header = reader
             .headers()
-            .map_err(|e| InferError::invalid(format!("{shown}: {e}")))?
-            .iter()
-            .map(str::to_string)
-            .collect();
+            .map_err(|e| InferError::invalid(format!("{shown}: {e}")))?;
+        spdcam_core::limits::check_csv_columns(header.len(), shown)?;
+        let names: Vec<String> = header.iter().map(str::to_string).collect();
+        let max_rows = spdcam_core::limits::CSV_ROWS.value();
         if names.iter().all(String::is_empty) {
             return Err(InferError::invalid(format!("{shown}: the file is empty")));
         }
@@ -78,6 +78,9 @@ impl FeatureRows {
         let mut rows = 0;
         for record in reader.records() {
             let record = record.map_err(|e| InferError::invalid(format!("{shown}: {e}")))?;
+            if rows as u64 >= max_rows {
+                return Err(spdcam_core::limits::CSV_ROWS.exceeded(shown).into());
+            }
             let line = record.position().map_or(0, |p| p.line());
             if record.iter().all(str::is_empty) {
                 continue;

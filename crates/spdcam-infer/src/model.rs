@@ -364,12 +364,9 @@ impl Model {
         Ok(())
     }
 
-    /// Reads a model file.
+    /// Reads a model file (at most [`spdcam_core::limits::MODEL_BYTES`]).
     pub fn load(path: &Path) -> Result<Model> {
-        let bytes = std::fs::read(path).map_err(|source| InferError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let bytes = spdcam_core::fsio::read_limited(path, &spdcam_core::limits::MODEL_BYTES)?;
         Model::from_bytes(&bytes).map_err(|e| match e {
             InferError::ModelFile { message, .. } => InferError::ModelFile {
                 path: path.to_path_buf(),

@@ -9,8 +9,8 @@
 
 use crate::error::{InferError, Result};
 use rayon::prelude::*;
-use spdcam_core::feature_check;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_core::{feature_check, limits};
 use std::io::{Read, Write};
 use std::path::Path;
 
@@ -52,7 +52,8 @@ impl FeatureStream {
         FeatureStream::new(Box::new(file), &path.display().to_string())
     }
 
-    /// A stream over `input`, named `source` in errors; reads the header.
+    /// A stream over `input`, named `source` in errors; reads the header, refusing one of
+    /// more than [`limits::CSV_COLUMNS`] columns as soon as it has read that many.
     pub fn new(input: Box<dyn Read + Send>, source: &str) -> Result<FeatureStream> {
         let mut stream = FeatureStream {
             input,
@@ -62,18 +63,31 @@ impl FeatureStream {
             line: 1,
             finished: false,
         };
+        let max_columns = limits::CSV_COLUMNS.value();
+        // Bytes of the header looked at so far, and the separators among them.
+        let (mut scanned, mut separators) = (0, 0u64);
         let header = loop {
-            if let Some(end) = stream.pending.iter().position(|&b| b == b'\n') {
-                let header: Vec<u8> = stream.pending.drain(..=end).collect();
+            let fresh = &stream.pending[scanned..];
+            if let Some(end) = fresh.iter().position(|&b| b == b'\n') {
+                let header: Vec<u8> = stream.pending.drain(..=scanned + end).collect();
                 break header;
             }
             if stream.finished {
                 break std::mem::take(&mut stream.pending);
             }
+            separators += fresh.iter().filter(|&&b| b == b',').count() as u64;
+            scanned = stream.pending.len();
+            if separators >= max_columns {
+                return Err(limits::CSV_COLUMNS
+                    .exceeded(&format!("{source}, line 1"))
+                    .into());
+            }
+            stream.check_line_length(1)?;
             stream.fill()?;
         };
         stream.line = 2;
         let names = parse_quoted(&header).map_err(|e| stream.error(1, e))?;
+        limits::check_csv_columns(names.len(), source)?;
         if names.iter().all(String::is_empty) {
             return Err(InferError::invalid(format!(
                 "{}: the file is empty",
@@ -109,6 +123,18 @@ impl FeatureStream {
         Ok(())
     }
 
+    /// Refuses a line (`line`, still unfinished in `pending`) longer than
+    /// [`limits::TEXT_FILE_BYTES`]: a stream without line breaks (`/dev/zero`) must not
+    /// fill the memory.
+    fn check_line_length(&self, line: usize) -> Result<()> {
+        if self.pending.len() as u64 > limits::TEXT_FILE_BYTES.value() {
+            return Err(limits::TEXT_FILE_BYTES
+                .exceeded(&format!("{} line {line} (one line)", self.source))
+                .into());
+        }
+        Ok(())
+    }
+
     fn error(&self, line: usize, message: String) -> InferError {
         InferError::invalid(format!("{} line {line}: {message}", self.source))
     }
@@ -128,7 +154,10 @@ impl FeatureStream {
                     Some(end) => end + 1,
                     None if self.finished => self.pending.len(),
                     // One line longer than a block: read on.
-                    None => continue,
+                    None => {
+                        self.check_line_length(self.line)?;
+                        continue;
+                    }
                 }
             };
             let text: Vec<u8> = self.pending.drain(..cut).collect();

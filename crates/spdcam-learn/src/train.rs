@@ -664,13 +664,18 @@ fn fit_network(
             });
         }
         let seconds = t0.elapsed().as_secs_f64();
-        let snapshot = net.to_network(&init)?;
+        if !loss_sum.is_finite() {
+            return Err(diverged(epoch, "the training loss", lr));
+        }
+        // The network is built from its own architecture, so the only way its parameters
+        // fail the model's checks is by holding non-finite values.
+        let snapshot = net
+            .to_network(&init)
+            .map_err(|e| diverged(epoch, &format!("the parameters ({e})"), lr))?;
         let outputs = snapshot.forward(&val.x)?;
         let (val_loss, val_gfc) = score(fitted, &outputs, &val.y, &val.spds)?;
         if !val_loss.is_finite() {
-            return Err(LearnError::Numerical(format!(
-                "training diverged at epoch {epoch} (validation loss {val_loss}); try a smaller learning rate"
-            )));
+            return Err(diverged(epoch, "the validation loss", lr));
         }
         let record = EpochRecord {
             epoch,
@@ -700,6 +705,15 @@ fn fit_network(
     }
     let (_, network, epoch) = best.ok_or_else(|| LearnError::invalid("no epoch was run"))?;
     Ok((network, log, epoch))
+}
+
+/// The error of a training whose loss or parameters became non-finite (`what`) at `epoch`.
+fn diverged(epoch: usize, what: &str, lr: f64) -> LearnError {
+    LearnError::Numerical(format!(
+        "training diverged at epoch {epoch}: {what} became non-finite (NaN or infinite); \
+         try a smaller learning rate than {} (--lr)",
+        spdcam_core::error::short_number(lr)
+    ))
 }
 
 /// How to fine-tune a model on new data (the thesis's transfer learning, section 6.4).

@@ -68,8 +68,7 @@ pub fn photos(measured: &MeasuredPhotos, indices: &[usize]) -> Vec<CalibrationPh
 
 /// Reads an in-camera stage written by `spdcam calibrate` (or a bare in-camera JSON object).
 pub fn read_in_camera(path: &Path) -> Result<InCamera> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text = spdcam_core::fsio::read_text(path)?;
     let value: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
     let inner = value.get("in_camera").cloned().unwrap_or(value);

@@ -340,7 +340,10 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             .map(Estimate::to_json)
             .collect::<spdcam_infer::Result<Vec<_>>>()?;
         println!("{}", serde_json::to_string_pretty(&json)?);
-    } else if !quiet(&args) {
+    }
+    if quiet(&args) {
+        verdicts_to_stderr(&estimates);
+    } else {
         print_estimates(&estimates, &args);
     }
     if failed > 0 {
@@ -563,6 +566,20 @@ fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimator) -> Resu
         write_plot(plot, &spds_band_svg(&title, &grid, &series, &bands)?)?;
     }
     if quiet(args) {
+        let judged = run
+            .first
+            .iter()
+            .map(|(name, _, _, trust)| (name.as_str(), trust));
+        for (name, trust) in judged {
+            eprintln!("{}", verdict_line(name, trust));
+        }
+        if run.rows > run.first.len() {
+            eprintln!(
+                "(verdicts of the first {} of {} rows; --json gives every one)",
+                run.first.len(),
+                run.rows
+            );
+        }
         return Ok(());
     }
     if detailed {
@@ -725,6 +742,29 @@ fn report_item(
 fn write_report(path: &Path, title: &str, items: &[ReportItem]) -> Result<()> {
     fsio::write_atomic(path, report_html(title, items).as_bytes())?;
     Ok(())
+}
+
+/// With the data on standard output (`-o -`, `--json`), each estimate's verdict on standard
+/// error, so that whoever runs the command still hears that an estimate is unusable.
+fn verdicts_to_stderr(estimates: &[Estimate]) {
+    for e in estimates {
+        if let Some(t) = &e.trust {
+            eprintln!("{}", verdict_line(&e.name, t));
+        }
+    }
+}
+
+/// `name: UNUSABLE, no estimate to rely on; verdict: unusable (reasons)`, or
+/// `name: verdict: ok` — the verdict of one estimate on one line.
+fn verdict_line(name: &str, t: &Trust) -> String {
+    if t.verdict == Verdict::Unusable {
+        format!(
+            "{name}: UNUSABLE, no estimate to rely on; {}",
+            trust_line(t)
+        )
+    } else {
+        format!("{name}: {}", trust_line(t))
+    }
 }
 
 /// The verdict and its reasons on one line: `verdict: doubtful (2 of 24 patches are …)`.

@@ -198,6 +198,7 @@ fn worst_case_image(model: &Model, e: &Evaluation, data_dir: &DataDir) -> Result
 /// Runs `spdcam evaluate`.
 pub fn run(args: EvaluateArgs, data_dir: &DataDir) -> Result<()> {
     check_report_dir(&args.output, args.force)?;
+    spdcam_core::fsio::check_output_apart(&args.output, &[&args.data, &args.model])?;
     let model = Model::load(&args.model)?;
     let set = TrainingSet::load(&args.data)?;
     let e = evaluate(&model, &set)?;

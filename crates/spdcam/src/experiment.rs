@@ -242,6 +242,7 @@ fn thesis(args: ThesisArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<
             bail!("give --thesis-data DIR, or --data-dir / SPDCAM_DATA holding thesis/")
         }
     };
+    spdcam_core::fsio::check_output_apart(&args.output, &[&root])?;
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("creating {}", args.output.display()))?;
     let grid = Grid::parse(&args.grid)?;

@@ -123,9 +123,30 @@ fn report_plan(plan: &Plan, output: &Path, chunk_size: u64) {
     }
 }
 
+/// The files and directories the run reads that the options name: the in-camera
+/// rendering, the camera split, and a camera, camera pool or lighting file given as a path
+/// (`leds:FILE`); the output must lie apart from them.
+fn input_files(args: &GenerateArgs) -> Vec<PathBuf> {
+    let named = [
+        Some(args.camera.camera.as_str()),
+        args.cameras.as_deref(),
+        args.lighting.split_once(':').map(|(_, rest)| rest),
+    ];
+    args.in_camera
+        .iter()
+        .chain(&args.camera_split)
+        .cloned()
+        .chain(named.into_iter().flatten().map(PathBuf::from))
+        .filter(|p| p.exists())
+        .collect()
+}
+
 /// Runs `spdcam generate`.
 pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
     let grid = Grid::SIMULATION;
+    let inputs = input_files(&args);
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    spdcam_core::fsio::check_output_apart(&args.output, &inputs)?;
     let options = GenerateOptions {
         count: args.count,
         seed: args.seed,

@@ -21,6 +21,7 @@ mod finetune;
 mod generate;
 mod lamps;
 mod list;
+mod messages;
 mod metrics;
 mod photo_args;
 mod plot_file;

@@ -1,5 +1,6 @@
 //! `spdcam render`: one chart under one light through the virtual camera.
 
+use crate::messages::Messages;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
@@ -8,8 +9,9 @@ use spdcam_core::camera::demosaic::DemosaicMethod;
 use spdcam_core::camera::noise::NoiseParams;
 use spdcam_core::camera::sensor::{Sensitivities, SensorMode};
 use spdcam_core::camera::white_balance::WhiteBalance;
-use spdcam_core::camera::{Camera, CameraConfig, WhiteBalanceStatistics};
+use spdcam_core::camera::{Camera, CameraConfig, WhiteBalanceStatistics, MAX_EXPOSURE};
 use spdcam_core::chart::{Chart, Layout};
+use spdcam_core::error::short_number;
 use spdcam_core::lighting::Lighting;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
@@ -44,7 +46,7 @@ pub struct CameraArgs {
     /// Sensor: a Bayer pattern (rggb, bggr, grbg, gbrg) or `three` for three sensors.
     #[arg(long, default_value = "rggb")]
     pub sensor: SensorMode,
-    /// Brightest raw value as a fraction of full scale (> 0; above 1 clips).
+    /// Brightest raw value as a fraction of full scale (0 < e ≤ 100; above 1 clips).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub exposure: f64,
     /// Noise preset: thesis, phone, or off.
@@ -92,10 +94,11 @@ fn parse_pair(text: &str, what: &str) -> Result<(usize, usize)> {
 impl CameraArgs {
     /// The camera settings these options describe.
     pub fn config(&self) -> Result<CameraConfig> {
-        if !(self.exposure.is_finite() && self.exposure > 0.0) {
+        if !(self.exposure > 0.0 && self.exposure <= MAX_EXPOSURE) {
             bail!(
-                "--exposure {} is not a positive fraction of full scale (e.g. 0.8, or 1.5 to clip)",
-                self.exposure
+                "--exposure {} is not a positive fraction of full scale up to {MAX_EXPOSURE} \
+                 (e.g. 0.8, or 1.5 to clip)",
+                short_number(self.exposure)
             );
         }
         let noise = match self.noise.as_str() {
@@ -215,6 +218,9 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
     if fsio::is_stdout(&args.output) && args.features.as_deref().is_some_and(fsio::is_stdout) {
         bail!("only one of -o and --features can go to standard output");
     }
+    let messages = Messages::new(
+        fsio::is_stdout(&args.output) || args.features.as_deref().is_some_and(fsio::is_stdout),
+    );
     if let Some(dir) = &args.stages {
         // Made here, before the render, so a bad place fails at once.
         std::fs::create_dir_all(dir)
@@ -262,16 +268,27 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
     if let Some(path) = &args.spd_out {
         let values = spd.spd.normalised_by_max().into_values();
         SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?.write_csv(path)?;
-        println!("light SPD: {}", path.display());
+        messages.say(format_args!("light SPD: {}", path.display()));
     }
     if let Some((width, height)) = scene {
-        return render_scene(&args, &spd.spd, &spd.name, (width, height), data_dir);
+        return render_scene(
+            &args,
+            &spd.spd,
+            &spd.name,
+            (width, height),
+            data_dir,
+            messages,
+        );
     }
     let camera = args.camera.camera(data_dir, &grid)?;
     let rendering = camera.render(&spd.spd, args.seed, args.stages.is_some())?;
     let depth = camera.config().colour.bit_depth;
     if let Some(dir) = &args.stages {
         write_stages(dir, &rendering.stages)?;
+        messages.say(format_args!(
+            "stages (linear raw, 16-bit): {}",
+            dir.display()
+        ));
     }
     if let Some(path) = &args.features {
         let names = camera.chart().feature_names();
@@ -279,7 +296,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         let text = format!("{}\n{}\n", names.join(","), values.join(","));
         fsio::write_output(path, text.as_bytes())?;
         if !fsio::is_stdout(path) {
-            println!("features: {}", path.display());
+            messages.say(format_args!("features: {}", path.display()));
         }
     }
     fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
@@ -287,7 +304,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         return Ok(());
     }
     let l = &camera.chart().layout;
-    println!(
+    messages.say(format_args!(
         "rendered {} under {} with {} ({}×{} px, {}-bit sRGB): {}",
         camera.chart().name,
         spd.name,
@@ -296,7 +313,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         l.height,
         depth,
         args.output.display()
-    );
+    ));
     Ok(())
 }
 
@@ -307,6 +324,7 @@ fn render_scene(
     light_name: &str,
     (width, height): (usize, usize),
     data_dir: &DataDir,
+    messages: Messages,
 ) -> Result<()> {
     let grid = Grid::SIMULATION;
     let chart = args.camera.chart(data_dir, &grid)?;
@@ -329,13 +347,13 @@ fn render_scene(
         .iter()
         .map(|[x, y]| format!("{x:.1},{y:.1}"))
         .collect();
-    println!(
+    messages.say(format_args!(
         "photographed {} under {light_name} with {} in a {width}×{height} scene: {} (chart corners {})",
         chart.name,
         camera.camera_name(),
         args.output.display(),
         corners.join(",")
-    );
+    ));
     Ok(())
 }
 
@@ -352,6 +370,5 @@ fn write_stages(dir: &Path, stages: &spdcam_core::camera::Stages) -> Result<()> 
             imageio::write_png(&dir.join(name), image, 16)?;
         }
     }
-    println!("stages (linear raw, 16-bit): {}", dir.display());
     Ok(())
 }

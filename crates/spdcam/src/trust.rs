@@ -1171,8 +1171,7 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
     md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable | mean GFC: ok / doubtful |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     let mut diagram = Vec::new();
     for ((path, model, chart_name), cal_path) in models.iter().zip(&args.calibration) {
-        let text = std::fs::read_to_string(cal_path)
-            .with_context(|| format!("reading {}", cal_path.display()))?;
+        let text = spdcam_core::fsio::read_text(cal_path)?;
         let cal = Calibration::from_json(&text, &cal_path.display().to_string())?;
         if cal.model != model.fingerprint() {
             bail!(

@@ -50,6 +50,11 @@ use serde::{Deserialize, Serialize};
 use tone::ToneRendering;
 use white_balance::{RegionGeometry, WhiteBalance};
 
+/// The largest exposure (fraction of full scale the brightest raw value is scaled to):
+/// above 1 the brightest patches clip; at 100 every patch brighter than 1 % of the
+/// brightest does, beyond which a photo holds nothing more.
+pub const MAX_EXPOSURE: f64 = 100.0;
+
 /// Every setting of the camera, one field per stage; `None` switches a stage off.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CameraConfig {
@@ -198,10 +203,12 @@ impl Camera {
         if let Some(noise) = &config.noise {
             noise.validate()?;
         }
-        if !(config.sensor.exposure > 0.0 && config.sensor.exposure <= 1.0) {
+        let exposure = config.sensor.exposure;
+        if !(exposure > 0.0 && exposure <= MAX_EXPOSURE) {
             return Err(Error::invalid(format!(
-                "exposure {} is outside (0, 1]",
-                config.sensor.exposure
+                "exposure {} is outside (0, {MAX_EXPOSURE}]: a fraction of full scale, above \
+                 1 the brightest patches clip",
+                crate::error::short_number(exposure)
             )));
         }
         if let Some(ic) = &config.in_camera {

@@ -143,7 +143,7 @@ pub struct SensorConfig {
     /// One Bayer sensor (demosaiced) or three full-resolution sensors.
     pub mode: SensorMode,
     /// The brightest raw value is scaled to this fraction of full scale (the thesis
-    /// normalises to the maximum: 1.0).
+    /// normalises to the maximum: 1.0); above 1 the brightest patches clip.
     pub exposure: f64,
 }
 

@@ -52,6 +52,7 @@ fn header(reader: &mut csv::Reader<std::fs::File>, path: &Path) -> Result<Vec<St
     let header = reader
         .headers()
         .map_err(|e| Error::parse(path.display().to_string(), format!("line 1: {e}")))?;
+    crate::limits::check_csv_columns(header.len(), &path.display().to_string())?;
     let names: Vec<String> = header.iter().map(str::to_string).collect();
     if names.iter().all(String::is_empty) {
         return Err(Error::parse(
@@ -219,7 +220,7 @@ pub fn import_csv(
     columns
         .validate()
         .map_err(|e| Error::parse(features.display().to_string(), e.to_string()))?;
-    let output = prepare_output(out, overwrite)?;
+    let output = prepare_output(out, &[features, spds], overwrite)?;
     let mut writer = DatasetWriter::new(out, columns.clone(), options.chunk_size)?;
     let mut feature_rows = feature_reader.records();
     let mut spd_rows = spd_reader.records();
@@ -493,7 +494,7 @@ pub fn export_csv(
     let columns = dataset.columns();
     let grid = options.spd_grid.unwrap_or(columns.spd_grid);
     let map = SpdMap::new(&columns.spd_grid.wavelengths(), &grid)?;
-    let output = prepare_output(out, overwrite)?;
+    let output = prepare_output(out, &[dataset.dir()], overwrite)?;
     let mut written = Vec::new();
 
     let path = out.join("features.csv");

@@ -75,6 +75,80 @@ fn check_coverage(settings: &GenerateSettings, shards: &[&Dataset]) -> Result<()
     Ok(())
 }
 
+/// The generate runs whose samples `origin` holds: its own, or those of the datasets it
+/// merged. (A split part holds only some of its source's samples, so it is not looked into.)
+fn generated_runs(origin: &Origin) -> Vec<&GenerateSettings> {
+    match origin {
+        Origin::Generated(s) => vec![s.as_ref()],
+        Origin::Merged { sources } => sources.iter().flat_map(generated_runs).collect(),
+        Origin::Imported(_) | Origin::Split { .. } => Vec::new(),
+    }
+}
+
+/// Whether two runs draw the same sample for the same number: everything that makes a
+/// sample equal (seed, lighting, camera, chart, pipeline, grid, randomisation), whatever
+/// the count, the shard or the file size.
+fn same_draws(a: &GenerateSettings, b: &GenerateSettings) -> bool {
+    let draws = |s: &GenerateSettings| GenerateSettings {
+        count: 0,
+        shard: None,
+        sample_range: [0, 0],
+        chunk_size: 0,
+        images: false,
+        ..s.clone()
+    };
+    draws(a) == draws(b)
+}
+
+/// Refuses two inputs that hold the same samples: overlapping samples of one generate run
+/// (a dataset given twice, a copy of it, runs with the same seed and settings), the same
+/// part of one split, or identical sample files. Merging them would hold each sample twice,
+/// and a split of the result would put copies in both train and test.
+fn check_distinct(inputs: &[Dataset]) -> Result<()> {
+    for (i, a) in inputs.iter().enumerate() {
+        for b in &inputs[i + 1..] {
+            let (ma, mb) = (a.manifest(), b.manifest());
+            let shown = || format!("{} and {}", a.dir().display(), b.dir().display());
+            for ra in generated_runs(&ma.origin) {
+                for rb in generated_runs(&mb.origin) {
+                    let start = ra.sample_range[0].max(rb.sample_range[0]);
+                    let end = ra.sample_range[1].min(rb.sample_range[1]);
+                    if same_draws(ra, rb) && start < end {
+                        return Err(Error::invalid(format!(
+                            "{} hold the same samples: numbers {start}–{} of one generate run \
+                             (lighting {}, seed {}); merging would hold each of them twice. \
+                             Give each dataset once, or generate with another --seed",
+                            shown(),
+                            end - 1,
+                            ra.lighting.spec,
+                            ra.seed
+                        )));
+                    }
+                }
+            }
+            if matches!(ma.origin, Origin::Split { .. }) && ma.origin == mb.origin {
+                return Err(Error::invalid(format!(
+                    "{} are the same part of one split: merging would hold each sample twice",
+                    shown()
+                )));
+            }
+            let shared = ma
+                .files
+                .iter()
+                .find(|f| f.sha256.is_some() && mb.files.iter().any(|g| g.sha256 == f.sha256));
+            if let Some(file) = shared {
+                return Err(Error::invalid(format!(
+                    "{} hold identical sample files ({} of the first): merging would hold \
+                     its samples twice",
+                    shown(),
+                    file.name
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The columns all inputs share (features stored in the widest precision of any input).
 fn common_columns(inputs: &[Dataset]) -> Result<Columns> {
     let first = inputs[0].columns();
@@ -122,18 +196,13 @@ pub fn merge(
     if inputs.is_empty() {
         return Err(Error::invalid("merge needs at least one dataset"));
     }
-    if let Ok(target) = out.canonicalize() {
-        if let Some(d) = inputs
-            .iter()
-            .find(|d| d.dir().canonicalize().is_ok_and(|p| p == target))
-        {
-            return Err(Error::invalid(format!(
-                "the output {} is one of the inputs",
-                d.dir().display()
-            )));
-        }
+    let dirs: Vec<&Path> = inputs.iter().map(Dataset::dir).collect();
+    crate::fsio::check_output_apart(out, &dirs)?;
+    let shards = shards_of_one_run(inputs);
+    if shards.is_none() {
+        check_distinct(inputs)?;
     }
-    let (ordered, columns, chunk_size, origin) = match shards_of_one_run(inputs) {
+    let (ordered, columns, chunk_size, origin) = match shards {
         Some((settings, shards)) => {
             check_coverage(&settings, &shards)?;
             let columns = shards[0].columns().clone();
@@ -153,7 +222,7 @@ pub fn merge(
             },
         ),
     };
-    let output = prepare_output(out, overwrite)?;
+    let output = prepare_output(out, &dirs, overwrite)?;
     let mut writer = DatasetWriter::new(out, columns, chunk_size)?;
     for dataset in ordered {
         for batch in dataset.batches() {

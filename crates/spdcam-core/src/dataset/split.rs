@@ -50,7 +50,7 @@ pub fn split(
     progress: &dyn Fn(u64),
 ) -> Result<[Manifest; 3]> {
     let parts = assign_parts(input.len(), fractions, seed)?;
-    let output = prepare_output(out, overwrite)?;
+    let output = prepare_output(out, &[input.dir()], overwrite)?;
     let dirs = SPLIT_PARTS.map(|p| out.join(p));
     for dir in &dirs {
         ensure_dir(dir)?;

@@ -171,9 +171,12 @@ impl Drop for Output {
     }
 }
 
-/// Makes `dir` ready for new output and locks it: creates it, or, when it holds files,
-/// refuses unless `overwrite`, which removes what spdcam wrote there before.
-pub(crate) fn prepare_output(dir: &Path, overwrite: bool) -> Result<Output> {
+/// Makes `dir` ready for new output and locks it: refuses it when it is, holds or lies
+/// inside one of `inputs` ([`fsio::check_output_apart`]), before anything is touched;
+/// creates it, or, when it holds files, refuses unless `overwrite`, which removes what
+/// spdcam wrote there before.
+pub(crate) fn prepare_output(dir: &Path, inputs: &[&Path], overwrite: bool) -> Result<Output> {
+    fsio::check_output_apart(dir, inputs)?;
     let created = ensure_dir(dir)?;
     let lock = DirLock::acquire(dir)?;
     clear_output(dir, overwrite)?;

@@ -28,6 +28,7 @@ pub fn best_gfc(lighting: &Lighting, seed: u64, n: u64, targets: &[Spd]) -> Resu
     if n == 0 {
         return Err(Error::invalid("coverage needs at least one draw"));
     }
+    crate::limits::DRAWS.check(n, &format!("coverage of '{}'", lighting.spec()))?;
     let keep = visible(lighting);
     let targets = targets
         .iter()

@@ -153,7 +153,7 @@ impl LampLibrary {
 /// The type of each of `names` from an info table `column,type[,category]`.
 fn read_types(path: &Path, names: &[String]) -> Result<Vec<LampType>> {
     let source = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = crate::fsio::read_text(path)?;
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)

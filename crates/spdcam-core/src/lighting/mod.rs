@@ -415,7 +415,7 @@ fn parse_lamp(rest: &str, spec: &str, grid: &Grid) -> Result<LampDraws> {
                 })?
             }
             Some(("fits", path)) => {
-                let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+                let text = crate::fsio::read_text(std::path::Path::new(path))?;
                 fits = Some(LampFits::from_json(&text, path)?);
             }
             _ => {

@@ -158,7 +158,7 @@ impl ValidationSplit {
 
     /// Reads a split written by [`ValidationSplit::write`].
     pub fn read(path: &Path) -> Result<ValidationSplit> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::fsio::read_text(path)?;
         let split: ValidationSplit = serde_json::from_str(&text).map_err(|e| {
             Error::parse(
                 path.display().to_string(),

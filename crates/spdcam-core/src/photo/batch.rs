@@ -71,8 +71,19 @@ pub fn analyse_photo(path: &Path, options: &AnalyseOptions) -> Result<PhotoAnaly
     analyse(&photo, options)
 }
 
-/// [`analyse_photo`] for a decoded photo.
+/// [`analyse_photo`] for a decoded photo. When it fails, the error tells what the decoder
+/// noticed too (a truncated or corrupt file explains a chart not found).
 pub fn analyse(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnalysis> {
+    analyse_decoded(photo, options).map_err(|e| {
+        if photo.warnings.is_empty() {
+            e
+        } else {
+            Error::invalid(format!("{e}; note: {}", photo.warnings.join("; ")))
+        }
+    })
+}
+
+fn analyse_decoded(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnalysis> {
     let templates = &options.templates;
     let Some(first) = templates.first() else {
         return Err(Error::invalid("no chart to look for"));

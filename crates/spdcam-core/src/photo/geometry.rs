@@ -1,7 +1,7 @@
 //! Plane geometry: homographies fitted by normalised least squares (DLT), and checks on the
 //! four corners a user gives.
 
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// A plane projective map `p' ~ H p`, stored row-major with `h[2][2] = 1` where possible.
@@ -184,8 +184,8 @@ pub fn sort_corners(corners: &[[f64; 2]], width: usize, height: usize) -> Result
             return Err(Error::invalid(format!(
                 "corner {} ({}, {}) lies outside the {width}×{height} image",
                 i + 1,
-                p[0],
-                p[1]
+                short_number(p[0]),
+                short_number(p[1])
             )));
         }
     }

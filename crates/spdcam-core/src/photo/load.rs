@@ -3,16 +3,21 @@
 
 use super::exposure::Exposure;
 use crate::error::{Error, Result};
-use crate::limits;
+use crate::{fsio, limits};
 use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader};
 use std::io::Cursor;
 use std::path::Path;
 
 /// Smallest width and height of a photo that can show a chart.
 pub const MIN_PHOTO_SIDE: usize = 16;
-/// Largest memory the decoder may allocate (a 50-megapixel 16-bit RGBA photo needs 400 MB),
-/// and the largest photo file read; a safety net below [`limits::IMAGE_PIXELS`].
-const MAX_DECODE_BYTES: u64 = 1 << 30;
+/// Bytes the decoder may allocate per pixel allowed by [`limits::IMAGE_PIXELS`]: a 16-bit
+/// RGBA pixel; a safety net behind the pixel count checked from the header.
+const DECODE_BYTES_PER_PIXEL: u64 = 8;
+/// What [`JpegEnd::Truncated`] means, for messages.
+const TRUNCATED: &str = "the JPEG file is truncated (it ends before its end-of-image marker)";
+/// What [`JpegEnd::Corrupt`] means, for messages.
+const CORRUPT: &str = "the JPEG data is corrupt (a damaged byte breaks its marker segments, \
+     though the file is complete)";
 /// Bytes of a 16-bit RGB pixel, the widest a photo is kept in.
 const RGB16_BYTES: u64 = 6;
 
@@ -183,23 +188,11 @@ fn drop_alpha<T: Copy>(mut rgba: Vec<T>) -> Vec<T> {
     rgba
 }
 
-/// Reads a photo file (JPEG, PNG 8/16-bit, TIFF; format from the content), applying its
-/// EXIF orientation.
+/// Reads a photo (JPEG, PNG 8/16-bit, TIFF; format from the content) from a file, a pipe
+/// or a device, at most [`limits::PHOTO_BYTES`] of it, applying its EXIF orientation.
 pub fn load_photo(path: &Path) -> Result<Photo> {
-    let size = std::fs::metadata(path)
-        .map_err(|e| Error::io(path, e))?
-        .len();
-    let source = path.display().to_string();
-    if size > MAX_DECODE_BYTES {
-        return Err(Error::Image {
-            context: source,
-            message: format!(
-                "the file is {size} bytes, more than any photo up to the pixel limit holds"
-            ),
-        });
-    }
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    decode_photo(&bytes, &source)
+    let bytes = fsio::read_limited(path, &limits::PHOTO_BYTES)?;
+    decode_photo(&bytes, &path.display().to_string())
 }
 
 /// Decodes a photo held in memory; `source` names it in messages. The pixel count is read
@@ -220,7 +213,7 @@ pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
     };
     let max_pixels = limits::IMAGE_PIXELS.value();
     let mut decode_limits = image::Limits::default();
-    decode_limits.max_alloc = Some(MAX_DECODE_BYTES);
+    decode_limits.max_alloc = Some(max_pixels.saturating_mul(DECODE_BYTES_PER_PIXEL));
     reader.limits(decode_limits);
     let mut decoder = reader
         .into_decoder()
@@ -247,40 +240,84 @@ pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
         .ok()
         .flatten()
         .and_then(Exposure::from_exif);
-    let mut image = DynamicImage::from_decoder(decoder)
-        .map_err(|e| image_error(format!("cannot decode (damaged or truncated?): {e}")))?;
+    let end = if format == ImageFormat::Jpeg {
+        jpeg_end(bytes)
+    } else {
+        JpegEnd::Complete
+    };
+    let mut image = DynamicImage::from_decoder(decoder).map_err(|e| {
+        image_error(match end {
+            JpegEnd::Truncated => format!("cannot decode: {e} ({TRUNCATED})"),
+            JpegEnd::Corrupt => format!("cannot decode: {e} ({CORRUPT})"),
+            JpegEnd::Complete => format!("cannot decode (damaged or truncated?): {e}"),
+        })
+    })?;
     image.apply_orientation(orientation);
     let mut photo = Photo::from_image(source, image)?;
     photo.exposure = exposure;
-    if format == ImageFormat::Jpeg && jpeg_is_truncated(bytes) {
-        photo.warnings.push(
-            "the JPEG file is truncated (it ends before its end-of-image marker); the \
-             missing part of the picture is filled in by the decoder"
-                .to_string(),
-        );
+    match end {
+        JpegEnd::Truncated => photo.warnings.push(format!(
+            "{TRUNCATED}; the missing part of the picture is filled in by the decoder"
+        )),
+        JpegEnd::Corrupt => photo.warnings.push(format!(
+            "{CORRUPT}; the decoder read past it, and part of the picture may be wrong"
+        )),
+        JpegEnd::Complete => {}
     }
     Ok(photo)
 }
 
-/// Whether a JPEG stream ends before its end-of-image marker (ITU-T T.81, B.1.1): walks
-/// the marker segments, skipping each segment by its length and the entropy-coded data
-/// after each start-of-scan, and reports whether the data ran out before EOI (`FF D9`).
-pub fn jpeg_is_truncated(bytes: &[u8]) -> bool {
+/// How a JPEG stream ends, judged from its markers (ITU-T T.81, B.1.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JpegEnd {
+    /// The marker segments lead to the end-of-image marker (`FF D9`); anything after it
+    /// (as some phones append) is ignored.
+    Complete,
+    /// The data ends before the end-of-image marker: the file was cut.
+    Truncated,
+    /// The marker segments do not lead to the end-of-image marker though the file holds
+    /// one after its image data: a damaged byte (a flipped bit) broke a marker or a
+    /// segment's length.
+    Corrupt,
+}
+
+/// How the JPEG stream `bytes` ends ([`JpegEnd`]); not a JPEG counts as complete.
+pub fn jpeg_end(bytes: &[u8]) -> JpegEnd {
+    const EOI: [u8; 2] = [0xFF, 0xD9];
     if !bytes.starts_with(&[0xFF, 0xD8]) {
-        return false;
+        return JpegEnd::Complete;
     }
+    match walk_jpeg_markers(bytes) {
+        Ok(()) => JpegEnd::Complete,
+        // Entropy-coded data never holds FF D9 (a 0xFF is followed by 0x00 or a restart
+        // code), so an end-of-image marker after the first scan's start is the real end.
+        Err(Some(scan)) if bytes[scan..].windows(2).any(|w| w == EOI) => JpegEnd::Corrupt,
+        Err(None) if bytes.ends_with(&EOI) => JpegEnd::Corrupt,
+        Err(_) => JpegEnd::Truncated,
+    }
+}
+
+/// Walks the marker segments of a JPEG stream, skipping each segment by its length and the
+/// entropy-coded data after each start-of-scan: `Ok` on reaching the end-of-image marker,
+/// else `Err` with where the first scan's data begins, when one was reached.
+fn walk_jpeg_markers(bytes: &[u8]) -> std::result::Result<(), Option<usize>> {
     let mut i = 2;
+    let mut first_scan = None;
     loop {
-        // A marker: one or more 0xFF fill bytes, then its code.
+        // A marker: one or more 0xFF fill bytes, then its code; anything else where a
+        // marker belongs means the structure is broken.
+        if bytes.get(i) != Some(&0xFF) {
+            return Err(first_scan);
+        }
         while i < bytes.len() && bytes[i] == 0xFF {
             i += 1;
         }
         let Some(&code) = bytes.get(i) else {
-            return true;
+            return Err(first_scan);
         };
         i += 1;
         match code {
-            0xD9 => return false,
+            0xD9 => return Ok(()),
             0x01 | 0xD0..=0xD7 => continue,
             _ => {}
         }
@@ -288,18 +325,19 @@ pub fn jpeg_is_truncated(bytes: &[u8]) -> bool {
             .get(i..i + 2)
             .map(|b| u16::from_be_bytes([b[0], b[1]]))
         else {
-            return true;
+            return Err(first_scan);
         };
         i += len as usize;
         if i > bytes.len() {
-            return true;
+            return Err(first_scan);
         }
         if code == 0xDA {
+            first_scan.get_or_insert(i);
             // Entropy-coded data: ends at the first 0xFF not followed by 0x00 (stuffing) or
             // a restart marker.
             loop {
                 match bytes.get(i..i + 2) {
-                    None => return true,
+                    None => return Err(first_scan),
                     Some([0xFF, next]) if *next != 0x00 && !(0xD0..=0xD7).contains(next) => break,
                     _ => i += 1,
                 }
@@ -345,14 +383,14 @@ mod tests {
     fn truncated_jpegs_decode_with_a_warning() {
         // Issue 15: JPEGs cut at 90 % and 99 % decoded without a word.
         let bytes = jpeg_of(64, 48);
-        assert!(!jpeg_is_truncated(&bytes));
+        assert_eq!(jpeg_end(&bytes), JpegEnd::Complete);
         assert!(decode_photo(&bytes, "whole.jpg")
             .unwrap()
             .warnings
             .is_empty());
         for percent in [50, 90, 99] {
             let cut = &bytes[..bytes.len() * percent / 100];
-            assert!(jpeg_is_truncated(cut), "{percent} %");
+            assert_eq!(jpeg_end(cut), JpegEnd::Truncated, "{percent} %");
             if let Ok(photo) = decode_photo(cut, "cut.jpg") {
                 assert!(
                     photo.warnings.iter().any(|w| w.contains("truncated")),
@@ -364,7 +402,7 @@ mod tests {
         // Data after the end-of-image marker (as some phones append) is not truncation.
         let mut trailing = bytes.clone();
         trailing.extend_from_slice(b"extra data");
-        assert!(!jpeg_is_truncated(&trailing));
+        assert_eq!(jpeg_end(&trailing), JpegEnd::Complete);
     }
 
     /// A PNG declaring `width × height` RGB pixels whose image data is one empty zlib

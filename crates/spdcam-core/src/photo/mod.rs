@@ -31,7 +31,7 @@ pub use batch::{
 pub use detect::{detect, detect_at, detect_traced, from_corners, SearchTrace, DETECTION_SIZE};
 pub use exposure::Exposure;
 pub use geometry::{sort_corners, Homography};
-pub use load::{decode_photo, load_photo, Photo, MIN_PHOTO_SIDE};
+pub use load::{decode_photo, jpeg_end, load_photo, JpegEnd, Photo, MIN_PHOTO_SIDE};
 pub use overlay::{analysis_overlay_jpeg, debug_overlay, write_overlay, OVERLAY_SIZE};
 pub use sample::{sample, PatchSample};
 

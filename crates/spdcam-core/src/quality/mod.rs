@@ -256,7 +256,39 @@ impl LightingMetrics {
         m.sp_ratio = Some(scotopic_photopic_ratio(light));
         m.ppf_per_lux = Some(ppf_per_lumen(light));
         m.blh_efficacy_w_per_lm = Some(blue_light_hazard_efficacy(light));
+        m.drop_non_finite();
         m
+    }
+
+    /// Makes a value that came out non-finite undefined, with a reason: no `NaN` (JSON
+    /// `null`) is ever left without saying why.
+    fn drop_non_finite(&mut self) {
+        let mut dropped = Vec::new();
+        for (key, value) in [
+            ("cct_k", &mut self.cct_k),
+            ("duv", &mut self.duv),
+            ("cri_ra", &mut self.cri_ra),
+            ("tm30_rf", &mut self.tm30_rf),
+            ("tm30_rg", &mut self.tm30_rg),
+            ("mel_der", &mut self.mel_der),
+            ("sp_ratio", &mut self.sp_ratio),
+            ("ppf_per_lux", &mut self.ppf_per_lux),
+            ("blh_efficacy_w_per_lm", &mut self.blh_efficacy_w_per_lm),
+        ] {
+            if value.is_some_and(|v| !v.is_finite()) {
+                *value = None;
+                dropped.push(key);
+            }
+        }
+        if self.cri_r.is_some_and(|r| r.iter().any(|v| !v.is_finite())) {
+            self.cri_r = None;
+            dropped.push("cri_r");
+        }
+        self.set_reason(
+            &dropped,
+            "the computation gave a non-finite number (the spectrum is beyond what double \
+             precision holds)",
+        );
     }
 
     /// The value of the single-number metric `key` (one of [`SCALAR_KEYS`]), `None` when it

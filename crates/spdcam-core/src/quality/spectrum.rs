@@ -1,7 +1,7 @@
 //! A light's spectrum on the grid the lighting-quality metrics work on.
 
 use crate::colorimetry::Observer;
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::spectral::{Extrapolation, Grid, Interpolation, ResampleReport, SpectralSet};
 use std::sync::OnceLock;
 
@@ -27,7 +27,10 @@ pub(crate) fn observer_2deg() -> &'static Observer {
 /// tristimulus values. Any sampling comes in: a regular grid of 6 or more samples is
 /// resampled with Sprague (1880) interpolation (CIE 167:2005, exact at the given samples),
 /// anything else linearly; wavelengths the data do not cover are zero (the light has no power
-/// there as far as anyone knows). Values are kept as given, small negatives included.
+/// there as far as anyone knows). Values are divided by the largest magnitude first (every
+/// metric is a ratio or a chromaticity, so none depends on the scale), so that an SPD in
+/// any units — 1e-320 or 1e308 per nm — gives the same metrics without under- or overflow
+/// in the sums; small negatives are kept.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightSpectrum {
     values: Vec<f64>,
@@ -76,21 +79,29 @@ impl LightSpectrum {
             .find(|(_, v)| **v < -NEGATIVE_TOLERANCE * peak || (peak == 0.0 && **v < 0.0))
         {
             return Err(Error::invalid(format!(
-                "spectrum '{name}' is negative ({v}) at {} nm; a light's SPD cannot be below \
-                 −1 % of its peak ({peak})",
-                w[i]
+                "spectrum '{name}' is negative ({}) at {} nm; a light's SPD cannot be below \
+                 −1 % of its peak ({})",
+                short_number(*v),
+                w[i],
+                short_number(peak)
             )));
         }
-        let values = if set.grid().is_some_and(|g| same_grid(&g, &QUALITY_GRID)) {
-            set.item(index).to_vec()
+        let magnitude = input.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = if magnitude > 0.0 {
+            1.0 / magnitude
         } else {
-            let one;
-            let single = if set.len() == 1 {
-                set
-            } else {
-                one = set.select(&[index]);
-                &one
-            };
+            1.0
+        };
+        let relative: Vec<f64> = if scale.is_finite() {
+            input.iter().map(|v| v * scale).collect()
+        } else {
+            // 1/magnitude overflows for the smallest subnormals: divide instead.
+            input.iter().map(|v| v / magnitude).collect()
+        };
+        let values = if set.grid().is_some_and(|g| same_grid(&g, &QUALITY_GRID)) {
+            relative
+        } else {
+            let single = SpectralSet::new(w.to_vec(), vec![name.clone()], vec![relative])?;
             let (resampled, _): (SpectralSet, ResampleReport) =
                 single.resample(&QUALITY_GRID, Interpolation::Auto, Extrapolation::Zero)?;
             resampled.item(0).to_vec()
@@ -111,12 +122,13 @@ impl LightSpectrum {
         })
     }
 
-    /// The values on [`QUALITY_GRID`].
+    /// The values on [`QUALITY_GRID`], divided by the input's largest magnitude.
     pub fn values(&self) -> &[f64] {
         &self.values
     }
 
-    /// CIE 1931 2° tristimulus values Σ S·x̄·Δλ etc. (CIE 015:2018), in the SPD's units × nm.
+    /// CIE 1931 2° tristimulus values Σ S·x̄·Δλ etc. (CIE 015:2018) of the SPD divided by its
+    /// largest magnitude, × nm.
     pub fn xyz(&self) -> [f64; 3] {
         self.xyz
     }
@@ -199,7 +211,7 @@ mod tests {
             .collect();
         let light = LightSpectrum::on_grid(&grid, &values).unwrap();
         assert_eq!(light.values().len(), 421);
-        assert!((light.values()[450 - 360] - 1.45).abs() < 1e-12);
+        assert!((light.values()[450 - 360] - 1.45 / 1.7).abs() < 1e-12);
         assert_eq!(light.values()[399 - 360], 0.0);
         assert_eq!(light.values()[701 - 360], 0.0);
         assert_eq!(light.source_range_nm(), (400.0, 700.0));

@@ -1,8 +1,8 @@
 //! Named spectra sharing one list of wavelengths, and the spectral CSV layout.
 
 use crate::error::{Error, Result};
-use crate::fsio;
 use crate::spectral::{Grid, Spd};
+use crate::{fsio, limits};
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -92,6 +92,13 @@ impl SpectralSet {
 
     /// Parses spectral CSV text; `source_name` (a path or built-in name) is used in errors.
     pub fn from_csv_str(text: &str, source_name: &str) -> Result<Self> {
+        SpectralSet::parse_csv(text, source_name, false)
+    }
+
+    /// [`SpectralSet::from_csv_str`]; with `limited`, refusing more than
+    /// [`limits::CSV_COLUMNS`] columns or [`limits::CSV_ROWS`] rows (text from outside; the
+    /// built-in tables are not limited).
+    fn parse_csv(text: &str, source_name: &str, limited: bool) -> Result<Self> {
         let err = |msg: String| Error::parse(source_name, msg);
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(false)
@@ -104,6 +111,9 @@ impl SpectralSet {
             None => return Err(err("the file is empty".into())),
             Some(r) => r.map_err(|e| err(format!("line 1: {e}")))?,
         };
+        if limited {
+            limits::check_csv_columns(header.len(), source_name)?;
+        }
         let first = header.get(0).unwrap_or("");
         if first.parse::<f64>().is_ok() {
             return Err(err(
@@ -127,8 +137,16 @@ impl SpectralSet {
         }
         let mut wavelengths = Vec::new();
         let mut values = vec![Vec::new(); names.len()];
+        let max_rows = if limited {
+            limits::CSV_ROWS.value()
+        } else {
+            u64::MAX
+        };
         for record in records {
             let record = record.map_err(|e| err(e.to_string()))?;
+            if wavelengths.len() as u64 >= max_rows {
+                return Err(limits::CSV_ROWS.exceeded(source_name));
+            }
             let line = record.position().map(|p| p.line()).unwrap_or(0);
             if record.iter().all(str::is_empty) {
                 continue;
@@ -171,10 +189,11 @@ impl SpectralSet {
         SpectralSet::new(wavelengths, names, values).map_err(|e| err(e.to_string()))
     }
 
-    /// Reads a spectral CSV file.
+    /// Reads a spectral CSV file (within [`limits::TEXT_FILE_BYTES`], [`limits::CSV_COLUMNS`]
+    /// and [`limits::CSV_ROWS`]).
     pub fn read_csv(path: &Path) -> Result<Self> {
         let text = fsio::read_text(path)?;
-        SpectralSet::from_csv_str(&text, &path.display().to_string())
+        SpectralSet::parse_csv(&text, &path.display().to_string(), true)
     }
 
     /// The set as spectral CSV text.

@@ -1,0 +1,29 @@
+//! Where a command's human messages go: standard output, unless standard output carries
+//! the command's data (`-o -`, `--features -`, `--json`), when they go to standard error so
+//! that the data stays clean for the program reading it.
+
+use std::fmt::Display;
+
+/// The destination of a command's messages for one run.
+#[derive(Debug, Clone, Copy)]
+pub struct Messages {
+    to_stderr: bool,
+}
+
+impl Messages {
+    /// Messages for a run whose standard output carries data when `stdout_carries_data`.
+    pub fn new(stdout_carries_data: bool) -> Messages {
+        Messages {
+            to_stderr: stdout_carries_data,
+        }
+    }
+
+    /// Prints one message line.
+    pub fn say(&self, text: impl Display) {
+        if self.to_stderr {
+            eprintln!("{text}");
+        } else {
+            println!("{text}");
+        }
+    }
+}
