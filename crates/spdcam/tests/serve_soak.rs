@@ -11,7 +11,10 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-const EXAMPLE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/sg-telelumen.jpg");
+const EXAMPLE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../examples/sg-telelumen.jpg"
+);
 const BOUNDARY: &str = "spdcam-soak-boundary";
 /// Slow clients start no new connection after this.
 const SLOW_UNTIL: Duration = Duration::from_secs(42);
@@ -108,7 +111,10 @@ fn slow_connection(addr: SocketAddr, body: bool, trickle: bool) -> (Option<u16>,
         if trickle {
             let _ = s.write_all(b"x");
         }
-        assert!(started.elapsed() < CUT_WITHIN * 2, "a slow client is never cut off");
+        assert!(
+            started.elapsed() < CUT_WITHIN * 2,
+            "a slow client is never cut off"
+        );
     });
     (status, started.elapsed())
 }

@@ -264,10 +264,7 @@ async fn job(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
 }
 
 async fn not_allowed(method: Method, uri: Uri) -> Answer {
-    Answer::error(
-        405,
-        format!("{method} is not allowed on {}", uri.path()),
-    )
+    Answer::error(405, format!("{method} is not allowed on {}", uri.path()))
 }
 
 async fn not_found(uri: Uri) -> Answer {

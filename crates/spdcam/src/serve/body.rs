@@ -117,8 +117,8 @@ impl Reading {
         if self.received > self.limit as u64 {
             return Err(BodyError::TooLarge);
         }
-        let units = u32::try_from(chunk.len().div_ceil(BUDGET_UNIT))
-            .map_err(|_| BodyError::TooLarge)?;
+        let units =
+            u32::try_from(chunk.len().div_ceil(BUDGET_UNIT)).map_err(|_| BodyError::TooLarge)?;
         if units > 0 {
             let permit = Arc::clone(&self.budget)
                 .try_acquire_many_owned(units)

@@ -78,8 +78,8 @@ async fn serve(stream: TcpStream, app: Router, header_timeout: Duration) {
              Cache-Control: no-store\r\nContent-Length: {}\r\n\r\n{body}",
             body.len()
         );
-        let _ = tokio::time::timeout(Duration::from_secs(1), stream.write_all(answer.as_bytes()))
-            .await;
+        let _ =
+            tokio::time::timeout(Duration::from_secs(1), stream.write_all(answer.as_bytes())).await;
     }
     let _ = tokio::time::timeout(Duration::from_secs(1), stream.shutdown()).await;
 }

@@ -218,7 +218,9 @@ mod tests {
     #[test]
     fn the_body_streams_own_error_is_passed_on() {
         let chunks: Vec<Result<Bytes, std::io::Error>> = vec![
-            Ok(Bytes::from_static(b"--b\r\nContent-Disposition: form-data; name=\"photo\"\r\n\r\nab")),
+            Ok(Bytes::from_static(
+                b"--b\r\nContent-Disposition: form-data; name=\"photo\"\r\n\r\nab",
+            )),
             Err(std::io::Error::other("too slow")),
         ];
         let future = read(futures_util::stream::iter(chunks), "b", LIMITS);
@@ -242,6 +244,8 @@ mod tests {
             boundary("application/json").unwrap_err(),
             "the request must be multipart/form-data with a field 'photo', not 'application/json'"
         );
-        assert!(boundary("multipart/form-data").unwrap_err().contains("boundary"));
+        assert!(boundary("multipart/form-data")
+            .unwrap_err()
+            .contains("boundary"));
     }
 }

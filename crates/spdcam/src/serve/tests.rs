@@ -309,7 +309,11 @@ fn slow_uploads_block_nothing_and_are_cut_off_with_408() {
         let (status, body) = request(addr, "GET", "/api/locus", None);
         assert_eq!(status, 200);
         assert!(json(&body)["spectral"].is_array());
-        assert!(asked.elapsed() < Duration::from_secs(1), "{:?}", asked.elapsed());
+        assert!(
+            asked.elapsed() < Duration::from_secs(1),
+            "{:?}",
+            asked.elapsed()
+        );
     }
     let body = form(&[("photo", Some("p.jpg"), EXAMPLE)]);
     let (status, got) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
@@ -319,13 +323,20 @@ fn slow_uploads_block_nothing_and_are_cut_off_with_408() {
     for mut stream in slow {
         let (status, head, body) = read_answer(&mut stream);
         assert_eq!(status, 408, "{head}");
-        assert!(head.to_ascii_lowercase().contains("connection: close"), "{head}");
+        assert!(
+            head.to_ascii_lowercase().contains("connection: close"),
+            "{head}"
+        );
         let message = json(&body)["error"].as_str().unwrap().to_string();
         assert!(message.contains("arrived too slowly"), "{message}");
     }
     // The grace of 2 s plus the pace's allowance for 1000 bytes (31 ms), with room for a
     // busy machine; not the 60 s a client could hold them.
-    assert!(started.elapsed() < Duration::from_secs(20), "{:?}", started.elapsed());
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "{:?}",
+        started.elapsed()
+    );
     server.stop();
 }
 
@@ -354,7 +365,11 @@ fn slow_headers_are_cut_off_with_408_and_idle_connections_closed() {
     let mut nothing = Vec::new();
     let _ = idle.read_to_end(&mut nothing);
     assert!(nothing.is_empty(), "{}", String::from_utf8_lossy(&nothing));
-    assert!(started.elapsed() < Duration::from_secs(10), "{:?}", started.elapsed());
+    assert!(
+        started.elapsed() < Duration::from_secs(10),
+        "{:?}",
+        started.elapsed()
+    );
     server.stop();
 }
 
@@ -380,8 +395,16 @@ fn a_huge_header_is_refused_with_431_without_being_read() {
     }
     let (status, head, _) = read_answer(&mut stream);
     assert_eq!(status, 431, "{head}");
-    assert!(sent < 64 << 20, "the server read {} MB of headers", sent >> 20);
-    assert!(started.elapsed() < Duration::from_secs(10), "{:?}", started.elapsed());
+    assert!(
+        sent < 64 << 20,
+        "the server read {} MB of headers",
+        sent >> 20
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(10),
+        "{:?}",
+        started.elapsed()
+    );
     // Still serving.
     let (status, _) = request(server.addr(), "GET", "/api/locus", None);
     assert_eq!(status, 200);
