@@ -1,38 +1,46 @@
 //! The routes: the embedded page and its assets, and the JSON API (`docs/web-api.md`).
-//! Uploads are read into memory up to the size limit, checked, and queued; nothing the
-//! client sends is used as a path.
+//! Uploads are read into memory as they stream in, up to the size limit and at a minimum
+//! pace, checked, and queued; nothing the client sends is used as a path.
 
+use super::body::{self, BodyError, Budget, Held, Pace};
 use super::jobs::{Jobs, Outcome, Progress, Upload};
-use super::multipart;
+use super::multipart::{self, FormError, Limits};
 use anyhow::Result;
+use axum::body::Body;
+use axum::extract::{Path, Request, State};
+use axum::http::{header, HeaderValue, Method, StatusCode, Uri};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::Router;
 use spdcam_core::colorimetry::{cct_to_uv_planck, uv1960_to_xy, Observer};
 use spdcam_core::spectral::Grid;
-use std::io::Read;
-use std::sync::Arc;
-use tiny_http::{Header, Method, Request, Response};
+use std::sync::{Arc, Mutex};
 
 const INDEX_HTML: &str = include_str!("page/index.html");
 const APP_JS: &str = include_str!("page/app.js");
 const STYLE_CSS: &str = include_str!("page/style.css");
 const EXAMPLE_JPG: &[u8] = include_bytes!("../../../../examples/sg-telelumen.jpg");
-/// Room for the multipart framing and the small fields beside the photo.
+/// Room for the multipart framing and the small fields beside the photo; also the longest
+/// field other than the photo.
 const FORM_OVERHEAD: usize = 64 * 1024;
 /// Longest label kept from a client's file name.
 const MAX_NAME_CHARS: usize = 120;
 
-/// The request handler, shared by the request threads.
+/// The request handler's state, shared by the connections.
 pub struct Api {
     jobs: Arc<Jobs>,
     max_upload_bytes: usize,
+    pace: Pace,
+    budget: Budget,
     locus: String,
 }
 
 /// An answer: status, content type, body.
-struct Answer(u16, &'static str, Vec<u8>);
+struct Answer(u16, &'static str, Body);
 
 impl Answer {
     fn json(status: u16, value: &serde_json::Value) -> Answer {
-        Answer(status, "application/json", value.to_string().into_bytes())
+        Answer(status, "application/json", value.to_string().into())
     }
 
     fn error(status: u16, message: impl Into<String>) -> Answer {
@@ -41,106 +49,84 @@ impl Answer {
 
     fn outcome(outcome: Outcome) -> Answer {
         match outcome {
-            Outcome::Done(json) => Answer(200, "application/json", json.as_bytes().to_vec()),
+            Outcome::Done(json) => Answer(200, "application/json", json.to_string().into()),
             Outcome::Failed(status, message) => Answer::error(status, message),
         }
     }
 }
 
+impl IntoResponse for Answer {
+    fn into_response(self) -> Response {
+        let Answer(status, kind, body) = self;
+        let mut response = Response::new(body);
+        *response.status_mut() =
+            StatusCode::from_u16(status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR);
+        let headers = response.headers_mut();
+        headers.insert(header::CONTENT_TYPE, HeaderValue::from_static(kind));
+        headers.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+        headers.insert(
+            header::X_CONTENT_TYPE_OPTIONS,
+            HeaderValue::from_static("nosniff"),
+        );
+        // The rest of an upload cut off for its size or pace is not read: the connection
+        // closes after the answer.
+        if status == 413 || status == 408 {
+            headers.insert(header::CONNECTION, HeaderValue::from_static("close"));
+        }
+        response
+    }
+}
+
 impl Api {
-    /// The handler for `jobs`, refusing photos over `max_upload_bytes`.
-    pub fn new(jobs: Arc<Jobs>, max_upload_bytes: usize) -> Result<Api> {
+    /// The handler for `jobs`, refusing photos over `max_upload_bytes` and uploads slower
+    /// than `pace`, holding at most `budget_bytes` of uploads in memory.
+    pub fn new(
+        jobs: Arc<Jobs>,
+        max_upload_bytes: usize,
+        pace: Pace,
+        budget_bytes: usize,
+    ) -> Result<Api> {
         Ok(Api {
             jobs,
             max_upload_bytes,
+            pace,
+            budget: Budget::new(budget_bytes.max(max_upload_bytes + FORM_OVERHEAD)),
             locus: locus_json()?.to_string(),
         })
     }
 
-    /// Answers one request (never panics on what the client sent).
-    pub fn handle(&self, mut request: Request) {
-        let answer = self.route(&mut request);
-        let Answer(status, kind, body) = answer;
-        let mut response = Response::from_data(body)
-            .with_chunked_threshold(usize::MAX)
-            .with_status_code(status)
-            .with_header(header("Content-Type", kind))
-            .with_header(header("Cache-Control", "no-store"))
-            .with_header(header("X-Content-Type-Options", "nosniff"));
-        if status == 413 {
-            response = response.with_header(header("Connection", "close"));
-        }
-        // A client that went away cannot be answered; nothing else to do.
-        let _ = request.respond(response);
-    }
-
-    fn route(&self, request: &mut Request) -> Answer {
-        let url = request.url().to_string();
-        let path = url.split('?').next().unwrap_or("");
-        let get = *request.method() == Method::Get;
-        let post = *request.method() == Method::Post;
-        if let Some(id) = path.strip_prefix("/api/jobs/").filter(|_| get) {
-            return self.job(id);
-        }
-        match path {
-            "/" | "/index.html" if get => {
-                Answer(200, "text/html; charset=utf-8", INDEX_HTML.into())
-            }
-            "/app.js" if get => Answer(200, "text/javascript; charset=utf-8", APP_JS.into()),
-            "/style.css" if get => Answer(200, "text/css; charset=utf-8", STYLE_CSS.into()),
-            "/example.jpg" if get => Answer(200, "image/jpeg", EXAMPLE_JPG.to_vec()),
-            "/api/locus" if get => Answer(200, "application/json", self.locus.clone().into()),
-            "/api/estimate" if post => match self.upload(request) {
-                Ok(upload) => match self.jobs.submit(upload) {
-                    Some(id) => Answer::outcome(self.jobs.wait(id)),
-                    None => busy(),
-                },
-                Err(answer) => answer,
-            },
-            "/api/jobs" if post => match self.upload(request) {
-                Ok(upload) => match self.jobs.submit(upload) {
-                    Some(id) => Answer::json(202, &serde_json::json!({ "id": id.to_string() })),
-                    None => busy(),
-                },
-                Err(answer) => answer,
-            },
-            "/" | "/index.html" | "/app.js" | "/style.css" | "/example.jpg" | "/api/locus"
-            | "/api/estimate" | "/api/jobs" => Answer::error(
-                405,
-                format!("{} is not allowed on {path}", request.method()),
-            ),
-            _ => Answer::error(404, format!("no such page or API: {path}")),
-        }
-    }
-
-    /// `GET /api/jobs/ID`: where the job is, and its result once finished.
-    fn job(&self, id: &str) -> Answer {
-        let Some(progress) = id.parse::<u64>().ok().and_then(|id| self.jobs.progress(id)) else {
-            return Answer::error(
-                404,
-                format!("no job '{id}' (finished jobs are kept a while)"),
-            );
+    /// The routes (`GET` routes answer `HEAD` too, without the body).
+    pub fn router(self: Arc<Api>) -> Router {
+        let page = |kind: &'static str, body: &'static [u8]| {
+            get(move || async move { Answer(200, kind, Body::from(body)) })
         };
-        let value = match progress {
-            Progress::Queued { ahead } => serde_json::json!({ "state": "queued", "ahead": ahead }),
-            Progress::Running { since } => serde_json::json!({
-                "state": "running",
-                "seconds": since.elapsed().as_secs_f64(),
-            }),
-            Progress::Finished(Outcome::Done(json)) => {
-                let result: serde_json::Value =
-                    serde_json::from_str(&json).unwrap_or(serde_json::Value::Null);
-                serde_json::json!({ "state": "done", "result": result })
-            }
-            Progress::Finished(Outcome::Failed(status, message)) => serde_json::json!({
-                "state": "failed", "status": status, "error": message,
-            }),
-        };
-        Answer::json(200, &value)
+        Router::new()
+            .route("/", page("text/html; charset=utf-8", INDEX_HTML.as_bytes()))
+            .route(
+                "/index.html",
+                page("text/html; charset=utf-8", INDEX_HTML.as_bytes()),
+            )
+            .route(
+                "/app.js",
+                page("text/javascript; charset=utf-8", APP_JS.as_bytes()),
+            )
+            .route(
+                "/style.css",
+                page("text/css; charset=utf-8", STYLE_CSS.as_bytes()),
+            )
+            .route("/example.jpg", page("image/jpeg", EXAMPLE_JPG))
+            .route("/api/locus", get(locus))
+            .route("/api/estimate", post(estimate))
+            .route("/api/jobs", post(submit))
+            .route("/api/jobs/{id}", get(job))
+            .method_not_allowed_fallback(not_allowed)
+            .fallback(not_found)
+            .with_state(self)
     }
 
-    /// Reads and checks an upload form: the size limit (413), the `photo` field, `corners`.
-    fn upload(&self, request: &mut Request) -> Result<Upload, Answer> {
+    /// Reads and checks an upload form: the size limit (413), the pace (408), the memory
+    /// budget (503), the `photo` field, `corners`.
+    async fn upload(&self, request: Request) -> Result<Upload, Answer> {
         let limit = self.max_upload_bytes + FORM_OVERHEAD;
         let too_large = || {
             Answer::error(
@@ -151,68 +137,142 @@ impl Api {
                 ),
             )
         };
-        if request.body_length().is_some_and(|n| n > limit) {
+        let (parts, content) = request.into_parts();
+        let declared = parts
+            .headers
+            .get(header::CONTENT_LENGTH)
+            .and_then(|v| v.to_str().ok())
+            .and_then(|v| v.parse::<u64>().ok());
+        if declared.is_some_and(|n| n > limit as u64) {
             return Err(too_large());
         }
-        let content_type = request
-            .headers()
-            .iter()
-            .find(|h| h.field.equiv("Content-Type"))
-            .map(|h| h.value.as_str().to_string())
+        let content_type = parts
+            .headers
+            .get(header::CONTENT_TYPE)
+            .map(|v| String::from_utf8_lossy(v.as_bytes()).into_owned())
             .unwrap_or_default();
         let boundary = multipart::boundary(&content_type).map_err(|e| Answer::error(400, e))?;
-        let mut body = Vec::new();
-        request
-            .as_reader()
-            .take(limit as u64 + 1)
-            .read_to_end(&mut body)
-            .map_err(|e| Answer::error(400, format!("reading the upload: {e}")))?;
-        if body.len() > limit {
-            return Err(too_large());
-        }
-        let fields = multipart::parse(&body, &boundary).map_err(|e| Answer::error(400, e))?;
-        drop(body);
-        let mut photo = None;
-        let mut corners = None;
-        for field in fields {
-            match field.name.as_str() {
-                "photo" if photo.is_none() => photo = Some(field),
-                "photo" => return Err(Answer::error(400, "one photo per request")),
-                "corners" => {
-                    let text = String::from_utf8_lossy(&field.data);
-                    if !text.trim().is_empty() {
-                        corners = Some(
-                            crate::photo_args::parse_corners(&text)
-                                .map_err(|e| Answer::error(400, e.to_string()))?,
-                        );
-                    }
-                }
-                _ => {}
+        let held = Arc::new(Mutex::new(Held::default()));
+        let stream = body::limited(content, limit, self.pace, &self.budget, Arc::clone(&held));
+        let limits = Limits {
+            photo_bytes: self.max_upload_bytes,
+            field_bytes: FORM_OVERHEAD,
+        };
+        let form = multipart::read(stream, &boundary, limits).await;
+        let mut held = std::mem::take(&mut *held.lock().unwrap_or_else(|p| p.into_inner()));
+        let form = match (form, held.failure.take()) {
+            (Ok(form), _) => form,
+            // The body's own failure explains any error multer reports after it.
+            (Err(_), Some(failure)) => {
+                return Err(match failure {
+                    BodyError::TooLarge => too_large(),
+                    BodyError::TimedOut => Answer::error(
+                        408,
+                        format!(
+                            "the upload arrived too slowly (under {} KB/s after the first {} s); \
+                             the connection is closed",
+                            body::MIN_BYTES_PER_SECOND >> 10,
+                            self.pace.grace.as_secs_f64()
+                        ),
+                    ),
+                    BodyError::Busy => Answer::error(
+                        503,
+                        "too many uploads are being received at once; try again in a moment",
+                    ),
+                    BodyError::Read(e) => Answer::error(400, format!("reading the upload: {e}")),
+                })
             }
-        }
-        let Some(photo) = photo else {
+            (Err(FormError::PhotoTooLarge), None) => return Err(too_large()),
+            (Err(FormError::Invalid(message)), None) => return Err(Answer::error(400, message)),
+            (Err(FormError::Body(e)), None) => {
+                return Err(Answer::error(400, format!("reading the upload: {e}")))
+            }
+        };
+        let corners = match form.corners.as_deref().map(str::trim) {
+            Some(text) if !text.is_empty() => Some(
+                crate::photo_args::parse_corners(text)
+                    .map_err(|e| Answer::error(400, e.to_string()))?,
+            ),
+            _ => None,
+        };
+        let Some(photo) = form.photo else {
             return Err(Answer::error(400, "the form has no field 'photo'"));
         };
-        if photo.data.len() > self.max_upload_bytes {
-            return Err(too_large());
-        }
-        if photo.data.is_empty() {
+        if photo.bytes.is_empty() {
             return Err(Answer::error(400, "the photo is empty"));
         }
         Ok(Upload {
             name: label(photo.filename.as_deref()),
-            bytes: photo.data,
+            bytes: photo.bytes,
             corners,
+            memory: held.permit,
         })
     }
 }
 
-fn busy() -> Answer {
-    Answer::error(503, "too many photos are waiting; try again in a moment")
+/// `POST /api/estimate`: the estimate of the uploaded photo, once made.
+async fn estimate(State(api): State<Arc<Api>>, request: Request) -> Answer {
+    match api.upload(request).await {
+        Ok(upload) => match api.jobs.submit(upload) {
+            Some(id) => Answer::outcome(api.jobs.wait(id).await),
+            None => busy(),
+        },
+        Err(answer) => answer,
+    }
 }
 
-fn header(name: &str, value: &str) -> Header {
-    Header::from_bytes(name.as_bytes(), value.as_bytes()).expect("static header is valid")
+/// `POST /api/jobs`: queues the uploaded photo and answers its job's id at once.
+async fn submit(State(api): State<Arc<Api>>, request: Request) -> Answer {
+    match api.upload(request).await {
+        Ok(upload) => match api.jobs.submit(upload) {
+            Some(id) => Answer::json(202, &serde_json::json!({ "id": id.to_string() })),
+            None => busy(),
+        },
+        Err(answer) => answer,
+    }
+}
+
+/// `GET /api/locus`: the outlines of the chromaticity diagram.
+async fn locus(State(api): State<Arc<Api>>) -> Answer {
+    Answer(200, "application/json", api.locus.clone().into())
+}
+
+/// `GET /api/jobs/ID`: where the job is, and its result once finished.
+async fn job(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
+    let Some(progress) = id.parse::<u64>().ok().and_then(|id| api.jobs.progress(id)) else {
+        return Answer::error(
+            404,
+            format!("no job '{id}' (finished jobs are kept a while)"),
+        );
+    };
+    let value = match progress {
+        Progress::Queued { ahead } => serde_json::json!({ "state": "queued", "ahead": ahead }),
+        Progress::Running { since } => serde_json::json!({
+            "state": "running",
+            "seconds": since.elapsed().as_secs_f64(),
+        }),
+        Progress::Finished(Outcome::Done(json)) => {
+            let result: serde_json::Value =
+                serde_json::from_str(&json).unwrap_or(serde_json::Value::Null);
+            serde_json::json!({ "state": "done", "result": result })
+        }
+        Progress::Finished(Outcome::Failed(status, message)) => serde_json::json!({
+            "state": "failed", "status": status, "error": message,
+        }),
+    };
+    Answer::json(200, &value)
+}
+
+async fn not_allowed(method: Method, uri: Uri) -> Answer {
+    Answer::error(405, format!("{method} is not allowed on {}", uri.path()))
+}
+
+async fn not_found(uri: Uri) -> Answer {
+    Answer::error(404, format!("no such page or API: {}", uri.path()))
+}
+
+fn busy() -> Answer {
+    Answer::error(503, "too many photos are waiting; try again in a moment")
 }
 
 /// A label from a client's file name: its last component only, printable, not too long.

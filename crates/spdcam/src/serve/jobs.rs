@@ -1,13 +1,15 @@
-//! The estimation queue: uploads wait in a bounded queue and a fixed pool of workers (one per
-//! core) estimates them off the request threads, so at most that many photos are decoded at
-//! once (memory stays bounded however many uploads arrive) and a page can poll its job's
-//! progress while a 24 MP photo is worked on.
+//! The estimation queue: uploads wait in a bounded queue and a fixed pool of worker threads
+//! (one per core) estimates them off the server's connection tasks, so at most that many
+//! photos are decoded at once (memory stays bounded however many uploads arrive), no
+//! connection waits on another's estimate, and a page can poll its job's progress while a
+//! 24 MP photo is worked on.
 
 use spdcam_core::photo;
 use spdcam_infer::{Estimator, InferError, PhotoOptions};
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::Instant;
+use tokio::sync::{Notify, OwnedSemaphorePermit};
 
 /// One uploaded photo to estimate, held in memory.
 #[derive(Debug)]
@@ -18,6 +20,8 @@ pub struct Upload {
     pub bytes: Vec<u8>,
     /// The chart's four corners, when the client placed them.
     pub corners: Option<Vec<[f64; 2]>>,
+    /// The share of the server's upload memory budget the bytes hold; released with them.
+    pub memory: Option<OwnedSemaphorePermit>,
 }
 
 /// How a job ended: the estimate's JSON, or an HTTP status and a message.
@@ -50,6 +54,7 @@ pub struct Engine {
 impl Engine {
     /// The estimate of one upload, by the estimator `spdcam estimate` uses: a photo that
     /// cannot be read or shows no chart is a 400, one with no model for its chart 422.
+    /// The one place the server estimates.
     pub fn estimate(&self, upload: Upload) -> Outcome {
         let options = PhotoOptions {
             corners: upload.corners,
@@ -63,6 +68,7 @@ impl Engine {
             Err(e) => return Outcome::Failed(400, e.to_string()),
         };
         drop(upload.bytes);
+        drop(upload.memory);
         let estimate = match self
             .estimator
             .estimate_analysis(analysed.analysis, upload.name)
@@ -89,7 +95,10 @@ struct State {
 /// The queue and its workers' shared state.
 pub struct Jobs {
     state: Mutex<State>,
+    /// Wakes the workers when an upload is queued or the queue stops.
     changed: Condvar,
+    /// Wakes the connections waiting for an outcome when a job finishes.
+    finished: Notify,
     engine: Engine,
     max_queued: usize,
     keep_finished: usize,
@@ -105,6 +114,7 @@ impl Jobs {
                 ..State::default()
             }),
             changed: Condvar::new(),
+            finished: Notify::new(),
             engine,
             max_queued,
             keep_finished,
@@ -141,19 +151,25 @@ impl Jobs {
         }
     }
 
-    /// Waits until job `id` has finished and gives its outcome.
-    pub fn wait(&self, id: u64) -> Outcome {
-        let mut state = self.lock();
+    /// Waits until job `id` has finished and gives its outcome (without holding a thread).
+    pub async fn wait(&self, id: u64) -> Outcome {
         loop {
-            match state.progress.get(&id) {
-                Some(Progress::Finished(outcome)) => return outcome.clone(),
-                None => return Outcome::Failed(500, format!("job {id} was forgotten")),
-                _ if state.stopping => {
-                    return Outcome::Failed(503, "the server is stopping".into())
+            let finished = self.finished.notified();
+            let mut finished = std::pin::pin!(finished);
+            // Registered before the state is read, so a job finishing in between wakes it.
+            finished.as_mut().enable();
+            {
+                let state = self.lock();
+                match state.progress.get(&id) {
+                    Some(Progress::Finished(outcome)) => return outcome.clone(),
+                    None => return Outcome::Failed(500, format!("job {id} was forgotten")),
+                    _ if state.stopping => {
+                        return Outcome::Failed(503, "the server is stopping".into())
+                    }
+                    _ => {}
                 }
-                _ => {}
             }
-            state = self.changed.wait(state).unwrap_or_else(|p| p.into_inner());
+            finished.await;
         }
     }
 
@@ -191,7 +207,8 @@ impl Jobs {
                     state.progress.remove(&old);
                 }
             }
-            self.changed.notify_all();
+            drop(state);
+            self.finished.notify_waiters();
         }
     }
 
@@ -200,5 +217,6 @@ impl Jobs {
     pub fn stop(&self) {
         self.lock().stopping = true;
         self.changed.notify_all();
+        self.finished.notify_waiters();
     }
 }

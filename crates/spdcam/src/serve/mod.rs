@@ -1,30 +1,40 @@
 //! `spdcam serve`: a local web app. A page embedded in the binary (no CDN, no network) where
 //! photos are dropped and the light's SPD, chromaticity and warnings are shown, and the small
-//! HTTP API it uses (see `docs/web-api.md`). Requests are served by a few threads; the
-//! estimates are made by the bounded queue of [`jobs`], one worker per core.
+//! HTTP API it uses (see `docs/web-api.md`). Connections are tasks of a small tokio runtime
+//! (hyper's HTTP/1 server under axum's routes), not threads: a slow client holds no thread,
+//! and is cut off by the header and body time limits. The estimates are made by the bounded
+//! queue of [`jobs`], one worker thread per core.
 
 mod api;
+mod body;
+mod connection;
 mod jobs;
 mod multipart;
 #[cfg(test)]
 mod tests;
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use jobs::{Engine, Jobs};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::Grid;
 use spdcam_infer::Estimator;
-use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::net::{SocketAddr, ToSocketAddrs};
 use std::sync::Arc;
 use std::thread::JoinHandle;
+use std::time::Duration;
 
-/// Threads that read requests and write answers (they wait on the queue, not compute).
-const REQUEST_THREADS: usize = 8;
+/// Threads of the runtime that reads requests and writes answers (they never estimate).
+const IO_THREADS: usize = 2;
+/// Connections served at once; more wait to be accepted until one closes.
+const MAX_CONNECTIONS: usize = 512;
 /// Uploads that may wait for a worker before new ones are refused with 503.
 const MAX_QUEUED: usize = 64;
 /// Finished jobs remembered for polling.
 const KEEP_FINISHED: usize = 256;
+/// Upload bytes held in memory at once (being received or waiting for a worker), at least
+/// one upload of the largest size; an upload that would overdraw it is refused with 503.
+const UPLOAD_BUDGET_BYTES: usize = 512 << 20;
 
 /// Options of `spdcam serve`.
 #[derive(Debug, Args)]
@@ -32,66 +42,102 @@ pub struct ServeArgs {
     /// Port to listen on; 0 picks a free one.
     #[arg(long, default_value_t = 8747)]
     port: u16,
-    /// Address to listen on. The default serves this machine only; give 0.0.0.0 to let
-    /// other machines of the network in.
-    #[arg(long, default_value_t = IpAddr::V4(Ipv4Addr::LOCALHOST))]
-    host: IpAddr,
+    /// Address or host name to listen on. The default serves this machine only; give
+    /// 0.0.0.0 to let other machines of the network in.
+    #[arg(long, default_value = "127.0.0.1")]
+    host: String,
     /// Largest photo accepted, in megabytes (larger uploads are refused with 413).
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..=1024))]
     max_upload_mb: u64,
 }
 
+/// How long a client may take.
+#[derive(Debug, Clone, Copy)]
+pub struct Timeouts {
+    /// To send a request's headers, and on a kept-alive connection to begin the next
+    /// request; then the connection is closed (after a 408 when headers had begun).
+    pub headers: Duration,
+    /// To send an upload's first bytes: after it the body must keep a pace of
+    /// 32 KiB/s on average or it is answered with 408.
+    pub body_grace: Duration,
+}
+
+impl Default for Timeouts {
+    fn default() -> Timeouts {
+        Timeouts {
+            headers: Duration::from_secs(10),
+            body_grace: Duration::from_secs(10),
+        }
+    }
+}
+
 /// How a server is set up.
 pub struct Config {
-    /// Where to listen (port 0: any free one).
-    pub addr: SocketAddr,
+    /// Where to listen, tried in turn until one is free (port 0: any free one).
+    pub addrs: Vec<SocketAddr>,
     /// Largest photo accepted, in bytes.
     pub max_upload_bytes: usize,
     /// Estimating workers.
     pub workers: usize,
+    /// The time limits of clients.
+    pub timeouts: Timeouts,
 }
 
 /// A running server.
 pub struct Server {
-    #[cfg(test)]
-    http: Arc<tiny_http::Server>,
+    runtime: tokio::runtime::Runtime,
+    accepting: tokio::task::JoinHandle<()>,
     #[cfg(test)]
     jobs: Arc<Jobs>,
-    threads: Vec<JoinHandle<()>>,
+    workers: Vec<JoinHandle<()>>,
     addr: SocketAddr,
 }
 
 impl Server {
-    /// Starts listening and the worker threads.
+    /// Starts listening, the runtime and the worker threads.
     pub fn start(config: Config, engine: Engine) -> Result<Server> {
-        let http = tiny_http::Server::http(config.addr)
-            .map_err(|e| anyhow!("cannot listen on {}: {e}", config.addr))?;
-        let addr = http
-            .server_addr()
-            .to_ip()
-            .context("the server listens on no IP address")?;
-        let http = Arc::new(http);
+        let listener = std::net::TcpListener::bind(&config.addrs[..])
+            .with_context(|| format!("cannot listen on {}", list(&config.addrs)))?;
+        listener.set_nonblocking(true)?;
+        let addr = listener.local_addr()?;
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(IO_THREADS)
+            .thread_name("spdcam-http")
+            .enable_io()
+            .enable_time()
+            .build()
+            .context("cannot start the server's runtime")?;
+        let listener = {
+            let _entered = runtime.enter();
+            tokio::net::TcpListener::from_std(listener)?
+        };
         let jobs = Arc::new(Jobs::new(engine, MAX_QUEUED, KEEP_FINISHED));
-        let api = Arc::new(api::Api::new(Arc::clone(&jobs), config.max_upload_bytes)?);
-        let mut threads = Vec::new();
-        for _ in 0..config.workers.max(1) {
-            let jobs = Arc::clone(&jobs);
-            threads.push(std::thread::spawn(move || jobs.work()));
-        }
-        for _ in 0..REQUEST_THREADS {
-            let (http, api) = (Arc::clone(&http), Arc::clone(&api));
-            threads.push(std::thread::spawn(move || {
-                while let Ok(request) = http.recv() {
-                    api.handle(request);
-                }
-            }));
-        }
+        let pace = body::Pace {
+            grace: config.timeouts.body_grace,
+        };
+        let api = Arc::new(api::Api::new(
+            Arc::clone(&jobs),
+            config.max_upload_bytes,
+            pace,
+            UPLOAD_BUDGET_BYTES,
+        )?);
+        let workers = (0..config.workers.max(1))
+            .map(|_| {
+                let jobs = Arc::clone(&jobs);
+                std::thread::spawn(move || jobs.work())
+            })
+            .collect();
+        let settings = connection::Settings {
+            header_timeout: config.timeouts.headers,
+            max_connections: MAX_CONNECTIONS,
+        };
+        let accepting = runtime.spawn(connection::accept(listener, api.router(), settings));
         Ok(Server {
-            #[cfg(test)]
-            http,
+            runtime,
+            accepting,
             #[cfg(test)]
             jobs,
-            threads,
+            workers,
             addr,
         })
     }
@@ -106,22 +152,45 @@ impl Server {
         format!("http://{}/", self.addr)
     }
 
-    /// Serves until the threads end (they end only when stopped).
+    /// Serves until the process ends.
     pub fn wait(self) {
-        for t in self.threads {
-            let _ = t.join();
+        let _ = self.runtime.block_on(self.accepting);
+        for worker in self.workers {
+            let _ = worker.join();
         }
     }
 
-    /// Stops serving and joins the threads.
+    /// Stops serving and joins the workers.
     #[cfg(test)]
     pub fn stop(self) {
         self.jobs.stop();
-        for _ in 0..REQUEST_THREADS {
-            self.http.unblock();
+        self.accepting.abort();
+        self.runtime.shutdown_timeout(Duration::from_secs(1));
+        for worker in self.workers {
+            let _ = worker.join();
         }
-        self.wait();
     }
+}
+
+/// `addrs` as a list for a message.
+fn list(addrs: &[SocketAddr]) -> String {
+    addrs
+        .iter()
+        .map(SocketAddr::to_string)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The addresses of `host` (an IP address or a name such as `localhost`) at `port`.
+fn resolve(host: &str, port: u16) -> Result<Vec<SocketAddr>> {
+    let addrs: Vec<SocketAddr> = (host, port)
+        .to_socket_addrs()
+        .with_context(|| format!("cannot resolve the host '{host}' (spdcam serve --host)"))?
+        .collect();
+    if addrs.is_empty() {
+        bail!("the host '{host}' has no address (spdcam serve --host)");
+    }
+    Ok(addrs)
 }
 
 /// The engine of `spdcam serve`: the shipped models, estimates on 400–700 nm in 5 nm steps
@@ -137,9 +206,10 @@ pub fn run(args: ServeArgs, data_dir: &DataDir) -> Result<()> {
     let workers = std::thread::available_parallelism().map_or(2, |n| n.get().clamp(1, 8));
     let server = Server::start(
         Config {
-            addr: SocketAddr::new(args.host, args.port),
+            addrs: resolve(&args.host, args.port)?,
             max_upload_bytes: usize::try_from(args.max_upload_mb << 20)?,
             workers,
+            timeouts: Timeouts::default(),
         },
         shipped_engine(data_dir)?,
     )?;

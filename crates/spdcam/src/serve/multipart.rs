@@ -1,138 +1,251 @@
-//! Reading a `multipart/form-data` body (RFC 7578) held in memory: the named fields and,
-//! for file fields, the file name the browser sent (kept as a label, never used as a path).
+//! Reading an upload form (`multipart/form-data`, RFC 7578) as it streams in, with multer:
+//! the `photo` file with the file name the browser sent (kept as a label, never used as a
+//! path) and the `corners` text, each under a size limit; other fields are read and dropped.
+//!
+//! This file depends only on multer, bytes and futures-util, so that the fuzz target
+//! `fuzz/fuzz_targets/multipart.rs` compiles it as it is and feeds it what the server would.
 
-/// One field of a form.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Field {
-    /// The field's name (`photo`, `corners`).
-    pub name: String,
-    /// The file name the client gave, for file fields.
+use bytes::Bytes;
+use futures_util::Stream;
+use std::error::Error as StdError;
+
+/// A boxed error of the body stream (a time-out, a size limit, a closed connection).
+pub type BodyFailure = Box<dyn StdError + Send + Sync>;
+
+/// What an upload form holds.
+#[derive(Debug, Default, PartialEq)]
+pub struct Form {
+    /// The `photo` field.
+    pub photo: Option<Photo>,
+    /// The last `corners` field, as text (parsed by the caller).
+    pub corners: Option<String>,
+}
+
+/// The `photo` field of a form.
+#[derive(Debug, PartialEq)]
+pub struct Photo {
+    /// The file name the client gave.
     pub filename: Option<String>,
-    /// The field's content.
-    pub data: Vec<u8>,
+    /// The file's content.
+    pub bytes: Vec<u8>,
+}
+
+/// The largest fields [`read`] keeps.
+#[derive(Debug, Clone, Copy)]
+pub struct Limits {
+    /// The photo, in bytes.
+    pub photo_bytes: usize,
+    /// Any other field, in bytes.
+    pub field_bytes: usize,
+}
+
+/// Why a form was not read.
+#[derive(Debug)]
+pub enum FormError {
+    /// The photo is larger than [`Limits::photo_bytes`].
+    PhotoTooLarge,
+    /// The form is not one the server reads; the message says why.
+    Invalid(String),
+    /// The body stream failed (its own error).
+    Body(BodyFailure),
 }
 
 /// The boundary named by a `Content-Type: multipart/form-data; boundary=…` header.
 pub fn boundary(content_type: &str) -> Result<String, String> {
-    let mut parts = content_type.split(';').map(str::trim);
-    let kind = parts.next().unwrap_or("");
+    let kind = content_type.split(';').next().unwrap_or("").trim();
     if !kind.eq_ignore_ascii_case("multipart/form-data") {
         return Err(format!(
             "the request must be multipart/form-data with a field 'photo', not '{kind}'"
         ));
     }
-    parts
-        .filter_map(|p| p.split_once('='))
-        .find(|(k, _)| k.trim().eq_ignore_ascii_case("boundary"))
-        .map(|(_, v)| v.trim().trim_matches('"').to_string())
+    multer::parse_boundary(content_type)
+        .ok()
         .filter(|b| !b.is_empty() && b.len() <= 200)
-        .ok_or_else(|| "the multipart/form-data request names no boundary".to_string())
+        .ok_or_else(|| "the multipart/form-data request names no valid boundary".to_string())
 }
 
-/// The fields of a multipart body delimited by `boundary`.
-pub fn parse(body: &[u8], boundary: &str) -> Result<Vec<Field>, String> {
-    let delimiter = format!("--{boundary}");
-    let next_part = format!("\r\n--{boundary}");
-    let Some(start) = find(body, delimiter.as_bytes(), 0) else {
-        return Err("the multipart body holds no part".into());
-    };
-    let mut at = start + delimiter.len();
-    let mut fields = Vec::new();
-    loop {
-        if body[at..].starts_with(b"--") {
-            return Ok(fields);
-        }
-        if !body[at..].starts_with(b"\r\n") {
-            return Err("the multipart body is malformed (no line break after a boundary)".into());
-        }
-        at += 2;
-        let Some(head_end) = find(body, b"\r\n\r\n", at) else {
-            return Err("a multipart part has no end of its headers".into());
+/// Reads the form of `body`, delimited by `boundary`, stopping at the first field over its
+/// limit, the first malformed part or the first error of `body`.
+pub async fn read<S, E>(body: S, boundary: &str, limits: Limits) -> Result<Form, FormError>
+where
+    S: Stream<Item = Result<Bytes, E>> + Send,
+    E: Into<BodyFailure>,
+{
+    let mut multipart = multer::Multipart::new(body, boundary);
+    let mut form = Form::default();
+    while let Some(mut field) = multipart.next_field().await.map_err(form_error)? {
+        let name = field.name().unwrap_or("").to_string();
+        let filename = field.file_name().map(str::to_string);
+        let limit = if name == "photo" {
+            if form.photo.is_some() {
+                return Err(FormError::Invalid("one photo per request".into()));
+            }
+            limits.photo_bytes
+        } else {
+            limits.field_bytes
         };
-        let head = String::from_utf8_lossy(&body[at..head_end]);
-        let data_start = head_end + 4;
-        let Some(data_end) = find(body, next_part.as_bytes(), data_start) else {
-            return Err("the multipart body ends before its closing boundary".into());
-        };
-        let (name, filename) = disposition(&head)?;
-        fields.push(Field {
-            name,
-            filename,
-            data: body[data_start..data_end].to_vec(),
-        });
-        at = data_end + next_part.len();
+        let mut data = Vec::new();
+        while let Some(chunk) = field.chunk().await.map_err(form_error)? {
+            if data.len() + chunk.len() > limit {
+                return Err(if name == "photo" {
+                    FormError::PhotoTooLarge
+                } else {
+                    FormError::Invalid(format!(
+                        "the form field '{}' is longer than {} bytes",
+                        printable(&name),
+                        limit
+                    ))
+                });
+            }
+            data.extend_from_slice(&chunk);
+        }
+        match name.as_str() {
+            "photo" => {
+                form.photo = Some(Photo {
+                    filename,
+                    bytes: data,
+                })
+            }
+            "corners" => form.corners = Some(String::from_utf8_lossy(&data).into_owned()),
+            _ => {}
+        }
+    }
+    Ok(form)
+}
+
+/// A multer error as a form error: the body stream's own failure passed on, the rest a
+/// message that says the body is malformed.
+fn form_error(error: multer::Error) -> FormError {
+    match error {
+        multer::Error::StreamReadFailed(e) => FormError::Body(e),
+        e => FormError::Invalid(format!("the multipart body is malformed: {e}")),
     }
 }
 
-/// The `name` and `filename` of a part's `Content-Disposition: form-data` header.
-fn disposition(head: &str) -> Result<(String, Option<String>), String> {
-    let line = head
-        .lines()
-        .find(|l| {
-            l.split(':')
-                .next()
-                .is_some_and(|k| k.trim().eq_ignore_ascii_case("content-disposition"))
-        })
-        .ok_or("a multipart part has no Content-Disposition header")?;
-    let value = line.split_once(':').map_or("", |(_, v)| v);
-    let param = |key: &str| {
-        value
-            .split(';')
-            .filter_map(|p| p.trim().split_once('='))
-            .find(|(k, _)| k.trim().eq_ignore_ascii_case(key))
-            .map(|(_, v)| v.trim().trim_matches('"').to_string())
-    };
-    let name = param("name").ok_or("a multipart part has no field name")?;
-    Ok((name, param("filename")))
-}
-
-/// The first position of `needle` in `haystack` at or after `from`.
-fn find(haystack: &[u8], needle: &[u8], from: usize) -> Option<usize> {
-    if from > haystack.len() {
-        return None;
-    }
-    haystack[from..]
-        .windows(needle.len())
-        .position(|w| w == needle)
-        .map(|p| p + from)
+/// A field name as it may appear in a message: printable, at most 40 characters.
+fn printable(name: &str) -> String {
+    name.chars().filter(|c| !c.is_control()).take(40).collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::task::{Context, Poll, Waker};
 
-    #[test]
-    fn fields_and_file_names_are_read() {
-        let body = b"--XyZ\r\nContent-Disposition: form-data; name=\"corners\"\r\n\r\n1,2,3,4,5,6,7,8\r\n\
+    const LIMITS: Limits = Limits {
+        photo_bytes: 64,
+        field_bytes: 32,
+    };
+
+    /// Runs `read` over `body` split into chunks of `chunk` bytes (an in-memory stream is
+    /// always ready, so one poll finishes it).
+    fn parse(body: &[u8], boundary: &str, chunk: usize) -> Result<Form, FormError> {
+        let chunks: Vec<Result<Bytes, std::io::Error>> = body
+            .chunks(chunk)
+            .map(|c| Ok(Bytes::copy_from_slice(c)))
+            .collect();
+        let future = read(futures_util::stream::iter(chunks), boundary, LIMITS);
+        let mut future = std::pin::pin!(future);
+        match future
+            .as_mut()
+            .poll(&mut Context::from_waker(Waker::noop()))
+        {
+            Poll::Ready(result) => result,
+            Poll::Pending => panic!("an in-memory form is read at once"),
+        }
+    }
+
+    use std::future::Future;
+
+    const FORM: &[u8] = b"--XyZ\r\nContent-Disposition: form-data; name=\"corners\"\r\n\r\n1,2,3,4,5,6,7,8\r\n\
+--XyZ\r\nContent-Disposition: form-data; name=\"other\"\r\n\r\nignored\r\n\
 --XyZ\r\nContent-Disposition: form-data; name=\"photo\"; filename=\"a b.jpg\"\r\nContent-Type: image/jpeg\r\n\r\n\
 \xff\xd8\r\n--X\r\n\xff\xd9\r\n--XyZ--\r\n";
-        let fields = parse(body, "XyZ").unwrap();
-        assert_eq!(fields.len(), 2);
-        assert_eq!(fields[0].name, "corners");
-        assert_eq!(fields[0].filename, None);
-        assert_eq!(fields[0].data, b"1,2,3,4,5,6,7,8");
-        assert_eq!(fields[1].name, "photo");
-        assert_eq!(fields[1].filename.as_deref(), Some("a b.jpg"));
-        // A line that starts like the boundary but is not it stays in the data.
-        assert_eq!(fields[1].data, b"\xff\xd8\r\n--X\r\n\xff\xd9");
+
+    #[test]
+    fn fields_and_file_names_are_read_however_the_body_is_split() {
+        for chunk in [1, 2, 7, 64, FORM.len()] {
+            let form = parse(FORM, "XyZ", chunk).unwrap();
+            assert_eq!(form.corners.as_deref(), Some("1,2,3,4,5,6,7,8"), "{chunk}");
+            let photo = form.photo.unwrap();
+            assert_eq!(photo.filename.as_deref(), Some("a b.jpg"));
+            // A line that starts like the boundary but is not it stays in the data.
+            assert_eq!(photo.bytes, b"\xff\xd8\r\n--X\r\n\xff\xd9");
+        }
     }
 
     #[test]
-    fn boundaries_and_broken_bodies_give_messages() {
+    fn limits_and_broken_bodies_give_errors() {
+        let big_photo = [
+            &b"--b\r\nContent-Disposition: form-data; name=\"photo\"; filename=\"p\"\r\n\r\n"[..],
+            &[7u8; 65],
+            b"\r\n--b--\r\n",
+        ]
+        .concat();
+        assert!(matches!(
+            parse(&big_photo, "b", 10),
+            Err(FormError::PhotoTooLarge)
+        ));
+        let big_field = [
+            &b"--b\r\nContent-Disposition: form-data; name=\"corners\"\r\n\r\n"[..],
+            &[b'1'; 33],
+            b"\r\n--b--\r\n",
+        ]
+        .concat();
+        match parse(&big_field, "b", 10) {
+            Err(FormError::Invalid(m)) => {
+                assert_eq!(m, "the form field 'corners' is longer than 32 bytes")
+            }
+            other => panic!("{other:?}"),
+        }
+        let two_photos = b"--b\r\nContent-Disposition: form-data; name=\"photo\"\r\n\r\nx\r\n\
+--b\r\nContent-Disposition: form-data; name=\"photo\"\r\n\r\ny\r\n--b--\r\n";
+        match parse(two_photos, "b", 5) {
+            Err(FormError::Invalid(m)) => assert_eq!(m, "one photo per request"),
+            other => panic!("{other:?}"),
+        }
+        for broken in [
+            &b"--b\r\nContent-Disposition: form-data; name=\"x\"\r\n\r\nabc"[..],
+            b"--garbage",
+        ] {
+            match parse(broken, "b", 3) {
+                Err(FormError::Invalid(m)) => assert!(m.contains("multipart"), "{m}"),
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn the_body_streams_own_error_is_passed_on() {
+        let chunks: Vec<Result<Bytes, std::io::Error>> = vec![
+            Ok(Bytes::from_static(
+                b"--b\r\nContent-Disposition: form-data; name=\"photo\"\r\n\r\nab",
+            )),
+            Err(std::io::Error::other("too slow")),
+        ];
+        let future = read(futures_util::stream::iter(chunks), "b", LIMITS);
+        let mut future = std::pin::pin!(future);
+        match future
+            .as_mut()
+            .poll(&mut Context::from_waker(Waker::noop()))
+        {
+            Poll::Ready(Err(FormError::Body(e))) => assert_eq!(e.to_string(), "too slow"),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn boundaries_are_read_from_the_content_type() {
         assert_eq!(
             boundary("multipart/form-data; boundary=\"ab\"").unwrap(),
             "ab"
         );
-        assert!(boundary("application/json")
+        assert_eq!(
+            boundary("application/json").unwrap_err(),
+            "the request must be multipart/form-data with a field 'photo', not 'application/json'"
+        );
+        assert!(boundary("multipart/form-data")
             .unwrap_err()
-            .contains("multipart"));
-        assert!(boundary("multipart/form-data").is_err());
-        assert!(parse(b"no parts here", "b").is_err());
-        assert!(parse(
-            b"--b\r\nContent-Disposition: form-data; name=\"x\"\r\n\r\nabc",
-            "b"
-        )
-        .unwrap_err()
-        .contains("closing boundary"));
+            .contains("boundary"));
     }
 }

@@ -1,22 +1,27 @@
 //! The server in-process on a free loopback port, spoken to over plain HTTP/1.1 sockets.
 
-use super::{shipped_engine, Config, Server};
+use super::{resolve, shipped_engine, Config, Server, Timeouts};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::Grid;
 use spdcam_infer::{estimate_photo_bytes, ModelSet, PhotoOptions};
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 const EXAMPLE: &[u8] = include_bytes!("../../../../examples/sg-telelumen.jpg");
 const BOUNDARY: &str = "spdcam-test-boundary-7f3a";
 
 fn start(max_upload_bytes: usize) -> Server {
+    start_with(max_upload_bytes, Timeouts::default())
+}
+
+fn start_with(max_upload_bytes: usize, timeouts: Timeouts) -> Server {
     Server::start(
         Config {
-            addr: "127.0.0.1:0".parse().unwrap(),
+            addrs: vec!["127.0.0.1:0".parse().unwrap()],
             max_upload_bytes,
             workers: 2,
+            timeouts,
         },
         shipped_engine(&DataDir::new(None)).unwrap(),
     )
@@ -59,21 +64,29 @@ fn request(addr: SocketAddr, method: &str, path: &str, body: Option<&[u8]>) -> (
     head.push_str("\r\n");
     stream.write_all(head.as_bytes()).unwrap();
     if let Some(b) = body {
-        stream.write_all(b).unwrap();
+        // A server may answer (413) and close before it has read all of a body.
+        let _ = stream.write_all(b);
     }
+    let (status, _, body) = read_answer(&mut stream);
+    (status, body)
+}
+
+/// Reads an answer to its end (the connection closed): status, head, body.
+fn read_answer(stream: &mut TcpStream) -> (u16, String, Vec<u8>) {
     let mut answer = Vec::new();
-    stream.read_to_end(&mut answer).unwrap();
+    // A reset after the answer (the server closed with unread bytes) ends it as well.
+    let _ = stream.read_to_end(&mut answer);
     parse_answer(&answer)
 }
 
-fn parse_answer(answer: &[u8]) -> (u16, Vec<u8>) {
+fn parse_answer(answer: &[u8]) -> (u16, String, Vec<u8>) {
     let split = answer
         .windows(4)
         .position(|w| w == b"\r\n\r\n")
-        .expect("an HTTP answer");
-    let head = String::from_utf8_lossy(&answer[..split]);
+        .unwrap_or_else(|| panic!("not an HTTP answer: {:?}", String::from_utf8_lossy(answer)));
+    let head = String::from_utf8_lossy(&answer[..split]).into_owned();
     let status = head.split(' ').nth(1).unwrap().parse().unwrap();
-    (status, answer[split + 4..].to_vec())
+    (status, head, answer[split + 4..].to_vec())
 }
 
 fn json(body: &[u8]) -> serde_json::Value {
@@ -245,4 +258,195 @@ fn the_page_and_its_assets_are_embedded() {
     assert_eq!(status, 200);
     assert_eq!(body, EXAMPLE);
     server.stop();
+}
+
+/// A connection that sent the head of an upload of `declared` bytes and `sent` bytes of its
+/// body, and stays open.
+fn slow_upload(addr: SocketAddr, declared: usize, sent: usize) -> TcpStream {
+    let mut stream = TcpStream::connect(addr).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(60)))
+        .unwrap();
+    let head = format!(
+        "POST /api/estimate HTTP/1.1\r\nHost: test\r\n\
+         Content-Type: multipart/form-data; boundary={BOUNDARY}\r\nContent-Length: {declared}\r\n\r\n"
+    );
+    let mut body = format!(
+        "--{BOUNDARY}\r\nContent-Disposition: form-data; name=\"photo\"; filename=\"slow.jpg\"\r\n\r\n"
+    )
+    .into_bytes();
+    body.resize(sent, b'x');
+    stream.write_all(head.as_bytes()).unwrap();
+    stream.write_all(&body).unwrap();
+    stream
+}
+
+#[test]
+fn slow_uploads_block_nothing_and_are_cut_off_with_408() {
+    let server = start_with(
+        16 << 20,
+        Timeouts {
+            headers: Duration::from_secs(2),
+            body_grace: Duration::from_secs(2),
+        },
+    );
+    let addr = server.addr();
+    let started = Instant::now();
+    let mut slow: Vec<TcpStream> = (0..12).map(|_| slow_upload(addr, 100_000, 1000)).collect();
+    // One of them trickles a byte every 300 ms: it is cut off all the same.
+    let trickle = std::thread::spawn({
+        let mut stream = slow.pop().unwrap();
+        move || {
+            while stream.write_all(b"x").is_ok() && started.elapsed() < Duration::from_secs(20) {
+                std::thread::sleep(Duration::from_millis(300));
+            }
+            stream
+        }
+    });
+    // Meanwhile other requests are answered at once, an upload too.
+    for _ in 0..5 {
+        let asked = Instant::now();
+        let (status, body) = request(addr, "GET", "/api/locus", None);
+        assert_eq!(status, 200);
+        assert!(json(&body)["spectral"].is_array());
+        assert!(
+            asked.elapsed() < Duration::from_secs(1),
+            "{:?}",
+            asked.elapsed()
+        );
+    }
+    let body = form(&[("photo", Some("p.jpg"), EXAMPLE)]);
+    let (status, got) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+    assert_eq!(status, 200);
+    assert_eq!(json(&got)["spd"], expected("p.jpg")["spd"]);
+    slow.push(trickle.join().unwrap());
+    for mut stream in slow {
+        let (status, head, body) = read_answer(&mut stream);
+        assert_eq!(status, 408, "{head}");
+        assert!(
+            head.to_ascii_lowercase().contains("connection: close"),
+            "{head}"
+        );
+        let message = json(&body)["error"].as_str().unwrap().to_string();
+        assert!(message.contains("arrived too slowly"), "{message}");
+    }
+    // The grace of 2 s plus the pace's allowance for 1000 bytes (31 ms), with room for a
+    // busy machine; not the 60 s a client could hold them.
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "{:?}",
+        started.elapsed()
+    );
+    server.stop();
+}
+
+#[test]
+fn slow_headers_are_cut_off_with_408_and_idle_connections_closed() {
+    let server = start_with(
+        16 << 20,
+        Timeouts {
+            headers: Duration::from_secs(1),
+            body_grace: Duration::from_secs(10),
+        },
+    );
+    let addr = server.addr();
+    let started = Instant::now();
+    let mut begun = TcpStream::connect(addr).unwrap();
+    begun
+        .write_all(b"GET /api/locus HTTP/1.1\r\nHost: test\r\nX-Slow: a")
+        .unwrap();
+    let mut idle = TcpStream::connect(addr).unwrap();
+    let (status, head, body) = read_answer(&mut begun);
+    assert_eq!(status, 408, "{head}");
+    assert_eq!(
+        json(&body)["error"],
+        "the request's headers did not arrive in time"
+    );
+    let mut nothing = Vec::new();
+    let _ = idle.read_to_end(&mut nothing);
+    assert!(nothing.is_empty(), "{}", String::from_utf8_lossy(&nothing));
+    assert!(
+        started.elapsed() < Duration::from_secs(10),
+        "{:?}",
+        started.elapsed()
+    );
+    server.stop();
+}
+
+#[test]
+fn a_huge_header_is_refused_with_431_without_being_read() {
+    let server = start(16 << 20);
+    let mut stream = TcpStream::connect(server.addr()).unwrap();
+    stream
+        .set_write_timeout(Some(Duration::from_secs(10)))
+        .unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(10)))
+        .unwrap();
+    let started = Instant::now();
+    stream
+        .write_all(b"GET /api/locus HTTP/1.1\r\nHost: test\r\nX-Huge: ")
+        .unwrap();
+    // A 400 MB header line, sent until the server stops reading it.
+    let chunk = vec![b'a'; 1 << 20];
+    let mut sent = 0usize;
+    while sent < 400 << 20 && stream.write_all(&chunk).is_ok() {
+        sent += chunk.len();
+    }
+    let (status, head, _) = read_answer(&mut stream);
+    assert_eq!(status, 431, "{head}");
+    assert!(
+        sent < 64 << 20,
+        "the server read {} MB of headers",
+        sent >> 20
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(10),
+        "{:?}",
+        started.elapsed()
+    );
+    // Still serving.
+    let (status, _) = request(server.addr(), "GET", "/api/locus", None);
+    assert_eq!(status, 200);
+    server.stop();
+}
+
+#[test]
+fn head_answers_like_get_without_a_body() {
+    let server = start(16 << 20);
+    for path in ["/", "/app.js", "/api/locus"] {
+        let (status, body) = request(server.addr(), "HEAD", path, None);
+        assert_eq!(status, 200, "{path}");
+        assert!(body.is_empty(), "{path}");
+    }
+    let (status, got) = request(server.addr(), "DELETE", "/", None);
+    assert_eq!(status, 405);
+    assert_eq!(json(&got)["error"], "DELETE is not allowed on /");
+    server.stop();
+}
+
+#[test]
+fn a_host_name_is_resolved() {
+    let addrs = resolve("localhost", 0).unwrap();
+    assert!(addrs.iter().all(|a| a.ip().is_loopback()), "{addrs:?}");
+    let server = Server::start(
+        Config {
+            addrs,
+            max_upload_bytes: 1 << 20,
+            workers: 1,
+            timeouts: Timeouts::default(),
+        },
+        shipped_engine(&DataDir::new(None)).unwrap(),
+    )
+    .unwrap();
+    assert!(server.addr().ip().is_loopback());
+    let (status, body) = request(server.addr(), "GET", "/", None);
+    assert_eq!(status, 200);
+    assert!(String::from_utf8_lossy(&body).contains("<html"));
+    server.stop();
+    let error = resolve("no-such-host.invalid", 0).unwrap_err();
+    assert!(
+        format!("{error:#}").starts_with("cannot resolve the host 'no-such-host.invalid'"),
+        "{error:#}"
+    );
 }
