@@ -20,7 +20,8 @@
 //!   metrics), the one path every front end calls; [`stream`]: any number of feature rows
 //!   in bounded memory.
 //! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
-//!   verdict); [`plot`] and [`report`]: SVG plots and the HTML report.
+//!   verdict); [`presentation`]: what an estimate means in words and rounded numbers;
+//!   [`plot`] and [`report`]: SVG plots and the HTML report.
 //! - [`error`]: the crate's error type.
 //!
 //! Estimating the light from the example photo of a ColorChecker Digital SG with the
@@ -64,6 +65,7 @@ pub mod model;
 pub mod network;
 pub mod pca;
 pub mod plot;
+pub mod presentation;
 pub mod record;
 pub mod report;
 pub mod scale;

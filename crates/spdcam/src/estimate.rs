@@ -322,7 +322,12 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             .iter()
             .map(|e| e.trust.as_ref().and_then(|t| t.uncertainty.as_ref()))
             .collect();
-        write_plot(plot, &spds_band_svg(&title, &grid, &series, &bands)?)?;
+        let plotted_truths: Vec<Option<&[f64]>> =
+            truths[..shown].iter().map(Option::as_deref).collect();
+        write_plot(
+            plot,
+            &spds_band_svg(&title, &grid, &series, &bands, &plotted_truths)?,
+        )?;
     }
     if let Some(path) = &args.report {
         let items = estimates
@@ -621,7 +626,13 @@ fn run_features(
         };
         let bands: Vec<Option<&Uncertainty>> =
             run.first.iter().map(|f| f.3.uncertainty.as_ref()).collect();
-        write_plot(plot, &spds_band_svg(&title, grid, &series, &bands)?)?;
+        let truths = (0..series.len())
+            .map(|row| run.truth(row))
+            .collect::<Result<Vec<_>>>()?;
+        write_plot(
+            plot,
+            &spds_band_svg(&title, grid, &series, &bands, &truths)?,
+        )?;
     }
     if quiet(args) {
         return Ok(());
@@ -774,7 +785,7 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     }
 }
 
-/// One estimate of the report: its JSON, for a photo the photo with the chart found
+/// One estimate of the report: the estimate, for a photo the photo with the chart found
 /// (decoded again and drawn as `--debug` draws it, among the charts of `templates`), and
 /// its truth.
 fn report_item(
@@ -807,11 +818,7 @@ fn report_item(
         }
         _ => None,
     };
-    Ok(ReportItem {
-        estimate: estimate.to_json()?,
-        image,
-        truth_spd: truth,
-    })
+    Ok(ReportItem::new(estimate.clone(), image, truth))
 }
 
 /// Writes the report of `items` to `path` atomically.

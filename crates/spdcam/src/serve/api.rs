@@ -2,7 +2,7 @@
 //! Uploads are read into memory up to the size limit, checked, and queued; nothing the
 //! client sends is used as a path.
 
-use super::jobs::{Jobs, Outcome, Progress, Upload};
+use super::jobs::{plain_error, Jobs, Outcome, Progress, Upload, CHARTS};
 use super::multipart;
 use anyhow::Result;
 use spdcam_core::colorimetry::{cct_to_uv_planck, uv1960_to_xy, Observer};
@@ -35,8 +35,15 @@ impl Answer {
         Answer(status, "application/json", value.to_string().into_bytes())
     }
 
-    fn error(status: u16, message: impl Into<String>) -> Answer {
-        Answer::json(status, &serde_json::json!({ "error": message.into() }))
+    /// `{"error", "code", "message"}`: the library's message, and a code and a message
+    /// for a person ([`plain_error`]).
+    fn error(status: u16, error: impl Into<String>) -> Answer {
+        let error = error.into();
+        let (code, message) = plain_error(status, &error);
+        Answer::json(
+            status,
+            &serde_json::json!({ "error": error, "code": code, "message": message }),
+        )
     }
 
     fn outcome(outcome: Outcome) -> Answer {
@@ -80,7 +87,10 @@ impl Api {
         let get = *request.method() == Method::Get;
         let post = *request.method() == Method::Post;
         if let Some(id) = path.strip_prefix("/api/jobs/").filter(|_| get) {
-            return self.job(id);
+            return match id.strip_suffix("/report") {
+                Some(id) => self.report(id),
+                None => self.job(id),
+            };
         }
         match path {
             "/" | "/index.html" if get => {
@@ -132,11 +142,23 @@ impl Api {
                     serde_json::from_str(&json).unwrap_or(serde_json::Value::Null);
                 serde_json::json!({ "state": "done", "result": result })
             }
-            Progress::Finished(Outcome::Failed(status, message)) => serde_json::json!({
-                "state": "failed", "status": status, "error": message,
-            }),
+            Progress::Finished(Outcome::Failed(status, error)) => {
+                let (code, message) = plain_error(status, &error);
+                serde_json::json!({
+                    "state": "failed", "status": status, "error": error, "code": code,
+                    "message": message,
+                })
+            }
         };
         Answer::json(200, &value)
+    }
+
+    /// `GET /api/jobs/ID/report`: the finished job's HTML report, while it is kept.
+    fn report(&self, id: &str) -> Answer {
+        match id.parse::<u64>().ok().and_then(|id| self.jobs.report(id)) {
+            Some(html) => Answer(200, "text/html; charset=utf-8", html.as_bytes().to_vec()),
+            None => Answer::error(404, format!("no report of job '{id}' is kept")),
+        }
     }
 
     /// Reads and checks an upload form: the size limit (413), the `photo` field, `corners`.
@@ -174,6 +196,7 @@ impl Api {
         drop(body);
         let mut photo = None;
         let mut corners = None;
+        let mut chart = None;
         for field in fields {
             match field.name.as_str() {
                 "photo" if photo.is_none() => photo = Some(field),
@@ -185,6 +208,23 @@ impl Api {
                             crate::photo_args::parse_corners(&text)
                                 .map_err(|e| Answer::error(400, e.to_string()))?,
                         );
+                    }
+                }
+                "chart" => {
+                    let text = String::from_utf8_lossy(&field.data);
+                    let name = text.trim();
+                    if !name.is_empty() {
+                        chart = Some(CHARTS.into_iter().find(|c| c.name() == name).ok_or_else(
+                            || {
+                                Answer::error(
+                                    400,
+                                    format!(
+                                        "unknown chart '{name}'; valid: {}",
+                                        CHARTS.map(|c| c.name()).join(", ")
+                                    ),
+                                )
+                            },
+                        )?);
                     }
                 }
                 _ => {}
@@ -203,6 +243,7 @@ impl Api {
             name: label(photo.filename.as_deref()),
             bytes: photo.data,
             corners,
+            chart,
         })
     }
 }
