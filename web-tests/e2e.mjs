@@ -123,15 +123,14 @@ const context = await chromium.launchPersistentContext(profile, {
   acceptDownloads: true,
 });
 /**
- * The example photo with its chart's patch area painted over in grey where detection looks,
- * leaving a ring of patches along the border: no chart is found, yet its four corners are
- * where the unmarked photo has them. Made in the browser (canvas, JPEG) into a file.
+ * The example photo mirrored left to right: its chart's patches lie in an order no chart
+ * has, so no chart is found, yet the chart is there and its corners are the unmarked
+ * photo's, mirrored. Made in the browser (canvas, JPEG) into a file.
  */
 async function noChartPhoto() {
   const tab = await context.newPage();
   await tab.goto(url);
-  const [c0, c1, c2, c3] = expected.photo.corners;
-  const data = await tab.evaluate(async (corners) => {
+  const data = await tab.evaluate(async () => {
     const img = new Image();
     img.src = 'example.jpg';
     await img.decode();
@@ -139,17 +138,11 @@ async function noChartPhoto() {
     canvas.width = img.naturalWidth;
     canvas.height = img.naturalHeight;
     const ctx = canvas.getContext('2d');
+    ctx.translate(canvas.width, 0);
+    ctx.scale(-1, 1);
     ctx.drawImage(img, 0, 0);
-    // The chart's inner part: each corner moved a fifth of the way to the opposite one.
-    const mid = (a, b, t) => [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
-    const inner = [mid(corners[0], corners[2], 0.2), mid(corners[1], corners[3], 0.2), mid(corners[2], corners[0], 0.2), mid(corners[3], corners[1], 0.2)];
-    ctx.fillStyle = '#777';
-    ctx.beginPath();
-    inner.forEach(([x, y], k) => (k ? ctx.lineTo(x, y) : ctx.moveTo(x, y)));
-    ctx.closePath();
-    ctx.fill();
     return canvas.toDataURL('image/jpeg', 0.92).split(',')[1];
-  }, [c0, c1, c2, c3]);
+  });
   await tab.close();
   const path = join(artefacts, 'no-chart.jpg');
   writeFileSync(path, Buffer.from(data, 'base64'));
@@ -342,8 +335,10 @@ await test('no metric shows a number where it is not meaningful, on the page and
   await cli.goto(pathToFileURL(reportPath).href);
   check(await checkNotMeaningful(cli, '#estimate-1', result) === greyed, 'the CLI report greys other metrics');
   const [download] = await Promise.all([tab.waitForEvent('download'), tab.click('#download-report')]);
+  const saved = join(artefacts, 'report-web-example.html');
+  await download.saveAs(saved);
   const web = await context.newPage();
-  await web.goto(pathToFileURL(await download.path()).href);
+  await web.goto(pathToFileURL(saved).href);
   check(await checkNotMeaningful(web, '#estimate-1', result) === greyed, 'the web report greys other metrics');
   for (const t of [tab, cli, web]) await t.close();
 });
@@ -365,13 +360,17 @@ await test('the report prints on one page on A4 and Letter, from the CLI and fro
   // The page's report of one of two photos: that photo's name and curve only.
   const tab = await context.newPage();
   await tab.goto(url);
-  await tab.setInputFiles('#files', [photoPath, { name: 'second.jpg', mimeType: 'image/jpeg', buffer: readFileSync(photoPath) }]);
+  const second = join(profile, 'second.jpg');
+  writeFileSync(second, readFileSync(photoPath));
+  await tab.setInputFiles('#files', [photoPath, second]);
   await tab.waitForFunction(() => document.querySelectorAll('#spd-plot polyline.spd').length === 2, null, { timeout: 60000 });
   await tab.locator('#list li').filter({ hasText: 'second.jpg' }).click();
   const [download] = await Promise.all([tab.waitForEvent('download'), tab.click('#download-report')]);
   check(download.suggestedFilename() === 'second.report.html', download.suggestedFilename());
+  const saved = join(artefacts, 'report-web.html');
+  await download.saveAs(saved);
   const web = await context.newPage();
-  await web.goto(pathToFileURL(await download.path()).href);
+  await web.goto(pathToFileURL(saved).href);
   check(await text(web, 'h1') === 'The light in second.jpg', `title ${await text(web, 'h1')}`);
   check(await web.locator('svg.spd-plot polyline.spd').count() === 1, 'the report plots another photo too');
   check(await web.locator('img.photo').count() === 1 && await web.locator('svg.tm30-cvg, [data-key="tm30_bins"]').count() >= 1, 'no photo or TM-30 part');
@@ -416,15 +415,15 @@ await test('a photo where no chart is found: shown large, four clicks, the chart
     const b = await view.boundingBox();
     return [b.x + tx + px * s, b.y + ty + py * s];
   };
-  for (const corner of expected.photo.corners) {
-    const [cx, cy] = await toScreen(corner);
+  for (const [x, y] of expected.photo.corners) {
+    const [cx, cy] = await toScreen([expected.photo.width - x, y]);
     await tab.mouse.click(cx, cy);
   }
   check(await tab.locator('#placer circle.corner').count() === 4, 'four corners not placed');
   await tab.waitForSelector('#chart-choice');
   check(await tab.locator('#estimate-corners').isDisabled(), 'the chart is guessed, not asked');
   await tab.screenshot({ path: join(artefacts, 'corners-placed.png') });
-  await tab.check('input[name="chart"][value="colorchecker_sg140"]');
+  await tab.check('input[name="chart"][value="colorchecker_sg96"]');
   await tab.click('#estimate-corners');
   await tab.waitForFunction(() => {
     const m = document.getElementById('method');
@@ -444,11 +443,9 @@ await test('every error message on the page is free of command-line words', asyn
   // Not an image; no chart; larger than the server's limit (64 MB).
   const big = join(profile, 'big.jpg');
   writeFileSync(big, Buffer.alloc(65 << 20, 0xff));
-  await tab.setInputFiles('#files', [
-    { name: 'notes.txt', mimeType: 'text/plain', buffer: Buffer.from('not a photo') },
-    noChartPath,
-    big,
-  ]);
+  const notes = join(profile, 'notes.txt');
+  writeFileSync(notes, 'not a photo');
+  await tab.setInputFiles('#files', [notes, noChartPath, big]);
   await tab.waitForFunction(() => document.querySelectorAll('#list li .error').length === 3, null, { timeout: 120000 });
   messages.push(...await tab.locator('#list li .error').allTextContents());
   // The server's own answers, as the page receives them.

@@ -56,9 +56,7 @@ pub fn spds_band_svg(
         .collect();
     let banded = bands.iter().flatten().count();
     let legend_shown = series.len() <= 12;
-    let entries = series.len()
-        + truths.iter().flatten().count()
-        + if banded > 0 { 2 } else { 0 };
+    let entries = series.len() + truths.iter().flatten().count() + if banded > 0 { 2 } else { 0 };
     let highest = bands
         .iter()
         .flatten()
@@ -66,7 +64,13 @@ pub fn spds_band_svg(
         .chain(truths.iter().flatten().flatten().copied())
         .filter(|v| v.is_finite())
         .fold(1.0f64, f64::max);
-    let top = highest * (1.05 + if legend_shown { LEGEND_ROOM * entries as f64 } else { 0.0 });
+    let top = highest
+        * (1.05
+            + if legend_shown {
+                LEGEND_ROOM * entries as f64
+            } else {
+                0.0
+            });
     svg((900, 520), |root| {
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
@@ -200,7 +204,14 @@ mod tests {
             &[Some(&truth)],
         )
         .unwrap();
-        for label in ["photo.jpg", "true SPD", "68 % band", "95 % band", ">400<", ">700<"] {
+        for label in [
+            "photo.jpg",
+            "true SPD",
+            "68 % band",
+            "95 % band",
+            ">400<",
+            ">700<",
+        ] {
             assert!(svg.contains(label), "no {label} in the plot");
         }
         assert!(!svg.contains("400.0"), "a tick reads 400.0");

@@ -176,10 +176,7 @@ impl Presentation {
     /// The presentation of `estimate`.
     pub fn of(estimate: &Estimate) -> Presentation {
         let light = describe_light(estimate);
-        let uncertainty = estimate
-            .trust
-            .as_ref()
-            .and_then(|t| t.uncertainty.as_ref());
+        let uncertainty = estimate.trust.as_ref().and_then(|t| t.uncertainty.as_ref());
         let groups = GROUPS
             .iter()
             .map(|(title, metrics)| {
@@ -378,7 +375,10 @@ pub fn round_with_uncertainty(value: f64, half: f64) -> (String, String) {
     let text = |x: f64| {
         let s = format!("{:.decimals$}", round(x));
         // No "-0".
-        if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+        if s.trim_start_matches('-')
+            .chars()
+            .all(|c| c == '0' || c == '.')
+        {
             s.trim_start_matches('-').to_string()
         } else {
             s
@@ -551,7 +551,10 @@ mod tests {
     fn numbers_are_rounded_to_what_their_uncertainty_supports() {
         let r = |v, h| round_with_uncertainty(v, h);
         assert_eq!(r(154.3, 10.83), ("154".into(), "11".into()));
-        assert_eq!(r(0.0002476, 0.0000662), ("0.00025".into(), "0.00007".into()));
+        assert_eq!(
+            r(0.0002476, 0.0000662),
+            ("0.00025".into(), "0.00007".into())
+        );
         assert_eq!(r(2718.0, 828.0), ("2700".into(), "800".into()));
         assert_eq!(r(40.36, 14.14), ("40".into(), "14".into()));
         assert_eq!(r(0.5, 0.0096), ("0.50".into(), "0.010".into()));

@@ -152,11 +152,12 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
                 esc(&e.name)
             );
         }
-        None => {
-            out.push_str("<p class=\"small\">No photo: estimated from chart features.</p>\n")
-        }
+        None => out.push_str("<p class=\"small\">No photo: estimated from chart features.</p>\n"),
     }
-    let truth = item.truth_spd.as_deref().and_then(|t| peak_one(t, e.spd.len()));
+    let truth = item
+        .truth_spd
+        .as_deref()
+        .and_then(|t| peak_one(t, e.spd.len()));
     let bands = e
         .trust
         .as_ref()
@@ -183,7 +184,11 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
     let _ = writeln!(
         out,
         "<div class=\"row{}\">\n<div>",
-        if bins.is_ok() { " with-tm30" } else { " single" }
+        if bins.is_ok() {
+            " with-tm30"
+        } else {
+            " single"
+        }
     );
     metrics_table(out, p);
     out.push_str("</div>\n");
@@ -276,7 +281,9 @@ fn metrics_table(out: &mut String, p: &Presentation) {
             }
         }
     }
-    out.push_str("</table>\n<p class=\"small\">±: the 95 % interval, calibrated on held-out lamps.</p>\n");
+    out.push_str(
+        "</table>\n<p class=\"small\">±: the 95 % interval, calibrated on held-out lamps.</p>\n",
+    );
 }
 
 /// CIE 13.3's R1–R14 in one row, or why they are not shown.
@@ -345,7 +352,10 @@ fn facts(out: &mut String, e: &Estimate) {
         rows.push((
             "illuminance",
             "illuminance (approx., from EXIF)",
-            format!("{} lx", crate::presentation::round_sig(level.illuminance_lux, 2)),
+            format!(
+                "{} lx",
+                crate::presentation::round_sig(level.illuminance_lux, 2)
+            ),
         ));
     }
     if let Some(w) = e
@@ -694,4 +704,3 @@ fn base64(bytes: &[u8]) -> String {
     }
     out
 }
-

@@ -120,22 +120,39 @@ fn the_report_of_the_example_photo_shows_its_numbers_as_json_gives_them() {
     }
     assert!(html.contains("data-key=\"cri_r\">CIE 13.3 R1–R14: not meaningful"));
     let gfc = format!("{:.4}", e["truth"]["gfc"].as_f64().unwrap());
-    assert!(html.contains(&format!("data-key=\"gfc\">GFC {gfc}, RMSE ")), "GFC {gfc}");
+    assert!(
+        html.contains(&format!("data-key=\"gfc\">GFC {gfc}, RMSE ")),
+        "GFC {gfc}"
+    );
     let x = format!("{:.4}", e["colorimetry"]["xy"][0].as_f64().unwrap());
     assert!(html.contains(&x), "x {x}");
-    let confidence = format!("(confidence {:.2})", e["photo"]["confidence"].as_f64().unwrap());
+    let confidence = format!(
+        "(confidence {:.2})",
+        e["photo"]["confidence"].as_f64().unwrap()
+    );
     assert!(html.contains(&confidence), "{confidence}");
     // The summary and the verdict in plain words at the top.
     let summary = html.find(&format!("<p class=\"summary\">{}", presentation.summary));
-    let verdict = html.find(&format!("data-verdict=\"{}\"", e["verdict"].as_str().unwrap()));
+    let verdict = html.find(&format!(
+        "data-verdict=\"{}\"",
+        e["verdict"].as_str().unwrap()
+    ));
     let plot = html.find("<svg class=\"spd-plot\"");
-    assert!(summary.is_some() && summary < verdict && verdict < plot, "the order");
+    assert!(
+        summary.is_some() && summary < verdict && verdict < plot,
+        "the order"
+    );
     // The plots inline, the truth and the bands drawn and in the legend, the photo as a data URI.
     assert!(html.contains("<polyline class=\"spd\""));
     assert!(html.contains("<polyline class=\"truth\""));
-    assert!(html.contains("<polygon class=\"band68\"") && html.contains("<polygon class=\"band95\""));
+    assert!(
+        html.contains("<polygon class=\"band68\"") && html.contains("<polygon class=\"band95\"")
+    );
     for label in ["estimate", "true spectrum", "68 % band", "95 % band"] {
-        assert!(html.contains(&format!(">{label}</text></g>")), "no legend entry {label}");
+        assert!(
+            html.contains(&format!(">{label}</text></g>")),
+            "no legend entry {label}"
+        );
     }
     assert!(html.contains("src=\"data:image/jpeg;base64,/9j/"));
     for w in e["metrics"]["warnings"].as_array().unwrap() {

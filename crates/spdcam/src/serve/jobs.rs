@@ -20,7 +20,7 @@ use std::time::Instant;
 pub const KEEP_REPORTS: usize = 32;
 
 /// The charts a client may name for its corners: a name, never a path.
-pub const CHARTS: [KnownChart; 2] = [KnownChart::ColorChecker24, KnownChart::Sg140];
+pub const CHARTS: [KnownChart; 2] = [KnownChart::ColorChecker24, KnownChart::Sg96];
 
 /// One uploaded photo to estimate, held in memory.
 #[derive(Debug)]
@@ -178,7 +178,10 @@ pub fn plain_error(status: u16, error: &str) -> (&'static str, String) {
                 "not_found",
                 "This is no longer kept on the server; add the photo again.".to_string(),
             ),
-            _ => ("failed", format!("The photo could not be estimated: {}", without_flags(error))),
+            _ => (
+                "failed",
+                format!("The photo could not be estimated: {}", without_flags(error)),
+            ),
         }
     };
     (code, message)
@@ -378,7 +381,11 @@ mod tests {
             }
         }
         assert_eq!(
-            plain_error(500, "the model broke (try spdcam estimate --debug d.png); really").1,
+            plain_error(
+                500,
+                "the model broke (try spdcam estimate --debug d.png); really"
+            )
+            .1,
             "The photo could not be estimated: the model broke; really"
         );
     }

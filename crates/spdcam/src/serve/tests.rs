@@ -264,12 +264,17 @@ fn a_job_keeps_its_report_and_corners_take_a_named_chart_only() {
         .as_array()
         .unwrap()
         .iter()
-        .flat_map(|c| c.as_array().unwrap().iter().map(|v| format!("{:.2}", v.as_f64().unwrap())))
+        .flat_map(|c| {
+            c.as_array()
+                .unwrap()
+                .iter()
+                .map(|v| format!("{:.2}", v.as_f64().unwrap()))
+        })
         .collect();
     let body = form(&[
         ("photo", Some("p.jpg"), EXAMPLE),
         ("corners", None, corners.join(",").as_bytes()),
-        ("chart", None, b"colorchecker_sg140"),
+        ("chart", None, b"colorchecker_sg96"),
     ]);
     let (status, got) = request(addr, "POST", "/api/jobs", Some(body.as_slice()));
     assert_eq!(status, 202);
@@ -285,7 +290,10 @@ fn a_job_keeps_its_report_and_corners_take_a_named_chart_only() {
     };
     assert_eq!(result["photo"]["method"], "corners");
     assert_eq!(result["photo"]["chart"], found["photo"]["chart"]);
-    assert_eq!(result["presentation"]["summary"], found["presentation"]["summary"]);
+    assert_eq!(
+        result["presentation"]["summary"],
+        found["presentation"]["summary"]
+    );
     let (status, report) = request(addr, "GET", &format!("/api/jobs/{id}/report"), None);
     assert_eq!(status, 200);
     let report = String::from_utf8(report).unwrap();
@@ -296,13 +304,16 @@ fn a_job_keeps_its_report_and_corners_take_a_named_chart_only() {
     assert_eq!(status, 404);
     assert_eq!(json(&got)["code"], "not_found");
     // A chart is a name, never a path.
-    let body = form(&[("photo", Some("p.jpg"), EXAMPLE), ("chart", None, b"/etc/passwd")]);
+    let body = form(&[
+        ("photo", Some("p.jpg"), EXAMPLE),
+        ("chart", None, b"/etc/passwd"),
+    ]);
     let (status, got) = request(addr, "POST", "/api/jobs", Some(body.as_slice()));
     assert_eq!(status, 400);
     let error = json(&got)["error"].as_str().unwrap().to_string();
     assert_eq!(
         error,
-        "unknown chart '/etc/passwd'; valid: colorchecker24, colorchecker_sg140"
+        "unknown chart '/etc/passwd'; valid: colorchecker24, colorchecker_sg96"
     );
     server.stop();
 }

@@ -302,7 +302,7 @@ function renderStage() {
 /** The charts a person can name for placed corners (the server's names). */
 const CHARTS = [
   ['colorchecker24', 'ColorChecker 24 (classic, 4 × 6 patches)'],
-  ['colorchecker_sg140', 'ColorChecker Digital SG (14 × 10 patches)'],
+  ['colorchecker_sg96', 'ColorChecker Digital SG (14 × 10 patches)'],
 ];
 
 /**
