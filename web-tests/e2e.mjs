@@ -1,16 +1,19 @@
 // End-to-end tests of the `spdcam serve` page in headless Chromium, as a person would use it.
-// Usage: node e2e.mjs URL EXPECTED.json PHOTO TRUTH.csv ARTEFACT_DIR [REPORT.html]
-// EXPECTED.json is `spdcam estimate --json PHOTO` (an array of one estimate); REPORT.html,
-// when given, is `spdcam estimate --report REPORT.html PHOTO`, opened offline from its file.
+// Usage: node e2e.mjs URL EXPECTED.json PHOTO TRUTH.csv ARTEFACT_DIR REPORT.html CLI.csv
+// EXPECTED.json is `spdcam estimate --json PHOTO` (an array of one estimate), REPORT.html
+// `spdcam estimate --report REPORT.html PHOTO` (opened offline from its file), CLI.csv
+// `spdcam estimate -o CLI.csv PHOTO`. A photo where detection fails is made from PHOTO in
+// the browser (see `noChartPhoto`).
 import { chromium } from 'playwright-core';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
-const [url, expectedPath, photoPath, truthPath, artefacts, reportPath] = process.argv.slice(2);
-if (!artefacts) {
-  console.error('usage: node e2e.mjs URL EXPECTED.json PHOTO TRUTH.csv ARTEFACT_DIR [REPORT.html]');
+const [url, expectedPath, photoPath, truthPath, artefacts, reportPath, csvPath] = process.argv.slice(2);
+if (!csvPath) {
+  console.error('usage: node e2e.mjs URL EXPECTED.json PHOTO TRUTH.csv ARTEFACT_DIR REPORT.html CLI.csv');
   process.exit(2);
 }
 const expected = JSON.parse(readFileSync(expectedPath, 'utf8'))[0];
@@ -48,6 +51,68 @@ async function plottedSpd(page, entry) {
 
 const text = async (page, selector) => (await page.locator(selector).textContent()).trim();
 
+/** Words of the command line that a person using the page cannot type. */
+const COMMAND_LINE = /--[a-z]|spdcam (serve|estimate)|\bcargo\b/;
+
+/** The metric cells of the CLI's report of the example: {key: shown text}. */
+async function reportCells() {
+  const tab = await context.newPage();
+  await tab.goto(pathToFileURL(reportPath).href);
+  const cells = await tab.evaluate(() => Object.fromEntries([...document.querySelectorAll('#estimate-1 table.metrics td[data-key]')]
+    .map((td) => [td.dataset.key, td.textContent.trim()])));
+  await tab.close();
+  return cells;
+}
+
+/** The pages of a PDF, by pdfinfo (poppler-utils). */
+function pdfPages(path) {
+  const info = execFileSync('pdfinfo', [path], { encoding: 'utf8' });
+  const m = info.match(/^Pages:\s+(\d+)/m);
+  if (!m) throw new Error(`pdfinfo gave no page count: ${info}`);
+  return Number(m[1]);
+}
+
+/** Prints `tab` to PDF on A4 and on Letter (the report's @page margins, Chromium's own
+ *  print layout) and gives the page counts. */
+async function printedPages(tab, label) {
+  const counts = {};
+  for (const format of ['A4', 'Letter']) {
+    const path = join(artefacts, `${label}.${format}.pdf`);
+    await tab.emulateMedia({ media: 'print' });
+    await tab.pdf({ path, format, printBackground: true });
+    counts[format] = pdfPages(path);
+  }
+  await tab.emulateMedia({ media: 'screen' });
+  return counts;
+}
+
+/** For every metric the presentation marks not meaningful: the page shows no number for it,
+ *  and its raw value appears nowhere in the text of `scope` (in any usual rounding). */
+async function checkNotMeaningful(tab, scope, result) {
+  const walked = await tab.evaluate((scope) => [...document.querySelectorAll(`${scope} tr.not-meaningful`)].map((tr) => ({
+    key: tr.dataset.key || tr.querySelector('[data-key]').dataset.key,
+    value: [...tr.querySelector('td').childNodes].filter((n) => n.nodeType === 3).map((n) => n.textContent).join('').trim(),
+    reason: (tr.querySelector('.reason') || {}).textContent || '',
+  })), scope);
+  const wanted = result.presentation.groups.flatMap((g) => g.metrics).filter((m) => m.value === null).map((m) => m.key);
+  check(JSON.stringify(walked.map((w) => w.key).sort()) === JSON.stringify(wanted.slice().sort()),
+    `greyed ${walked.map((w) => w.key)}, not meaningful ${wanted}`);
+  const all = await tab.locator(scope).innerText();
+  for (const w of walked) {
+    check(w.value === '—', `${w.key} shows '${w.value}' though not meaningful`);
+    check(/not meaningful|no colour temperature|not defined|undefined|cannot|no /.test(w.reason), `${w.key}: reason '${w.reason}'`);
+    const raw = w.key === 'cri_r9' ? result.metrics.cri_r && result.metrics.cri_r[8] : result.metrics[w.key];
+    if (typeof raw !== 'number') continue;
+    const forms = new Set([raw.toFixed(1), raw.toFixed(2), raw.toPrecision(4)]);
+    if (Math.abs(raw) >= 100) forms.add(raw.toFixed(0));
+    for (const f of forms) {
+      const re = new RegExp(`(^|[^0-9.])${f.replace('.', '\\.')}($|[^0-9])`);
+      check(!re.test(all), `${w.key}'s value ${f} is shown though not meaningful`);
+    }
+  }
+  return walked.length;
+}
+
 const profile = mkdtempSync(join(tmpdir(), 'spdcam-chromium-'));
 // A fresh profile (--user-data-dir) each run, given as Playwright asks for it.
 const context = await chromium.launchPersistentContext(profile, {
@@ -57,6 +122,34 @@ const context = await chromium.launchPersistentContext(profile, {
   viewport: { width: 1500, height: 1000 },
   acceptDownloads: true,
 });
+/**
+ * The example photo mirrored left to right: its chart's patches lie in an order no chart
+ * has, so no chart is found, yet the chart is there and its corners are the unmarked
+ * photo's, mirrored. Made in the browser (canvas, JPEG) into a file.
+ */
+async function noChartPhoto() {
+  const tab = await context.newPage();
+  await tab.goto(url);
+  const data = await tab.evaluate(async () => {
+    const img = new Image();
+    img.src = 'example.jpg';
+    await img.decode();
+    const canvas = document.createElement('canvas');
+    canvas.width = img.naturalWidth;
+    canvas.height = img.naturalHeight;
+    const ctx = canvas.getContext('2d');
+    ctx.translate(canvas.width, 0);
+    ctx.scale(-1, 1);
+    ctx.drawImage(img, 0, 0);
+    return canvas.toDataURL('image/jpeg', 0.92).split(',')[1];
+  });
+  await tab.close();
+  const path = join(artefacts, 'no-chart.jpg');
+  writeFileSync(path, Buffer.from(data, 'base64'));
+  return path;
+}
+const noChartPath = await noChartPhoto();
+
 const page = await context.newPage();
 const pageErrors = [];
 page.on('pageerror', (e) => pageErrors.push(e.message));
@@ -88,42 +181,61 @@ await test('opening the page and trying the example shows its SPD and details', 
   await (await timeExample('second tab')).close();
 });
 
-await test('an uploaded photo shows the SPD, xy, CCT and Duv of `spdcam estimate --json`', async () => {
+await test('an uploaded photo shows the SPD and xy of `spdcam estimate --json` and the metrics of its report', async () => {
   await page.goto(url);
   await page.setInputFiles('#files', photoPath);
-  await page.waitForSelector('#cct');
+  await page.waitForSelector('#metrics');
   const c = expected.colorimetry;
   check(await text(page, '#xy-x') === c.xy[0].toFixed(4), `x ${await text(page, '#xy-x')} vs ${c.xy[0]}`);
   check(await text(page, '#xy-y') === c.xy[1].toFixed(4), `y ${await text(page, '#xy-y')} vs ${c.xy[1]}`);
-  // CCT and Duv are given only near the Planckian locus (|Duv| <= 0.05), as the CLI does.
-  const cct = c.cct === null ? 'none (far from the Planckian locus)' : `${c.cct.toFixed(0)} K`;
-  const duv = c.duv === null ? '–' : (c.duv >= 0 ? '+' : '') + c.duv.toFixed(4);
-  check(await text(page, '#cct') === cct, `CCT ${await text(page, '#cct')} vs ${c.cct}`);
-  check(await text(page, '#duv') === duv, `Duv ${await text(page, '#duv')} vs ${c.duv}`);
-  // Ra with its calibrated 95 % interval, as the JSON gives them.
-  const ra = expected.metrics.cri_ra;
-  const raHalf = expected.metric_uncertainty && expected.metric_uncertainty.cri_ra;
-  check(raHalf && raHalf.half95 > 0, 'the CLI gives Ra an interval');
-  const raShown = await text(page, '#metric-cri_ra');
-  check(raShown === `${ra.toPrecision(4)} ± ${raHalf.half95.toPrecision(4)}`, `Ra shown as ${raShown}`);
+  // Every metric the same as in the CLI's report: the rounded value with its unit, or '—'.
+  const cells = await reportCells();
+  const keys = Object.keys(cells);
+  check(keys.length >= 10, `the report shows ${keys.length} metrics`);
+  for (const key of keys) {
+    const shown = (await page.locator(`#metric-${key}`).evaluate((td) => td.firstChild.textContent)).trim();
+    check(shown === cells[key], `${key}: the page shows '${shown}', the report '${cells[key]}'`);
+  }
+  // The groups in their order, with a line of explanation each.
+  const groups = await page.locator('#metrics tr.group').allTextContents();
+  check(JSON.stringify(groups) === JSON.stringify(['Colour', 'Colour rendering', 'Circadian and eye', 'Plants']), `groups ${groups}`);
+  check(await page.locator('#metrics tr.metric .explain').count() === keys.length, 'a metric without explanation');
   const points = await plottedSpd(page, expected.name);
   check(points && points.length === expected.spd.length, `plotted ${points && points.length} points`);
   const wl = expected.wavelength_nm;
-  const [left, right, top, bottom] = [52, 628, 14, 294];
+  const [left, right, top, bottom] = [52, 628, 40, 312];
+  const yTop = Number(await page.locator('#spd-plot').getAttribute('data-top'));
+  check(yTop >= 1, `plot top ${yTop}`);
   points.forEach(([x, y], i) => {
     close(wl[0] + ((x - left) / (right - left)) * (wl[wl.length - 1] - wl[0]), wl[i], 1e-3, `wavelength ${i}`);
-    close((bottom - y) / (bottom - top), expected.spd[i], 1e-4, `SPD at ${wl[i]} nm`);
+    close(((bottom - y) / (bottom - top)) * yTop, expected.spd[i], 1e-4, `SPD at ${wl[i]} nm`);
   });
+  // The bands stay inside the frame, and the legend lies above it (it covers no curve).
+  const inside = await page.evaluate(({ top, bottom }) => [...document.querySelectorAll('#spd-plot polygon.band')].every((p) => p.getAttribute('points').split(' ').every((q) => {
+    const y = Number(q.split(',')[1]);
+    return y >= top - 1e-6 && y <= bottom + 1e-6;
+  })), { top, bottom });
+  check(inside, 'a band leaves the plot frame');
+  const legend = await page.evaluate(() => [...document.querySelectorAll('#spd-plot g.legend')].map((g) => [g.textContent, g.getBBox().y + g.getBBox().height]));
+  check(legend.some(([t]) => t === '68 % band') && legend.some(([t]) => t === '95 % band'), `legend ${JSON.stringify(legend)}`);
+  check(legend.every(([, b]) => b <= top), `the legend reaches into the frame: ${JSON.stringify(legend)}`);
   // The point on the xy diagram.
   const dot = await page.locator('#xy-plot circle.xy-point').first().getAttribute('cx');
   close((Number(dot) - 44) / (388 - 44) * 0.8, c.xy[0], 1e-4, 'x on the diagram');
-  // The CSV download carries the exact numbers.
+  // The CSV download carries the exact numbers and the band columns of the CLI's -o CSV.
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download-csv')]);
   const csv = readFileSync(await download.path(), 'utf8').trim().split('\n');
-  check(csv[0] === `wavelength_nm,${expected.name}`, `CSV header ${csv[0]}`);
+  const cli = readFileSync(csvPath, 'utf8').trim().split('\n');
+  const n = expected.name;
+  check(csv[0] === `wavelength_nm,${n},${n}_lower68,${n}_upper68,${n}_lower95,${n}_upper95`, `CSV header ${csv[0]}`);
+  check(csv[0] === cli[0], `CSV header ${csv[0]}, the CLI's ${cli[0]}`);
+  check(csv.length === cli.length, `${csv.length} CSV lines, the CLI ${cli.length}`);
   csv.slice(1).forEach((line, i) => {
-    const [w, v] = line.split(',').map(Number);
-    check(w === wl[i] && v === expected.spd[i], `CSV row ${i}: ${line}`);
+    const v = line.split(',').map(Number);
+    const want = cli[i + 1].split(',').map(Number);
+    check(v[0] === wl[i] && v[1] === expected.spd[i], `CSV row ${i}: ${line}`);
+    check(v[2] === expected.band68.lower[i] && v[5] === expected.band95.upper[i], `CSV bands row ${i}: ${line}`);
+    want.forEach((w, k) => close(v[k], w, 1e-9, `CSV row ${i} column ${k}`));
   });
   const [json] = await Promise.all([page.waitForEvent('download'), page.click('#download-json')]);
   const saved = JSON.parse(readFileSync(await json.path(), 'utf8'));
@@ -165,12 +277,12 @@ await test('dragging a corner re-runs the estimate with those corners', async ()
   await page.screenshot({ path: join(artefacts, 'corners.png'), fullPage: true });
 });
 
-await test('a file that is no image shows the CLI\'s error in the page', async () => {
+await test('a file that is no image shows a plain error in the page', async () => {
   await page.setInputFiles('#files', { name: 'notes.txt', mimeType: 'text/plain', buffer: Buffer.from('these are notes, not a photo') });
-  const error = page.locator('#list li .error').filter({ hasText: 'notes.txt' });
+  const error = page.locator('#list li').filter({ hasText: 'notes.txt' }).locator('.error');
   await error.waitFor({ timeout: 30000 });
   const message = await error.textContent();
-  check(message.includes('not an image'), message);
+  check(message === 'This file is not a photo the page can read: use a JPEG, PNG or TIFF.', message);
   // The earlier estimate is still there and the page still works.
   check(await page.locator('#spd-plot polyline.spd').count() >= 1, 'the earlier SPD vanished');
   await page.screenshot({ path: join(artefacts, 'error.png'), fullPage: true });
@@ -180,6 +292,185 @@ await test('several photos share one plot', async () => {
   await page.setInputFiles('#files', [photoPath, photoPath]);
   await page.waitForFunction(() => document.querySelectorAll('#spd-plot polyline.spd').length >= 3, null, { timeout: 30000 });
   check(await page.locator('#xy-plot circle.xy-point').count() >= 3, 'fewer than three xy points');
+});
+
+await test('the summary says in plain words what the light is and how good the estimate is', async () => {
+  const tab = await context.newPage();
+  await tab.goto(url);
+  await tab.click('#example');
+  await tab.waitForSelector('#plain-summary.plain-summary');
+  const summary = await text(tab, '#plain-summary');
+  check(/light with an? [a-zA-Z ,()-]+ spectrum/.test(summary), `summary '${summary}'`);
+  check(/good to about ±\d+ % of the spectrum's peak/.test(summary), `summary '${summary}'`);
+  // The same words as the report, which has them from the same source.
+  const report = await context.newPage();
+  await report.goto(pathToFileURL(reportPath).href);
+  check(await text(report, '#estimate-1 .summary') === summary, 'the report says otherwise');
+  const verdict = await tab.locator('#verdict').getAttribute('data-verdict');
+  check(verdict === expected.verdict, `verdict ${verdict}, the CLI ${expected.verdict}`);
+  check((await text(tab, '#verdict')).startsWith('Verdict: '), 'no verdict headline');
+  check(/goodness-of-fit coefficient/.test(await text(tab, '#gfc-words')), 'the GFC is not explained');
+  // Above the photo and the plots.
+  const [s, p] = await Promise.all(['#overview', '#plots'].map((sel) => tab.locator(sel).boundingBox()));
+  check(s.y < p.y, 'the summary is not at the top');
+  await tab.screenshot({ path: join(artefacts, 'summary.png') });
+  await report.close();
+  await tab.close();
+});
+
+await test('no metric shows a number where it is not meaningful, on the page and in the reports', async () => {
+  const tab = await context.newPage();
+  await tab.goto(url);
+  await tab.click('#example');
+  await tab.waitForSelector('#metrics');
+  const result = await tab.evaluate(() => fetch('example.jpg').then((r) => r.blob()).then((b) => {
+    const form = new FormData();
+    form.append('photo', new File([b], 'sg-telelumen.jpg'));
+    return fetch('api/estimate', { method: 'POST', body: form }).then((r) => r.json());
+  }));
+  const greyed = await checkNotMeaningful(tab, 'main', result);
+  // The example light is far from the Planckian locus: at least CCT and Ra are greyed.
+  check(greyed >= 2, `${greyed} metrics greyed`);
+  const cli = await context.newPage();
+  await cli.goto(pathToFileURL(reportPath).href);
+  check(await checkNotMeaningful(cli, '#estimate-1', result) === greyed, 'the CLI report greys other metrics');
+  const [download] = await Promise.all([tab.waitForEvent('download'), tab.click('#download-report')]);
+  const saved = join(artefacts, 'report-web-example.html');
+  await download.saveAs(saved);
+  const web = await context.newPage();
+  await web.goto(pathToFileURL(saved).href);
+  check(await checkNotMeaningful(web, '#estimate-1', result) === greyed, 'the web report greys other metrics');
+  for (const t of [tab, cli, web]) await t.close();
+});
+
+await test('the report prints on one page on A4 and Letter, from the CLI and from the page', async () => {
+  const cli = await context.newPage();
+  await cli.goto(pathToFileURL(reportPath).href);
+  const pages = await printedPages(cli, 'report-cli');
+  check(pages.A4 === 1 && pages.Letter === 1, `the CLI report prints on ${JSON.stringify(pages)} pages`);
+  // Nothing runs out of its column: the hue-bin and R1–R14 tables fit, all 14 R values shown.
+  await cli.emulateMedia({ media: 'print' });
+  const overflow = await cli.evaluate(() => [...document.querySelectorAll('table')].filter((t) => t.scrollWidth > t.parentElement.clientWidth + 1).map((t) => t.className));
+  await cli.emulateMedia({ media: 'screen' });
+  check(overflow.length === 0, `tables wider than their column: ${overflow}`);
+  const rShown = await cli.locator('#estimate-1 [data-key^="cri_r."]').count();
+  const rGreyed = await cli.locator('#estimate-1 p[data-key="cri_r"]').count();
+  check(rShown === 14 || rGreyed === 1, `R1–R14: ${rShown} shown`);
+  await cli.close();
+  // The page's report of one of two photos: that photo's name and curve only.
+  const tab = await context.newPage();
+  await tab.goto(url);
+  const second = join(profile, 'second.jpg');
+  writeFileSync(second, readFileSync(photoPath));
+  await tab.setInputFiles('#files', [photoPath, second]);
+  await tab.waitForFunction(() => document.querySelectorAll('#spd-plot polyline.spd').length === 2, null, { timeout: 60000 });
+  await tab.locator('#list li').filter({ hasText: 'second.jpg' }).click();
+  const [download] = await Promise.all([tab.waitForEvent('download'), tab.click('#download-report')]);
+  check(download.suggestedFilename() === 'second.report.html', download.suggestedFilename());
+  const saved = join(artefacts, 'report-web.html');
+  await download.saveAs(saved);
+  const web = await context.newPage();
+  await web.goto(pathToFileURL(saved).href);
+  check(await text(web, 'h1') === 'The light in second.jpg', `title ${await text(web, 'h1')}`);
+  check(await web.locator('svg.spd-plot polyline.spd').count() === 1, 'the report plots another photo too');
+  check(await web.locator('img.photo').count() === 1 && await web.locator('svg.tm30-cvg, [data-key="tm30_bins"]').count() >= 1, 'no photo or TM-30 part');
+  check(await web.locator('.verdict').count() === 1, 'no verdict');
+  const webPages = await printedPages(web, 'report-web');
+  check(webPages.A4 === 1 && webPages.Letter === 1, `the page's report prints on ${JSON.stringify(webPages)} pages`);
+  await web.screenshot({ path: join(artefacts, 'report-web.png'), fullPage: true });
+  await web.close();
+  await tab.close();
+});
+
+await test('a photo where no chart is found: shown large, four clicks, the chart asked, then estimated', async () => {
+  const tab = await context.newPage();
+  await tab.goto(url);
+  await tab.setInputFiles('#files', noChartPath);
+  await tab.waitForSelector('#placer[data-ready="1"]', { timeout: 60000 });
+  const message = await text(tab, '#plain-summary');
+  check(message.startsWith('No colour chart was found'), message);
+  check(!COMMAND_LINE.test(message), message);
+  const view = tab.locator('#placer');
+  const box = await view.boundingBox();
+  check(box.width > 700 && box.height > 350, `the photo is shown ${box.width} × ${box.height}`);
+  // Zoom in around the middle and back out: the transform follows.
+  const before = Number(await view.getAttribute('data-scale'));
+  await tab.click('#zoom-in');
+  check(Number(await view.getAttribute('data-scale')) > before, 'zoom in did nothing');
+  await tab.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+  await tab.mouse.wheel(0, 300);
+  await tab.click('#zoom-fit');
+  // Pan: a drag moves the photo and places no corner.
+  const x0 = Number(await view.getAttribute('data-x'));
+  await tab.mouse.move(box.x + 200, box.y + 200);
+  await tab.mouse.down();
+  await tab.mouse.move(box.x + 260, box.y + 230, { steps: 6 });
+  await tab.mouse.up();
+  check(Number(await view.getAttribute('data-x')) > x0 + 50, 'the drag did not pan');
+  check(await tab.locator('#placer circle.corner').count() === 0, 'the drag placed a corner');
+  await tab.click('#zoom-fit');
+  // Four clicks on the chart's corners (those the detection finds on the unmarked photo).
+  const toScreen = async ([px, py]) => {
+    const [s, tx, ty] = await Promise.all(['data-scale', 'data-x', 'data-y'].map(async (a) => Number(await view.getAttribute(a))));
+    const b = await view.boundingBox();
+    return [b.x + tx + px * s, b.y + ty + py * s];
+  };
+  for (const [x, y] of expected.photo.corners) {
+    const [cx, cy] = await toScreen([expected.photo.width - x, y]);
+    await tab.mouse.click(cx, cy);
+  }
+  check(await tab.locator('#placer circle.corner').count() === 4, 'four corners not placed');
+  await tab.waitForSelector('#chart-choice');
+  check(await tab.locator('#estimate-corners').isDisabled(), 'the chart is guessed, not asked');
+  await tab.screenshot({ path: join(artefacts, 'corners-placed.png') });
+  await tab.check('input[name="chart"][value="colorchecker_sg96"]');
+  await tab.click('#estimate-corners');
+  await tab.waitForFunction(() => {
+    const m = document.getElementById('method');
+    return m && m.textContent === 'your corners';
+  }, null, { timeout: 60000 });
+  check((await text(tab, '#chart')).startsWith('colorchecker_sg'), `chart ${await text(tab, '#chart')}`);
+  check(await tab.locator('#spd-plot polyline.spd').count() === 1, 'no SPD');
+  check(await tab.locator('#plain-summary.plain-summary').count() === 1, 'no summary');
+  await tab.screenshot({ path: join(artefacts, 'corners-estimated.png'), fullPage: true });
+  await tab.close();
+});
+
+await test('every error message on the page is free of command-line words', async () => {
+  const tab = await context.newPage();
+  await tab.goto(url);
+  const messages = [];
+  // Not an image; no chart; larger than the server's limit (64 MB).
+  const big = join(profile, 'big.jpg');
+  writeFileSync(big, Buffer.alloc(65 << 20, 0xff));
+  const notes = join(profile, 'notes.txt');
+  writeFileSync(notes, 'not a photo');
+  await tab.setInputFiles('#files', [notes, noChartPath, big]);
+  await tab.waitForFunction(() => document.querySelectorAll('#list li .error').length === 3, null, { timeout: 120000 });
+  messages.push(...await tab.locator('#list li .error').allTextContents());
+  // The server's own answers, as the page receives them.
+  const answers = await tab.evaluate(async () => {
+    const form = (fields) => { const f = new FormData(); for (const [k, v] of fields) f.append(k, v); return f; };
+    const photo = await (await fetch('example.jpg')).blob();
+    const post = (fields) => fetch('api/jobs', { method: 'POST', body: form(fields) }).then((r) => r.json());
+    return [
+      await post([['photo', photo, 'p.jpg'], ['corners', '1,2,3']]),
+      await post([['photo', photo, 'p.jpg'], ['chart', '/etc/passwd']]),
+      await post([['other', 'x']]),
+      await fetch('api/jobs/999999').then((r) => r.json()),
+      await fetch('api/jobs/999999/report').then((r) => r.json()),
+      await fetch('no/such/page').then((r) => r.json()),
+    ];
+  });
+  for (const a of answers) {
+    check(typeof a.message === 'string' && typeof a.error === 'string', JSON.stringify(a));
+    messages.push(a.message);
+  }
+  check(messages.length === 9, `${messages.length} messages`);
+  for (const m of messages) check(!COMMAND_LINE.test(m), `'${m}' names the command line`);
+  check(messages.some((m) => m.includes('larger than this server accepts')), messages.join(' | '));
+  await tab.screenshot({ path: join(artefacts, 'errors.png'), fullPage: true });
+  await tab.close();
 });
 
 await test('the page asked for nothing outside the local server and raised no script error', async () => {
@@ -200,21 +491,22 @@ if (reportPath) {
     await tab.goto(pathToFileURL(reportPath).href, { waitUntil: 'load' });
     const shown = async (key) => (await tab.locator(`#estimate-1 [data-key="${key}"]`).first().textContent()).trim();
     const m = expected.metrics;
-    check(await shown('cri_ra') === m.cri_ra.toFixed(1), `Ra ${await shown('cri_ra')}, expected ${m.cri_ra.toFixed(1)}`);
-    check(await shown('tm30_rf') === m.tm30_rf.toFixed(1), `Rf ${await shown('tm30_rf')}, expected ${m.tm30_rf.toFixed(1)}`);
-    check(await shown('tm30_rg') === m.tm30_rg.toFixed(1), `Rg ${await shown('tm30_rg')}, expected ${m.tm30_rg.toFixed(1)}`);
-    check(await shown('cct_k') === m.cct_k.toFixed(0), `CCT ${await shown('cct_k')}, expected ${m.cct_k.toFixed(0)}`);
-    check(await shown('gfc') === expected.truth.gfc.toFixed(4), `GFC ${await shown('gfc')}, expected ${expected.truth.gfc.toFixed(4)}`);
+    const u = expected.metric_uncertainty;
+    check(await shown('mel_der') !== '—' && (await shown('mel_der')).includes(' ± '), `melanopic DER ${await shown('mel_der')}`);
+    close(Number((await shown('mel_der')).split(' ')[0]), m.mel_der, u.mel_der.half95 / 2, 'melanopic DER');
+    check(await shown('gfc') === `GFC ${expected.truth.gfc.toFixed(4)}, RMSE ${expected.truth.rmse.toFixed(4)}`, `GFC ${await shown('gfc')}`);
     const size = (selector) => tab.evaluate((sel) => {
       const r = document.querySelector(sel).getBoundingClientRect();
       return [r.width, r.height];
     }, selector);
-    for (const selector of ['#estimate-1 svg.spd-plot', '#estimate-1 svg.tm30-cvg']) {
+    for (const selector of ['#estimate-1 svg.spd-plot']) {
       const [w, h] = await size(selector);
       check(w > 0 && h > 0, `${selector} drawn ${w} × ${h}`);
     }
     check(await tab.locator('#estimate-1 svg.spd-plot polyline.spd').count() === 1, 'no SPD line');
-    check(await tab.locator('#estimate-1 svg.tm30-cvg polygon.test').count() === 1, 'no TM-30 test polygon');
+    check(await tab.locator('#estimate-1 svg.spd-plot polyline.truth').count() === 1, 'no truth line');
+    const legend = await tab.locator('#estimate-1 svg.spd-plot g.legend').allTextContents();
+    check(JSON.stringify(legend) === JSON.stringify(['estimate', 'true spectrum', '68 % band', '95 % band']), `legend ${legend}`);
     const image = await tab.evaluate(() => {
       const img = document.querySelector('#estimate-1 img.photo');
       return img && img.complete ? img.naturalWidth : 0;

@@ -23,7 +23,8 @@
 //!   verdict, bands) and what it is made from; [`stream`]: feature rows read a block at a
 //!   time, and the CSV layouts of many SPDs.
 //! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
-//!   verdict); [`plot`] and [`report`]: SVG plots and the HTML report.
+//!   verdict); [`presentation`]: what an estimate means in words and rounded numbers;
+//!   [`plot`] and [`report`]: SVG plots and the HTML report.
 //! - [`error`]: the crate's error type.
 //!
 //! Estimating the light from the example photo of a ColorChecker Digital SG with the
@@ -66,6 +67,7 @@ pub mod model;
 pub mod network;
 pub mod pca;
 pub mod plot;
+pub mod presentation;
 pub mod record;
 pub mod report;
 pub mod scale;

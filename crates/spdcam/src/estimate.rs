@@ -319,7 +319,12 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             .iter()
             .map(|e| e.trust.as_ref().and_then(|t| t.uncertainty.as_ref()))
             .collect();
-        write_plot(plot, &spds_band_svg(&title, &grid, &series, &bands)?)?;
+        let plotted_truths: Vec<Option<&[f64]>> =
+            truths[..shown].iter().map(Option::as_deref).collect();
+        write_plot(
+            plot,
+            &spds_band_svg(&title, &grid, &series, &bands, &plotted_truths)?,
+        )?;
     }
     if let Some(path) = &args.report {
         let items = estimates
@@ -563,7 +568,13 @@ fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimator) -> Resu
             .iter()
             .map(|e| e.trust.as_ref().and_then(|t| t.uncertainty.as_ref()))
             .collect();
-        write_plot(plot, &spds_band_svg(&title, &grid, &series, &bands)?)?;
+        let truths = (0..series.len())
+            .map(|row| run.truth(row))
+            .collect::<Result<Vec<_>>>()?;
+        write_plot(
+            plot,
+            &spds_band_svg(&title, &grid, &series, &bands, &truths)?,
+        )?;
     }
     if quiet(args) {
         let judged = run
@@ -721,21 +732,18 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
     }
 }
 
-/// One estimate of the report: its JSON, for a photo the photo with the chart found (the
-/// `overlay` drawn when it was analysed), and its truth.
+/// One estimate of the report: the estimate, for a photo the photo with the chart found
+/// (the `overlay` drawn when it was analysed), and its truth.
 fn report_item(
     estimate: &Estimate,
     overlay: Option<Vec<u8>>,
     truth: Option<Vec<f64>>,
 ) -> Result<ReportItem> {
-    Ok(ReportItem {
-        estimate: estimate.to_json()?,
-        image: overlay.map(|bytes| ReportImage {
-            mime: "image/jpeg",
-            bytes,
-        }),
-        truth_spd: truth,
-    })
+    let image = overlay.map(|bytes| ReportImage {
+        mime: "image/jpeg",
+        bytes,
+    });
+    Ok(ReportItem::new(estimate.clone(), image, truth))
 }
 
 /// Writes the report of `items` to `path` atomically.

@@ -36,6 +36,29 @@ fn assert_self_contained(html: &str) {
     }
 }
 
+/// The example's estimate as the library makes it (what the CLI estimates and reports).
+fn example_estimate() -> spdcam_infer::Estimate {
+    spdcam_infer::estimate_photo(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join(EXAMPLE),
+        &spdcam_infer::ModelSet::shipped().unwrap(),
+        &spdcam_infer::PhotoOptions::default(),
+        &spdcam_core::builtin::DataDir::new(None),
+        &spdcam_core::spectral::Grid::parse("400-700:5").unwrap(),
+    )
+    .unwrap()
+}
+
+/// The significant digits of a number's text: `0.00007` → 1, `11` → 2, `800` → 1.
+fn significant_digits(text: &str) -> usize {
+    let digits: String = text.chars().filter(char::is_ascii_digit).collect();
+    let digits = digits.trim_start_matches('0');
+    if text.contains('.') {
+        digits.len()
+    } else {
+        digits.trim_end_matches('0').len()
+    }
+}
+
 #[test]
 fn the_report_of_the_example_photo_shows_its_numbers_as_json_gives_them() {
     let dir = scratch("example");
@@ -53,45 +76,89 @@ fn the_report_of_the_example_photo_shows_its_numbers_as_json_gives_them() {
 
     let json: Value = serde_json::from_str(&ok(&["estimate", EXAMPLE, "--json"])).unwrap();
     let e = &json[0];
-    let m = &e["metrics"];
-    let ra = format!("{:.1}", m["cri_ra"].as_f64().unwrap());
-    let rf = format!("{:.1}", m["tm30_rf"].as_f64().unwrap());
-    let rg = format!("{:.1}", m["tm30_rg"].as_f64().unwrap());
-    let cct = format!("{:.0}", m["cct_k"].as_f64().unwrap());
-    for (key, value) in [
-        ("cri_ra", &ra),
-        ("tm30_rf", &rf),
-        ("tm30_rg", &rg),
-        ("cct_k", &cct),
-    ] {
-        let cell = format!("data-key=\"{key}\">{value}</td>");
-        assert!(html.contains(&cell), "no {cell} in the report");
+    // Every metric as the presentation gives it: rounded with its interval, or '—' and why.
+    let presentation = spdcam_infer::presentation::Presentation::of(&example_estimate());
+    let mut greyed = 0;
+    for line in presentation.groups.iter().flat_map(|g| &g.metrics) {
+        match &line.value {
+            Some(value) => {
+                let unit = if line.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", line.unit)
+                };
+                let cell = format!("data-key=\"{}\">{value}{unit}</td>", line.key);
+                assert!(html.contains(&cell), "no {cell} in the report");
+                // The half-width keeps one or two significant digits.
+                if let Some((_, half)) = value.split_once(" ± ") {
+                    let n = significant_digits(half);
+                    assert!((1..=2).contains(&n), "{}: {value}", line.key);
+                }
+            }
+            None => {
+                greyed += 1;
+                let why = line.not_meaningful.as_deref().unwrap();
+                let cell = format!(
+                    "<tr class=\"metric not-meaningful\"><th>{}</th><td data-key=\"{}\">—</td>\
+                     <td class=\"explain reason\">{}</td>",
+                    line.label,
+                    line.key,
+                    why.replace('\'', "&#39;")
+                );
+                assert!(html.contains(&cell), "no {cell} in the report");
+            }
+        }
     }
+    // This LED mix lies far from the Planckian locus: no CCT, no Ra anywhere in the report.
+    assert!(greyed >= 2, "{greyed} metrics greyed");
+    let m = &e["metrics"];
+    for key in ["cct_k", "cri_ra"] {
+        let raw = m[key].as_f64().unwrap();
+        for text in [format!("{raw:.0}"), format!("{raw:.1}")] {
+            assert!(!html.contains(&format!(">{text}")), "{key} {text} is shown");
+        }
+    }
+    assert!(html.contains("data-key=\"cri_r\">CIE 13.3 R1–R14: not meaningful"));
     let gfc = format!("{:.4}", e["truth"]["gfc"].as_f64().unwrap());
     assert!(
-        html.contains(&format!("data-key=\"gfc\">{gfc}</td>")),
+        html.contains(&format!("data-key=\"gfc\">GFC {gfc}, RMSE ")),
         "GFC {gfc}"
     );
     let x = format!("{:.4}", e["colorimetry"]["xy"][0].as_f64().unwrap());
     assert!(html.contains(&x), "x {x}");
-    let confidence = format!("{:.2}", e["photo"]["confidence"].as_f64().unwrap());
-    assert!(
-        html.contains(&format!("data-key=\"confidence\">{confidence}")),
-        "confidence {confidence}"
+    let confidence = format!(
+        "(confidence {:.2})",
+        e["photo"]["confidence"].as_f64().unwrap()
     );
-    // The plots inline, the truth drawn, the photo as a data URI.
-    assert!(html.contains("<svg class=\"spd-plot\""));
+    assert!(html.contains(&confidence), "{confidence}");
+    // The summary and the verdict in plain words at the top.
+    let summary = html.find(&format!("<p class=\"summary\">{}", presentation.summary));
+    let verdict = html.find(&format!(
+        "data-verdict=\"{}\"",
+        e["verdict"].as_str().unwrap()
+    ));
+    let plot = html.find("<svg class=\"spd-plot\"");
+    assert!(
+        summary.is_some() && summary < verdict && verdict < plot,
+        "the order"
+    );
+    // The plots inline, the truth and the bands drawn and in the legend, the photo as a data URI.
     assert!(html.contains("<polyline class=\"spd\""));
     assert!(html.contains("<polyline class=\"truth\""));
-    assert!(html.contains("<svg class=\"tm30-cvg\""));
-    assert!(html.contains("ANSI/IES TM-30-20"));
+    assert!(
+        html.contains("<polygon class=\"band68\"") && html.contains("<polygon class=\"band95\"")
+    );
+    for label in ["estimate", "true spectrum", "68 % band", "95 % band"] {
+        assert!(
+            html.contains(&format!(">{label}</text></g>")),
+            "no legend entry {label}"
+        );
+    }
     assert!(html.contains("src=\"data:image/jpeg;base64,/9j/"));
-    // Every warning, and the numbers no section shows in the details table.
     for w in e["metrics"]["warnings"].as_array().unwrap() {
         let w = w.as_str().unwrap().replace('\'', "&#39;");
         assert!(html.contains(&w), "warning {w}");
     }
-    assert!(html.contains("data-key=\"photo.homography[0]\""));
     assert_eq!(html.matches("<section class=\"estimate\"").count(), 1);
 }
 
@@ -114,8 +181,8 @@ fn several_photos_and_feature_rows_share_one_page() {
     let html = std::fs::read_to_string(&report).unwrap();
     assert_eq!(html.matches("<section class=\"estimate\"").count(), 2);
     assert_eq!(html.matches("src=\"data:image/jpeg;base64,").count(), 2);
-    assert!(html.contains("<h2>sg-telelumen.jpg</h2>"));
-    assert!(html.contains("<h2>again.jpg</h2>"));
+    assert!(html.contains("<h1>The light in sg-telelumen.jpg</h1>"));
+    assert!(html.contains("<h1>The light in again.jpg</h1>"));
     // The copy has no truth beside it: one truth line only.
     assert_eq!(html.matches("<polyline class=\"truth\"").count(), 1);
 
@@ -132,7 +199,9 @@ fn several_photos_and_feature_rows_share_one_page() {
     assert_eq!(html.matches("<section class=\"estimate\"").count(), 2);
     assert!(!html.contains("data:image"));
     assert!(html.contains("estimated from chart features"));
-    assert!(html.contains("<svg class=\"tm30-cvg\""));
+    // The example's light is too far from white for TM-30: the reason, not the graphic.
+    assert!(html.contains("<p class=\"undefined\" data-key=\"tm30_bins\">not meaningful"));
+    assert!(!html.contains("<svg class=\"tm30-cvg\""));
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! pace, checked, and queued; nothing the client sends is used as a path.
 
 use super::body::{self, BodyError, Budget, Held, Pace};
-use super::jobs::{Jobs, Outcome, Progress, Upload};
+use super::jobs::{plain_error, Jobs, Outcome, Progress, Upload, CHARTS};
 use super::multipart::{self, FormError, Limits};
 use anyhow::Result;
 use axum::body::Body;
@@ -43,8 +43,15 @@ impl Answer {
         Answer(status, "application/json", value.to_string().into())
     }
 
-    fn error(status: u16, message: impl Into<String>) -> Answer {
-        Answer::json(status, &serde_json::json!({ "error": message.into() }))
+    /// `{"error", "code", "message"}`: the library's message, and a code and a message
+    /// for a person ([`plain_error`]).
+    fn error(status: u16, error: impl Into<String>) -> Answer {
+        let error = error.into();
+        let (code, message) = plain_error(status, &error);
+        Answer::json(
+            status,
+            &serde_json::json!({ "error": error, "code": code, "message": message }),
+        )
     }
 
     fn outcome(outcome: Outcome) -> Answer {
@@ -119,6 +126,7 @@ impl Api {
             .route("/api/estimate", post(estimate))
             .route("/api/jobs", post(submit))
             .route("/api/jobs/{id}", get(job))
+            .route("/api/jobs/{id}/report", get(report))
             .method_not_allowed_fallback(not_allowed)
             .fallback(not_found)
             .with_state(self)
@@ -195,6 +203,23 @@ impl Api {
             ),
             _ => None,
         };
+        let chart = match form.chart.as_deref().map(str::trim) {
+            Some(name) if !name.is_empty() => Some(
+                CHARTS
+                    .into_iter()
+                    .find(|c| c.name() == name)
+                    .ok_or_else(|| {
+                        Answer::error(
+                            400,
+                            format!(
+                                "unknown chart '{name}'; valid: {}",
+                                CHARTS.map(|c| c.name()).join(", ")
+                            ),
+                        )
+                    })?,
+            ),
+            _ => None,
+        };
         let Some(photo) = form.photo else {
             return Err(Answer::error(400, "the form has no field 'photo'"));
         };
@@ -206,6 +231,7 @@ impl Api {
             bytes: photo.bytes,
             corners,
             memory: held.permit,
+            chart,
         })
     }
 }
@@ -256,11 +282,23 @@ async fn job(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
                 serde_json::from_str(&json).unwrap_or(serde_json::Value::Null);
             serde_json::json!({ "state": "done", "result": result })
         }
-        Progress::Finished(Outcome::Failed(status, message)) => serde_json::json!({
-            "state": "failed", "status": status, "error": message,
-        }),
+        Progress::Finished(Outcome::Failed(status, error)) => {
+            let (code, message) = plain_error(status, &error);
+            serde_json::json!({
+                "state": "failed", "status": status, "error": error, "code": code,
+                "message": message,
+            })
+        }
     };
     Answer::json(200, &value)
+}
+
+/// `GET /api/jobs/ID/report`: the finished job's HTML report, while it is kept.
+async fn report(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
+    match id.parse::<u64>().ok().and_then(|id| api.jobs.report(id)) {
+        Some(html) => Answer(200, "text/html; charset=utf-8", html.as_bytes().to_vec().into()),
+        None => Answer::error(404, format!("no report of job '{id}' is kept")),
+    }
 }
 
 async fn not_allowed(method: Method, uri: Uri) -> Answer {

@@ -1,6 +1,6 @@
 //! Reading an upload form (`multipart/form-data`, RFC 7578) as it streams in, with multer:
 //! the `photo` file with the file name the browser sent (kept as a label, never used as a
-//! path) and the `corners` text, each under a size limit; other fields are read and dropped.
+//! path), the `corners` and `chart` texts, each under a size limit; other fields are read and dropped.
 //!
 //! This file depends only on multer, bytes and futures-util, so that the fuzz target
 //! `fuzz/fuzz_targets/multipart.rs` compiles it as it is and feeds it what the server would.
@@ -19,6 +19,8 @@ pub struct Form {
     pub photo: Option<Photo>,
     /// The last `corners` field, as text (parsed by the caller).
     pub corners: Option<String>,
+    /// The last `chart` field (the chart the corners belong to), as text.
+    pub chart: Option<String>,
 }
 
 /// The `photo` field of a form.
@@ -107,6 +109,7 @@ where
                 })
             }
             "corners" => form.corners = Some(String::from_utf8_lossy(&data).into_owned()),
+            "chart" => form.chart = Some(String::from_utf8_lossy(&data).into_owned()),
             _ => {}
         }
     }

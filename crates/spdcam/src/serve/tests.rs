@@ -3,6 +3,7 @@
 use super::{resolve, shipped_engine, Config, Server, Timeouts};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::Grid;
+use spdcam_infer::presentation::Presentation;
 use spdcam_infer::{estimate_photo_bytes, ModelSet, PhotoOptions};
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
@@ -95,9 +96,10 @@ fn json(body: &[u8]) -> serde_json::Value {
     })
 }
 
-/// What `spdcam estimate --json` gives for the example under `name`.
+/// What `spdcam estimate --json` gives for the example under `name`, with its
+/// `presentation`.
 fn expected(name: &str) -> serde_json::Value {
-    estimate_photo_bytes(
+    let estimate = estimate_photo_bytes(
         EXAMPLE,
         name,
         &ModelSet::shipped().unwrap(),
@@ -105,9 +107,10 @@ fn expected(name: &str) -> serde_json::Value {
         &DataDir::new(None),
         &Grid::parse("400-700:5").unwrap(),
     )
-    .unwrap()
-    .to_json()
-    .unwrap()
+    .unwrap();
+    let mut json = estimate.to_json().unwrap();
+    json["presentation"] = serde_json::to_value(Presentation::of(&estimate)).unwrap();
+    json
 }
 
 #[test]
@@ -197,8 +200,12 @@ fn bad_input_gets_a_clear_error_and_the_server_keeps_serving() {
     for (body, want_status, want_text) in cases {
         let (status, got) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
         assert_eq!(status, want_status);
-        let message = json(&got)["error"].as_str().unwrap().to_string();
+        let got = json(&got);
+        let message = got["error"].as_str().unwrap().to_string();
         assert!(message.contains(want_text), "{message}");
+        // Beside it, a message for a person, without command-line words.
+        let plain = got["message"].as_str().unwrap();
+        assert!(!plain.contains("--") && !plain.is_empty(), "{plain}");
     }
     let (status, got) = request(addr, "GET", "/no/such/page", None);
     assert_eq!(status, 404);
@@ -449,4 +456,68 @@ fn a_host_name_is_resolved() {
         format!("{error:#}").starts_with("cannot resolve the host 'no-such-host.invalid'"),
         "{error:#}"
     );
+}
+
+#[test]
+fn a_job_keeps_its_report_and_corners_take_a_named_chart_only() {
+    let server = start(16 << 20);
+    let addr = server.addr();
+    // The corners and the chart the detection finds, given by hand.
+    let found = expected("p.jpg");
+    let corners: Vec<String> = found["photo"]["corners"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|c| {
+            c.as_array()
+                .unwrap()
+                .iter()
+                .map(|v| format!("{:.2}", v.as_f64().unwrap()))
+        })
+        .collect();
+    let body = form(&[
+        ("photo", Some("p.jpg"), EXAMPLE),
+        ("corners", None, corners.join(",").as_bytes()),
+        ("chart", None, b"colorchecker_sg96"),
+    ]);
+    let (status, got) = request(addr, "POST", "/api/jobs", Some(body.as_slice()));
+    assert_eq!(status, 202);
+    let id = json(&got)["id"].as_str().unwrap().to_string();
+    let result = loop {
+        let (_, got) = request(addr, "GET", &format!("/api/jobs/{id}"), None);
+        let got = json(&got);
+        if got["state"] == "done" {
+            break got["result"].clone();
+        }
+        assert_ne!(got["state"], "failed", "{got}");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(result["photo"]["method"], "corners");
+    assert_eq!(result["photo"]["chart"], found["photo"]["chart"]);
+    assert_eq!(
+        result["presentation"]["summary"],
+        found["presentation"]["summary"]
+    );
+    let (status, report) = request(addr, "GET", &format!("/api/jobs/{id}/report"), None);
+    assert_eq!(status, 200);
+    let report = String::from_utf8(report).unwrap();
+    assert!(report.contains("<h1>The light in p.jpg</h1>"), "no title");
+    assert_eq!(report.matches("<polyline class=\"spd\"").count(), 1);
+    assert!(report.contains("src=\"data:image/jpeg;base64,"));
+    let (status, got) = request(addr, "GET", "/api/jobs/999999/report", None);
+    assert_eq!(status, 404);
+    assert_eq!(json(&got)["code"], "not_found");
+    // A chart is a name, never a path.
+    let body = form(&[
+        ("photo", Some("p.jpg"), EXAMPLE),
+        ("chart", None, b"/etc/passwd"),
+    ]);
+    let (status, got) = request(addr, "POST", "/api/jobs", Some(body.as_slice()));
+    assert_eq!(status, 400);
+    let error = json(&got)["error"].as_str().unwrap().to_string();
+    assert_eq!(
+        error,
+        "unknown chart '/etc/passwd'; valid: colorchecker24, colorchecker_sg96"
+    );
+    server.stop();
 }

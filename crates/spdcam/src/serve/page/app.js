@@ -1,6 +1,9 @@
 // The spdcam page: uploads photos to the local API (docs/web-api.md), polls their jobs, and
-// draws the photo with the chart's outline, the SPDs, the xy diagram and the details. Plain
-// JavaScript, no library, nothing fetched from outside this server.
+// draws the photo with the chart's outline, the SPDs, the xy diagram and the details; the
+// summary, verdict and metrics are the estimate's `presentation` (the same words and rounded
+// numbers as the report). When no chart is found, the photo is shown large with zoom and pan
+// to place its four corners by clicks. Plain JavaScript, no library, nothing fetched from
+// outside this server.
 'use strict';
 
 const SVG = 'http://www.w3.org/2000/svg';
@@ -31,12 +34,21 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 // ---- talking to the server ------------------------------------------------------------
 
+/** An error for a person: the server's plain `message` (never its command-line words) and
+ *  its `code` (`no_chart` when the chart was not found). */
+function serverError(body, status) {
+  const e = new Error(body.message || `The server answered ${status}; try again.`);
+  e.code = body.code || null;
+  return e;
+}
+
 /** Posts a photo as a job (with upload progress); resolves to the job id. */
-function submit(entry, corners) {
+function submit(entry, corners, chart) {
   return new Promise((resolve, reject) => {
     const form = new FormData();
     form.append('photo', entry.file, entry.name);
     if (corners) form.append('corners', corners.map((p) => p.map((v) => v.toFixed(2)).join(',')).join(','));
+    if (chart) form.append('chart', chart);
     const xhr = new XMLHttpRequest();
     xhr.open('POST', 'api/jobs');
     xhr.responseType = 'json';
@@ -46,9 +58,9 @@ function submit(entry, corners) {
     xhr.onload = () => {
       const body = xhr.response || {};
       if (xhr.status === 202 && body.id) resolve(body.id);
-      else reject(new Error(body.error || `the server answered ${xhr.status}`));
+      else reject(serverError(body, xhr.status));
     };
-    xhr.onerror = () => reject(new Error('the server cannot be reached'));
+    xhr.onerror = () => reject(new Error('The server cannot be reached; is it still running?'));
     xhr.send(form);
   });
 }
@@ -59,24 +71,32 @@ async function poll(entry, id) {
     await sleep(POLL_MS);
     const r = await fetch(`api/jobs/${encodeURIComponent(id)}`);
     const s = await r.json();
-    if (!r.ok) throw new Error(s.error || `the server answered ${r.status}`);
+    if (!r.ok) throw serverError(s, r.status);
     if (s.state === 'done') return s.result;
-    if (s.state === 'failed') throw new Error(s.error);
+    if (s.state === 'failed') throw serverError(s, s.status);
     if (s.state === 'queued') setStatus(entry, s.ahead > 0 ? `waiting (${s.ahead} ahead)` : 'waiting');
     else setStatus(entry, `estimating… ${s.seconds.toFixed(1)} s`);
   }
 }
 
-async function run(entry, corners) {
+async function run(entry, corners, chart) {
   entry.error = null;
+  entry.errorCode = null;
   entry.busy = true;
   setStatus(entry, 'uploading');
+  render();
   try {
-    const id = await submit(entry, corners);
+    const id = await submit(entry, corners, chart);
     entry.result = await poll(entry, id);
+    entry.jobId = id;
+    entry.placing = null;
     entry.corners = entry.result.photo ? entry.result.photo.corners.map((p) => p.slice()) : null;
   } catch (e) {
     entry.error = e.message;
+    entry.errorCode = e.code || null;
+    // No chart found: the photo is shown large to place its corners (not for a TIFF, which
+    // browsers cannot show).
+    if (e.code === 'no_chart' && !/\.tiff?$/i.test(entry.name)) entry.placing = entry.placing || { points: [], chart: null };
     if (corners && entry.result) entry.corners = entry.result.photo.corners.map((p) => p.slice());
   }
   entry.busy = false;
@@ -97,8 +117,8 @@ function addFiles(files) {
   for (const file of files) {
     const entry = {
       id: state.nextId++, file, name: file.name || 'photo', url: URL.createObjectURL(file),
-      color: COLORS[state.entries.length % COLORS.length], result: null, error: null,
-      status: '', busy: false, visible: true, corners: null,
+      color: COLORS[state.entries.length % COLORS.length], result: null, error: null, errorCode: null,
+      status: '', busy: false, visible: true, corners: null, jobId: null, placing: null,
     };
     state.entries.push(entry);
     if (!first) first = entry;
@@ -194,6 +214,7 @@ function scoreAgainstReference(result) {
 
 function render() {
   renderList();
+  renderOverview();
   renderStage();
   renderSpd();
   renderXy();
@@ -219,7 +240,7 @@ function renderList() {
     html('span', { class: 'swatch', style: `background:${e.color}` }, top);
     html('span', { class: 'name' }, top, e.name);
     let status = e.status;
-    if (!e.busy && e.result) status = e.result.colorimetry.cct ? `${fmt(e.result.colorimetry.cct, 0)} K` : 'estimated';
+    if (!e.busy && e.result) status = listStatus(e.result);
     html('div', { class: 'status' }, li, status);
     if (e.error) html('div', { class: 'error', role: 'alert' }, li, e.error);
     if (e.result) {
@@ -233,12 +254,27 @@ function renderList() {
   }
 }
 
+/** A result in a few words for the list: its CCT when meaningful, and the verdict. */
+function listStatus(r) {
+  const p = r.presentation;
+  if (!p) return 'estimated';
+  const cct = p.groups.flatMap((g) => g.metrics).find((m) => m.key === 'cct_k');
+  const parts = [];
+  if (cct && cct.value !== null) parts.push(`${cct.value} K`);
+  if (p.verdict) parts.push(p.verdict.label);
+  return parts.join(' · ') || 'estimated';
+}
+
 function renderStage() {
   const stage = $('stage');
   const e = selected();
+  const view = $('photo-view');
+  view.classList.toggle('wide', Boolean(e && e.placing));
   $('photo-title').textContent = e ? e.name : 'Photo';
   stage.replaceChildren();
+  $('stage-tools').replaceChildren();
   if (!e) { html('p', { class: 'placeholder' }, stage, 'No photo yet.'); return; }
+  if (e.placing) { renderPlacer(stage, e); return; }
   const photo = e.result && e.result.photo;
   if (e.error && !e.result) { html('p', { class: 'error' }, stage, e.error); return; }
   const img = html('img', { src: e.url, alt: e.name }, stage);
@@ -256,7 +292,143 @@ function renderStage() {
       drawOverlay(svg, e, photo, Math.max(photo.width, photo.height));
     });
     draw(photo.width, photo.height);
+    if (!/\.tiff?$/i.test(e.name)) {
+      const again = html('button', { type: 'button', id: 'place-corners' }, $('stage-tools'), 'Place the corners yourself');
+      again.addEventListener('click', () => { e.placing = { points: [], chart: null }; render(); });
+    }
   }
+}
+
+/** The charts a person can name for placed corners (the server's names). */
+const CHARTS = [
+  ['colorchecker24', 'ColorChecker 24 (classic, 4 × 6 patches)'],
+  ['colorchecker_sg96', 'ColorChecker Digital SG (14 × 10 patches)'],
+];
+
+/**
+ * The photo large, with zoom (wheel or buttons) and pan (drag), where four clicks place the
+ * chart's corners; then the chart is asked (never guessed) and the estimate made with both.
+ * The view's transform is on `#placer` as data-scale, data-x, data-y (screen px per photo
+ * px, and the photo's offset in the view).
+ */
+function renderPlacer(stage, e) {
+  const p = e.placing;
+  const tools = $('stage-tools');
+  html('p', { class: 'instructions', id: 'placer-help' }, stage,
+    p.points.length < 4
+      ? `Click the chart's four outer corners, in any order (${p.points.length} of 4 placed). Scroll or use + and − to zoom, drag to move the photo.`
+      : 'All four corners placed. Which chart is it?');
+  const button = (label, id, action, parent) => {
+    const b = html('button', { type: 'button', id }, parent || tools, label);
+    b.addEventListener('click', action);
+    return b;
+  };
+  const view = html('div', { id: 'placer', class: 'placer' }, stage);
+  const inner = html('div', { class: 'placer-inner' }, view);
+  const img = html('img', { src: e.url, alt: e.name, draggable: 'false' }, inner);
+  const marks = el('svg', { class: 'placer-marks' }, inner);
+  const apply = () => {
+    const t = p.view;
+    if (!t) return;
+    inner.style.transform = `translate(${t.x}px, ${t.y}px) scale(${t.scale})`;
+    view.dataset.scale = t.scale; view.dataset.x = t.x; view.dataset.y = t.y;
+    drawMarks();
+  };
+  const drawMarks = () => {
+    marks.replaceChildren();
+    const t = p.view;
+    if (!t) return;
+    const r = 7 / t.scale;
+    if (p.points.length > 1) {
+      el(p.points.length === 4 ? 'polygon' : 'polyline', { points: orderCorners(p.points).map((q) => q.join(',')).join(' '), fill: 'none', stroke: '#ffeb3b', 'stroke-width': 2.5 / t.scale }, marks);
+    }
+    p.points.forEach((q, k) => {
+      el('circle', { class: 'corner', cx: q[0], cy: q[1], r, fill: 'rgba(255,235,59,0.45)', stroke: '#000', 'stroke-width': 1.5 / t.scale }, marks);
+      el('text', { x: q[0] + 1.6 * r, y: q[1] - 1.6 * r, 'font-size': 16 / t.scale, fill: '#ffeb3b', stroke: '#000', 'stroke-width': 0.6 / t.scale, 'font-family': 'sans-serif' }, marks, String(k + 1));
+    });
+  };
+  const zoom = (factor, cx, cy) => {
+    const t = p.view;
+    const scale = Math.min(Math.max(t.scale * factor, t.fit / 2), 8);
+    t.x = cx - ((cx - t.x) * scale) / t.scale;
+    t.y = cy - ((cy - t.y) * scale) / t.scale;
+    t.scale = scale;
+    apply();
+  };
+  const fit = () => {
+    const w = img.naturalWidth, h = img.naturalHeight;
+    const scale = Math.min(view.clientWidth / w, view.clientHeight / h);
+    p.view = { scale, fit: scale, x: (view.clientWidth - w * scale) / 2, y: (view.clientHeight - h * scale) / 2 };
+    apply();
+  };
+  const ready = () => {
+    marks.setAttribute('viewBox', `0 0 ${img.naturalWidth} ${img.naturalHeight}`);
+    marks.setAttribute('width', img.naturalWidth);
+    marks.setAttribute('height', img.naturalHeight);
+    if (p.view) apply(); else fit();
+    view.dataset.ready = '1';
+  };
+  if (img.complete && img.naturalWidth) ready(); else img.addEventListener('load', ready);
+  img.addEventListener('error', () => html('p', { class: 'error' }, stage, 'This photo cannot be shown in the browser, so its corners cannot be placed here.'));
+  button('+', 'zoom-in', () => zoom(1.5, view.clientWidth / 2, view.clientHeight / 2));
+  button('−', 'zoom-out', () => zoom(1 / 1.5, view.clientWidth / 2, view.clientHeight / 2));
+  button('Fit', 'zoom-fit', fit);
+  button('Undo last corner', 'undo-corner', () => { p.points.pop(); render(); }).disabled = p.points.length === 0;
+  button('Cancel', 'cancel-corners', () => { e.placing = null; render(); });
+  view.addEventListener('wheel', (ev) => {
+    ev.preventDefault();
+    const box = view.getBoundingClientRect();
+    zoom(ev.deltaY < 0 ? 1.25 : 1 / 1.25, ev.clientX - box.left, ev.clientY - box.top);
+  }, { passive: false });
+  let drag = null;
+  view.addEventListener('pointerdown', (ev) => {
+    if (!p.view) return;
+    view.setPointerCapture(ev.pointerId);
+    drag = { x: ev.clientX, y: ev.clientY, tx: p.view.x, ty: p.view.y, moved: false };
+  });
+  view.addEventListener('pointermove', (ev) => {
+    if (!drag) return;
+    const dx = ev.clientX - drag.x, dy = ev.clientY - drag.y;
+    if (Math.hypot(dx, dy) > 4) drag.moved = true;
+    if (drag.moved) { p.view.x = drag.tx + dx; p.view.y = drag.ty + dy; apply(); }
+  });
+  view.addEventListener('pointerup', (ev) => {
+    const d = drag;
+    drag = null;
+    if (!d || d.moved || p.points.length >= 4) return;
+    const box = view.getBoundingClientRect();
+    const t = p.view;
+    const x = (ev.clientX - box.left - t.x) / t.scale;
+    const y = (ev.clientY - box.top - t.y) / t.scale;
+    if (x < 0 || y < 0 || x > img.naturalWidth || y > img.naturalHeight) return;
+    p.points.push([x, y]);
+    render();
+  });
+  if (p.points.length === 4) {
+    const ask = html('fieldset', { class: 'chart-choice', id: 'chart-choice' }, stage);
+    html('legend', {}, ask, 'Which chart is in the photo?');
+    for (const [name, label] of CHARTS) {
+      const l = html('label', {}, ask);
+      const radio = html('input', { type: 'radio', name: 'chart', value: name }, l);
+      radio.checked = p.chart === name;
+      radio.addEventListener('change', () => { p.chart = name; go.disabled = false; });
+      l.append(` ${label}`);
+    }
+    const go = button('Estimate with these corners', 'estimate-corners', () => {
+      if (!p.chart || e.busy) return;
+      run(e, orderCorners(p.points), p.chart);
+    }, ask);
+    go.disabled = !p.chart || e.busy;
+  }
+  if (e.error && e.errorCode !== 'no_chart') html('p', { class: 'error', role: 'alert' }, stage, e.error);
+}
+
+/** Four points in order around their centre (so the outline does not cross itself). */
+function orderCorners(points) {
+  if (points.length < 3) return points;
+  const cx = points.reduce((s, q) => s + q[0], 0) / points.length;
+  const cy = points.reduce((s, q) => s + q[1], 0) / points.length;
+  return points.slice().sort((a, b) => Math.atan2(a[1] - cy, a[0] - cx) - Math.atan2(b[1] - cy, b[0] - cx));
 }
 
 function drawOverlay(svg, entry, photo, size) {
@@ -312,7 +484,17 @@ function band(result, key) {
   return null;
 }
 
-const SPD_BOX = { left: 52, right: 628, top: 14, bottom: 294 };
+const SPD_BOX = { left: 52, right: 628, top: 40, bottom: 312 };
+
+/** The plot's top value: 1, raised in steps of 0.25 to hold the shown bands and curves. */
+function spdTop(shown) {
+  let top = 1;
+  for (const e of shown) {
+    const b = band(e.result, 'band95');
+    if (b) top = Math.max(top, ...b.hi.filter(Number.isFinite));
+  }
+  return Math.min(Math.ceil(top * 4 - 1e-9) / 4, 3);
+}
 
 function renderSpd() {
   const svg = $('spd-plot');
@@ -322,50 +504,66 @@ function renderSpd() {
   const x0 = Math.min(...shown.map((e) => e.result.wavelength_nm[0]), wl[0]);
   const x1 = Math.max(...shown.map((e) => e.result.wavelength_nm[e.result.wavelength_nm.length - 1]), wl[wl.length - 1]);
   const { left, right, top, bottom } = SPD_BOX;
+  const yTop = spdTop(shown);
+  svg.dataset.top = yTop;
   const X = (w) => left + ((w - x0) / (x1 - x0)) * (right - left);
-  const Y = (v) => bottom - v * (bottom - top);
-  el('rect', { x: 0, y: 0, width: 640, height: 340, fill: '#fff' }, svg);
+  // Values are clamped to the frame: nothing is drawn above or below it.
+  const Y = (v) => bottom - (Math.min(Math.max(v, 0), yTop) / yTop) * (bottom - top);
+  const text = (attrs, content) => el('text', { 'font-size': 12, fill: '#5b6475', 'font-family': 'sans-serif', ...attrs }, svg, content);
+  el('rect', { x: 0, y: 0, width: 640, height: 356, fill: '#fff' }, svg);
+  const clip = el('clipPath', { id: 'spd-frame' }, el('defs', {}, svg));
+  el('rect', { x: left, y: top, width: right - left, height: bottom - top }, clip);
   for (let w = Math.ceil(x0 / 50) * 50; w <= x1; w += 50) {
     el('line', { x1: X(w), x2: X(w), y1: top, y2: bottom, stroke: '#eceef2' }, svg);
-    el('text', { x: X(w), y: bottom + 16, 'text-anchor': 'middle', 'font-size': 12, fill: '#5b6475', 'font-family': 'sans-serif' }, svg, w);
+    text({ x: X(w), y: bottom + 16, 'text-anchor': 'middle' }, w);
   }
-  for (let v = 0; v <= 1.0001; v += 0.25) {
+  for (let v = 0; v <= yTop + 1e-9; v += 0.25) {
     el('line', { x1: left, x2: right, y1: Y(v), y2: Y(v), stroke: '#eceef2' }, svg);
-    el('text', { x: left - 6, y: Y(v) + 4, 'text-anchor': 'end', 'font-size': 12, fill: '#5b6475', 'font-family': 'sans-serif' }, svg, v.toFixed(2));
+    text({ x: left - 6, y: Y(v) + 4, 'text-anchor': 'end' }, v.toFixed(2));
   }
   el('rect', { x: left, y: top, width: right - left, height: bottom - top, fill: 'none', stroke: '#9aa6bd' }, svg);
-  el('text', { x: (left + right) / 2, y: 330, 'text-anchor': 'middle', 'font-size': 13, fill: '#1d2330', 'font-family': 'sans-serif' }, svg, 'wavelength (nm)');
-  el('text', { x: 14, y: (top + bottom) / 2, transform: `rotate(-90 14 ${(top + bottom) / 2})`, 'text-anchor': 'middle', 'font-size': 13, fill: '#1d2330', 'font-family': 'sans-serif' }, svg, 'relative power');
+  text({ x: (left + right) / 2, y: 348, 'text-anchor': 'middle', 'font-size': 13, fill: '#1d2330' }, 'wavelength (nm)');
+  text({ x: 14, y: (top + bottom) / 2, transform: `rotate(-90 14 ${(top + bottom) / 2})`, 'text-anchor': 'middle', 'font-size': 13, fill: '#1d2330' }, 'relative power');
+  const plot = el('g', { 'clip-path': 'url(#spd-frame)' }, svg);
+  let banded = false;
   for (const e of shown) {
     const r = e.result;
-    for (const [key, opacity] of [['band95', 0.12], ['band68', 0.22]]) {
+    for (const [key, opacity] of [['band95', 0.12], ['band68', 0.24]]) {
       const b = band(r, key);
       if (!b) continue;
+      banded = true;
       const pts = r.wavelength_nm.map((w, i) => `${X(w).toFixed(2)},${Y(b.hi[i]).toFixed(2)}`)
         .concat(r.wavelength_nm.map((w, i) => `${X(w).toFixed(2)},${Y(b.lo[i]).toFixed(2)}`).reverse());
-      el('polygon', { class: 'band', 'data-band': key, points: pts.join(' '), fill: e.color, 'fill-opacity': opacity, stroke: 'none' }, svg);
+      el('polygon', { class: 'band', 'data-band': key, points: pts.join(' '), fill: e.color, 'fill-opacity': opacity, stroke: 'none' }, plot);
     }
     el('polyline', {
       class: 'spd', 'data-entry': e.name, fill: 'none', stroke: e.color, 'stroke-width': e.id === state.selected ? 2.5 : 1.6,
       points: r.wavelength_nm.map((w, i) => `${X(w).toFixed(3)},${Y(r.spd[i]).toFixed(3)}`).join(' '),
-    }, svg);
+    }, plot);
   }
   const ref = state.reference;
   if (ref) {
     const m = Math.max(...ref.wl.map((w, i) => (w >= x0 && w <= x1 ? ref.v[i] : -Infinity)));
     const pts = ref.wl.map((w, i) => [w, ref.v[i]]).filter(([w]) => w >= x0 && w <= x1)
       .map(([w, v]) => `${X(w).toFixed(2)},${Y(v / m).toFixed(2)}`);
-    el('polyline', { class: 'reference', fill: 'none', stroke: '#1d2330', 'stroke-dasharray': '5 4', 'stroke-width': 1.5, points: pts.join(' ') }, svg);
+    el('polyline', { class: 'reference', fill: 'none', stroke: '#1d2330', 'stroke-dasharray': '5 4', 'stroke-width': 1.5, points: pts.join(' ') }, plot);
   }
-  let ly = top + 14;
-  for (const e of shown.slice(0, 8)) {
-    el('line', { x1: right - 170, x2: right - 150, y1: ly - 4, y2: ly - 4, stroke: e.color, 'stroke-width': 2.5 }, svg);
-    el('text', { x: right - 145, y: ly, 'font-size': 12, fill: '#1d2330', 'font-family': 'sans-serif' }, svg, e.name.slice(0, 24));
-    ly += 16;
+  // The legend above the frame, in rows: it covers no curve.
+  const items = shown.slice(0, 3).map((e) => ({ label: e.name.slice(0, 22), attrs: { stroke: e.color, 'stroke-width': 2.5 } }));
+  if (shown.length > 3) items.push({ label: `… ${shown.length - 3} more`, attrs: { stroke: 'none' } });
+  if (ref) items.push({ label: `reference: ${ref.name.slice(0, 16)}`, attrs: { stroke: '#1d2330', 'stroke-dasharray': '5 4', 'stroke-width': 1.5 } });
+  if (banded) {
+    items.push({ label: '68 % band', attrs: { stroke: '#5b6475', 'stroke-opacity': 0.45, 'stroke-width': 10 } });
+    items.push({ label: '95 % band', attrs: { stroke: '#5b6475', 'stroke-opacity': 0.22, 'stroke-width': 10 } });
   }
-  if (ref) {
-    el('line', { x1: right - 170, x2: right - 150, y1: ly - 4, y2: ly - 4, stroke: '#1d2330', 'stroke-dasharray': '5 4' }, svg);
-    el('text', { x: right - 145, y: ly, 'font-size': 12, fill: '#1d2330', 'font-family': 'sans-serif' }, svg, `reference: ${ref.name.slice(0, 16)}`);
+  let lx = left, ly = 12;
+  for (const item of items) {
+    const width = 34 + 6.6 * item.label.length;
+    if (lx + width > right && lx > left) { lx = left; ly += 15; }
+    const g = el('g', { class: 'legend' }, svg);
+    el('line', { x1: lx, x2: lx + 20, y1: ly - 4, y2: ly - 4, ...item.attrs }, g);
+    el('text', { x: lx + 25, y: ly, 'font-size': 12, fill: '#1d2330', 'font-family': 'sans-serif' }, g, item.label);
+    lx += width + 10;
   }
 }
 
@@ -410,33 +608,54 @@ function row(table, label, value, id) {
   return td;
 }
 
-/** Readable names of the lighting metrics' keys; other keys are shown as they are. */
-const METRIC_LABELS = {
-  cct_k: 'CCT (K)', duv: 'Duv', cri_ra: 'CRI Ra', tm30_rf: 'TM-30 Rf', tm30_rg: 'TM-30 Rg',
-  mel_der: 'melanopic DER', sp_ratio: 'S/P ratio', ppf_per_lux: 'PPF per lux (µmol s⁻¹ m⁻² lx⁻¹)',
-  blh_efficacy_w_per_lm: 'blue-light hazard efficacy (W/lm)', alpha_opic_der: 'α-opic DER',
-  alpha_opic_elr_mw_per_lm: 'α-opic ELR (mW/lm)', reasons: 'not given:',
-};
-
-/** A metric's number as the page shows it. */
-function metricNumber(v) {
-  return Math.abs(v) >= 100 ? v.toFixed(0) : v.toPrecision(4);
+/** The summary at the top for the selected photo: the light in plain words, the verdict and
+ *  what it means (the estimate's `presentation`, as the report says it). */
+function renderOverview() {
+  const box = $('overview');
+  box.replaceChildren();
+  const e = selected();
+  if (!e) {
+    html('p', { class: 'placeholder' }, box, 'Add a photo of a colour chart, or try the example: a summary of the light appears here.');
+    return;
+  }
+  if (!e.result || !e.result.presentation) {
+    if (e.placing) html('p', { id: 'plain-summary', class: 'error' }, box, e.error || 'Place the chart\'s corners on the photo.');
+    else if (e.error) html('p', { id: 'plain-summary', class: 'error', role: 'alert' }, box, e.error);
+    else html('p', { class: 'placeholder' }, box, 'Estimating…');
+    return;
+  }
+  const p = e.result.presentation;
+  html('p', { id: 'plain-summary', class: 'plain-summary' }, box, p.summary);
+  if (p.verdict) {
+    const v = html('div', { class: `verdict ${p.verdict.label}`, id: 'verdict', 'data-verdict': p.verdict.label }, box);
+    html('strong', {}, v, `Verdict: ${p.verdict.headline}`);
+    v.append(` ${p.verdict.explanation}`);
+    if (p.verdict.reasons.length) {
+      const ul = html('ul', { class: 'reasons' }, v);
+      p.verdict.reasons.forEach((t) => html('li', {}, ul, t));
+    }
+  }
+  html('p', { class: 'note', id: 'gfc-words' }, box, p.gfc);
 }
 
-/**
- * A metrics object (possibly nested) as table rows; lists (per-sample values) are left out.
- * `intervals` (the estimate's `metric_uncertainty`) adds "± half-width" (95 %) to top-level values.
- */
-function metricRows(table, obj, prefix, intervals) {
-  for (const [k, v] of Object.entries(obj)) {
-    if (k === 'warnings') continue;
-    const label = prefix ? `${prefix} ${METRIC_LABELS[k] || k}` : METRIC_LABELS[k] || k;
-    if (v && typeof v === 'object' && !Array.isArray(v)) metricRows(table, v, label);
-    else if (typeof v === 'number') {
-      const half = !prefix && intervals && intervals[k] ? intervals[k].half95 : null;
-      const shown = half != null ? `${metricNumber(v)} ± ${metricNumber(half)}` : metricNumber(v);
-      row(table, label, shown, prefix ? undefined : `metric-${k}`);
-    } else if (typeof v === 'string' || typeof v === 'boolean') row(table, label, String(v));
+/** The grouped metrics of a presentation: a rounded value with ± (95 %) and a line of what it
+ *  tells, or, when not meaningful for this light, no number but the reason (greyed). */
+function metricGroups(box, presentation) {
+  const table = html('table', { id: 'metrics', class: 'metrics' }, box);
+  for (const group of presentation.groups) {
+    const head = html('tr', { class: 'group' }, table);
+    html('th', { colspan: 2 }, head, group.title);
+    for (const m of group.metrics) {
+      const tr = html('tr', { class: m.value === null ? 'metric not-meaningful' : 'metric', 'data-key': m.key }, table);
+      const th = html('th', {}, tr, m.label);
+      html('div', { class: 'explain' }, th, m.explanation);
+      if (m.value !== null) {
+        html('td', { id: `metric-${m.key}`, class: 'value' }, tr, m.unit ? `${m.value} ${m.unit}` : m.value);
+      } else {
+        const td = html('td', { id: `metric-${m.key}`, class: 'value' }, tr, '—');
+        html('div', { class: 'reason' }, td, m.not_meaningful);
+      }
+    }
   }
 }
 
@@ -451,17 +670,16 @@ function renderSummary() {
     return;
   }
   const r = e.result;
-  if (r.verdict) html('p', { class: 'verdict', id: 'verdict' }, box, `Verdict: ${r.verdict}`);
-  if (Array.isArray(r.reasons) && r.reasons.length) {
-    const ul = html('ul', { class: 'warnings' }, box);
-    r.reasons.forEach((t) => html('li', {}, ul, t));
+  if (r.presentation) {
+    html('h3', {}, box, 'Lighting metrics');
+    metricGroups(box, r.presentation);
+    if (r.metric_uncertainty) html('p', { class: 'note' }, box, '± : the 95 % interval of the metric, calibrated on held-out lamps; numbers are rounded to what it supports.');
   }
-  const table = html('table', {}, box);
+  html('h3', {}, box, 'Details');
+  const table = html('table', { id: 'facts' }, box);
   const c = r.colorimetry;
   row(table, 'CIE 1931 x', fmt(c.xy[0], 4), 'xy-x');
   row(table, 'CIE 1931 y', fmt(c.xy[1], 4), 'xy-y');
-  row(table, 'CCT', c.cct != null ? `${fmt(c.cct, 0)} K` : 'none (far from the Planckian locus)', 'cct');
-  row(table, 'Duv', c.duv != null ? (c.duv >= 0 ? '+' : '') + fmt(c.duv, 4) : '–', 'duv');
   if (typeof r.expected_gfc === 'number') row(table, 'expected GFC', fmt(r.expected_gfc, 3), 'expected-gfc');
   if (typeof r.band_widening === 'number' && r.band_widening > 1) {
     // The light found explains this photo worse than the calibration photos: wider bands.
@@ -474,7 +692,7 @@ function renderSummary() {
     if (r.absolute.melanopic_edi_lux != null) row(table, 'melanopic EDI (approx.)', `${fmt(r.absolute.melanopic_edi_lux, 0)} lx`);
   }
   if (r.photo) {
-    row(table, 'chart', r.photo.chart);
+    row(table, 'chart', r.photo.chart, 'chart');
     row(table, 'found by', r.photo.method === 'corners' ? 'your corners' : 'detection', 'method');
     row(table, 'detection confidence', fmt(r.photo.confidence, 2));
     row(table, 'photo', `${r.photo.width} × ${r.photo.height} px`);
@@ -486,14 +704,9 @@ function renderSummary() {
     row(table, 'GFC against the reference', fmt(score.gfc, 4), 'ref-gfc');
     row(table, 'RMSE against the reference', fmt(score.rmse, 4), 'ref-rmse');
   }
-  if (r.metrics && typeof r.metrics === 'object') {
-    html('h2', {}, box, 'Lighting metrics');
-    metricRows(html('table', { id: 'metrics' }, box), r.metrics, '', r.metric_uncertainty);
-    if (r.metric_uncertainty) html('p', { class: 'note' }, box, '± : the 95 % interval of the metric, calibrated on held-out lamps.');
-  }
   const warnings = ((r.photo && r.photo.warnings) || []).concat((r.metrics && r.metrics.warnings) || []);
   if (warnings.length) {
-    html('h2', {}, box, 'Warnings');
+    html('h3', {}, box, 'Warnings');
     const ul = html('ul', { class: 'warnings', id: 'warnings' }, box);
     warnings.forEach((w) => html('li', {}, ul, w));
   }
@@ -506,13 +719,38 @@ function renderSummary() {
   button('SPD as CSV', 'download-csv', () => save(new Blob([spdCsv(r)], { type: 'text/csv' }), `${stem}.spd.csv`));
   button('JSON', 'download-json', () => save(new Blob([JSON.stringify(r, null, 2)], { type: 'application/json' }), `${stem}.json`));
   button('Plot as PNG', 'download-png', () => svgToPng($('spd-plot'), 2).then((b) => save(b, `${stem}.spd.png`)));
-  button('Report', 'download-report', () => save(new Blob([report(e)], { type: 'text/html' }), `${stem}.report.html`));
+  if (e.jobId) button('Report', 'download-report', () => downloadReport(e, `${stem}.report.html`));
 }
 
-/** The SPD as spectral CSV, as `spdcam estimate --output` writes it. */
+/** Saves the server's report of the entry's estimate (the report `spdcam estimate --report`
+ *  writes, for this photo only). */
+async function downloadReport(e, name) {
+  try {
+    const r = await fetch(`api/jobs/${encodeURIComponent(e.jobId)}/report`);
+    if (!r.ok) throw serverError(await r.json(), r.status);
+    save(await r.blob(), name);
+  } catch (err) {
+    e.error = err.message;
+    render();
+  }
+}
+
+/** A CSV field, quoted when it must be. */
+function csvField(s) {
+  return /[",\n]/.test(s) ? `"${s.replace(/"/g, '""')}"` : s;
+}
+
+/** The SPD as spectral CSV, as `spdcam estimate --output` writes it: the estimate, then its
+ *  bands' edges (`NAME_lower68`, `NAME_upper68`, `NAME_lower95`, `NAME_upper95`). */
 function spdCsv(r) {
-  const lines = [`wavelength_nm,${r.name.includes(',') ? `"${r.name.replace(/"/g, '""')}"` : r.name}`];
-  r.wavelength_nm.forEach((w, i) => lines.push(`${w},${r.spd[i]}`));
+  const columns = [[r.name, r.spd]];
+  const b68 = band(r, 'band68');
+  const b95 = band(r, 'band95');
+  if (b68 && b95) {
+    columns.push([`${r.name}_lower68`, b68.lo], [`${r.name}_upper68`, b68.hi], [`${r.name}_lower95`, b95.lo], [`${r.name}_upper95`, b95.hi]);
+  }
+  const lines = [['wavelength_nm', ...columns.map(([name]) => csvField(name))].join(',')];
+  r.wavelength_nm.forEach((w, i) => lines.push([w, ...columns.map(([, v]) => v[i])].join(',')));
   return lines.join('\n') + '\n';
 }
 
@@ -547,24 +785,6 @@ function svgToPng(svg, scale) {
     img.onerror = () => reject(new Error('the plot could not be drawn'));
     img.src = `data:image/svg+xml;charset=utf-8,${encodeURIComponent(svgText(svg))}`;
   });
-}
-
-function escapeHtml(s) {
-  return String(s).replace(/[&<>"]/g, (ch) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[ch]));
-}
-
-/** A one-page HTML report of an estimate: the details table, the plots, the warnings. */
-function report(e) {
-  const details = $('summary').querySelector('table');
-  const metrics = $('metrics');
-  const warnings = $('warnings');
-  return `<!doctype html><html lang="en"><head><meta charset="utf-8"><title>spdcam: ${escapeHtml(e.name)}</title>
-<style>body{font:14px sans-serif;max-width:900px;margin:20px auto;color:#1d2330}table{border-collapse:collapse}td,th{text-align:left;padding:2px 8px;border-bottom:1px solid #ddd}svg{width:48%;vertical-align:top}.warnings li{color:#8a5a00}</style></head>
-<body><h1>The light in ${escapeHtml(e.name)}</h1>
-<p>Estimated by spdcam (${escapeHtml(e.result.model)}) on ${escapeHtml(new Date().toISOString().slice(0, 10))}.</p>
-${svgText($('spd-plot'))}${svgText($('xy-plot'))}
-${details ? details.outerHTML : ''}${metrics ? `<h2>Lighting metrics</h2>${metrics.outerHTML}` : ''}
-${warnings ? `<h2>Warnings</h2>${warnings.outerHTML}` : ''}</body></html>`;
 }
 
 async function start() {

@@ -1,0 +1,609 @@
+//! What an estimate means, in words and in numbers rounded to what their uncertainty
+//! supports: the one source of the HTML report ([`crate::report`]) and of the web page's
+//! summary and metric tables, so the two never say different things.
+//!
+//! - Numbers with an uncertainty are rounded by the Particle Data Group's rule (Review of
+//!   Particle Physics, Introduction §5.3): the 95 % half-width keeps two significant digits
+//!   when its three leading digits are 100–354, one when 355–949, and is rounded up to two
+//!   when 950–999; the value is rounded to the same decimal place (`154 ± 11`,
+//!   `0.00025 ± 0.00007`).
+//! - A metric that is not meaningful for the light has no number, only the reason: CCT and
+//!   TM-30 (whose reference illuminant is chosen by the CCT) farther than |Duv| 0.05 from the
+//!   Planckian locus (CIE 015:2018 §9.5; Ohno 2014), CIE 13.3 Ra and R1–R14 farther than
+//!   ΔC 5.4·10⁻³ (CIE 13.3-1995 §5.2).
+//! - The light is described by simple rules on its chromaticity and its spectrum's shape
+//!   ([`describe_light`]).
+
+use crate::estimate::Estimate;
+use crate::trust::Verdict;
+use serde::Serialize;
+use spdcam_core::quality::CRI_MAX_DUV;
+
+/// Farther than this from the Planckian locus (|Duv|, CIE 1960 uv) a correlated colour
+/// temperature is not meaningful (CIE 015:2018 §9.5; Ohno 2014, LEUKOS 10:1).
+pub const CCT_MAX_DUV: f64 = 0.05;
+
+/// Within this |Duv| a light reads as white without a tint (ANSI C78.377-2017 puts its
+/// nominal white quadrangles about ±0.006 around the locus).
+const WHITE_DUV: f64 = 0.006;
+
+/// Beyond this |Duv| the tint is plain to see, not slight.
+const TINTED_DUV: f64 = 0.02;
+
+/// A peak of the peak-normalised SPD counts when it stands this far above the deeper of the
+/// two valleys beside it.
+const PEAK_PROMINENCE: f64 = 0.15;
+
+/// Everything the report and the page say about one estimate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Presentation {
+    /// One or two sentences at the top: the light, and how far the estimate can be trusted.
+    pub summary: String,
+    /// The light in words, e.g. `warm white light with an LED-like spectrum`.
+    pub light: String,
+    /// The verdict in plain words, when the estimate was judged.
+    pub verdict: Option<VerdictWords>,
+    /// What the goodness-of-fit coefficient is, and what this estimate's expected one means.
+    pub gfc: String,
+    /// The metrics in groups (colour, colour rendering, circadian and eye, plants), each
+    /// group's meaningful metrics first.
+    pub groups: Vec<MetricGroup>,
+}
+
+/// The verdict with its reasons, in plain words.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct VerdictWords {
+    /// `ok`, `doubtful` or `unusable` (as the JSON's `verdict`).
+    pub label: &'static str,
+    /// One line: what to do with the numbers.
+    pub headline: &'static str,
+    /// What the verdict rests on.
+    pub explanation: &'static str,
+    /// What lowered it, and checks that could not be made.
+    pub reasons: Vec<String>,
+}
+
+/// A group of metrics under one heading.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MetricGroup {
+    /// The heading, e.g. `Colour rendering`.
+    pub title: &'static str,
+    /// Its metrics, the meaningful ones first.
+    pub metrics: Vec<MetricLine>,
+}
+
+/// One metric as it is shown: a rounded value, or why there is none.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MetricLine {
+    /// The key in the estimate's `metrics` (`cri_r9` for R9).
+    pub key: &'static str,
+    /// Its name, e.g. `CRI Ra`.
+    pub label: &'static str,
+    /// Its unit, empty for none.
+    pub unit: &'static str,
+    /// One line of what it tells.
+    pub explanation: &'static str,
+    /// The value rounded to what its uncertainty supports, with `± half-width (95 %)` when
+    /// there is one; `None` when not meaningful or undefined.
+    pub value: Option<String>,
+    /// Why there is no value; `None` when there is one.
+    pub not_meaningful: Option<String>,
+}
+
+/// The metrics shown, by group: key, label, unit, explanation.
+const GROUPS: [(&str, &[(&str, &str, &str, &str)]); 4] = [
+    (
+        "Colour",
+        &[
+            (
+                "cct_k",
+                "CCT",
+                "K",
+                "How warm (low) or cool (high) a white light looks.",
+            ),
+            (
+                "duv",
+                "Duv",
+                "",
+                "How far from white the colour is: above 0 greenish, below 0 pinkish.",
+            ),
+        ],
+    ),
+    (
+        "Colour rendering",
+        &[
+            (
+                "cri_ra",
+                "CRI Ra",
+                "",
+                "How true eight pastel colours look (100 = like daylight or a bulb).",
+            ),
+            (
+                "cri_r9",
+                "CRI R9",
+                "",
+                "How true a saturated red looks (skin, food, wood).",
+            ),
+            (
+                "tm30_rf",
+                "TM-30 Rf",
+                "",
+                "Colour fidelity over 99 samples (100 = like the reference light).",
+            ),
+            (
+                "tm30_rg",
+                "TM-30 Rg",
+                "",
+                "Colour gamut: above 100 colours look more saturated, below 100 duller.",
+            ),
+        ],
+    ),
+    (
+        "Circadian and eye",
+        &[
+            (
+                "mel_der",
+                "Melanopic DER",
+                "",
+                "Effect on the body clock per lux, relative to daylight D65 (1 = same).",
+            ),
+            (
+                "sp_ratio",
+                "S/P ratio",
+                "",
+                "Night (rod) vision per lux relative to day vision; higher looks brighter at dusk.",
+            ),
+            (
+                "blh_efficacy_w_per_lm",
+                "Blue-light hazard",
+                "W/lm",
+                "Retinal blue-light hazard per lumen (IEC TR 62778); lower is gentler.",
+            ),
+        ],
+    ),
+    (
+        "Plants",
+        &[(
+            "ppf_per_lux",
+            "PPF per lux",
+            "µmol s⁻¹ m⁻² lx⁻¹",
+            "Photosynthetic photons (400–700 nm) per lux of light.",
+        )],
+    ),
+];
+
+impl Presentation {
+    /// The presentation of `estimate`.
+    pub fn of(estimate: &Estimate) -> Presentation {
+        let light = describe_light(estimate);
+        let uncertainty = estimate.trust.as_ref().and_then(|t| t.uncertainty.as_ref());
+        let groups = GROUPS
+            .iter()
+            .map(|(title, metrics)| {
+                let mut lines: Vec<MetricLine> = metrics
+                    .iter()
+                    .map(|&(key, label, unit, explanation)| {
+                        let half95 = uncertainty
+                            .and_then(|u| u.metrics.get(key))
+                            .map(|i| i.half95);
+                        let (value, not_meaningful) = match meaningful_value(estimate, key) {
+                            Ok(v) => (Some(shown_value(key, v, half95)), None),
+                            Err(why) => (None, Some(why)),
+                        };
+                        MetricLine {
+                            key,
+                            label,
+                            unit,
+                            explanation,
+                            value,
+                            not_meaningful,
+                        }
+                    })
+                    .collect();
+                // Stable: the meaningful ones first, each part in its own order.
+                lines.sort_by_key(|l| l.value.is_none());
+                MetricGroup {
+                    title,
+                    metrics: lines,
+                }
+            })
+            .collect();
+        let spread = band_spread(estimate);
+        let cct = estimate
+            .metrics
+            .cct_k
+            .filter(|_| cct_meaningful(estimate).is_ok());
+        let mut summary = capitalised(&light);
+        match cct {
+            Some(cct) => summary.push_str(&format!(", about {} K", round_sig(cct, 2))),
+            None => summary.push_str(", too far from white for a colour temperature"),
+        }
+        summary.push('.');
+        match (spread, uncertainty) {
+            (Some(spread), Some(u)) => summary.push_str(&format!(
+                " The estimate is good to about ±{} % of the spectrum's peak (95 % band, \
+                 averaged over {}–{} nm); expected GFC {:.3}.",
+                round_sig(100.0 * spread, 1),
+                estimate.grid.start_nm,
+                estimate.grid.end_nm(),
+                u.expected_gfc
+            )),
+            _ => summary.push_str(" How good the estimate is cannot be said: no calibration."),
+        }
+        let verdict = estimate.trust.as_ref().map(|t| {
+            let (headline, explanation) = verdict_words(t.verdict);
+            VerdictWords {
+                label: t.verdict.label(),
+                headline,
+                explanation,
+                reasons: t.reasons.clone(),
+            }
+        });
+        Presentation {
+            summary,
+            light,
+            verdict,
+            gfc: gfc_words(uncertainty.map(|u| u.expected_gfc)),
+            groups,
+        }
+    }
+
+    /// The line of `key`, if it is shown.
+    pub fn metric(&self, key: &str) -> Option<&MetricLine> {
+        self.groups
+            .iter()
+            .flat_map(|g| &g.metrics)
+            .find(|m| m.key == key)
+    }
+}
+
+/// The verdict's headline and what it rests on.
+fn verdict_words(verdict: Verdict) -> (&'static str, &'static str) {
+    match verdict {
+        Verdict::Ok => (
+            "Good: nothing was found against this estimate.",
+            "The chart was found clearly, its patches are well exposed, and the light found \
+             explains them as well as it explains the photos spdcam was calibrated on.",
+        ),
+        Verdict::Doubtful => (
+            "Use with care: something makes this estimate less sure than usual.",
+            "The numbers may be further off than their ± says; the reasons below say why. \
+             A new photo (chart square to the camera, evenly lit by this light alone, not \
+             overexposed) usually clears them.",
+        ),
+        Verdict::Unusable => (
+            "Do not use these numbers: the photo does not say what the light is.",
+            "The reasons below say what went wrong; take a new photo of the chart.",
+        ),
+    }
+}
+
+/// What the GFC is, with the expected one when known.
+fn gfc_words(expected: Option<f64>) -> String {
+    let what = "GFC (goodness-of-fit coefficient) says how alike two spectra's shapes are: \
+                1 is identical, above 0.99 a close match, above 0.999 an excellent one; \
+                below 0.95 they differ visibly (Hernández-Andrés et al. 2001).";
+    match expected {
+        Some(g) => format!(
+            "{what} Photos like this one reach a GFC of about {g:.3} against the true \
+             spectrum (the median on spdcam's calibration photos)."
+        ),
+        None => what.to_string(),
+    }
+}
+
+/// The value of metric `key` when it is meaningful for this light, else why not.
+fn meaningful_value(estimate: &Estimate, key: &str) -> Result<f64, String> {
+    let m = &estimate.metrics;
+    let undefined = || {
+        let reason_key = if key == "cri_r9" { "cri_r" } else { key };
+        Err(m
+            .reasons
+            .get(reason_key)
+            .cloned()
+            .unwrap_or_else(|| "not defined for this light".into()))
+    };
+    let Some(value) = m.scalar(key) else {
+        return undefined();
+    };
+    match key {
+        "cct_k" | "tm30_rf" | "tm30_rg" => cct_meaningful(estimate)?,
+        "cri_ra" | "cri_r9" => cri_meaningful(estimate)?,
+        _ => {}
+    }
+    Ok(value)
+}
+
+/// Whether the CCT (and what is built on it, TM-30's reference) is meaningful.
+pub fn cct_meaningful(estimate: &Estimate) -> Result<(), String> {
+    match estimate.metrics.duv {
+        Some(duv) if duv.abs() > CCT_MAX_DUV => Err(format!(
+            "not meaningful this far from white: |Duv| {:.3} is beyond {CCT_MAX_DUV}",
+            duv.abs()
+        )),
+        Some(_) => Ok(()),
+        None => Err("not meaningful: the light has no colour temperature".into()),
+    }
+}
+
+/// Whether CIE 13.3's Ra and R1–R14 are meaningful.
+pub fn cri_meaningful(estimate: &Estimate) -> Result<(), String> {
+    match estimate.metrics.duv {
+        Some(duv) if duv.abs() > CRI_MAX_DUV => Err(format!(
+            "not meaningful this far from white: |Duv| {:.3} is beyond CIE 13.3's {CRI_MAX_DUV}",
+            duv.abs()
+        )),
+        Some(_) => Ok(()),
+        None => Err("not meaningful: the light has no colour temperature".into()),
+    }
+}
+
+/// A metric's value as shown: with its 95 % half-width rounded by the PDG rule, or without
+/// one to the metric's usual precision.
+fn shown_value(key: &str, value: f64, half95: Option<f64>) -> String {
+    let signed = key == "duv";
+    match half95.filter(|h| *h > 0.0 && h.is_finite()) {
+        Some(half) => {
+            let (v, h) = round_with_uncertainty(value, half);
+            format!("{}{v} ± {h}", if signed && value >= 0.0 { "+" } else { "" })
+        }
+        None => match key {
+            "cct_k" => format!("{value:.0}"),
+            "duv" => format!("{value:+.4}"),
+            "cri_ra" | "cri_r9" | "tm30_rf" | "tm30_rg" => format!("{value:.0}"),
+            _ => round_sig(value, 3),
+        },
+    }
+}
+
+/// `value` and its half-width `half` (> 0) rounded by the Particle Data Group's rule (Review
+/// of Particle Physics, Introduction §5.3), as text: `(154.3, 10.83)` → `("154", "11")`.
+pub fn round_with_uncertainty(value: f64, half: f64) -> (String, String) {
+    let exponent = half.log10().floor() as i32;
+    let leading = half / 10f64.powi(exponent - 2);
+    // The decimal place (10^place) both numbers are rounded to.
+    // Two significant digits for 100–354, one for 355–949; 950–999 rounds up to 1000,
+    // which is two significant digits at the same place.
+    let place = if leading < 354.5 {
+        exponent - 1
+    } else {
+        exponent
+    };
+    let unit = 10f64.powi(place);
+    let round = |x: f64| (x / unit).round() * unit;
+    let decimals = (-place).max(0) as usize;
+    let text = |x: f64| {
+        let s = format!("{:.decimals$}", round(x));
+        // No "-0".
+        if s.trim_start_matches('-')
+            .chars()
+            .all(|c| c == '0' || c == '.')
+        {
+            s.trim_start_matches('-').to_string()
+        } else {
+            s
+        }
+    };
+    (text(value), text(half))
+}
+
+/// `x` to `digits` significant digits, never in exponent notation: `2718` → `2700` (2).
+pub fn round_sig(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let place = x.abs().log10().floor() as i32 - (digits - 1);
+    let unit = 10f64.powi(place);
+    let decimals = (-place).max(0) as usize;
+    format!("{:.decimals$}", (x / unit).round() * unit)
+}
+
+/// The mean half-width of the 95 % band over the wavelengths (the SPD's peak is 1).
+fn band_spread(estimate: &Estimate) -> Option<f64> {
+    let u = estimate.trust.as_ref()?.uncertainty.as_ref()?;
+    let b = &u.band95;
+    let n = b.upper.len().min(b.lower.len());
+    (n > 0).then(|| {
+        b.upper
+            .iter()
+            .zip(&b.lower)
+            .map(|(hi, lo)| (hi - lo) / 2.0)
+            .sum::<f64>()
+            / n as f64
+    })
+}
+
+/// The light in words, by documented rules:
+///
+/// - colour: near the Planckian locus (|Duv| ≤ 0.05) by its CCT in the colour-appearance
+///   groups of EN 12464-1:2021 §5.3.4 (warm below 3300 K, neutral to 5300 K, cool above),
+///   tinted `slightly greenish`/`slightly pinkish` beyond |Duv| 0.006 (ANSI C78.377's
+///   tolerance) and `greenish`/`pinkish` beyond 0.02; farther, a coloured light named by
+///   its hue angle around the equal-energy white point in CIE 1931 xy;
+/// - spectrum: peaks of the peak-normalised SPD that stand 0.15 above the deeper valley
+///   beside them; one blue peak (430–475 nm) with the maximum beyond 500 nm is
+///   `LED-like (a blue peak and a broad phosphor hump)`, three or more peaks `spiky
+///   (fluorescent- or multi-LED-like)`, none with the maximum in the last fifth of the
+///   range `smooth, rising towards red (incandescent- or halogen-like)`, none otherwise
+///   `smooth and broad (daylight-like)`.
+pub fn describe_light(estimate: &Estimate) -> String {
+    let colour = match (estimate.metrics.cct_k, estimate.metrics.duv) {
+        (Some(cct), Some(duv)) if duv.abs() <= CCT_MAX_DUV => {
+            let base = if cct < 3300.0 {
+                "warm white"
+            } else if cct <= 5300.0 {
+                "neutral white"
+            } else {
+                "cool white"
+            };
+            let tint = match (duv.abs(), duv > 0.0) {
+                (d, _) if d <= WHITE_DUV => "",
+                (d, true) if d <= TINTED_DUV => "slightly greenish ",
+                (d, false) if d <= TINTED_DUV => "slightly pinkish ",
+                (_, true) => "greenish ",
+                (_, false) => "pinkish ",
+            };
+            format!("{tint}{base} light")
+        }
+        _ => format!("{} coloured light", hue_name(estimate.colorimetry.xy)),
+    };
+    let shape = spectrum_shape(&estimate.grid.wavelengths(), &estimate.spd);
+    format!("{colour} with a {shape} spectrum")
+}
+
+/// The hue of a chromaticity far from white, by its angle around the equal-energy point.
+fn hue_name(xy: [f64; 2]) -> &'static str {
+    let angle = (xy[1] - 1.0 / 3.0).atan2(xy[0] - 1.0 / 3.0).to_degrees();
+    match angle {
+        a if (-20.0..20.0).contains(&a) => "reddish",
+        a if (20.0..60.0).contains(&a) => "yellowish",
+        a if (60.0..140.0).contains(&a) => "greenish",
+        a if (140.0..=180.0).contains(&a) || a < -160.0 => "bluish-green",
+        a if (-160.0..-100.0).contains(&a) => "bluish",
+        _ => "purplish",
+    }
+}
+
+/// The shape of the spectrum in words (see [`describe_light`]).
+fn spectrum_shape(wavelengths: &[f64], spd: &[f64]) -> &'static str {
+    let peak = spd.iter().copied().fold(0.0_f64, f64::max);
+    if peak <= 0.0 || spd.len() < 3 {
+        return "flat";
+    }
+    let v: Vec<f64> = spd.iter().map(|x| x / peak).collect();
+    let peaks = prominent_peaks(&v);
+    // The last fifth of the range.
+    let red_end = wavelengths[0] + 0.8 * (wavelengths[wavelengths.len() - 1] - wavelengths[0]);
+    let top = v
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map_or(0, |(i, _)| i);
+    let blue = peaks
+        .iter()
+        .filter(|&&i| (430.0..=475.0).contains(&wavelengths[i]))
+        .count();
+    if peaks.len() >= 3 {
+        "spiky (fluorescent- or multi-LED-like)"
+    } else if blue == 1 && wavelengths[top] > 500.0 {
+        "LED-like (a blue peak and a broad phosphor hump)"
+    } else if peaks.is_empty() && wavelengths[top] >= red_end {
+        "smooth, rising towards red (incandescent- or halogen-like)"
+    } else if peaks.is_empty() {
+        "smooth and broad (daylight-like)"
+    } else {
+        "peaked"
+    }
+}
+
+/// Indices of the local maxima of `v` standing at least [`PEAK_PROMINENCE`] above the
+/// higher of the lowest points on either side before a higher value (topographic
+/// prominence); the ends count as peaks only where the curve falls away from them.
+fn prominent_peaks(v: &[f64]) -> Vec<usize> {
+    let n = v.len();
+    (0..n)
+        .filter(|&i| {
+            let left_ok = i == 0 || v[i] > v[i - 1];
+            let right_ok = i + 1 == n || v[i] >= v[i + 1];
+            if !(left_ok && right_ok) {
+                return false;
+            }
+            // The lowest point on each side before the curve rises above this peak.
+            let side = |range: &mut dyn Iterator<Item = usize>| -> Option<f64> {
+                let mut low = v[i];
+                let mut any = false;
+                for j in range {
+                    if v[j] > v[i] {
+                        return Some(low);
+                    }
+                    low = low.min(v[j]);
+                    any = true;
+                }
+                any.then_some(low)
+            };
+            let left = side(&mut (0..i).rev());
+            let right = side(&mut (i + 1..n));
+            let base = match (left, right) {
+                (Some(l), Some(r)) => l.max(r),
+                (Some(l), None) => l,
+                (None, Some(r)) => r,
+                (None, None) => return false,
+            };
+            v[i] - base >= PEAK_PROMINENCE
+        })
+        .collect()
+}
+
+/// `text` with its first letter upper-case.
+fn capitalised(text: &str) -> String {
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(c) => c.to_uppercase().chain(chars).collect(),
+        None => String::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_rounded_to_what_their_uncertainty_supports() {
+        let r = |v, h| round_with_uncertainty(v, h);
+        assert_eq!(r(154.3, 10.83), ("154".into(), "11".into()));
+        assert_eq!(
+            r(0.0002476, 0.0000662),
+            ("0.00025".into(), "0.00007".into())
+        );
+        assert_eq!(r(2718.0, 828.0), ("2700".into(), "800".into()));
+        assert_eq!(r(40.36, 14.14), ("40".into(), "14".into()));
+        assert_eq!(r(0.5, 0.0096), ("0.50".into(), "0.010".into()));
+        assert_eq!(r(81.26, 4.04), ("81".into(), "4".into()));
+        assert_eq!(r(-0.0004, 0.0031), ("-0.0004".into(), "0.0031".into()));
+        assert_eq!(r(-0.00001, 0.004), ("0.000".into(), "0.004".into()));
+        assert_eq!(round_sig(2718.0, 2), "2700");
+        assert_eq!(round_sig(0.06349, 1), "0.06");
+        assert_eq!(round_sig(12.3456, 3), "12.3");
+    }
+
+    #[test]
+    fn peaks_and_shapes_follow_the_documented_rules() {
+        let w: Vec<f64> = (0..61).map(|i| 400.0 + 5.0 * f64::from(i)).collect();
+        let gauss = |c: f64, s: f64| -> Vec<f64> {
+            w.iter()
+                .map(|&x| (-(x - c).powi(2) / (2.0 * s * s)).exp())
+                .collect()
+        };
+        // A white LED: a blue peak at 450 nm and a phosphor hump at 580 nm.
+        let led: Vec<f64> = gauss(450.0, 10.0)
+            .iter()
+            .zip(gauss(580.0, 50.0))
+            .map(|(a, b)| 0.7 * a + b)
+            .collect();
+        assert_eq!(
+            spectrum_shape(&w, &led),
+            "LED-like (a blue peak and a broad phosphor hump)"
+        );
+        let bulb: Vec<f64> = w.iter().map(|x| (x - 380.0) / 320.0).collect();
+        assert_eq!(
+            spectrum_shape(&w, &bulb),
+            "smooth, rising towards red (incandescent- or halogen-like)"
+        );
+        let tri: Vec<f64> = [gauss(450.0, 6.0), gauss(545.0, 6.0), gauss(610.0, 6.0)]
+            .iter()
+            .fold(vec![0.0; w.len()], |acc, g| {
+                acc.iter().zip(g).map(|(a, b)| a + b).collect()
+            });
+        assert_eq!(
+            spectrum_shape(&w, &tri),
+            "spiky (fluorescent- or multi-LED-like)"
+        );
+        assert_eq!(
+            spectrum_shape(&w, &gauss(540.0, 120.0)),
+            "smooth and broad (daylight-like)"
+        );
+        assert_eq!(hue_name([0.2, 0.6]), "greenish");
+        assert_eq!(hue_name([0.65, 0.3]), "reddish");
+        assert_eq!(hue_name([0.16, 0.08]), "bluish");
+    }
+}
