@@ -1,11 +1,11 @@
 //! One call from a photo file to its feature row: decode ─► find (or place) the chart ─►
 //! sample ─► features, confidence, flags and warnings; several photos in parallel.
 
-use super::detect::{detect_traced, from_corners, no_chart};
+use super::detect::{detect_traced, from_corners, from_corners_any, no_chart};
 use super::exposure::Exposure;
 use super::geometry::Homography;
 use super::load::{load_photo, Photo};
-use super::overlay::{debug_overlay, write_overlay};
+use super::overlay::{debug_overlay_full, write_overlay};
 use super::sample::{sample, PatchSample};
 use super::{ChartTemplate, Detection};
 use crate::error::{Error, Result};
@@ -23,8 +23,8 @@ const LOW_CONFIDENCE: f64 = 0.8;
 /// How to analyse photos.
 #[derive(Debug, Clone, Default)]
 pub struct AnalyseOptions {
-    /// The charts to look for; with [`AnalyseOptions::corners`], the first is the chart
-    /// those corners outline.
+    /// The charts to look for; with [`AnalyseOptions::corners`], the one whose patches fit
+    /// the photo inside those corners best.
     pub templates: Vec<ChartTemplate>,
     /// The chart's four outer corners in photo pixels, any order; `None` to detect.
     pub corners: Option<Vec<[f64; 2]>>,
@@ -85,11 +85,17 @@ pub fn analyse(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnalysis>
 
 fn analyse_decoded(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnalysis> {
     let templates = &options.templates;
-    let Some(first) = templates.first() else {
+    if templates.is_empty() {
         return Err(Error::invalid("no chart to look for"));
-    };
+    }
     let (detection, trace, method) = match &options.corners {
-        Some(corners) => (Some(from_corners(photo, first, corners)?), None, "corners"),
+        Some(corners) => {
+            let detection = match templates.as_slice() {
+                [only] => from_corners(photo, only, corners)?,
+                _ => from_corners_any(photo, templates, corners)?.0,
+            };
+            (Some(detection), None, "corners")
+        }
         None => {
             let (d, trace) = detect_traced(photo, templates)?;
             (d, Some(trace), "detected")
@@ -97,7 +103,7 @@ fn analyse_decoded(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnaly
     };
     let Some(detection) = detection else {
         if let Some(path) = &options.debug {
-            write_overlay(path, &debug_overlay(photo, None, trace.as_ref()))?;
+            write_overlay(path, &debug_overlay_full(photo, None, trace.as_ref()))?;
         }
         return Err(no_chart(photo, templates));
     };
@@ -110,7 +116,7 @@ fn analyse_decoded(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnaly
     }));
     let patches = sample(photo, template, &h)?;
     if let Some(path) = &options.debug {
-        let image = debug_overlay(photo, Some((template, &detection, &patches)), None);
+        let image = debug_overlay_full(photo, Some((template, &detection, &patches)), None);
         write_overlay(path, &image)?;
     }
     Ok(assemble(photo, template, detection, method, patches))

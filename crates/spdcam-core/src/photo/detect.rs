@@ -100,38 +100,54 @@ pub fn detect_at(
     let mut trace = SearchTrace::default();
     loop {
         let level = Level::new(photo, factor);
-        let (best, blobs) = search_level(&level, templates);
-        if trace.blobs.is_empty() || best.is_some() {
-            let f = factor as f64;
-            trace.blobs = blobs
-                .iter()
-                .map(|b| ([b.centre[0] * f, b.centre[1] * f], b.side() * f))
-                .collect();
-        }
-        if let Some(c) = &best {
-            let map = c.map.scaled_output(factor as f64);
-            let t = &templates[c.template];
-            let corners = t.corners().map(|p| map.apply(p));
-            let confidence = c.confidence();
-            trace.best = Some((corners, confidence));
-            if confidence >= MIN_CONFIDENCE {
-                return Ok((
-                    Some(Detection {
-                        chart: t.name.clone(),
-                        corners,
-                        homography: map.to_rows(),
-                        confidence,
-                    }),
-                    trace,
-                ));
-            }
+        if let Some(found) = search_traced(&level, factor as f64, templates, &mut trace) {
+            return Ok((Some(found), trace));
         }
         // Small charts may need a finer level, down to the finest one searched.
         if factor <= finest {
-            return Ok((None, trace));
+            break;
         }
         factor = (factor / 2).max(finest);
     }
+    // Charts whose patches are only a few pixels wide: the full-resolution photo enlarged.
+    if factor == 1 && 4 * photo.width * photo.height <= MAX_SEARCH_PIXELS {
+        let level = Level::new(photo, 1).enlarged();
+        if let Some(found) = search_traced(&level, 0.5, templates, &mut trace) {
+            return Ok((Some(found), trace));
+        }
+    }
+    Ok((None, trace))
+}
+
+/// Searches one level whose pixels are `scale` photo pixels wide, noting what it saw in
+/// `trace`; the detection when one reaches [`MIN_CONFIDENCE`].
+fn search_traced(
+    level: &Level,
+    scale: f64,
+    templates: &[ChartTemplate],
+    trace: &mut SearchTrace,
+) -> Option<Detection> {
+    let (best, blobs) = search_level(level, templates);
+    if trace.blobs.is_empty() || best.is_some() {
+        trace.blobs = blobs
+            .iter()
+            .map(|b| ([b.centre[0] * scale, b.centre[1] * scale], b.side() * scale))
+            .collect();
+    }
+    let c = best?;
+    let map = c.map.scaled_output(scale);
+    let t = &templates[c.template];
+    let corners = t.corners().map(|p| map.apply(p));
+    let confidence = c.confidence();
+    if trace.best.as_ref().is_none_or(|b| confidence >= b.1) {
+        trace.best = Some((corners, confidence));
+    }
+    (confidence >= MIN_CONFIDENCE).then(|| Detection {
+        chart: t.name.clone(),
+        corners,
+        homography: map.to_rows(),
+        confidence,
+    })
 }
 
 /// The smallest reduction factor the search goes down to: the level that keeps at most
@@ -346,40 +362,140 @@ pub fn from_corners(
     template: &ChartTemplate,
     corners: &[[f64; 2]],
 ) -> Result<Detection> {
+    Ok(
+        corner_placements(photo, std::slice::from_ref(template), corners)?
+            .remove(0)
+            .1,
+    )
+}
+
+/// [`from_corners`] for a photo that may show any of `templates`: each is laid on the
+/// corners, and the one whose patches the rectified photo shows best is taken — the share
+/// of the brightness variance in the patches' sampling squares that lies between patches
+/// rather than within them ([`template_fit`]): a chart with another grid lays its squares
+/// across patch edges. The fit of every template, best first, comes with it.
+pub fn from_corners_any(
+    photo: &Photo,
+    templates: &[ChartTemplate],
+    corners: &[[f64; 2]],
+) -> Result<(Detection, Vec<(String, f64)>)> {
+    let mut placed = corner_placements(photo, templates, corners)?;
+    let fits = placed
+        .iter()
+        .map(|(fit, d)| (d.chart.clone(), *fit))
+        .collect();
+    Ok((placed.remove(0).1, fits))
+}
+
+/// Every template laid on the corners in its best orientation, with its fit; best first.
+fn corner_placements(
+    photo: &Photo,
+    templates: &[ChartTemplate],
+    corners: &[[f64; 2]],
+) -> Result<Vec<(f64, Detection)>> {
+    if templates.is_empty() {
+        return Err(Error::invalid("no chart template to lay on the corners"));
+    }
     let quad = sort_corners(corners, photo.width, photo.height)?;
     let factor = Level::factor_for(photo.width, photo.height, DETECTION_SIZE);
     let level = Level::new(photo, factor);
-    let (w, h) = template.size();
     let side = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
-    let mut best: Option<(f64, usize, Homography)> = None;
-    let mut taus = Vec::new();
-    for s in 0..4 {
-        let image: Vec<[f64; 2]> = (0..4).map(|k| quad[(s + k) % 4]).collect();
-        let map = Homography::fit(&template.corners(), &image)?;
-        let across = 0.5 * (side(image[0], image[1]) + side(image[2], image[3]));
-        let down = 0.5 * (side(image[1], image[2]) + side(image[3], image[0]));
-        let aspect_error = ((across / down) / (w / h)).ln().abs();
-        let tau = neutral_order(&level, template, &map.scaled_output(1.0 / factor as f64))
-            .unwrap_or(-1.0);
-        let score = tau - 2.0 * aspect_error;
-        taus.push((tau, score));
-        if best.as_ref().is_none_or(|b| score > b.0) {
-            best = Some((score, s, map));
+    let mut out = Vec::with_capacity(templates.len());
+    for template in templates {
+        let (w, h) = template.size();
+        // Per orientation: the map, its neutral order, its fit.
+        let mut ways = Vec::with_capacity(4);
+        for s in 0..4 {
+            let image: Vec<[f64; 2]> = (0..4).map(|k| quad[(s + k) % 4]).collect();
+            let map = Homography::fit(&template.corners(), &image)?;
+            let across = 0.5 * (side(image[0], image[1]) + side(image[2], image[3]));
+            let down = 0.5 * (side(image[1], image[2]) + side(image[3], image[0]));
+            let aspect_error = ((across / down) / (w / h)).ln().abs();
+            let on_level = map.scaled_output(1.0 / factor as f64);
+            let tau = neutral_order(&level, template, &on_level).unwrap_or(-1.0);
+            let fit = template_fit(&level, template, &on_level);
+            ways.push((map, tau, aspect_error, fit));
         }
+        let best_fit = ways.iter().map(|w| w.3).fold(f64::NEG_INFINITY, f64::max);
+        // Orientations that fit the grid clearly worse than the best are out of the running
+        // (a quarter turn of a 6 × 4 grid); among the rest the neutral order decides.
+        let scores: Vec<f64> = ways
+            .iter()
+            .map(|(_, tau, aspect, fit)| tau - 2.0 * aspect - 4.0 * (best_fit - fit))
+            .collect();
+        let chosen = (0..4)
+            .max_by(|&a, &b| scores[a].total_cmp(&scores[b]))
+            .ok_or_else(|| Error::invalid("no placement for the corners"))?;
+        let other = (0..4)
+            .filter(|&s| s != chosen)
+            .map(|s| scores[s])
+            .fold(-1.0, f64::max);
+        let (map, tau, _, fit) = ways.swap_remove(chosen);
+        let confidence = tau.max(0.0) * (0.5 + scores[chosen] - other).clamp(0.0, 1.0);
+        out.push((
+            fit,
+            Detection {
+                chart: template.name.clone(),
+                corners: template.corners().map(|p| map.apply(p)),
+                homography: map.to_rows(),
+                confidence,
+            },
+        ));
     }
-    let (_, chosen, map) = best.ok_or_else(|| Error::invalid("no placement for the corners"))?;
-    let (tau, score) = taus[chosen];
-    let other = (0..4)
-        .filter(|&s| s != chosen)
-        .map(|s| taus[s].1)
-        .fold(-1.0, f64::max);
-    let confidence = tau.max(0.0) * (0.5 + score - other).clamp(0.0, 1.0);
-    Ok(Detection {
-        chart: template.name.clone(),
-        corners: template.corners().map(|p| map.apply(p)),
-        homography: map.to_rows(),
-        confidence,
-    })
+    out.sort_by(|a, b| b.0.total_cmp(&a.0));
+    Ok(out)
+}
+
+/// How well `t`'s patches fit the photo through `map` (chart → level): 5 × 5 points in
+/// the centre half of every patch, and the share of their brightness variance that lies
+/// between the patches' means (the coefficient of determination of the partition into
+/// patches, an analysis-of-variance R²). Near 1 when every square falls inside one flat
+/// patch; low when squares straddle patch edges.
+fn template_fit(level: &Level, t: &ChartTemplate, map: &Homography) -> f64 {
+    let mut values: Vec<Vec<f64>> = Vec::with_capacity(t.patch_count());
+    for p in 0..t.patch_count() {
+        let square = t.patch_square(p, 0.5);
+        let mut patch = Vec::with_capacity(25);
+        for j in 0..5 {
+            for i in 0..5 {
+                let (a, b) = (i as f64 / 4.0, j as f64 / 4.0);
+                let top = lerp(square[0], square[1], a);
+                let bottom = lerp(square[3], square[2], a);
+                let q = map.apply(lerp(top, bottom, b));
+                if !(q[0] >= 0.0
+                    && q[1] >= 0.0
+                    && q[0] < level.width as f64
+                    && q[1] < level.height as f64)
+                {
+                    continue;
+                }
+                patch.push(level.bilinear(q).iter().map(|&v| f64::from(v)).sum());
+            }
+        }
+        values.push(patch);
+    }
+    let all: Vec<f64> = values.iter().flatten().copied().collect();
+    if all.len() < 2 {
+        return 0.0;
+    }
+    let grand = all.iter().sum::<f64>() / all.len() as f64;
+    let total: f64 = all.iter().map(|v| (v - grand).powi(2)).sum();
+    let within: f64 = values
+        .iter()
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let m = p.iter().sum::<f64>() / p.len() as f64;
+            p.iter().map(|v| (v - m).powi(2)).sum::<f64>()
+        })
+        .sum();
+    if total <= 0.0 {
+        return 0.0;
+    }
+    1.0 - within / total
+}
+
+fn lerp(a: [f64; 2], b: [f64; 2], t: f64) -> [f64; 2] {
+    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
 }
 
 #[cfg(test)]

@@ -25,9 +25,6 @@ pub struct Lattice {
 const SNAP: f64 = 0.22;
 /// Most seeds tried.
 const MAX_SEEDS: usize = 40;
-/// Patch side over patch pitch assumed before the chart is known (between the
-/// ColorCheckers' 0.84 and 0.88).
-const TYPICAL_FRACTION: f64 = 0.86;
 
 /// Lattices of at least `min_members` blobs, largest first.
 pub fn find_lattices(blobs: &[Blob], min_members: usize) -> Vec<Lattice> {
@@ -59,16 +56,23 @@ pub fn find_lattices(blobs: &[Blob], min_members: usize) -> Vec<Lattice> {
     out
 }
 
-/// For each blob, the blobs of similar size at about one patch pitch.
+/// Grid neighbours measured in a blob's own metric ([`Blob::metric_length`]): a square
+/// patch's side measures √12 ≈ 3.46, so its neighbours one pitch away (patch over pitch
+/// 0.86) measure about 4.0, or more when edges trim the blob; diagonal ones 5.7.
+const NEIGHBOUR_METRIC: (f64, f64) = (2.8, 6.4);
+
+/// For each blob, the blobs of similar size at about one patch pitch, measured in the
+/// blob's own metric so that foreshortened patches find their neighbours as square ones do.
 fn neighbour_lists(blobs: &[Blob]) -> Vec<Vec<usize>> {
     let mut idx: Vec<usize> = (0..blobs.len()).collect();
     idx.sort_by(|&a, &b| blobs[a].centre[0].total_cmp(&blobs[b].centre[0]));
     let xs: Vec<f64> = idx.iter().map(|&i| blobs[i].centre[0]).collect();
     let mut out = vec![Vec::new(); blobs.len()];
-    for (k, &i) in idx.iter().enumerate() {
+    for &i in &idx {
         let bi = &blobs[i];
-        let pitch = bi.side() / TYPICAL_FRACTION;
-        let reach = 2.0 * pitch;
+        let [a, b, c] = bi.moments;
+        let largest = 0.5 * (a + c) + (0.25 * (a - c).powi(2) + b * b).sqrt();
+        let reach = NEIGHBOUR_METRIC.1 * largest.max(0.0).sqrt();
         let lo = xs.partition_point(|&x| x < bi.centre[0] - reach);
         for &j in &idx[lo..] {
             let bj = &blobs[j];
@@ -78,30 +82,34 @@ fn neighbour_lists(blobs: &[Blob]) -> Vec<Vec<usize>> {
             if j == i {
                 continue;
             }
-            let d = (bj.centre[0] - bi.centre[0]).hypot(bj.centre[1] - bi.centre[1]);
+            let d = bi.metric_length([bj.centre[0] - bi.centre[0], bj.centre[1] - bi.centre[1]]);
             let ratio = bj.area / bi.area;
-            if (0.7 * pitch..=1.6 * pitch).contains(&d) && (0.4..=2.5).contains(&ratio) {
+            if (NEIGHBOUR_METRIC.0..=NEIGHBOUR_METRIC.1).contains(&d)
+                && (0.4..=2.5).contains(&ratio)
+            {
                 out[i].push(j);
             }
         }
-        let _ = k;
     }
     out
 }
 
 /// An affine grid map from a seed and its neighbours, or `None` without an orthogonal pair.
+/// Lengths and angles are those of the seed's own metric, in which a foreshortened grid is
+/// square again.
 fn seed_map(blobs: &[Blob], neighbours: &[usize], seed: usize) -> Option<Homography> {
-    let c = blobs[seed].centre;
+    let b = &blobs[seed];
+    let c = b.centre;
     let mut vecs: Vec<[f64; 2]> = neighbours
         .iter()
         .map(|&j| [blobs[j].centre[0] - c[0], blobs[j].centre[1] - c[1]])
         .collect();
-    vecs.sort_by(|a, b| a[0].hypot(a[1]).total_cmp(&b[0].hypot(b[1])));
+    vecs.sort_by(|p, q| b.metric_length(*p).total_cmp(&b.metric_length(*q)));
     let u = *vecs.first()?;
-    let lu = u[0].hypot(u[1]);
+    let lu = b.metric_length(u);
     let v = vecs.iter().skip(1).find(|v| {
-        let lv = v[0].hypot(v[1]);
-        let cos = (u[0] * v[0] + u[1] * v[1]) / (lu * lv);
+        let lv = b.metric_length(**v);
+        let cos = b.metric_dot(u, **v) / (lu * lv);
         cos.abs() < 0.45 && (lv / lu) < 1.6
     })?;
     // Keep the grid unmirrored: (u, v) turn like the screen's (x, y).

@@ -14,6 +14,7 @@
 
 mod batch;
 mod detect;
+pub mod detection_rate;
 pub mod exposure;
 mod geometry;
 mod lattice;
@@ -28,11 +29,16 @@ pub use batch::{
     analyse, analyse_photo, analyse_photos, debug_path, debug_paths, features_csv,
     write_features_csv, AnalyseOptions, PhotoAnalysis,
 };
-pub use detect::{detect, detect_at, detect_traced, from_corners, SearchTrace, DETECTION_SIZE};
+pub use detect::{
+    detect, detect_at, detect_traced, from_corners, from_corners_any, SearchTrace, DETECTION_SIZE,
+};
 pub use exposure::Exposure;
 pub use geometry::{sort_corners, Homography};
 pub use load::{decode_photo, jpeg_end, load_photo, JpegEnd, Photo, MIN_PHOTO_SIDE};
-pub use overlay::{analysis_overlay_jpeg, debug_overlay, write_overlay, OVERLAY_SIZE};
+pub use overlay::{
+    analysis_overlay_jpeg, debug_factor, debug_overlay, debug_overlay_full, write_overlay,
+    DEBUG_MAX_PIXELS, OVERLAY_SIZE,
+};
 pub use sample::{sample, PatchSample};
 
 use crate::builtin::DataDir;

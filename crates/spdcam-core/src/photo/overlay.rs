@@ -1,4 +1,5 @@
-//! The debug image: the photo (reduced to at most [`OVERLAY_SIZE`] px), the chart's
+//! The debug image: the photo (at full resolution up to [`DEBUG_MAX_PIXELS`], else reduced
+//! by [`debug_factor`]; for a report reduced to at most [`OVERLAY_SIZE`] px), the chart's
 //! outline with its first corner marked, every sampled region with its patch number, and,
 //! when no chart was found, the patch candidates the search saw.
 
@@ -15,8 +16,18 @@ use crate::sampler::SAMPLING_FRACTION;
 use image::ImageEncoder;
 use std::path::Path;
 
-/// Longest side of the debug image.
+/// Longest side of the overlay embedded in a report.
 pub const OVERLAY_SIZE: usize = 1600;
+/// Most pixels of a debug image written at the photo's full resolution (150 MB of RGB);
+/// larger photos are reduced by [`debug_factor`].
+pub const DEBUG_MAX_PIXELS: usize = 50_000_000;
+
+/// The integer factor by which the debug image of a `width × height` photo is reduced: 1
+/// (full resolution) up to [`DEBUG_MAX_PIXELS`].
+pub fn debug_factor(width: usize, height: usize) -> usize {
+    let pixels = width as f64 * height as f64;
+    (pixels / DEBUG_MAX_PIXELS as f64).sqrt().ceil().max(1.0) as usize
+}
 
 const GREEN: [u8; 3] = [0, 255, 64];
 const RED: [u8; 3] = [255, 32, 32];
@@ -107,15 +118,36 @@ impl Canvas {
     }
 }
 
-/// Draws the debug image. With a detection: its outline (green, first corner marked
-/// yellow) and each sampled square (white; red when clipped) with its 1-based patch number.
-/// Without one: the candidates in `trace` (red squares) and the best rejected outline.
+/// Draws the debug image reduced to about [`OVERLAY_SIZE`] px (for a report). With a
+/// detection: its outline (green, first corner marked yellow) and each sampled square
+/// (white; red when clipped) with its 1-based patch number. Without one: the candidates in
+/// `trace` (red squares) and the best rejected outline.
 pub fn debug_overlay(
     photo: &Photo,
     found: Option<(&ChartTemplate, &Detection, &[PatchSample])>,
     trace: Option<&SearchTrace>,
 ) -> image::RgbImage {
     let factor = Level::factor_for(photo.width, photo.height, OVERLAY_SIZE);
+    draw_overlay(photo, found, trace, factor)
+}
+
+/// [`debug_overlay`] at the photo's full resolution (reduced by [`debug_factor`] beyond
+/// [`DEBUG_MAX_PIXELS`]): the `--debug` image, in which a small chart's patches can be
+/// told apart.
+pub fn debug_overlay_full(
+    photo: &Photo,
+    found: Option<(&ChartTemplate, &Detection, &[PatchSample])>,
+    trace: Option<&SearchTrace>,
+) -> image::RgbImage {
+    draw_overlay(photo, found, trace, debug_factor(photo.width, photo.height))
+}
+
+fn draw_overlay(
+    photo: &Photo,
+    found: Option<(&ChartTemplate, &Detection, &[PatchSample])>,
+    trace: Option<&SearchTrace>,
+    factor: usize,
+) -> image::RgbImage {
     let level = Level::new(photo, factor);
     let s = 1.0 / factor as f64;
     let mut canvas = Canvas {

@@ -47,6 +47,27 @@ impl Level {
         }
     }
 
+    /// This level enlarged twice in each direction by bilinear interpolation: a chart whose
+    /// patches are a few pixels wide keeps a low-gradient core that the segmentation can
+    /// find, where the edges' gradient covers the patches at their own size.
+    pub fn enlarged(&self) -> Level {
+        let (w, h) = (2 * self.width, 2 * self.height);
+        let mut planes: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0.0; w * h]);
+        for y in 0..h {
+            for x in 0..w {
+                let v = self.bilinear([(x as f64 + 0.5) / 2.0, (y as f64 + 0.5) / 2.0]);
+                for c in 0..3 {
+                    planes[c][y * w + x] = v[c];
+                }
+            }
+        }
+        Level {
+            width: w,
+            height: h,
+            planes,
+        }
+    }
+
     /// The factor that brings a photo of `width × height` to about `target` px on its
     /// longer side (never below 1).
     pub fn factor_for(width: usize, height: usize, target: usize) -> usize {

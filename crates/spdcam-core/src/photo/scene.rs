@@ -47,6 +47,82 @@ pub struct SceneOptions {
     /// corner (top left of its patch grid), its width a share of the grid's width; `None`:
     /// none.
     pub glow: Option<Glow>,
+    /// The chart's centre as a share of the photo's width and height; `None`: anywhere the
+    /// chart fits, drawn at random.
+    pub centre: Option<[f64; 2]>,
+    /// The chart's rotation in its own plane, degrees clockwise; `None`: drawn at random.
+    pub rotation_deg: Option<f64>,
+    /// The chart's plane seen at an angle (a perspective view, replacing the random corner
+    /// displacement of [`SceneOptions::perspective`]); `None`: seen face-on up to that
+    /// displacement.
+    pub tilt: Option<Tilt>,
+    /// A shadow over part of the chart; `None`: evenly lit.
+    pub shadow: Option<Shadow>,
+    /// With a second light on the right half ([`SceneLight::right_half`]): each half
+    /// exposed and white-balanced for its own light, as two photos of the scene joined at
+    /// the chart's middle; else one exposure (metered under the first light) and one white
+    /// balance over the whole frame.
+    pub balance_halves: bool,
+}
+
+/// The axis of the photo about which the chart's plane is turned away from the camera.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TiltAxis {
+    /// The photo's horizontal axis: the chart is foreshortened vertically (a chart lying on
+    /// a table).
+    Horizontal,
+    /// The photo's vertical axis: the chart is foreshortened horizontally (a chart on a
+    /// side wall).
+    Vertical,
+}
+
+/// A chart whose plane is turned by `degrees` about `axis`, photographed by a pinhole
+/// camera of focal length [`TILT_FOCAL_SHARE`] × the photo's width: the chart's outline is
+/// the perspective projection of the turned plane (Hartley & Zisserman 2004, "Multiple View
+/// Geometry", section 6.1), foreshortened by about cos(degrees) and larger on its near side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tilt {
+    /// The angle between the chart's normal and the line of sight, degrees (−85…85; the
+    /// sign says which side comes nearer).
+    pub degrees: f64,
+    /// The axis turned about.
+    pub axis: TiltAxis,
+}
+
+/// Focal length of the pinhole camera that views a tilted chart, as a share of the photo's
+/// width (a 26 mm-equivalent phone lens is 0.72 of the width, a 50 mm lens 1.39).
+pub const TILT_FOCAL_SHARE: f64 = 0.9;
+
+/// Largest tilt, degrees: beyond it the chart is seen nearly edge-on.
+pub const MAX_TILT_DEG: f64 = 85.0;
+
+/// A shadow on the chart: every point of the chart beyond a straight edge is darker by
+/// `factor`, with a soft edge (penumbra) a twentieth of the chart's width wide.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shadow {
+    /// The light left in the shadow (0 < factor < 1).
+    pub factor: f64,
+    /// The share of the chart's width (along the shadow's direction) the shadow covers, 0…1.
+    pub cover: f64,
+    /// The direction the shadow comes from, degrees clockwise from the chart's right side:
+    /// 0 shades its right part, 90 its bottom part.
+    pub direction_deg: f64,
+}
+
+impl Shadow {
+    /// The light left at chart-canvas point `(u, v)` (shares of the canvas's width and
+    /// height, 0…1): 1 in the light, `factor` deep in the shadow.
+    pub fn light_at(&self, u: f64, v: f64) -> f64 {
+        let (s, c) = self.direction_deg.to_radians().sin_cos();
+        // Position along the shadow's direction, 0…1 across the chart's extent that way.
+        let reach = 0.5 * (c.abs() + s.abs());
+        let along = ((u - 0.5) * c + (v - 0.5) * s) / reach.max(1e-9) * 0.5 + 0.5;
+        let edge = 1.0 - self.cover;
+        let penumbra = 0.05;
+        let t = ((along - edge) / penumbra + 0.5).clamp(0.0, 1.0);
+        let shaded = t * t * (3.0 - 2.0 * t);
+        1.0 - shaded * (1.0 - self.factor)
+    }
 }
 
 impl Default for SceneOptions {
@@ -60,6 +136,11 @@ impl Default for SceneOptions {
             vignetting: (0.0, 0.25),
             jpeg_quality: (80, 95),
             glow: None,
+            centre: None,
+            rotation_deg: None,
+            tilt: None,
+            shadow: None,
+            balance_halves: false,
         }
     }
 }
@@ -135,6 +216,65 @@ pub fn photograph(
     seed: u64,
     options: &SceneOptions,
 ) -> Result<ScenePhoto> {
+    let shot = match (light.right_half, options.balance_halves) {
+        (Some(right), true) => {
+            // Two photos of one scene, each exposed and balanced for its own light, joined
+            // at the chart's middle.
+            let mut left = develop_scene(camera, SceneLight::single(light.spd), seed, options)?;
+            let right = develop_scene(camera, SceneLight::single(right), seed, options)?;
+            let w = left.image.width;
+            for y in 0..left.image.height {
+                for x in 0..w {
+                    let q = left.inverse.apply([x as f64 + 0.5, y as f64 + 0.5]);
+                    let (cw, ch) = left.canvas;
+                    if q[0] >= cw / 2.0 && q[0] <= cw && q[1] >= 0.0 && q[1] <= ch {
+                        for (l, r) in left.image.planes.iter_mut().zip(&right.image.planes) {
+                            l[y * w + x] = r[y * w + x];
+                        }
+                    }
+                }
+            }
+            for (k, right_lit) in left.right_lit.iter().enumerate() {
+                if *right_lit {
+                    left.expected_features[3 * k..3 * k + 3]
+                        .copy_from_slice(&right.expected_features[3 * k..3 * k + 3]);
+                }
+            }
+            left
+        }
+        _ => develop_scene(camera, light, seed, options)?,
+    };
+    Ok(ScenePhoto {
+        jpeg: imageio::encode_jpeg(&shot.image, shot.quality)?,
+        corners: shot.corners,
+        patch_px: shot.patch_px,
+        expected_features: shot.expected_features,
+    })
+}
+
+/// A scene photo before JPEG encoding, with what is true about it.
+struct DevelopedScene {
+    image: RgbImage,
+    quality: u8,
+    corners: [[f64; 2]; 4],
+    patch_px: f64,
+    expected_features: Vec<f32>,
+    /// Photo → chart canvas.
+    inverse: Homography,
+    /// The chart canvas's width and height: canvas points right of its middle are the
+    /// right half.
+    canvas: (f64, f64),
+    /// Per feature patch: on the right half.
+    right_lit: Vec<bool>,
+}
+
+/// [`photograph`] up to the developed image.
+fn develop_scene(
+    camera: &Camera,
+    light: SceneLight,
+    seed: u64,
+    options: &SceneOptions,
+) -> Result<DevelopedScene> {
     let (w, h) = (options.width, options.height);
     check_scene_size(w, h)?;
     if !(options.width_share.0 > 0.0
@@ -146,6 +286,7 @@ pub fn photograph(
             options.width_share
         )));
     }
+    check_placement(options)?;
     let chart = camera.chart();
     let template = ChartTemplate::from_chart(chart)?;
     let layout = &chart.layout;
@@ -196,6 +337,11 @@ pub fn photograph(
     scene.planes = background(&mut rng, w, h, white);
     let region_map = layout.region_map();
     let half = cw as f64 / 2.0;
+    let shade = |u: f64, v: f64| {
+        options
+            .shadow
+            .map_or(1.0, |sh| sh.light_at(u / cw as f64, v / ch as f64) as f32)
+    };
     for y in 0..h {
         for x in 0..w {
             let q = inverse.apply([x as f64 + 0.5, y as f64 + 0.5]);
@@ -215,10 +361,11 @@ pub fn photograph(
                 exposed[lit][usize::from(region_map[cy * cw + cx])]
             };
             let (a, b, c, d) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
+            let light = shade(u + 0.5, v + 0.5);
             for (k, plane) in scene.planes.iter_mut().enumerate() {
                 let top = a[k] * (1.0 - fx) + b[k] * fx;
                 let bottom = c[k] * (1.0 - fx) + d[k] * fx;
-                plane[y * w + x] = top * (1.0 - fy) + bottom * fy;
+                plane[y * w + x] = (top * (1.0 - fy) + bottom * fy) * light;
             }
         }
     }
@@ -244,7 +391,6 @@ pub fn photograph(
     let developed = camera.develop(&scene, seed::derive(seed, 1));
     let (q0, q1) = options.jpeg_quality;
     let quality = rng.random_range(q0.clamp(1, 100)..=q1.clamp(q0.clamp(1, 100), 100));
-    let jpeg = imageio::encode_jpeg(&developed.image, quality)?;
     let gains = developed.white_balance_gains;
     let expected_features = chart
         .feature_patches
@@ -261,16 +407,29 @@ pub fn photograph(
             };
             let g = vignetting.gain(at, w, h) as f32;
             let glow = glow_at(at) as f32;
+            let light = shade(canvas_centre[0], canvas_centre[1]);
             let raw: [f32; 3] =
-                std::array::from_fn(|c| (exposed[lit][p][c] + glow * patch_mean[c]) * g);
+                std::array::from_fn(|c| (exposed[lit][p][c] * light + glow * patch_mean[c]) * g);
             camera.encode_exposed(raw, gains).map(|v| 255.0 * v)
         })
         .collect();
-    Ok(ScenePhoto {
-        jpeg,
+    let right_lit = chart
+        .feature_patches
+        .iter()
+        .map(|&p| {
+            let (px, _) = layout.patch_origin(p);
+            px as f64 + layout.patch_px as f64 / 2.0 >= half
+        })
+        .collect();
+    Ok(DevelopedScene {
+        image: developed.image,
+        quality,
         corners,
         patch_px,
         expected_features,
+        inverse,
+        canvas: (cw as f64, ch as f64),
+        right_lit,
     })
 }
 
@@ -282,8 +441,10 @@ fn draw(rng: &mut SmallRng, (lo, hi): (f64, f64)) -> f64 {
     }
 }
 
-/// A random placement of the chart canvas inside the photo: scaled so the patch grid spans
-/// the drawn share of the width, rotated at random, each corner displaced for perspective.
+/// A placement of the chart canvas inside the photo: scaled so the patch grid spans the
+/// drawn share of the width (face-on), rotated in its plane, then either turned away by the
+/// tilt and projected or each corner displaced at random for perspective; centred where
+/// given, else anywhere it fits (drawn again until it does).
 fn placement(
     rng: &mut SmallRng,
     canvas: (f64, f64),
@@ -294,17 +455,43 @@ fn placement(
     for _ in 0..10_000 {
         let share = draw(rng, options.width_share);
         let scale = share * w / grid_w;
-        let (s, c) = rng.random_range(0.0..std::f64::consts::TAU).sin_cos();
+        let angle = match options.rotation_deg {
+            Some(deg) => deg.to_radians(),
+            None => rng.random_range(0.0..std::f64::consts::TAU),
+        };
+        let (s, c) = angle.sin_cos();
         let (cw, ch) = (canvas.0 * scale, canvas.1 * scale);
-        let (cx, cy) = (rng.random_range(0.0..w), rng.random_range(0.0..h));
-        let jitter = (options.perspective * cw.min(ch)).max(1e-9);
-        let corners = [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]].map(|[u, v]| {
-            let (x, y) = (u * cw, v * ch);
-            [
-                cx + c * x - s * y + rng.random_range(-jitter..jitter),
-                cy + s * x + c * y + rng.random_range(-jitter..jitter),
-            ]
-        });
+        let (cx, cy) = match options.centre {
+            Some([x, y]) => (x * w, y * h),
+            None => (rng.random_range(0.0..w), rng.random_range(0.0..h)),
+        };
+        let unit = [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]];
+        let corners = match options.tilt {
+            Some(tilt) => {
+                let focal = TILT_FOCAL_SHARE * w;
+                let (ts, tc) = tilt.degrees.to_radians().sin_cos();
+                unit.map(|[u, v]| {
+                    let (x, y) = (u * cw, v * ch);
+                    let (x, y) = (c * x - s * y, s * x + c * y);
+                    let (x, y, z) = match tilt.axis {
+                        TiltAxis::Vertical => (x * tc, y, x * ts),
+                        TiltAxis::Horizontal => (x, y * tc, y * ts),
+                    };
+                    let depth = (focal + z).max(1e-9);
+                    [cx + focal * x / depth, cy + focal * y / depth]
+                })
+            }
+            None => {
+                let jitter = (options.perspective * cw.min(ch)).max(1e-9);
+                unit.map(|[u, v]| {
+                    let (x, y) = (u * cw, v * ch);
+                    [
+                        cx + c * x - s * y + rng.random_range(-jitter..jitter),
+                        cy + s * x + c * y + rng.random_range(-jitter..jitter),
+                    ]
+                })
+            }
+        };
         let margin = 4.0;
         if corners
             .iter()
@@ -312,11 +499,66 @@ fn placement(
         {
             return Ok(corners);
         }
+        if options.centre.is_some()
+            && options.rotation_deg.is_some()
+            && options.width_share.0 == options.width_share.1
+            && (options.tilt.is_some() || options.perspective == 0.0)
+        {
+            break;
+        }
     }
     Err(Error::invalid(format!(
-        "a chart spanning {:?} of the width does not fit a {}×{} scene",
-        options.width_share, options.width, options.height
+        "a chart spanning {:?} of the width does not fit a {}×{} scene{}",
+        options.width_share,
+        options.width,
+        options.height,
+        if options.centre.is_some() {
+            " at the centre given"
+        } else {
+            ""
+        }
     )))
+}
+
+/// Checks the placement options: the centre inside the photo, the rotation finite, the tilt
+/// within ±[`MAX_TILT_DEG`], the shadow's factor in (0, 1) and cover in [0, 1].
+fn check_placement(options: &SceneOptions) -> Result<()> {
+    if let Some([x, y]) = options.centre {
+        if !((0.0..=1.0).contains(&x) && (0.0..=1.0).contains(&y)) {
+            return Err(Error::invalid(format!(
+                "the chart's centre {x},{y} must lie in the photo: shares of its width and \
+                 height, 0…1"
+            )));
+        }
+    }
+    if let Some(r) = options.rotation_deg.filter(|r| !r.is_finite()) {
+        return Err(Error::invalid(format!(
+            "the chart's rotation {r} is not an angle in degrees"
+        )));
+    }
+    if let Some(t) = options.tilt {
+        if !(t.degrees.abs() <= MAX_TILT_DEG) {
+            return Err(Error::invalid(format!(
+                "a tilt of {}° is out of range: give −{MAX_TILT_DEG}…{MAX_TILT_DEG}°",
+                t.degrees
+            )));
+        }
+    }
+    if let Some(sh) = options.shadow {
+        if !(sh.factor > 0.0 && sh.factor < 1.0) {
+            return Err(Error::invalid(format!(
+                "a shadow's factor {} must lie between 0 and 1 (the light left in it)",
+                sh.factor
+            )));
+        }
+        if !((0.0..=1.0).contains(&sh.cover) && sh.direction_deg.is_finite()) {
+            return Err(Error::invalid(format!(
+                "a shadow covering {} of the chart from {}° is out of range: give a cover 0…1",
+                sh.cover, sh.direction_deg
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Smooth value noise on 0…1 with cells of `cell` pixels.

@@ -20,12 +20,29 @@ pub struct Blob {
     pub area: f64,
     /// Mean colour (encoded sRGB, 0…1).
     pub colour: [f32; 3],
+    /// Second central moments (σxx, σxy, σyy) in pixels²: the blob's shape, from which a
+    /// foreshortened patch's own frame is known.
+    pub moments: [f64; 3],
 }
 
 impl Blob {
     /// Side of the square of the blob's area.
     pub fn side(&self) -> f64 {
         self.area.sqrt()
+    }
+
+    /// The length of `v` (pixels) in the blob's own metric: √(vᵀ Σ⁻¹ v) with Σ its second
+    /// moments (the Mahalanobis length). A square of side s has Σ = s²/12 · I, so a vector
+    /// one side long measures √12 whatever the square's foreshortening or rotation.
+    pub fn metric_length(&self, v: [f64; 2]) -> f64 {
+        self.metric_dot(v, v).max(0.0).sqrt()
+    }
+
+    /// The inner product uᵀ Σ⁻¹ v of the blob's metric.
+    pub fn metric_dot(&self, u: [f64; 2], v: [f64; 2]) -> f64 {
+        let [a, b, c] = self.moments;
+        let det = (a * c - b * b).max(1e-12);
+        (u[0] * (c * v[0] - b * v[1]) + u[1] * (a * v[1] - b * v[0])) / det
     }
 }
 
@@ -35,6 +52,9 @@ const THRESHOLDS: [f32; 4] = [0.02, 0.04, 0.08, 0.16];
 const MIN_AREA: usize = 12;
 /// Most candidates kept (the squarest first), a bound on the work of the lattice search.
 const MAX_BLOBS: usize = 3000;
+/// Longest axis over shortest of a candidate: a square seen at 78° from face-on (cos 78° ≈
+/// 1/4.8), so that charts tilted to 70° are found with the perspective across them.
+const MAX_ELONGATION: f64 = 4.8;
 
 /// The patch candidates of a level.
 pub fn find_blobs(level: &Level) -> Vec<Blob> {
@@ -186,7 +206,7 @@ fn measure(level: &Level, pixels: &[usize]) -> Option<(f64, Blob)> {
     let tr = sxx + syy;
     let disc = ((tr * tr / 4.0) - det).max(0.0).sqrt();
     let elongation = ((tr / 2.0 + disc) / (tr / 2.0 - disc).max(1e-9)).sqrt();
-    if !(0.88..=1.12).contains(&squareness) || elongation > 3.0 {
+    if !(0.88..=1.12).contains(&squareness) || elongation > MAX_ELONGATION {
         return None;
     }
     // The quadrilateral through the extreme points must cover the region.
@@ -242,6 +262,7 @@ fn measure(level: &Level, pixels: &[usize]) -> Option<(f64, Blob)> {
             centre: [cx + 0.5, cy + 0.5],
             area: n,
             colour: colour.map(|v| (v / n) as f32),
+            moments: [sxx, sxy, syy],
         },
     ))
 }
