@@ -90,8 +90,11 @@ pub struct MetricLine {
     pub not_meaningful: Option<String>,
 }
 
-/// The metrics shown, by group: key, label, unit, explanation.
-const GROUPS: [(&str, &[(&str, &str, &str, &str)]); 4] = [
+/// A metric shown: key, label, unit, explanation.
+type MetricSpec = (&'static str, &'static str, &'static str, &'static str);
+
+/// The metrics shown, by group.
+const GROUPS: [(&str, &[MetricSpec]); 4] = [
     (
         "Colour",
         &[
