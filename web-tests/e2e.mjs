@@ -420,6 +420,11 @@ await test('a photo where no chart is found: shown large, four clicks, the chart
     await tab.mouse.click(cx, cy);
   }
   check(await tab.locator('#placer circle.corner').count() === 4, 'four corners not placed');
+  // The photo is drawn where the clicks are mapped: its box is the transform's.
+  const [imgBox, scale, tx] = [await tab.locator('#placer img').boundingBox(), Number(await view.getAttribute('data-scale')), Number(await view.getAttribute('data-x'))];
+  const viewBox = await view.boundingBox();
+  close(imgBox.width, expected.photo.width * scale, 1, 'the photo\'s drawn width');
+  close(imgBox.x, viewBox.x + tx, 1, 'the photo\'s drawn left edge');
   await tab.waitForSelector('#chart-choice');
   check(await tab.locator('#estimate-corners').isDisabled(), 'the chart is guessed, not asked');
   await tab.screenshot({ path: join(artefacts, 'corners-placed.png') });

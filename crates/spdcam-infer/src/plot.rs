@@ -209,8 +209,8 @@ mod tests {
             "true SPD",
             "68 % band",
             "95 % band",
-            ">400<",
-            ">700<",
+            ">\n400\n</text>",
+            ">\n700\n</text>",
         ] {
             assert!(svg.contains(label), "no {label} in the plot");
         }

@@ -90,8 +90,11 @@ pub struct MetricLine {
     pub not_meaningful: Option<String>,
 }
 
-/// The metrics shown, by group: key, label, unit, explanation.
-const GROUPS: [(&str, &[(&str, &str, &str, &str)]); 4] = [
+/// A metric shown: key, label, unit, explanation.
+type MetricSpec = (&'static str, &'static str, &'static str, &'static str);
+
+/// The metrics shown, by group.
+const GROUPS: [(&str, &[MetricSpec]); 4] = [
     (
         "Colour",
         &[
@@ -424,8 +427,8 @@ fn band_spread(estimate: &Estimate) -> Option<f64> {
 ///   beside them; one blue peak (430–475 nm) with the maximum beyond 500 nm is
 ///   `LED-like (a blue peak and a broad phosphor hump)`, three or more peaks `spiky
 ///   (fluorescent- or multi-LED-like)`, none with the maximum in the last fifth of the
-///   range `smooth, rising towards red (incandescent- or halogen-like)`, none otherwise
-///   `smooth and broad (daylight-like)`.
+///   range `smooth, rising towards red (incandescent- or halogen-like)`, at most one
+///   otherwise `smooth and broad (daylight-like)`, two `two-peaked`.
 pub fn describe_light(estimate: &Estimate) -> String {
     let colour = match (estimate.metrics.cct_k, estimate.metrics.duv) {
         (Some(cct), Some(duv)) if duv.abs() <= CCT_MAX_DUV => {
@@ -489,23 +492,22 @@ fn spectrum_shape(wavelengths: &[f64], spd: &[f64]) -> &'static str {
         "LED-like (a blue peak and a broad phosphor hump)"
     } else if peaks.is_empty() && wavelengths[top] >= red_end {
         "smooth, rising towards red (incandescent- or halogen-like)"
-    } else if peaks.is_empty() {
+    } else if peaks.len() <= 1 {
         "smooth and broad (daylight-like)"
     } else {
-        "peaked"
+        "two-peaked"
     }
 }
 
 /// Indices of the local maxima of `v` standing at least [`PEAK_PROMINENCE`] above the
 /// higher of the lowest points on either side before a higher value (topographic
-/// prominence); the ends count as peaks only where the curve falls away from them.
+/// prominence); the ends of the range are never peaks (a curve rising to its end is not
+/// one).
 fn prominent_peaks(v: &[f64]) -> Vec<usize> {
     let n = v.len();
-    (0..n)
+    (1..n.saturating_sub(1))
         .filter(|&i| {
-            let left_ok = i == 0 || v[i] > v[i - 1];
-            let right_ok = i + 1 == n || v[i] >= v[i + 1];
-            if !(left_ok && right_ok) {
+            if !(v[i] > v[i - 1] && v[i] >= v[i + 1]) {
                 return false;
             }
             // The lowest point on each side before the curve rises above this peak.
@@ -521,14 +523,10 @@ fn prominent_peaks(v: &[f64]) -> Vec<usize> {
                 }
                 any.then_some(low)
             };
-            let left = side(&mut (0..i).rev());
-            let right = side(&mut (i + 1..n));
-            let base = match (left, right) {
-                (Some(l), Some(r)) => l.max(r),
-                (Some(l), None) => l,
-                (None, Some(r)) => r,
-                (None, None) => return false,
+            let (Some(left), Some(right)) = (side(&mut (0..i).rev()), side(&mut (i + 1..n))) else {
+                return false;
             };
+            let base = left.max(right);
             v[i] - base >= PEAK_PROMINENCE
         })
         .collect()
@@ -557,7 +555,7 @@ mod tests {
         );
         assert_eq!(r(2718.0, 828.0), ("2700".into(), "800".into()));
         assert_eq!(r(40.36, 14.14), ("40".into(), "14".into()));
-        assert_eq!(r(0.5, 0.0096), ("0.50".into(), "0.010".into()));
+        assert_eq!(r(0.5, 0.0096), ("0.500".into(), "0.010".into()));
         assert_eq!(r(81.26, 4.04), ("81".into(), "4".into()));
         assert_eq!(r(-0.0004, 0.0031), ("-0.0004".into(), "0.0031".into()));
         assert_eq!(r(-0.00001, 0.004), ("0.000".into(), "0.004".into()));

@@ -544,13 +544,16 @@ fn tm30_graphic(out: &mut String, bins: &[HueBin], e: &Estimate) {
     );
 }
 
+/// A row of the hue-bin table: its label and how a bin's value is written.
+type BinRow = (&'static str, fn(&HueBin) -> String);
+
 /// The hue bins' local fidelity, chroma shift and hue shift, 16 columns across the page.
 fn tm30_table(out: &mut String, bins: &[HueBin]) {
     out.push_str("<table class=\"grid-table tm30-bins\"><tr><th>TM-30 hue bin</th>");
     for j in 1..=16 {
         let _ = write!(out, "<th>{j}</th>");
     }
-    let rows: [(&str, fn(&HueBin) -> String); 3] = [
+    let rows: [BinRow; 3] = [
         ("local fidelity R<sub>f,h</sub>", |b| format!("{:.0}", b.rf)),
         ("chroma shift R<sub>cs,h</sub> %", |b| {
             format!("{:.0}", 100.0 * b.chroma_shift)

@@ -115,7 +115,9 @@ fn the_report_of_the_example_photo_shows_its_numbers_as_json_gives_them() {
     for key in ["cct_k", "cri_ra"] {
         let raw = m[key].as_f64().unwrap();
         for text in [format!("{raw:.0}"), format!("{raw:.1}")] {
-            assert!(!html.contains(&format!(">{text}")), "{key} {text} is shown");
+            for cell in [format!(">{text}<"), format!(">{text} ±")] {
+                assert!(!html.contains(&cell), "{key} {text} is shown");
+            }
         }
     }
     assert!(html.contains("data-key=\"cri_r\">CIE 13.3 R1–R14: not meaningful"));
@@ -132,7 +134,10 @@ fn the_report_of_the_example_photo_shows_its_numbers_as_json_gives_them() {
     );
     assert!(html.contains(&confidence), "{confidence}");
     // The summary and the verdict in plain words at the top.
-    let summary = html.find(&format!("<p class=\"summary\">{}", presentation.summary));
+    let summary = html.find(&format!(
+        "<p class=\"summary\">{}",
+        presentation.summary.replace('\'', "&#39;")
+    ));
     let verdict = html.find(&format!(
         "data-verdict=\"{}\"",
         e["verdict"].as_str().unwrap()
@@ -200,7 +205,9 @@ fn several_photos_and_feature_rows_share_one_page() {
     assert!(!html.contains("data:image"));
     assert!(html.contains("estimated from chart features"));
     // The example's light is too far from white for TM-30: the reason, not the graphic.
-    assert!(html.contains("<p class=\"undefined\" data-key=\"tm30_bins\">not meaningful"));
+    assert!(html.contains(
+        "<p class=\"undefined\" data-key=\"tm30_bins\">TM-30 colour vector graphic: not meaningful"
+    ));
     assert!(!html.contains("<svg class=\"tm30-cvg\""));
 }
 

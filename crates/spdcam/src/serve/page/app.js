@@ -362,6 +362,9 @@ function renderPlacer(stage, e) {
     apply();
   };
   const ready = () => {
+    // The photo at its own pixel size; the view's transform scales it.
+    img.style.width = `${img.naturalWidth}px`;
+    img.style.height = `${img.naturalHeight}px`;
     marks.setAttribute('viewBox', `0 0 ${img.naturalWidth} ${img.naturalHeight}`);
     marks.setAttribute('width', img.naturalWidth);
     marks.setAttribute('height', img.naturalHeight);
