@@ -203,11 +203,30 @@ fn estimate_from_photos(
 ) -> Result<PhotoEstimates> {
     let options = args.photo.options()?;
     let templates = chart_templates(models, options.chart.as_deref(), data_dir)?;
+    // Debug images written from now on are announced (file times run on a coarser clock).
+    let started = std::time::SystemTime::now() - std::time::Duration::from_secs(1);
     let results = analyse_photos(&args.photos, &options, templates.clone())?;
     let labels = photo_labels(&args.photos);
+    let debug = options
+        .debug
+        .as_ref()
+        .map(|d| photo::debug_paths(d, &args.photos));
     let mut analyses: Vec<(PathBuf, String, PhotoAnalysis)> = Vec::new();
     let mut failed = 0;
-    for ((path, label), result) in args.photos.iter().zip(labels).zip(results) {
+    for (i, ((path, label), result)) in args.photos.iter().zip(labels).zip(results).enumerate() {
+        if let Some(written) = debug.as_ref().map(|d| &d[i]).filter(|d| {
+            std::fs::metadata(d)
+                .and_then(|m| m.modified())
+                .is_ok_and(|t| t >= started)
+        }) {
+            let factor = result
+                .as_ref()
+                .map_or(1, |a| photo::debug_factor(a.width, a.height));
+            match factor {
+                1 => eprintln!("debug → {}", written.display()),
+                k => eprintln!("debug → {} (1:{k} of the photo)", written.display()),
+            }
+        }
         match result {
             Ok(a) => {
                 for w in &a.warnings {
