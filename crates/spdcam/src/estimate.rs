@@ -198,11 +198,30 @@ struct PhotoEstimates {
 fn estimate_from_photos(args: &EstimateArgs, estimator: &Estimator) -> Result<PhotoEstimates> {
     let mut options = args.photo.options()?;
     options.overlay_width = args.report.is_some().then_some(REPORT_IMAGE_WIDTH);
+    // Debug images written from now on are announced (file times run on a coarser clock).
+    let started = std::time::SystemTime::now() - std::time::Duration::from_secs(1);
     let results = estimator.analyse_photos(&args.photos, &options)?;
     let labels = photo_labels(&args.photos);
+    let debug = options
+        .debug
+        .as_ref()
+        .map(|d| photo::debug_paths(d, &args.photos));
     let mut analyses: Vec<(PathBuf, String, PhotoAnalysis, Option<Vec<u8>>)> = Vec::new();
     let mut failed = 0;
-    for ((path, label), result) in args.photos.iter().zip(labels).zip(results) {
+    for (i, ((path, label), result)) in args.photos.iter().zip(labels).zip(results).enumerate() {
+        if let Some(written) = debug.as_ref().map(|d| &d[i]).filter(|d| {
+            std::fs::metadata(d)
+                .and_then(|m| m.modified())
+                .is_ok_and(|t| t >= started)
+        }) {
+            let factor = result
+                .as_ref()
+                .map_or(1, |a| photo::debug_factor(a.analysis.width, a.analysis.height));
+            match factor {
+                1 => eprintln!("debug → {}", written.display()),
+                k => eprintln!("debug → {} (1:{k} of the photo)", written.display()),
+            }
+        }
         match result {
             Ok(a) => {
                 for w in &a.analysis.warnings {

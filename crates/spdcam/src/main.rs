@@ -7,6 +7,7 @@
 mod calibrate;
 mod coverage;
 mod dataset;
+mod detection;
 mod estimate;
 #[cfg(feature = "train")]
 mod evaluate;
@@ -70,6 +71,8 @@ enum Command {
     Train(Box<train::TrainArgs>),
     /// Estimate the light's SPD from photos of a colour chart (or chart features).
     Estimate(Box<estimate::EstimateArgs>),
+    /// How often the charts are found in scene photos, per difficulty (Markdown).
+    Detection(detection::DetectionArgs),
     #[cfg(feature = "train")]
     /// Score a model on a dataset: metrics, per-band error, plots.
     Evaluate(evaluate::EvaluateArgs),
@@ -123,6 +126,7 @@ fn main() -> ExitCode {
         #[cfg(feature = "train")]
         Command::Train(args) => train::run(*args, &data_dir),
         Command::Estimate(args) => estimate::run(*args, &data_dir),
+        Command::Detection(args) => detection::run(args, &data_dir),
         #[cfg(feature = "train")]
         Command::Evaluate(args) => evaluate::run(args, &data_dir),
         #[cfg(feature = "train")]

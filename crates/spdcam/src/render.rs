@@ -13,7 +13,7 @@ use spdcam_core::camera::{Camera, CameraConfig, WhiteBalanceStatistics, MAX_EXPO
 use spdcam_core::chart::{Chart, Layout};
 use spdcam_core::error::short_number;
 use spdcam_core::lighting::Lighting;
-use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
+use spdcam_core::photo::scene::{self, SceneLight, SceneOptions, Shadow, Tilt, TiltAxis};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_core::{fsio, imageio, light};
@@ -199,12 +199,146 @@ pub struct RenderArgs {
     /// vignetting, noise, written as a JPEG (`-o photo.jpg`).
     #[arg(long, value_name = "WxH")]
     scene: Option<String>,
+    /// With --scene: the patch grid's width as a share of the photo's width (face-on),
+    /// e.g. 0.25 or 1/15; default: drawn between 0.3 and 0.6.
+    #[arg(long, value_name = "SHARE", requires = "scene")]
+    chart_width: Option<String>,
+    /// With --scene: the chart's centre as shares of the photo's width and height (0.5,0.5
+    /// is the middle); default: anywhere it fits.
+    #[arg(long, value_name = "X,Y", requires = "scene")]
+    chart_centre: Option<String>,
+    /// With --scene: the chart's rotation in its own plane, degrees clockwise; default:
+    /// drawn at random.
+    #[arg(
+        long,
+        value_name = "DEG",
+        requires = "scene",
+        allow_negative_numbers = true
+    )]
+    chart_rotation: Option<f64>,
+    /// With --scene: the chart's plane turned away from the camera by DEG (up to 85; a
+    /// perspective view, foreshortened by about cos DEG); default: face-on with a little
+    /// random perspective.
+    #[arg(
+        long,
+        value_name = "DEG",
+        requires = "scene",
+        allow_negative_numbers = true
+    )]
+    tilt: Option<f64>,
+    /// With --tilt: the photo's axis the chart is turned about: horizontal (a chart lying
+    /// on a table) or vertical (a chart on a side wall).
+    #[arg(
+        long,
+        value_name = "AXIS",
+        default_value = "horizontal",
+        requires = "tilt"
+    )]
+    tilt_axis: TiltAxisArg,
+    /// With --scene: a shadow over part of the chart, FACTOR (the light left in it, 0–1)
+    /// [,COVER (the share of the chart shaded, default 0.5) [,DIRECTION (degrees clockwise
+    /// from the chart's right side it comes from, default 0)]].
+    #[arg(long, value_name = "FACTOR[,COVER[,DIR]]", requires = "scene")]
+    shadow: Option<String>,
+    /// With --scene: a second light on the right half of the chart (as --spd), at the
+    /// exposure the first gives; the camera balances the photo as a whole (see
+    /// --balance-halves).
+    #[arg(long, value_name = "SPD", requires = "scene")]
+    right_light: Option<String>,
+    /// With --right-light: each half exposed and white-balanced for its own light (two
+    /// photos of the scene joined at the chart's middle).
+    #[arg(long, requires = "right_light")]
+    balance_halves: bool,
     /// Also write the light's SPD (normalised to a maximum of 1) as spectral CSV, e.g. as
     /// the truth beside a scene photo.
     #[arg(long, value_name = "FILE.csv")]
     spd_out: Option<PathBuf>,
     #[command(flatten)]
     camera: CameraArgs,
+}
+
+/// The axis a chart is tilted about (`--tilt-axis`).
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum TiltAxisArg {
+    /// The photo's horizontal axis.
+    Horizontal,
+    /// The photo's vertical axis.
+    Vertical,
+}
+
+/// A share written as a decimal or a fraction (`0.25`, `1/15`).
+fn parse_share(text: &str, what: &str) -> Result<f64> {
+    let value = match text.split_once('/') {
+        Some((a, b)) => {
+            let a: f64 = a.trim().parse().ok().context(format!("{what} '{text}'"))?;
+            let b: f64 = b.trim().parse().ok().context(format!("{what} '{text}'"))?;
+            a / b
+        }
+        None => text
+            .trim()
+            .parse()
+            .ok()
+            .with_context(|| format!("{what} '{text}' is not a number"))?,
+    };
+    if !(value > 0.0 && value < 1.0) {
+        bail!("{what} '{text}' must be a share between 0 and 1 (e.g. 0.25 or 1/15)");
+    }
+    Ok(value)
+}
+
+/// Comma-separated numbers.
+fn parse_numbers(text: &str, what: &str) -> Result<Vec<f64>> {
+    text.split(',')
+        .map(|s| {
+            s.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .with_context(|| format!("{what} '{text}': '{s}' is not a number"))
+        })
+        .collect()
+}
+
+impl RenderArgs {
+    /// The scene options of a `width × height` scene these arguments describe.
+    fn scene_options(&self, width: usize, height: usize) -> Result<SceneOptions> {
+        let mut options = SceneOptions {
+            width,
+            height,
+            ..SceneOptions::default()
+        };
+        if let Some(text) = &self.chart_width {
+            let share = parse_share(text, "--chart-width")?;
+            options.width_share = (share, share);
+        }
+        if let Some(text) = &self.chart_centre {
+            match parse_numbers(text, "--chart-centre")?.as_slice() {
+                &[x, y] => options.centre = Some([x, y]),
+                _ => bail!("--chart-centre '{text}' needs two shares X,Y (0.5,0.5 is the middle)"),
+            }
+        }
+        options.rotation_deg = self.chart_rotation;
+        options.balance_halves = self.balance_halves;
+        options.tilt = self.tilt.map(|degrees| Tilt {
+            degrees,
+            axis: match self.tilt_axis {
+                TiltAxisArg::Horizontal => TiltAxis::Horizontal,
+                TiltAxisArg::Vertical => TiltAxis::Vertical,
+            },
+        });
+        if let Some(text) = &self.shadow {
+            let v = parse_numbers(text, "--shadow")?;
+            if v.is_empty() || v.len() > 3 {
+                bail!("--shadow '{text}' needs FACTOR[,COVER[,DIRECTION]]");
+            }
+            options.shadow = Some(Shadow {
+                factor: v[0],
+                cover: v.get(1).copied().unwrap_or(0.5),
+                direction_deg: v.get(2).copied().unwrap_or(0.0),
+            });
+        }
+        Ok(options)
+    }
 }
 
 /// Runs `spdcam render`.
@@ -236,6 +370,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         .transpose()?;
     if let Some((w, h)) = scene {
         scene::check_scene_size(w, h)?;
+        args.scene_options(w, h)?;
     }
     let extension = args
         .output
@@ -331,12 +466,17 @@ fn render_scene(
     let template = ChartTemplate::from_chart(&chart)?;
     let chart = chart.with_layout(scene::scene_layout(&template))?;
     let camera = args.camera.camera_for(chart, data_dir, &grid)?;
-    let options = SceneOptions {
-        width,
-        height,
-        ..SceneOptions::default()
+    let options = args.scene_options(width, height)?;
+    let right = args
+        .right_light
+        .as_deref()
+        .map(|spec| light::resolve_spd(spec, data_dir, &grid))
+        .transpose()?;
+    let light = SceneLight {
+        spd,
+        right_half: right.as_ref().map(|r| &r.spd),
     };
-    let shot = scene::photograph(&camera, SceneLight::single(spd), args.seed, &options)?;
+    let shot = scene::photograph(&camera, light, args.seed, &options)?;
     let chart = camera.chart();
     fsio::write_output(&args.output, &shot.jpeg)?;
     if fsio::is_stdout(&args.output) {
@@ -347,6 +487,10 @@ fn render_scene(
         .iter()
         .map(|[x, y]| format!("{x:.1},{y:.1}"))
         .collect();
+    let light_name = match &right {
+        Some(r) => format!("{light_name} (right half: {})", r.name),
+        None => light_name.to_string(),
+    };
     messages.say(format_args!(
         "photographed {} under {light_name} with {} in a {width}×{height} scene: {} (chart corners {})",
         chart.name,

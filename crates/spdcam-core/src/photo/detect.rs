@@ -397,7 +397,8 @@ fn corner_placements(
         return Err(Error::invalid("no chart template to lay on the corners"));
     }
     let quad = sort_corners(corners, photo.width, photo.height)?;
-    let factor = Level::factor_for(photo.width, photo.height, DETECTION_SIZE);
+    // The finest level searched: a foreshortened chart's patches may be a few pixels tall.
+    let factor = finest_factor(photo.width, photo.height);
     let level = Level::new(photo, factor);
     let side = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     let mut out = Vec::with_capacity(templates.len());

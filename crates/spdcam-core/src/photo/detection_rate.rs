@@ -266,6 +266,9 @@ pub fn markdown_table(rates: &[BucketRate]) -> String {
         let _ = write!(out, "| {} | {} |", b.difficulty.label(), b.label);
         for c in &charts {
             match rates.iter().find(|r| r.chart == *c && r.bucket == *b) {
+                Some(r) if r.found == 0 => {
+                    let _ = write!(out, " 0.0 % (0/{}) | – |", r.photos);
+                }
                 Some(r) => {
                     let _ = write!(
                         out,
