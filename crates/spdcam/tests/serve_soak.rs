@@ -225,7 +225,8 @@ fn slow_clients_never_stop_uploads_and_memory_stays_bounded() {
     let slowest = uploads.iter().map(|u| u.2).max().unwrap();
     let peak_rss_mb = proc_kb(pid, "VmHWM:").max(peak_rss_kb.load(Ordering::Relaxed)) / 1024;
     let cuts = cuts.lock().unwrap();
-    let (bodies, heads): (Vec<_>, Vec<_>) = cuts.iter().partition(|c| c.0);
+    let (bodies, heads): (Vec<&(bool, Option<u16>, Duration)>, Vec<_>) =
+        cuts.iter().partition(|c| c.0);
     let longest_cut = cuts.iter().map(|c| c.2).max().unwrap();
     println!(
         "soak {:.0} s: {} uploads answered, slowest {:.2} s; {} slow bodies and {} slow \
