@@ -127,8 +127,8 @@ fn with_corners_the_chart_whose_patches_fit_them_is_chosen() {
             assert_eq!(a.chart, name, "templates {:?}", order.map(|t| &t.name));
             assert_eq!(a.method, "corners");
             assert!(a.confidence > 0.5, "{name}: confidence {}", a.confidence);
-            for k in 0..4 {
-                let d = (a.corners[k][0] - corners[k][0]).hypot(a.corners[k][1] - corners[k][1]);
+            for (k, (got, want)) in a.corners.iter().zip(&corners).enumerate() {
+                let d = (got[0] - want[0]).hypot(got[1] - want[1]);
                 assert!(
                     d < 2.0,
                     "{name}: corner {k} {d:.1} px off: oriented wrongly"

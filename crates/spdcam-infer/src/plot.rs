@@ -184,8 +184,10 @@ mod tests {
         let grid = Grid::new(400.0, 700.0, 10.0).unwrap();
         let spd: Vec<f64> = (0..grid.count).map(|k| 0.5 + 0.01 * k as f64).collect();
         let band = |d: f64| Band {
-            lower: spd.iter().map(|v| v - d).collect(),
-            upper: spd.iter().map(|v| v + d).collect(),
+            lower: spdcam_core::spectral::Spd::new(grid, spd.iter().map(|v| v - d).collect())
+                .unwrap(),
+            upper: spdcam_core::spectral::Spd::new(grid, spd.iter().map(|v| v + d).collect())
+                .unwrap(),
         };
         let u = Uncertainty {
             band68: band(0.05),

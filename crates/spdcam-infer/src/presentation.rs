@@ -227,8 +227,8 @@ impl Presentation {
                 " The estimate is good to about ±{} % of the spectrum's peak (95 % band, \
                  averaged over {}–{} nm); expected GFC {:.3}.",
                 round_sig(100.0 * spread, 1),
-                estimate.grid.start_nm,
-                estimate.grid.end_nm(),
+                estimate.spd.grid().start_nm,
+                estimate.spd.grid().end_nm(),
                 u.expected_gfc
             )),
             _ => summary.push_str(" How good the estimate is cannot be said: no calibration."),
@@ -409,7 +409,7 @@ fn band_spread(estimate: &Estimate) -> Option<f64> {
     (n > 0).then(|| {
         b.upper
             .iter()
-            .zip(&b.lower)
+            .zip(b.lower.iter())
             .map(|(hi, lo)| (hi - lo) / 2.0)
             .sum::<f64>()
             / n as f64
@@ -450,7 +450,7 @@ pub fn describe_light(estimate: &Estimate) -> String {
         }
         _ => format!("{} coloured light", hue_name(estimate.colorimetry.xy)),
     };
-    let shape = spectrum_shape(&estimate.grid.wavelengths(), &estimate.spd);
+    let shape = spectrum_shape(&estimate.spd.grid().wavelengths(), &estimate.spd);
     format!("{colour} with a {shape} spectrum")
 }
 

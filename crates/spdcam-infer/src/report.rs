@@ -166,7 +166,7 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
     let _ = writeln!(
         out,
         "<figure>{}<figcaption>The estimated spectrum (relative, peak 1){}{}.</figcaption></figure>",
-        spd_svg(&e.grid.wavelengths(), &e.spd, truth.as_deref(), bands),
+        spd_svg(&e.spd.grid().wavelengths(), &e.spd, truth.as_deref(), bands),
         if truth.is_some() {
             ", the true spectrum dashed (peak 1)"
         } else {
@@ -228,8 +228,8 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
         "<p class=\"small\">{} The spectrum is relative (peak 1) and estimated on {}–{} nm only; \
          the metrics are computed on that range. Made by spdcam ({}).</p>\n</section>",
         esc(&p.gfc),
-        e.grid.start_nm,
-        e.grid.end_nm(),
+        e.spd.grid().start_nm,
+        e.spd.grid().end_nm(),
         esc(&e.model)
     );
 }
@@ -397,7 +397,7 @@ fn spd_svg(w: &[f64], spd: &[f64], truth: Option<&[f64]>, bands: Option<(&Band, 
     let top = spd
         .iter()
         .chain(truth.into_iter().flatten())
-        .chain(bands.iter().flat_map(|(_, b95)| &b95.upper))
+        .chain(bands.iter().flat_map(|(_, b95)| b95.upper.iter()))
         .copied()
         .filter(|v| v.is_finite())
         .fold(1.0_f64, f64::max);

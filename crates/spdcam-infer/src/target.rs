@@ -211,7 +211,7 @@ mod tests {
             let mut s: Vec<f64> = (0..d)
                 .map(|j| (0..4).map(|c| w[c] * truth[c][j]).sum())
                 .collect();
-            normalise(&mut s);
+            spdcam_core::spectral::normalise_peak(&mut s).unwrap();
             weights.extend(w);
             spds.extend(s);
         }

@@ -214,9 +214,9 @@ fn estimate_from_photos(args: &EstimateArgs, estimator: &Estimator) -> Result<Ph
                 .and_then(|m| m.modified())
                 .is_ok_and(|t| t >= started)
         }) {
-            let factor = result
-                .as_ref()
-                .map_or(1, |a| photo::debug_factor(a.analysis.width, a.analysis.height));
+            let factor = result.as_ref().map_or(1, |a| {
+                photo::debug_factor(a.analysis.width, a.analysis.height)
+            });
             match factor {
                 1 => eprintln!("debug → {}", written.display()),
                 k => eprintln!("debug → {} (1:{k} of the photo)", written.display()),
@@ -596,12 +596,10 @@ fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimator) -> Resu
         )?;
     }
     if quiet(args) {
-        let judged = run
-            .first
-            .iter()
-            .map(|(name, _, _, trust)| (name.as_str(), trust));
-        for (name, trust) in judged {
-            eprintln!("{}", verdict_line(name, trust));
+        for e in &run.first {
+            if let Some(trust) = &e.trust {
+                eprintln!("{}", verdict_line(&e.name, trust));
+            }
         }
         if run.rows > run.first.len() {
             eprintln!(

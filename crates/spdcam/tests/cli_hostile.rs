@@ -756,6 +756,7 @@ fn extreme_but_finite_spds_give_the_metrics_of_the_unscaled_spd() {
     let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let rows = rows.as_array().unwrap();
     let value = |row: usize, key: &str| rows[row]["metrics"][key].as_f64();
+    #[allow(clippy::needless_range_loop)] // `row` also picks the tolerance and the values
     for row in 1..rows.len() {
         assert!(
             rows[row]["metrics"]["reasons"]

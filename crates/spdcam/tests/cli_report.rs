@@ -38,12 +38,14 @@ fn assert_self_contained(html: &str) {
 
 /// The example's estimate as the library makes it (what the CLI estimates and reports).
 fn example_estimate() -> spdcam_infer::Estimate {
-    spdcam_infer::estimate_photo(
+    spdcam_infer::Estimator::shipped(
+        spdcam_core::builtin::DataDir::new(None),
+        spdcam_core::spectral::Grid::parse("400-700:5").unwrap(),
+    )
+    .unwrap()
+    .estimate_photo(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join(EXAMPLE),
-        &spdcam_infer::ModelSet::shipped().unwrap(),
         &spdcam_infer::PhotoOptions::default(),
-        &spdcam_core::builtin::DataDir::new(None),
-        &spdcam_core::spectral::Grid::parse("400-700:5").unwrap(),
     )
     .unwrap()
 }

@@ -25,6 +25,8 @@ const UPLOAD_EVERY: Duration = Duration::from_millis(2100);
 const ANSWER_WITHIN: Duration = Duration::from_secs(5);
 /// The server's default limits: headers within 10 s, a body's first bytes within 10 s.
 const CUT_WITHIN: Duration = Duration::from_secs(20);
+/// One slow connection's end: whether it was a slow body, the status it got, and when.
+type Cut = (bool, Option<u16>, Duration);
 
 /// `spdcam serve` running, killed when dropped.
 struct Serving {
@@ -183,7 +185,7 @@ fn slow_clients_never_stop_uploads_and_memory_stays_bounded() {
     assert!(want_spd.is_array());
 
     let started = Instant::now();
-    let cuts: Arc<Mutex<Vec<(bool, Option<u16>, Duration)>>> = Arc::default();
+    let cuts: Arc<Mutex<Vec<Cut>>> = Arc::default();
     let peak_rss_kb = Arc::new(AtomicU64::new(0));
     let sampling = Arc::new(AtomicBool::new(true));
     let uploads = std::thread::scope(|s| {
@@ -225,8 +227,7 @@ fn slow_clients_never_stop_uploads_and_memory_stays_bounded() {
     let slowest = uploads.iter().map(|u| u.2).max().unwrap();
     let peak_rss_mb = proc_kb(pid, "VmHWM:").max(peak_rss_kb.load(Ordering::Relaxed)) / 1024;
     let cuts = cuts.lock().unwrap();
-    let (bodies, heads): (Vec<&(bool, Option<u16>, Duration)>, Vec<_>) =
-        cuts.iter().partition(|c| c.0);
+    let (bodies, heads): (Vec<&Cut>, Vec<_>) = cuts.iter().partition(|c| c.0);
     let longest_cut = cuts.iter().map(|c| c.2).max().unwrap();
     println!(
         "soak {:.0} s: {} uploads answered, slowest {:.2} s; {} slow bodies and {} slow \

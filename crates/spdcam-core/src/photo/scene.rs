@@ -537,7 +537,7 @@ fn check_placement(options: &SceneOptions) -> Result<()> {
         )));
     }
     if let Some(t) = options.tilt {
-        if !(t.degrees.abs() <= MAX_TILT_DEG) {
+        if t.degrees.is_nan() || t.degrees.abs() > MAX_TILT_DEG {
             return Err(Error::invalid(format!(
                 "a tilt of {}° is out of range: give −{MAX_TILT_DEG}…{MAX_TILT_DEG}°",
                 t.degrees

@@ -120,7 +120,7 @@ pub fn normalise_peak(values: &mut [f64]) -> Result<()> {
         )));
     }
     let peak = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if !(peak > 0.0) {
+    if peak.is_nan() || peak <= 0.0 {
         return Err(Error::invalid(
             "a spectrum without a positive value (dark) has no peak to normalise by",
         ));

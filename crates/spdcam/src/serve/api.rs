@@ -296,7 +296,11 @@ async fn job(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
 /// `GET /api/jobs/ID/report`: the finished job's HTML report, while it is kept.
 async fn report(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
     match id.parse::<u64>().ok().and_then(|id| api.jobs.report(id)) {
-        Some(html) => Answer(200, "text/html; charset=utf-8", html.as_bytes().to_vec().into()),
+        Some(html) => Answer(
+            200,
+            "text/html; charset=utf-8",
+            html.as_bytes().to_vec().into(),
+        ),
         None => Answer::error(404, format!("no report of job '{id}' is kept")),
     }
 }
