@@ -112,9 +112,15 @@ fn dechunk(mut body: &[u8]) -> Vec<u8> {
 
 /// The JSON without the keys that name where the photo came from (the command line's path,
 /// the upload's name).
+/// The estimate without what only one front end adds: the photo's source (a path for the
+/// command line, the upload's name for the web app) and the web app's `presentation` (the
+/// page's words, documented in docs/web-api.md).
 fn without_source(mut v: serde_json::Value) -> serde_json::Value {
     if let Some(photo) = v.get_mut("photo").and_then(|p| p.as_object_mut()) {
         photo.remove("source");
+    }
+    if let Some(object) = v.as_object_mut() {
+        object.remove("presentation");
     }
     v
 }
