@@ -151,7 +151,10 @@ fn the_command_line_and_the_web_app_give_one_estimate() {
         .chain(cli.as_object().unwrap().keys())
         .collect();
     let differ: Vec<&&String> = keys.iter().filter(|k| web[k] != cli[k]).collect();
-    assert!(differ.is_empty(), "the web app and the CLI differ in {differ:?}");
+    assert!(
+        differ.is_empty(),
+        "the web app and the CLI differ in {differ:?}"
+    );
 }
 
 #[test]

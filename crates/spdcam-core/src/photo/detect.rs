@@ -372,7 +372,7 @@ pub fn from_corners(
 /// [`from_corners`] for a photo that may show any of `templates`: each is laid on the
 /// corners, and the one whose patches the rectified photo shows best is taken — the share
 /// of the brightness variance in the patches' sampling squares that lies between patches
-/// rather than within them ([`template_fit`]): a chart with another grid lays its squares
+/// rather than within them (`template_fit`): a chart with another grid lays its squares
 /// across patch edges. The fit of every template, best first, comes with it.
 pub fn from_corners_any(
     photo: &Photo,

@@ -34,14 +34,14 @@ pub struct Uncertainty {
     pub band95: Band,
     /// The GFC such estimates reach, in the median: the calibration's [`GfcModel`].
     pub expected_gfc: f64,
-    /// The mean spread of the perturbed estimates (see [`Perturbed::spread`]).
+    /// The mean spread of the perturbed estimates (see [`Perturbed::spread`](super::spread::Perturbed::spread)).
     pub difficulty: f64,
     /// How many times the bands and intervals are widened because the estimated light
     /// explains this photo worse than it explains a typical calibration photo
     /// ([`Calibration::widening`]); 1 when it explains it as well or better.
     pub widening: f64,
     /// Half-widths of the 68 % and 95 % intervals of the single-number metrics, by key
-    /// ([`SCALAR_KEYS`]): "Ra 82 ± 4" is `cri_ra` ± `half95`. Only metrics the calibration
+    /// ([`SCALAR_KEYS`](spdcam_core::quality::SCALAR_KEYS)): "Ra 82 ± 4" is `cri_ra` ± `half95`. Only metrics the calibration
     /// measured and the perturbed copies define.
     pub metrics: BTreeMap<String, MetricInterval>,
 }
@@ -59,7 +59,7 @@ pub struct MetricInterval {
 /// [`Calibration`]) with the metric's spread over the perturbed copies as the scale.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MetricCalibration {
-    /// The metric's key ([`SCALAR_KEYS`]).
+    /// The metric's key ([`SCALAR_KEYS`](spdcam_core::quality::SCALAR_KEYS)).
     pub key: String,
     /// The median absolute error of the metric on the calibration photos.
     pub floor: f64,
@@ -284,7 +284,7 @@ impl Calibration {
 
     /// The bands, expected GFC and metric intervals of `spd` (the model's peak-normalised
     /// estimate) whose perturbed estimates spread by `spread` per wavelength and by
-    /// `metric_spread` per metric ([`Perturbed`]), and whose self-check residual is
+    /// `metric_spread` per metric ([`Perturbed`](super::spread::Perturbed)), and whose self-check residual is
     /// `residual` ([`SelfCheck::mean`]; `None` without a self-check).
     pub fn uncertainty(
         &self,
