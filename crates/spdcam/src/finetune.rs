@@ -119,7 +119,7 @@ fn run_chosen(args: &FinetuneArgs, model: &Model, data: &TrainingSet) -> Result<
     let scored = &tuned.scored;
     for s in scored {
         println!(
-            "  {:<36} cross-validated GFC {:.5}",
+            "  {:<40} cross-validated GFC {:.5}",
             s.recipe.name, s.cv_gfc
         );
     }
