@@ -337,7 +337,8 @@ impl Alignment {
     /// `row` (0–255 features) mapped into the virtual domain, as features whose mean is 1
     /// (what [`ridge_inputs`] then leaves as they are).
     pub fn apply(&self, row: &[f64]) -> Vec<f64> {
-        let x = &normalised(std::slice::from_ref(&row.to_vec()))[0];
+        // The ridge's inputs; the zip below leaves their bias out.
+        let x = ridge_inputs(row);
         let centred: Vec<f64> = x
             .iter()
             .zip(&self.source_mean)
