@@ -3,13 +3,17 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::Grid;
-use spdcam_infer::{estimate_features, FeatureRows, ModelSet};
+use spdcam_infer::{Estimator, FeatureRows};
 use std::sync::OnceLock;
 
-fn models() -> &'static ModelSet {
-    static MODELS: OnceLock<ModelSet> = OnceLock::new();
-    MODELS.get_or_init(|| ModelSet::shipped().expect("the shipped models load"))
+fn estimator() -> &'static Estimator {
+    static ESTIMATOR: OnceLock<Estimator> = OnceLock::new();
+    ESTIMATOR.get_or_init(|| {
+        Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)
+            .expect("the shipped models load")
+    })
 }
 
 fuzz_target!(|data: &[u8]| {
@@ -20,5 +24,5 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     assert_eq!(rows.values.len(), rows.rows * rows.names.len());
-    let _ = estimate_features(models(), &rows, "fuzz.csv", &Grid::ESTIMATION);
+    let _ = estimator().estimate_rows(&rows, "fuzz.csv");
 });
