@@ -22,6 +22,7 @@ use spdcam_infer::{Estimate, Estimator, FeatureRows, Model, ModelSet, PhotoOptio
 use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
 use spdcam_learn::pca::Components;
 use spdcam_learn::recipe;
+use spdcam_learn::scale::RowScale;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{
     add_photo_chart, Backend, FinetuneOptions, Progress, Schedule, TrainOptions, TrainingSet,
@@ -573,6 +574,7 @@ fn train(
             let mut schedule = Schedule::default_for(&architecture);
             schedule.epochs = epochs.unwrap_or(schedule.epochs);
             let options = TrainOptions {
+                row_scale: RowScale::Max,
                 target: TargetKind::Pca(Components::Variance(0.99)),
                 grid: Grid::parse("400-700:5")?,
                 schedule,

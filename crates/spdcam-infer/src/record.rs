@@ -3,6 +3,7 @@
 
 use crate::error::{InferError, Result};
 use crate::network::Architecture;
+use crate::scale::RowScale;
 use crate::target::TargetKind;
 use serde::{Deserialize, Serialize};
 use spdcam_core::dataset::Dataset;
@@ -97,6 +98,9 @@ pub struct TrainOptions {
     pub architecture: Architecture,
     /// PCA coefficients or channel weights.
     pub target: TargetKind,
+    /// What each feature row is divided by (records from before it: the maximum).
+    #[serde(default)]
+    pub row_scale: RowScale,
     /// The grid the model estimates SPDs on (a sub-grid of the dataset's).
     pub grid: Grid,
     /// The optimisation schedule (ignored by `linear`).

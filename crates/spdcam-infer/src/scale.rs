@@ -1,27 +1,52 @@
 //! The thesis's scaling of inputs and targets, fitted on the training set and stored in the
-//! model: each feature row divided by its own maximum, then each feature min-max scaled;
-//! each target min-max scaled to [0, 1] so that a sigmoid output can reach it.
+//! model: each feature row divided by its own maximum (or its mean, [`RowScale`]), then each
+//! feature min-max scaled; each target min-max scaled to [0, 1] so that a sigmoid output can
+//! reach it.
 
 use crate::error::{InferError, Result};
 use serde::{Deserialize, Serialize};
 
-/// Per-feature minimum and maximum (after the per-sample maximum), fitted on training rows.
+/// What each feature row is divided by before the per-feature scaling, so that the photo's
+/// exposure drops out.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RowScale {
+    /// Its maximum (the thesis's choice).
+    #[default]
+    Max,
+    /// Its mean: no single patch, clipped or lit by glare, sets the scale (the input of the
+    /// ridge that transfers best to real cameras, `docs/real-cameras.md`).
+    Mean,
+}
+
+impl RowScale {
+    /// The divisor of `row`: its maximum or mean, or 1 when that is not positive.
+    fn divisor(self, row: &[f64]) -> f64 {
+        let d = match self {
+            RowScale::Max => row.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            RowScale::Mean => row.iter().sum::<f64>() / row.len().max(1) as f64,
+        };
+        if d > 0.0 {
+            d
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Per-feature minimum and maximum (after the per-row division), fitted on training rows.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FeatureScaler {
-    /// Whether each row is first divided by its own maximum (the thesis's choice).
-    pub per_sample_max: bool,
+    /// Whether each row is first divided by its own maximum or mean (`row_scale`).
+    #[serde(rename = "per_sample_max")]
+    pub per_row: bool,
+    /// What the row is divided by (files from before this field: the maximum).
+    #[serde(default)]
+    pub row_scale: RowScale,
     /// Per-feature minimum over the training rows.
     pub min: Vec<f64>,
     /// Per-feature maximum over the training rows.
     pub max: Vec<f64>,
-}
-
-/// Divides a row by its maximum in place; a row with no positive value is left as it is.
-fn divide_by_max(row: &mut [f64]) {
-    let max = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if max > 0.0 {
-        row.iter_mut().for_each(|v| *v /= max);
-    }
 }
 
 /// Checks stored per-column bounds: equal, non-zero lengths and finite numbers.
@@ -67,8 +92,9 @@ fn min_max(data: &[f64], width: usize) -> (Vec<f64>, Vec<f64>) {
 }
 
 impl FeatureScaler {
-    /// Fits the scaler on `data`, rows of `width` features.
-    pub fn fit(data: &[f64], width: usize, per_sample_max: bool) -> Result<FeatureScaler> {
+    /// Fits the scaler on `data`, rows of `width` features, each first divided as `per_row`
+    /// says (or not at all).
+    pub fn fit(data: &[f64], width: usize, per_row: Option<RowScale>) -> Result<FeatureScaler> {
         let rows = check_rows(data, width, "features")?;
         if rows == 0 {
             return Err(InferError::invalid(
@@ -76,12 +102,16 @@ impl FeatureScaler {
             ));
         }
         let mut copy = data.to_vec();
-        if per_sample_max {
-            copy.chunks_exact_mut(width).for_each(divide_by_max);
+        if let Some(scale) = per_row {
+            for row in copy.chunks_exact_mut(width) {
+                let d = scale.divisor(row);
+                row.iter_mut().for_each(|v| *v /= d);
+            }
         }
         let (min, max) = min_max(&copy, width);
         Ok(FeatureScaler {
-            per_sample_max,
+            per_row: per_row.is_some(),
+            row_scale: per_row.unwrap_or_default(),
             min,
             max,
         })
@@ -94,13 +124,11 @@ impl FeatureScaler {
 
     /// Scales one row into `out` (as f32, the networks' type).
     pub fn transform_into(&self, row: &[f64], out: &mut [f32]) {
-        let mut peak = 1.0;
-        if self.per_sample_max {
-            let max = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            if max > 0.0 {
-                peak = max;
-            }
-        }
+        let peak = if self.per_row {
+            self.row_scale.divisor(row)
+        } else {
+            1.0
+        };
         for (j, (o, &v)) in out.iter_mut().zip(row).enumerate() {
             let range = self.max[j] - self.min[j];
             let scaled = if range > 0.0 {
@@ -194,7 +222,7 @@ mod tests {
     fn features_per_sample_max_then_min_max() {
         // Two rows; the second is the first at twice the brightness plus a change.
         let data = [10.0, 5.0, 0.0, 40.0, 10.0, 20.0];
-        let s = FeatureScaler::fit(&data, 3, true).unwrap();
+        let s = FeatureScaler::fit(&data, 3, Some(RowScale::Max)).unwrap();
         // After /max: [1, .5, 0] and [1, .25, .5].
         assert_eq!(s.min, vec![1.0, 0.25, 0.0]);
         assert_eq!(s.max, vec![1.0, 0.5, 0.5]);
@@ -204,6 +232,36 @@ mod tests {
         let brighter: Vec<f64> = data[..3].iter().map(|v| v * 3.0).collect();
         assert_eq!(s.transform(&brighter).unwrap(), t[..3].to_vec());
         assert!(s.transform(&[1.0, 2.0]).is_err());
+    }
+
+    #[test]
+    fn features_per_row_mean_then_min_max() {
+        // Row means 5 and 20: after /mean [2, 1, 0] and [2, .5, .5].
+        let data = [10.0, 5.0, 0.0, 40.0, 10.0, 10.0];
+        let s = FeatureScaler::fit(&data, 3, Some(RowScale::Mean)).unwrap();
+        assert_eq!(s.min, vec![2.0, 0.5, 0.0]);
+        assert_eq!(s.max, vec![2.0, 1.0, 0.5]);
+        assert_eq!(
+            s.transform(&data).unwrap(),
+            vec![0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+        );
+        // A black row is left undivided rather than divided by zero.
+        assert_eq!(s.transform(&[0.0; 3]).unwrap(), vec![0.0, -1.0, 0.0]);
+    }
+
+    #[test]
+    fn a_scaler_written_before_the_row_scale_divides_by_the_maximum() {
+        let old = r#"{"per_sample_max": true, "min": [0.0], "max": [1.0]}"#;
+        let s: FeatureScaler = serde_json::from_str(old).unwrap();
+        assert!(s.per_row);
+        assert_eq!(s.row_scale, RowScale::Max);
+        let new = serde_json::to_string(&FeatureScaler {
+            row_scale: RowScale::Mean,
+            ..s
+        })
+        .unwrap();
+        assert!(new.contains(r#""per_sample_max":true"#), "{new}");
+        assert!(new.contains(r#""row_scale":"mean""#), "{new}");
     }
 
     #[test]

@@ -21,6 +21,7 @@ use burn::tensor::activation::{relu, sigmoid};
 use burn::tensor::{Device, Tensor, TensorData};
 use spdcam_learn::network::{Architecture, CnnSpec};
 use spdcam_learn::pca::Components;
+use spdcam_learn::scale::RowScale;
 use spdcam_learn::synthetic::gaussian_set;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{train_in_parts, Backend, Schedule, TrainOptions, BATCH_PARTS};
@@ -86,6 +87,7 @@ fn straightforward_epoch(x: &[f32], y: &[f32], f: usize, k: usize, rows: usize) 
 
 fn options(schedule: Schedule) -> TrainOptions {
     TrainOptions {
+        row_scale: RowScale::Max,
         architecture: Architecture::Cnn1d(CnnSpec::thesis()),
         target: TargetKind::Pca(Components::default()),
         grid: spdcam_core::spectral::Grid::ESTIMATION,

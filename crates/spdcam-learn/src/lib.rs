@@ -20,12 +20,14 @@
 //! use spdcam_core::spectral::Grid;
 //! use spdcam_learn::network::Architecture;
 //! use spdcam_learn::pca::Components;
+//! use spdcam_learn::scale::RowScale;
 //! use spdcam_learn::synthetic::gaussian_set;
 //! use spdcam_learn::target::TargetKind;
 //! use spdcam_learn::train::{train, Backend, Schedule, TrainOptions};
 //!
 //! let data = gaussian_set(400, 24, 1, 2);
 //! let options = TrainOptions {
+//!     row_scale: RowScale::Max,
 //!     architecture: Architecture::Linear { ridge: 0.0 },
 //!     target: TargetKind::Pca(Components::default()),
 //!     grid: Grid::ESTIMATION,

@@ -15,6 +15,7 @@ use crate::model::Model;
 use crate::network::Architecture;
 use crate::pca::Components;
 use crate::record::{Backend, Schedule};
+use crate::scale::RowScale;
 use crate::target::TargetKind;
 use crate::train::{finetune, train, FinetuneOptions, TrainOptions, TrainingSet};
 use spdcam_core::dataset::SampleBatch;
@@ -67,6 +68,7 @@ impl Fit {
             }
             Fit::Ridge { penalty } => {
                 let options = TrainOptions {
+                    row_scale: RowScale::Max,
                     architecture: Architecture::Linear { ridge: *penalty },
                     target: TargetKind::Pca(Components::Variance(0.999)),
                     grid: model.grid(),

@@ -407,7 +407,7 @@ pub fn train_in_parts(
     let weights = take_rows(&data.samples.weights, data.samples.weight_count, &train_idx);
     let raw_targets = targets_of(&target, &train_spds, &weights);
     let fitted = Fitted {
-        features: FeatureScaler::fit(&train_features, f, true)?,
+        features: FeatureScaler::fit(&train_features, f, Some(options.row_scale))?,
         targets: TargetScaler::fit(&raw_targets, target.len())?,
         target,
     };
@@ -885,6 +885,7 @@ mod tests {
     use super::*;
     use crate::network::{Architecture, CnnSpec};
     use crate::pca::Components;
+    use crate::scale::RowScale;
     use crate::synthetic::gaussian_set;
 
     #[test]
@@ -899,6 +900,7 @@ mod tests {
     fn batch_parts_give_the_one_graph_weights() {
         let data = gaussian_set(300, 24, 3, 4);
         let options = TrainOptions {
+            row_scale: RowScale::Max,
             architecture: Architecture::Cnn1d(CnnSpec::thesis()),
             target: TargetKind::Pca(Components::default()),
             grid: Grid::ESTIMATION,

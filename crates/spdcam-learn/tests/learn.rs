@@ -6,6 +6,7 @@ use spdcam_core::spectral::Grid;
 use spdcam_learn::model::Model;
 use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
 use spdcam_learn::pca::Components;
+use spdcam_learn::scale::RowScale;
 use spdcam_learn::synthetic::gaussian_set;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{
@@ -16,6 +17,7 @@ fn options(architecture: Architecture, target: TargetKind, epochs: usize) -> Tra
     TrainOptions {
         architecture,
         target,
+        row_scale: RowScale::Max,
         grid: Grid::ESTIMATION,
         schedule: Schedule {
             epochs,

@@ -20,6 +20,7 @@ use spdcam_infer::FeatureRows;
 use spdcam_learn::evaluate::evaluate;
 use spdcam_learn::pca::Components;
 use spdcam_learn::record::DataInfo;
+use spdcam_learn::scale::RowScale;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{train, Schedule, TrainOptions, TrainingSet};
 use std::collections::BTreeMap;
@@ -267,6 +268,7 @@ fn thesis(args: ThesisArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<
             }
             let options = TrainOptions {
                 architecture,
+                row_scale: RowScale::Max,
                 target: match args.target {
                     TargetArg::Weights => TargetKind::Weights,
                     TargetArg::Pca => TargetKind::Pca(Components::default()),

@@ -8,6 +8,7 @@ use spdcam_core::spectral::Grid;
 use spdcam_learn::evaluate::loss_curve_svg;
 use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
 use spdcam_learn::pca::Components;
+use spdcam_learn::scale::RowScale;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{
     add_photo_chart, train, Backend, EpochRecord, Progress, Schedule, TrainOptions, TrainingSet,
@@ -129,6 +130,15 @@ impl ScheduleArgs {
     }
 }
 
+/// `--row-scale`: what each feature row is divided by.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum RowScaleArg {
+    /// Its maximum.
+    Max,
+    /// Its mean.
+    Mean,
+}
+
 /// Options of `spdcam train`.
 #[derive(Debug, Args)]
 pub struct TrainArgs {
@@ -152,6 +162,10 @@ pub struct TrainArgs {
     /// PCA components: an explained-variance share (0.99) or a count (12).
     #[arg(long, default_value = "0.99")]
     components: String,
+    /// What each feature row is divided by before scaling: its maximum (the thesis) or its
+    /// mean (no single clipped or glare-lit patch sets the scale).
+    #[arg(long, value_enum, default_value = "max")]
+    row_scale: RowScaleArg,
     /// Schedule preset; --epochs, --batch, --lr and --patience override it.
     #[arg(long, value_enum, default_value = "default")]
     preset: Preset,
@@ -262,6 +276,10 @@ pub fn run(args: TrainArgs, data_dir: &DataDir) -> Result<()> {
         target: match args.target {
             TargetArg::Pca => TargetKind::Pca(parse_components(&args.components)?),
             TargetArg::Weights => TargetKind::Weights,
+        },
+        row_scale: match args.row_scale {
+            RowScaleArg::Max => RowScale::Max,
+            RowScaleArg::Mean => RowScale::Mean,
         },
         grid: Grid::parse(&args.grid)?,
         schedule: args.schedule.apply(base),

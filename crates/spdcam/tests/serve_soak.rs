@@ -43,9 +43,15 @@ impl Drop for Serving {
 
 /// Starts `spdcam serve --port 0 --host HOST` and reads the address it prints.
 fn serve(host: &str) -> Serving {
+    serve_with(host, &[])
+}
+
+/// As [`serve`], with environment variables set.
+fn serve_with(host: &str, env: &[(&str, &str)]) -> Serving {
     let mut child = Command::new(env!("CARGO_BIN_EXE_spdcam"))
         .args(["serve", "--port", "0", "--host", host])
         .env_remove("SPDCAM_DATA")
+        .envs(env.iter().copied())
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
@@ -267,4 +273,23 @@ fn serve_listens_on_a_host_name() {
     stream.read_to_string(&mut got).unwrap();
     assert!(got.starts_with("HTTP/1.1 200 OK\r\n"), "{got}");
     assert!(got.ends_with("\r\n\r\n"), "a body after HEAD: {got}");
+}
+
+#[test]
+fn the_photo_size_limit_of_every_command_caps_uploads_too() {
+    let server = serve_with("127.0.0.1", &[("SPDCAM_MAX_PHOTO_BYTES", "100000")]);
+    let mut stream = TcpStream::connect(server.addr).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(30)))
+        .unwrap();
+    // Under the server's own 64 MB default, over the photo limit with the form's overhead.
+    let head = format!(
+        "POST /api/estimate HTTP/1.1\r\nHost: cap\r\nConnection: close\r\n\
+         Content-Type: multipart/form-data; boundary={BOUNDARY}\r\nContent-Length: 300000\r\n\r\n"
+    );
+    stream.write_all(head.as_bytes()).unwrap();
+    let mut got = String::new();
+    stream.read_to_string(&mut got).unwrap();
+    assert!(got.starts_with("HTTP/1.1 413"), "{got}");
+    assert!(got.contains("too_large"), "{got}");
 }

@@ -23,6 +23,16 @@ const EXAMPLE_JPG: &[u8] = include_bytes!("../../../../examples/sg-telelumen.jpg
 /// Room for the multipart framing and the small fields beside the photo; also the longest
 /// field other than the photo.
 const FORM_OVERHEAD: usize = 64 * 1024;
+
+/// `bytes` in megabytes (2²⁰ bytes) for messages: whole from 10 MB, else to 0.1 MB.
+fn megabytes(bytes: usize) -> String {
+    let mb = bytes as f64 / f64::from(1 << 20);
+    if mb >= 10.0 {
+        format!("{mb:.0}")
+    } else {
+        format!("{mb:.1}")
+    }
+}
 /// Longest label kept from a client's file name.
 const MAX_NAME_CHARS: usize = 120;
 
@@ -140,8 +150,9 @@ impl Api {
             Answer::error(
                 413,
                 format!(
-                    "the upload is larger than the limit of {} MB (spdcam serve --max-upload-mb)",
-                    self.max_upload_bytes >> 20
+                    "the upload is larger than the limit of {} MB (spdcam serve --max-upload-mb, \
+                     at most SPDCAM_MAX_PHOTO_BYTES)",
+                    megabytes(self.max_upload_bytes)
                 ),
             )
         };

@@ -17,6 +17,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use jobs::{Engine, Jobs};
 use spdcam_core::builtin::DataDir;
+use spdcam_core::limits;
 use spdcam_core::spectral::Grid;
 use spdcam_infer::Estimator;
 use std::net::{SocketAddr, ToSocketAddrs};
@@ -46,7 +47,8 @@ pub struct ServeArgs {
     /// 0.0.0.0 to let other machines of the network in.
     #[arg(long, default_value = "127.0.0.1")]
     host: String,
-    /// Largest photo accepted, in megabytes (larger uploads are refused with 413).
+    /// Largest photo accepted, in megabytes (larger uploads are refused with 413); never
+    /// more than the photo size every command keeps to (`SPDCAM_MAX_PHOTO_BYTES`).
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..=1024))]
     max_upload_mb: u64,
 }
@@ -207,7 +209,9 @@ pub fn run(args: ServeArgs, data_dir: &DataDir) -> Result<()> {
     let server = Server::start(
         Config {
             addrs: resolve(&args.host, args.port)?,
-            max_upload_bytes: usize::try_from(args.max_upload_mb << 20)?,
+            max_upload_bytes: usize::try_from(
+                (args.max_upload_mb << 20).min(limits::PHOTO_BYTES.value()),
+            )?,
             workers,
             timeouts: Timeouts::default(),
         },
