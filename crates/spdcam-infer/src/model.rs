@@ -154,6 +154,59 @@ impl Model {
         Ok(model)
     }
 
+    /// The ensemble of `members` ([`Architecture::Average`]): one model whose outputs are the
+    /// mean of theirs. They must read the same features the same way and predict the same
+    /// target (trained on one dataset with the same scaling and PCA settings). Its record
+    /// is the first member's, with the average's architecture, the members' summed training
+    /// time and their mean validation loss and GFC (the average itself was not validated).
+    pub fn average(members: &[Model]) -> Result<Model> {
+        let first = members
+            .first()
+            .ok_or_else(|| InferError::invalid("an average needs members, got none"))?;
+        let (a, mut network_list) = (&first.header, Vec::with_capacity(members.len()));
+        for (i, m) in members.iter().enumerate() {
+            let b = &m.header;
+            let differs = |what: &str| {
+                Err(InferError::invalid(format!(
+                    "member {} differs from the first in its {what}; the members of an average \
+                     must be trained on one dataset with the same scaling and target",
+                    i + 1
+                )))
+            };
+            if b.feature_names != a.feature_names {
+                return differs("feature names");
+            }
+            if b.feature_scaler != a.feature_scaler {
+                return differs("feature scaling");
+            }
+            if b.target != a.target || b.target_scaler != a.target_scaler {
+                return differs("target");
+            }
+            if b.grid != a.grid || b.chart != a.chart || b.camera != a.camera {
+                return differs("grid, chart or camera");
+            }
+            network_list.push(m.network.clone());
+        }
+        let network = Network::average(&network_list)?;
+        let n = members.len() as f64;
+        let mut training = a.training.clone();
+        training.options.architecture = network.architecture().clone();
+        training.seconds = members.iter().map(|m| m.training().seconds).sum();
+        training.val_loss = members.iter().map(|m| m.training().val_loss).sum::<f64>() / n;
+        training.val_gfc = members.iter().map(|m| m.training().val_gfc).sum::<f64>() / n;
+        let mut model = Model::assemble(
+            network,
+            a.feature_scaler.clone(),
+            a.target.clone(),
+            a.target_scaler.clone(),
+            a.grid,
+            a.feature_names.clone(),
+            training,
+        )?;
+        model.header.photo_chart = a.photo_chart.clone();
+        Ok(model)
+    }
+
     /// Checks that all the parts agree with each other.
     fn validate(&self) -> Result<()> {
         let h = &self.header;
@@ -266,7 +319,7 @@ impl Model {
         };
         format!(
             "{} on {} features → {target}, SPD {} nm; chart {}, camera {}",
-            h.architecture.name(),
+            h.architecture.label(),
             h.feature_names.len(),
             h.grid.label(),
             h.chart.as_deref().unwrap_or("unknown"),

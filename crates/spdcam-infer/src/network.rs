@@ -105,6 +105,14 @@ pub enum Architecture {
         /// The ridge penalty λ (on normalised features).
         ridge: f64,
     },
+    /// The mean of the outputs of trained networks that share the model's scalings and
+    /// target (an ensemble, made by `spdcam average`): averaging learners that err
+    /// differently cancels part of their errors (Breiman 1996, "Bagging predictors", Machine
+    /// Learning 24: 123–140; here a network and a ridge, which fail on different photos).
+    Average {
+        /// The members, each a network or ridge (not an average).
+        members: Vec<Architecture>,
+    },
 }
 
 impl Architecture {
@@ -114,6 +122,22 @@ impl Architecture {
             Architecture::Cnn1d(_) => "cnn1d",
             Architecture::Mlp(_) => "mlp",
             Architecture::Linear { .. } => "linear",
+            Architecture::Average { .. } => "average",
+        }
+    }
+
+    /// A short description: the name, and an average's members.
+    pub fn label(&self) -> String {
+        match self {
+            Architecture::Average { members } => format!(
+                "average of {}",
+                members
+                    .iter()
+                    .map(|m| m.label())
+                    .collect::<Vec<_>>()
+                    .join(" and ")
+            ),
+            other => other.name().to_string(),
         }
     }
 
@@ -151,6 +175,13 @@ impl Architecture {
                 dense("output", width, outputs);
             }
             Architecture::Linear { .. } => dense("output", inputs, outputs),
+            Architecture::Average { members } => {
+                for (i, member) in members.iter().enumerate() {
+                    for (name, shape) in member.parameter_shapes(inputs, outputs)? {
+                        shapes.push((format!("m{i}.{name}"), shape));
+                    }
+                }
+            }
         }
         Ok(shapes)
     }
@@ -189,6 +220,20 @@ impl Architecture {
                     return bad(format!("the ridge penalty {ridge} must be ≥ 0"));
                 }
             }
+            Architecture::Average { members } => {
+                if members.len() < 2 {
+                    return bad(format!(
+                        "an average needs at least two members, got {}",
+                        members.len()
+                    ));
+                }
+                for member in members {
+                    if let Architecture::Average { .. } = member {
+                        return bad("an average's member is itself an average".into());
+                    }
+                    member.validate()?;
+                }
+            }
         }
         Ok(())
     }
@@ -212,6 +257,8 @@ pub struct Network {
     inputs: usize,
     outputs: usize,
     parameters: Vec<Parameter>,
+    /// An average's members (their parameters without the `m{i}.` prefix); empty otherwise.
+    members: Vec<Network>,
 }
 
 /// Rows per block of a batched forward pass (blocks run in parallel).
@@ -286,12 +333,67 @@ impl Network {
                 )));
             }
         }
+        let members = match &architecture {
+            Architecture::Average { members } => {
+                let mut rest = parameters.iter();
+                members
+                    .iter()
+                    .enumerate()
+                    .map(|(i, member)| {
+                        let count = member.parameter_shapes(inputs, outputs)?.len();
+                        let prefix = format!("m{i}.");
+                        let own = rest
+                            .by_ref()
+                            .take(count)
+                            .map(|p| Parameter {
+                                name: p.name.trim_start_matches(&prefix).to_string(),
+                                ..p.clone()
+                            })
+                            .collect();
+                        Network::new(member.clone(), inputs, outputs, own)
+                    })
+                    .collect::<Result<Vec<_>>>()?
+            }
+            _ => Vec::new(),
+        };
         Ok(Network {
             architecture,
             inputs,
             outputs,
             parameters,
+            members,
         })
+    }
+
+    /// The mean of `members`' outputs, as one network (see [`Architecture::Average`]); an
+    /// error unless they have the same inputs and outputs and none is itself an average.
+    pub fn average(members: &[Network]) -> Result<Network> {
+        let first = members
+            .first()
+            .ok_or_else(|| InferError::invalid("an average needs members, got none"))?;
+        if let Some(m) = members
+            .iter()
+            .find(|m| (m.inputs, m.outputs) != (first.inputs, first.outputs))
+        {
+            return Err(InferError::invalid(format!(
+                "the members differ in size: {} → {} and {} → {}",
+                first.inputs, first.outputs, m.inputs, m.outputs
+            )));
+        }
+        let architecture = Architecture::Average {
+            members: members.iter().map(|m| m.architecture.clone()).collect(),
+        };
+        let parameters = members
+            .iter()
+            .enumerate()
+            .flat_map(|(i, m)| {
+                m.parameters.iter().map(move |p| Parameter {
+                    name: format!("m{i}.{}", p.name),
+                    ..p.clone()
+                })
+            })
+            .collect();
+        Network::new(architecture, first.inputs, first.outputs, parameters)
     }
 
     /// The architecture.
@@ -330,7 +432,8 @@ impl Network {
     }
 
     /// Outputs for `rows` rows of normalised features (row-major); sigmoid outputs for the
-    /// networks, plain linear outputs for `linear`. Blocks of rows run in parallel.
+    /// networks, plain linear outputs for `linear`, their mean for `average`. Blocks of rows
+    /// run in parallel.
     pub fn forward(&self, x: &[f32]) -> Result<Vec<f32>> {
         if x.len() % self.inputs != 0 {
             return Err(InferError::invalid(format!(
@@ -371,6 +474,17 @@ impl Network {
             Architecture::Linear { .. } => {
                 let (w, b) = self.layer(0);
                 dense_into(x, rows, self.inputs, self.inputs, w, b, out, false);
+            }
+            Architecture::Average { .. } => {
+                out[..rows * self.outputs].fill(0.0);
+                let mut own = vec![0.0f32; rows * self.outputs];
+                let share = 1.0 / self.members.len() as f32;
+                for member in &self.members {
+                    member.forward_block(x, rows, &mut own);
+                    for (o, v) in out.iter_mut().zip(&own) {
+                        *o += share * v;
+                    }
+                }
             }
         }
     }
@@ -421,6 +535,11 @@ impl Network {
     ) -> Result<Network> {
         use rand::{Rng, SeedableRng};
         architecture.validate()?;
+        if let Architecture::Average { .. } = architecture {
+            return Err(InferError::invalid(
+                "an average is made of trained networks (spdcam average), not initialised",
+            ));
+        }
         let shapes = architecture.parameter_shapes(inputs, outputs)?;
         let mut rng = rand::rngs::SmallRng::seed_from_u64(seed);
         let mut parameters = Vec::with_capacity(shapes.len());
@@ -546,5 +665,85 @@ mod tests {
         assert!(net.forward(&[0.0; 71]).is_err());
         // The CNN needs enough inputs for its kernels.
         assert!(Network::init(Architecture::Cnn1d(CnnSpec::thesis()), 10, 5, 1).is_err());
+    }
+
+    #[test]
+    fn an_average_outputs_the_mean_of_its_members() {
+        let mlp = Network::init(
+            Architecture::Mlp(MlpSpec {
+                hidden: vec![8, 4],
+                dropout: 0.0,
+            }),
+            6,
+            3,
+            1,
+        )
+        .unwrap();
+        // A linear member with known weights: output j = j + 0.5 · x₀.
+        let linear = Network::new(
+            Architecture::Linear { ridge: 1e-3 },
+            6,
+            3,
+            vec![
+                Parameter {
+                    name: "output.weight".into(),
+                    shape: vec![6, 3],
+                    data: (0..18).map(|i| if i < 3 { 0.5 } else { 0.0 }).collect(),
+                },
+                Parameter {
+                    name: "output.bias".into(),
+                    shape: vec![3],
+                    data: vec![0.0, 1.0, 2.0],
+                },
+            ],
+        )
+        .unwrap();
+        let average = Network::average(&[mlp.clone(), linear.clone()]).unwrap();
+        assert_eq!(average.architecture().label(), "average of mlp and linear");
+        assert_eq!(average.parameters()[0].name, "m0.hidden0.weight");
+        assert_eq!(average.parameters().last().unwrap().name, "m1.output.bias");
+        let rows = 300; // more than one block
+        let x: Vec<f32> = (0..rows * 6).map(|i| (i % 7) as f32 / 7.0).collect();
+        let (a, b, mean) = (
+            mlp.forward(&x).unwrap(),
+            linear.forward(&x).unwrap(),
+            average.forward(&x).unwrap(),
+        );
+        for r in 0..rows {
+            for j in 0..3 {
+                let k = r * 3 + j;
+                assert_eq!(b[k], j as f32 + 0.5 * x[r * 6]);
+                assert!((mean[k] - 0.5 * (a[k] + b[k])).abs() < 1e-6, "{k}");
+            }
+        }
+        // Rebuilt from its stored parameters (as a model file is read), it is the same.
+        let again = Network::new(
+            average.architecture().clone(),
+            6,
+            3,
+            average.parameters().to_vec(),
+        )
+        .unwrap();
+        assert_eq!(again.forward(&x).unwrap(), mean);
+    }
+
+    #[test]
+    fn a_bad_average_is_an_error() {
+        let mlp = Network::init(Architecture::Mlp(MlpSpec::thesis()), 72, 5, 1).unwrap();
+        let other = Network::init(Architecture::Mlp(MlpSpec::thesis()), 72, 4, 1).unwrap();
+        assert!(Network::average(&[]).is_err());
+        assert!(
+            Network::average(&[mlp.clone(), other]).is_err(),
+            "sizes differ"
+        );
+        // One member, or an average inside an average, is not an average.
+        assert!(Architecture::Average {
+            members: vec![Architecture::Linear { ridge: 0.0 }]
+        }
+        .validate()
+        .is_err());
+        let pair = Network::average(&[mlp.clone(), mlp.clone()]).unwrap();
+        assert!(Network::average(&[pair.clone(), mlp]).is_err());
+        assert!(Network::init(pair.architecture().clone(), 72, 5, 1).is_err());
     }
 }

@@ -46,10 +46,18 @@ fn tensor_of(p: &Parameter, device: &Device) -> Result<Param<Tensor<2>>> {
 impl BurnNet {
     /// A burn module holding the weights of `network` on `device`.
     pub(crate) fn from_network(network: &Network, device: &Device) -> Result<BurnNet> {
-        if let Architecture::Linear { .. } = network.architecture() {
-            return Err(LearnError::invalid(
-                "the linear model is fitted in closed form, not trained by gradient",
-            ));
+        match network.architecture() {
+            Architecture::Linear { .. } => {
+                return Err(LearnError::invalid(
+                    "the linear model is fitted in closed form, not trained by gradient",
+                ))
+            }
+            Architecture::Average { .. } => {
+                return Err(LearnError::invalid(
+                    "an average is made of trained models, not trained by gradient",
+                ))
+            }
+            _ => {}
         }
         let mut layers = Vec::new();
         for pair in network.parameters().chunks_exact(2) {
@@ -223,7 +231,7 @@ pub(crate) fn dropout_masks(
             (s.dropout, vec![l3 * s.conv2_filters])
         }
         Architecture::Mlp(s) => (s.dropout, s.hidden.clone()),
-        Architecture::Linear { .. } => (0.0, Vec::new()),
+        Architecture::Linear { .. } | Architecture::Average { .. } => (0.0, Vec::new()),
     };
     if p <= 0.0 {
         return Ok(Vec::new());
@@ -295,8 +303,8 @@ pub(crate) fn prepare(
             TensorData::new(x.to_vec(), [rows, features]),
             device,
         ))),
-        Architecture::Linear { .. } => Err(LearnError::invalid(
-            "the linear model is fitted in closed form, not trained by gradient",
+        Architecture::Linear { .. } | Architecture::Average { .. } => Err(LearnError::invalid(
+            "a linear model or an average is not trained by gradient",
         )),
     }
 }

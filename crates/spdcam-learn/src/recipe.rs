@@ -101,14 +101,26 @@ pub struct Scored {
 /// was best among 150, 600 and 3,000 on the real Telelumen dev photos in `spdcam sim2real
 /// --finetune`; 600 for when there are more photos); and the output layer alone, the feature
 /// layers frozen, for 600 steps; and ridge on the photos alone at each of
-/// [`RIDGE_PENALTIES`].
-pub fn candidates(n: usize, seed: u64, backend: Backend) -> Vec<Recipe> {
+/// [`RIDGE_PENALTIES`]. A model with no network to fine-tune (`linear`, `average`) has the
+/// unchanged model and the ridges only.
+pub fn candidates(model: &Model, n: usize, seed: u64, backend: Backend) -> Vec<Recipe> {
     let steps = |count: usize| all_layers(n, count, seed, backend);
+    let unchanged = Recipe {
+        name: "the model unchanged",
+        fit: Fit::Unchanged,
+    };
+    let ridges = RIDGE_PENALTIES.iter().map(|&(penalty, name)| Recipe {
+        name,
+        fit: Fit::Ridge { penalty },
+    });
+    if matches!(
+        model.network().architecture(),
+        Architecture::Linear { .. } | Architecture::Average { .. }
+    ) {
+        return std::iter::once(unchanged).chain(ridges).collect();
+    }
     let mut all = vec![
-        Recipe {
-            name: "the model unchanged",
-            fit: Fit::Unchanged,
-        },
+        unchanged,
         Recipe {
             name: "all layers, about 150 steps",
             fit: Fit::Finetune(steps(150)),
@@ -125,10 +137,7 @@ pub fn candidates(n: usize, seed: u64, backend: Backend) -> Vec<Recipe> {
             }),
         },
     ];
-    all.extend(RIDGE_PENALTIES.iter().map(|&(penalty, name)| Recipe {
-        name,
-        fit: Fit::Ridge { penalty },
-    }));
+    all.extend(ridges);
     all
 }
 
@@ -191,13 +200,16 @@ pub fn choose(
         )));
     }
     let folds = FOLDS.min(n / 2);
-    let mut sums = vec![0.0; candidates(n, seed, backend).len()];
+    let mut sums = vec![0.0; candidates(model, n, seed, backend).len()];
     let fits = folds * sums.len();
     for f in 0..folds {
         let (test, train): (Vec<usize>, Vec<usize>) = (0..n).partition(|i| i % folds == f);
         let test_set = subset(data, &test)?;
         let train_set = subset(data, &train)?;
-        for (k, recipe) in candidates(train.len(), seed, backend).iter().enumerate() {
+        for (k, recipe) in candidates(model, train.len(), seed, backend)
+            .iter()
+            .enumerate()
+        {
             // Too few photos to hold some back for early stopping: the training photos
             // validate, as in `spdcam sim2real --finetune`.
             let scored = evaluate(&recipe.fit.run(model, &train_set, seed)?, &test_set)?;
@@ -205,7 +217,7 @@ pub fn choose(
             progress(f * sums.len() + k + 1, fits);
         }
     }
-    let mut scored: Vec<Scored> = candidates(n, seed, backend)
+    let mut scored: Vec<Scored> = candidates(model, n, seed, backend)
         .into_iter()
         .zip(sums)
         .map(|(recipe, sum)| Scored {

@@ -767,10 +767,19 @@ pub fn finetune(
     options.schedule.validate()?;
     check_set(data)?;
     model.check_features(&data.columns.feature_names, &data.info.path)?;
-    if matches!(model.network().architecture(), Architecture::Linear { .. }) {
-        return Err(LearnError::invalid(
-            "a linear model has no layers to transfer; train a new one on the data instead",
-        ));
+    match model.network().architecture() {
+        Architecture::Linear { .. } => {
+            return Err(LearnError::invalid(
+                "a linear model has no layers to transfer; train a new one on the data instead",
+            ))
+        }
+        Architecture::Average { .. } => {
+            return Err(LearnError::invalid(
+                "an average of models has no one network to fine-tune; fine-tune a member, or \
+                 fit ridge on the photos (finetune without recipe flags weighs it)",
+            ))
+        }
+        _ => {}
     }
     if options.keep_output && options.refit_pca {
         return Err(LearnError::invalid(

@@ -4,6 +4,8 @@
 // not a link.
 #![allow(rustdoc::broken_intra_doc_links)]
 
+#[cfg(feature = "train")]
+mod average;
 mod calibrate;
 mod coverage;
 mod dataset;
@@ -69,6 +71,9 @@ enum Command {
     #[cfg(feature = "train")]
     /// Train a model (1D CNN, MLP or ridge baseline) on a dataset.
     Train(Box<train::TrainArgs>),
+    #[cfg(feature = "train")]
+    /// Make one model of several trained ones that estimates the mean of their outputs.
+    Average(average::AverageArgs),
     /// Estimate the light's SPD from photos of a colour chart (or chart features).
     Estimate(Box<estimate::EstimateArgs>),
     /// How often the charts are found in scene photos, per difficulty (Markdown).
@@ -125,6 +130,8 @@ fn main() -> ExitCode {
         Command::Metrics(args) => metrics::run(args, &data_dir),
         #[cfg(feature = "train")]
         Command::Train(args) => train::run(*args, &data_dir),
+        #[cfg(feature = "train")]
+        Command::Average(args) => average::run(args),
         Command::Estimate(args) => estimate::run(*args, &data_dir),
         Command::Detection(args) => detection::run(args, &data_dir),
         #[cfg(feature = "train")]

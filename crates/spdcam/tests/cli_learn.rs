@@ -350,3 +350,96 @@ fn evaluate_renders_the_worst_case() {
     assert_eq!(pixel(panel + 2, h / 2), [255, 255, 255], "a white gap");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn an_average_of_a_network_and_a_ridge_estimates_between_them() {
+    let dir = scratch("average");
+    let (data, features) = dataset(&dir, "train", 600, 24, 4);
+    let (few, _) = dataset(&dir, "few", 40, 24, 5);
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (network, ridge, average) = (
+        dir.join("network.spdm"),
+        dir.join("ridge.spdm"),
+        dir.join("average.spdm"),
+    );
+    for (model, out) in [("mlp", &network), ("linear", &ridge)] {
+        ok(&[
+            "train",
+            "--data",
+            &s(&data),
+            "--model",
+            model,
+            "--row-scale",
+            "mean",
+            "--epochs",
+            "2",
+            "--seed",
+            "1",
+            "-o",
+            &s(out),
+        ]);
+    }
+    let out = ok(&["average", &s(&network), &s(&ridge), "-o", &s(&average)]);
+    assert!(out.contains("average of mlp and linear"), "{out}");
+    // Its estimate of each row is the mean of the members' (before peak normalisation,
+    // which the members' similar scale keeps close to the mean of the normalised SPDs).
+    let estimate = |model: &Path| -> Vec<Vec<f64>> {
+        let csv = dir.join("estimate.csv");
+        ok(&[
+            "estimate",
+            "--model",
+            &s(model),
+            "--features",
+            &s(&features),
+            "-o",
+            &s(&csv),
+        ]);
+        let text = std::fs::read_to_string(&csv).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').skip(1).map(|v| v.parse().unwrap()).collect())
+            .collect()
+    };
+    let (a, b, mean) = (estimate(&network), estimate(&ridge), estimate(&average));
+    assert_eq!(mean.len(), a.len());
+    let (mut between, mut cells) = (0, 0);
+    for ((ra, rb), rm) in a.iter().zip(&b).zip(&mean) {
+        for ((x, y), m) in ra.iter().zip(rb).zip(rm) {
+            cells += 1;
+            between += usize::from(x.min(*y) - 0.05 <= *m && *m <= x.max(*y) + 0.05);
+        }
+    }
+    assert!(
+        between * 100 >= cells * 95,
+        "{between} of {cells} between the members"
+    );
+    // A member cannot be overwritten, and members must share their scaling.
+    let err = fails(&["average", &s(&network), &s(&ridge), "-o", &s(&ridge)]);
+    assert!(err.contains("is a member"), "{err}");
+    let max_scaled = dir.join("max.spdm");
+    ok(&[
+        "train",
+        "--data",
+        &s(&data),
+        "--model",
+        "linear",
+        "-o",
+        &s(&max_scaled),
+    ]);
+    let err = fails(&["average", &s(&network), &s(&max_scaled), "-o", &s(&average)]);
+    assert!(err.contains("feature scaling"), "{err}");
+    // Fine-tuning an average weighs the model unchanged and ridge on the photos only.
+    let out = ok(&[
+        "finetune",
+        "--model",
+        &s(&average),
+        "--data",
+        &s(&few),
+        "-o",
+        &s(&dir.join("tuned.spdm")),
+    ]);
+    let scores = out.matches("cross-validated GFC ").count();
+    assert_eq!(scores, 5, "four candidates and the choice: {out}");
+    assert!(!out.contains("all layers"), "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
