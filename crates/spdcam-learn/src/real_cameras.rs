@@ -61,13 +61,17 @@ pub struct SplitSet {
 /// Reads the three real sets under `thesis` (the data directory's `thesis/`), split as the
 /// module documentation says; SPDs on [`score_grid`].
 pub fn split_sets(thesis: &Path) -> Result<Vec<SplitSet>> {
-    let grid = score_grid();
+    split_sets_on(thesis, &score_grid())
+}
+
+/// As [`split_sets`], the SPDs on `grid` (the trust calibration's, a model's grid).
+pub fn split_sets_on(thesis: &Path, grid: &Grid) -> Result<Vec<SplitSet>> {
     let read = |folder: &str| -> Result<MeasuredPhotos> {
         let dir = thesis.join("measured").join(folder);
         Ok(MeasuredPhotos::read(
             &dir.join("features.csv"),
             &dir.join("spds.csv"),
-            &grid,
+            grid,
         )?)
     };
     let dev = read("telelumen_canon5d4_dev")?;

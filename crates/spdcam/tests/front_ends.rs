@@ -174,7 +174,8 @@ fn the_photos_feature_row_gives_the_photos_spd_and_verdict() {
     let (photo, row) = (&photo[0], &rows[0]);
     assert_eq!(row["name"], "estimate_1");
     // The features file holds the features rounded to what the CSV writes; the SPD is the
-    // photo's to the last digits.
+    // photo's to within what that rounding moves (the SG model's ridge member carries a
+    // feature's last digit on to about 10⁻⁶ of the peak).
     let (a, b) = (
         photo["spd"].as_array().unwrap(),
         row["spd"].as_array().unwrap(),
@@ -182,7 +183,7 @@ fn the_photos_feature_row_gives_the_photos_spd_and_verdict() {
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(b) {
         let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
-        assert!((x - y).abs() < 1e-6, "{x} {y}");
+        assert!((x - y).abs() < 1e-5, "{x} {y}");
     }
     assert_eq!(row["verdict"], photo["verdict"]);
     assert_eq!(row["model"], photo["model"]);

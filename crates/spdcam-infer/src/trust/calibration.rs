@@ -143,6 +143,11 @@ pub struct Calibration {
     /// photos (saturated colours clip a channel under narrow-band light, and the model was
     /// trained with them); more make the estimate doubtful.
     pub clipped_doubtful: usize,
+    /// Real photos among the calibration photos (the real-camera study's validation photos,
+    /// `spdcam trust calibrate --real`): they join the bands, the expected GFC, the metric
+    /// intervals and the clipping and difficulty levels; 0 for virtual photos alone.
+    #[serde(default)]
+    pub real_photos: usize,
 }
 
 /// The GFC to expect of an estimate, from the estimate itself: a ridge regression (Hoerl &
@@ -438,6 +443,7 @@ mod tests {
             colour_gradient_doubtful: None,
             glare_doubtful: None,
             clipped_doubtful: 0,
+            real_photos: 0,
         };
         let (spd, spread) = ([1.0, 0.5], [0.05, 0.05]);
         let plain = cal
