@@ -282,7 +282,7 @@ fn metrics_table(out: &mut String, p: &Presentation) {
         }
     }
     out.push_str(
-        "</table>\n<p class=\"small\">±: the 95 % interval, calibrated on held-out lamps.</p>\n",
+        "</table>\n<p class=\"small\">±: the 95 % interval, calibrated on photos held out from training.</p>\n",
     );
 }
 

@@ -45,6 +45,11 @@ pub struct Sim2realArgs {
     /// model on growing numbers of real photos, beside ridge on those photos alone.
     #[arg(long, value_name = "MODEL.spdm")]
     finetune: Option<PathBuf>,
+    /// With --finetune: fine-tune as `spdcam finetune` does without recipe flags (the recipe
+    /// chosen by cross-validation on the photos used, ridge on the photos among the
+    /// candidates) instead of the one fixed network recipe.
+    #[arg(long, requires = "finetune")]
+    choose: bool,
     /// Numbers of real photos of the learning curve.
     #[arg(long, value_delimiter = ',', default_values_t = [0, 10, 30, 100, 300])]
     sizes: Vec<usize>,
@@ -309,6 +314,7 @@ fn curve_table(
         sizes: args.sizes.clone(),
         folds: args.folds.max(2),
         seed: 1,
+        choose: args.choose,
     };
     const COLUMNS: [&str; 3] = ["fine-tuned", "ridge", "ridge towards virtual"];
     let mut md = format!(
@@ -350,14 +356,21 @@ fn curve_table(
     md += &format!(
         "\nMean GFC (400–700 nm; the model at 5 nm, ridge at 10 nm) on the photos of the test \
          fold, {}-fold cross-validated; the photos used come from the other folds (seeded \
-         random picks). Model: `{}` ({}), fine-tuned with its output layer kept, all layers, \
-         learning rate 2e-4, batch ≤ 16, about 150 steps. Ridge: features ÷ their mean → SPD, \
+         random picks). Model: `{}` ({}), fine-tuned {}. Ridge: features ÷ their mean → SPD, \
          the penalty chosen by 5-fold cross-validation on the photos used; towards virtual: \
          shrunk towards the ridge trained on {} virtual samples (randomised cameras, \
          in-camera stage and lighting gradient) instead of towards zero.\n",
         options.folds,
         path.display(),
         model.describe(),
+        if args.choose {
+            "as `spdcam finetune` without recipe flags: the recipe chosen by 5-fold \
+             cross-validation on the photos used among the model unchanged, the network \
+             recipes (for a network) and ridge on the photos at three penalties"
+        } else {
+            "with its output layer kept, all layers, learning rate 2e-4, batch ≤ 16, about \
+             150 steps"
+        },
         args.count
     );
     write_atomic(&args.output, md.as_bytes())?;

@@ -26,6 +26,9 @@ pub struct CurveOptions {
     pub folds: usize,
     /// Seed of the photo picks and the fine-tuning.
     pub seed: u64,
+    /// Fine-tune by the recipe [`recipe::tune`] chooses (as `spdcam finetune` without recipe
+    /// flags) instead of the fixed [`recipe`].
+    pub choose: bool,
 }
 
 /// One point of a curve: mean GFCs, `None` where the folds hold fewer photos than the size
@@ -143,15 +146,20 @@ pub fn learning_curve(
                 (model_gfc(model, set, &test, set_grid)?, Vec::new())
             } else {
                 let data = training_set(set, picked, &names, set_grid);
-                let trained = finetune(
-                    model,
-                    &data,
-                    Some(&data),
-                    &recipe(size, options.seed),
-                    &mut |_| {},
-                )?;
+                let tuned = if options.choose {
+                    recipe::tune(model, &data, options.seed, Backend::Cpu, &mut |_, _| {})?.model
+                } else {
+                    finetune(
+                        model,
+                        &data,
+                        Some(&data),
+                        &recipe(size, options.seed),
+                        &mut |_| {},
+                    )?
+                    .model
+                };
                 (
-                    model_gfc(&trained.model, set, &test, set_grid)?,
+                    model_gfc(&tuned, set, &test, set_grid)?,
                     baselines(picked, &test)?,
                 )
             };

@@ -676,7 +676,7 @@ function renderSummary() {
   if (r.presentation) {
     html('h3', {}, box, 'Lighting metrics');
     metricGroups(box, r.presentation);
-    if (r.metric_uncertainty) html('p', { class: 'note' }, box, '± : the 95 % interval of the metric, calibrated on held-out lamps; numbers are rounded to what it supports.');
+    if (r.metric_uncertainty) html('p', { class: 'note' }, box, '± : the 95 % interval of the metric, calibrated on photos held out from training; numbers are rounded to what it supports.');
   }
   html('h3', {}, box, 'Details');
   const table = html('table', { id: 'facts' }, box);
