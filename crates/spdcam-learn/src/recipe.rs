@@ -68,7 +68,7 @@ impl Fit {
             }
             Fit::Ridge { penalty } => {
                 let options = TrainOptions {
-                    row_scale: RowScale::Max,
+                    row_scale: RowScale::Mean,
                     architecture: Architecture::Linear { ridge: *penalty },
                     target: TargetKind::Pca(Components::Variance(0.999)),
                     grid: model.grid(),

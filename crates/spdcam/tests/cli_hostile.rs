@@ -824,7 +824,8 @@ fn exposure_above_one_clips_as_documented() {
     // Issue 29, item 6: `--exposure 1.5` was refused though the help says "above 1 clips".
     let dir = scratch("exposure-clips");
     let png = s(&dir.join("c.png"));
-    let mean_feature = |exposure: &str| -> f64 {
+    // The ColorChecker 24's features; patches 19 and 20 are its white and lightest grey.
+    let features = |exposure: &str| -> Vec<f64> {
         let out = spdcam(&[
             "render",
             "--spd",
@@ -844,21 +845,37 @@ fn exposure_above_one_clips_as_documented() {
             String::from_utf8_lossy(&out.stderr)
         );
         let text = String::from_utf8_lossy(&out.stdout).into_owned();
-        let values: Vec<f64> = text
-            .lines()
+        text.lines()
             .nth(1)
             .unwrap()
             .split(',')
             .map(|v| v.parse().unwrap())
-            .collect();
-        values.iter().sum::<f64>() / values.len() as f64
+            .collect()
     };
-    let (normal, over) = (mean_feature("1"), mean_feature("1.5"));
-    // Accepted as documented; the features of the render are not darker for it.
-    assert!(
-        over >= normal,
-        "exposure 1.5 is not darker: {over} vs {normal}"
+    let patch = |f: &[f64], p: usize| f[3 * (p - 1)..3 * p].to_vec();
+    let spread = |rgb: &[f64]| {
+        rgb.iter().cloned().fold(f64::MIN, f64::max) - rgb.iter().cloned().fold(f64::MAX, f64::min)
+    };
+    let (under, normal, over, far) = (
+        features("0.5"),
+        features("1"),
+        features("1.5"),
+        features("3"),
     );
+    // Up to 1 nothing clips: the exposure drops out with the white balance, and the white
+    // stays white.
+    assert_eq!(under, normal);
+    assert!(
+        spread(&patch(&normal, 19)) <= 3.0,
+        "{:?}",
+        patch(&normal, 19)
+    );
+    // Above 1 the brightest raw channel clips: the white takes a cast, and at 3 the white
+    // and the lightest grey clip to one colour.
+    assert_ne!(over, normal);
+    assert!(spread(&patch(&over, 19)) > 10.0, "{:?}", patch(&over, 19));
+    assert_eq!(patch(&far, 19), patch(&far, 20));
+    assert_ne!(patch(&normal, 19), patch(&normal, 20));
     let help = String::from_utf8_lossy(&spdcam(&["render", "--help"]).stdout).into_owned();
     assert!(help.contains("above 1 clips"), "{help}");
     for (value, shown) in [("1e300", "1e300"), ("-1e300", "-1e300"), ("0", "0")] {

@@ -242,6 +242,17 @@ impl Camera {
         Ok(camera)
     }
 
+    /// The stages' settings of a shot with the in-camera record `ic` ([`Shot::of`]); without
+    /// one, the thesis's camera, which puts its brightest value at the configured exposure
+    /// of full scale and so clips only an exposure above 1.
+    fn shot(&self, ic: Option<&InCamera>) -> Shot {
+        let mut shot = Shot::of(ic);
+        if ic.is_none() && self.config.sensor.exposure > 1.0 {
+            shot.full_scale = 1.0;
+        }
+        shot
+    }
+
     /// Thesis 3.1.6: white-balanced camera RGB of every patch under D65 against the
     /// patches' XYZ under D65 (perfect white Y = 1).
     fn fit_d65_matrix(&self) -> Result<nalgebra::Matrix3<f64>> {
@@ -378,7 +389,7 @@ impl Camera {
     /// photo of the chart is composed from ([`crate::photo::scene`]), a second light lighting
     /// part of the chart as the camera metered the first.
     pub fn exposed_chart(&self, spds: &[&Spd]) -> Result<Vec<Vec<[f32; 3]>>> {
-        let shot = Shot::of(self.config.in_camera.as_ref());
+        let shot = self.shot(self.config.in_camera.as_ref());
         let mut out: Vec<Vec<[f32; 3]>> = Vec::with_capacity(spds.len());
         for spd in spds {
             let light = self.light(spd)?;
@@ -437,7 +448,7 @@ impl Camera {
     /// The configured shot without the patch-level JPEG model (scene photos are encoded by
     /// a real encoder).
     fn scene_shot(&self) -> Shot {
-        let mut shot = Shot::of(self.config.in_camera.as_ref());
+        let mut shot = self.shot(self.config.in_camera.as_ref());
         if let Some(rendering) = &mut shot.rendering {
             rendering.jpeg_quality = None;
         }
@@ -502,7 +513,7 @@ impl Camera {
         buffers: &mut RenderBuffers,
         mut stages: Option<&mut Stages>,
     ) -> [f32; 3] {
-        let shot = Shot::of(self.config.in_camera.as_ref());
+        let shot = self.shot(self.config.in_camera.as_ref());
         let gains = self.capture_balanced(&shot, light, seed, buffers, stages.as_deref_mut());
         self.finish_image(&shot, buffers, stages);
         gains
@@ -554,7 +565,7 @@ impl Camera {
         buffers: &mut RenderBuffers,
         out: &mut Vec<f32>,
     ) {
-        let shot = Shot::of(ic);
+        let shot = self.shot(ic);
         self.capture_balanced(&shot, light, seed, buffers, None);
         let RenderBuffers {
             image,
@@ -738,7 +749,7 @@ impl Camera {
         raw: &mut Vec<[f32; 3]>,
         out: &mut Vec<f32>,
     ) {
-        let shot = Shot::of(ic);
+        let shot = self.shot(ic);
         self.balanced_regions(&shot, light, raw);
         self.finish_features(&shot, raw, out);
     }
@@ -757,7 +768,7 @@ impl Camera {
         raw: &mut Vec<[f32; 3]>,
         out: &mut Vec<f32>,
     ) {
-        let shot = Shot::of(ic);
+        let shot = self.shot(ic);
         self.lit_regions(&shot, light, raw);
         let scale = self.exposure_scale(&shot, raw);
         let mut by_other = Vec::new();
@@ -790,7 +801,8 @@ struct Shot {
     glare: VeilingGlare,
     auto_exposure: Option<AutoExposure>,
     /// Raw values clip here: full scale (1) for a metering JPEG camera; the thesis's camera
-    /// normalises to the brightest value and never clips.
+    /// normalises to the brightest value and clips only an exposure above 1
+    /// ([`Camera::shot`]).
     full_scale: f32,
     adaptation: f64,
     rendering: Option<ToneRendering>,
