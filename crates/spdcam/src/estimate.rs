@@ -11,11 +11,11 @@ use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
 use spdcam_core::photo::{self, PhotoAnalysis};
-use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use spdcam_infer::estimate::{Colorimetry, Score};
 use spdcam_infer::estimator::EstimatedBlock;
 use spdcam_infer::plot::spds_band_svg;
+use spdcam_infer::presentation::{cct_meaningful, cri_meaningful};
 use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
 use spdcam_infer::stream::{
     long_header, long_rows, row_name, FeatureStream, Layout, WIDE_LAYOUT_MAX_ROWS,
@@ -665,7 +665,7 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
                 colorimetry_line(&e.colorimetry, intervals)
             );
             println!("  relative SPD: {}", spd_line(&e.spd));
-            println!("  {}", metrics_line(&e.metrics, intervals));
+            println!("  {}", metrics_line(e, intervals));
             match (&e.absolute, e.photo.as_ref().and_then(|p| p.exposure)) {
                 (Some(Ok(a)), _) => println!(
                     "  absolute (approximate, from {}): {:.0} lx, PPFD {}, melanopic EDI {}",
@@ -716,6 +716,7 @@ fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
             "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and gamut; \
              M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: scotopic/photopic; \
              PPF: µmol/s of 400–700 nm photons per klm; ± the 95 % interval when calibrated; \
+             — where not defined or not meaningful (CRI and TM-30 need a light near white); \
              computed on the estimate's {}–{} nm only \
              (`spdcam metrics` on a wider SPD, `--json` for every number)",
             estimates[0].spd.grid().start_nm,
@@ -821,14 +822,17 @@ fn with_bands(estimates: &[Estimate], grid: &Grid) -> Result<SpectralSet> {
     Ok(SpectralSet::on_grid(grid, names, values)?)
 }
 
-/// The main lighting-quality numbers on one line, `—` where undefined, each with its 95 %
+/// The main lighting-quality numbers on one line, `—` where undefined or not meaningful for
+/// this light (CRI and TM-30 far from white, as the report shows them), each with its 95 %
 /// interval when the estimate has one: `Ra 82 ± 4 (R9 20 ± 15), …`.
-fn metrics_line(
-    m: &LightingMetrics,
-    intervals: Option<&BTreeMap<String, MetricInterval>>,
-) -> String {
+fn metrics_line(e: &Estimate, intervals: Option<&BTreeMap<String, MetricInterval>>) -> String {
     let f = |key: &str, d: usize, unit: f64| {
-        let Some(v) = m.scalar(key) else {
+        let meaningful = match key {
+            "cri_ra" | "cri_r9" => cri_meaningful(e).is_ok(),
+            "tm30_rf" | "tm30_rg" => cct_meaningful(e).is_ok(),
+            _ => true,
+        };
+        let Some(v) = e.metrics.scalar(key).filter(|_| meaningful) else {
             return "—".to_string();
         };
         match intervals.and_then(|i| i.get(key)) {
