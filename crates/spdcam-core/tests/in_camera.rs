@@ -92,6 +92,21 @@ fn tone_stages_match_hand_computed_values() {
     let rolled = 0.6 + 0.4 * (1.0 - (-1.5f64).exp());
     assert!((ic.rendering().encode(&ct, [1.2, 0.5, 0.0])[0] - enc(rolled)).abs() < 1e-5);
     assert!((ic.rendering().encode(&ct, [1.2, 0.5, 0.0])[1] - enc(0.5)).abs() < 1e-5);
+    // Black floor 0.1: a channel pushed below black reads 0.1, white stays 1, and the
+    // rest is scaled between them.
+    let ic = InCamera {
+        floor: 0.1,
+        ..InCamera::NEUTRAL
+    };
+    let out = ic.rendering().encode(&ct, [-0.2, 1.0, 0.1]);
+    assert!((out[0] - 0.1).abs() < 1e-6 && (out[1] - 1.0).abs() < 1e-6, "{out:?}");
+    assert!((out[2] - (0.1 + 0.9 * enc(0.1))).abs() < 1e-5, "{out:?}");
+    assert!(InCamera {
+        floor: 0.6,
+        ..InCamera::NEUTRAL
+    }
+    .validate()
+    .is_err());
     // Gamma 2 on linear 0.3 → 0.09.
     let ic = InCamera {
         gamma: 2.0,
@@ -178,6 +193,7 @@ fn calibration_recovers_known_parameters() {
         contrast: 0.2,
         jpeg_quality: None,
         gradient: [0.0, 0.0],
+        floor: 0.0,
     };
     let cam = camera(None);
     let lights = [

@@ -58,7 +58,16 @@ pub struct InCamera {
     /// lighting (sensible magnitudes up to 0.5).
     #[serde(default)]
     pub gradient: [f64; 2],
+    /// Black floor of the rendered values (0 = none; sensible 0–0.2): each encoded value
+    /// becomes `floor + (1 − floor)·value`, as a real camera's black offset, noise and
+    /// residual flare keep its darkest channels above 0 where the colour matrix pushes a
+    /// saturated patch's channel below black (`docs/real-cameras.md`).
+    #[serde(default)]
+    pub floor: f64,
 }
+
+/// Largest black floor: half of full scale.
+const MAX_FLOOR: f64 = 0.5;
 
 impl Default for InCamera {
     fn default() -> Self {
@@ -93,6 +102,7 @@ impl InCamera {
         contrast: 0.0,
         jpeg_quality: None,
         gradient: [0.0, 0.0],
+        floor: 0.0,
     };
 
     /// The fitted parameters as a vector in [`RANGES`] order (exposure target 0 when off).
@@ -146,6 +156,12 @@ impl InCamera {
                 self.gradient
             )));
         }
+        if !(self.floor.is_finite() && (0.0..=MAX_FLOOR).contains(&self.floor)) {
+            return Err(Error::invalid(format!(
+                "in-camera black floor {} is outside [0, {MAX_FLOOR}]",
+                self.floor
+            )));
+        }
         if let Some(q) = self.jpeg_quality {
             if !(1..=100).contains(&q) {
                 return Err(Error::invalid(format!(
@@ -181,6 +197,7 @@ impl InCamera {
             gamma: self.gamma,
             contrast: self.contrast,
             jpeg_quality: self.jpeg_quality,
+            floor: self.floor,
         }
     }
 }

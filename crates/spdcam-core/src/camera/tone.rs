@@ -21,6 +21,8 @@ pub struct ToneRendering {
     pub contrast: f64,
     /// JPEG quality (1–100) whose DC quantisation steps round each pixel; `None`: no JPEG.
     pub jpeg_quality: Option<u8>,
+    /// Black floor on encoded values: `floor + (1 − floor)·y` (0 = none).
+    pub floor: f64,
 }
 
 impl ToneRendering {
@@ -36,6 +38,7 @@ impl ToneRendering {
         let width = self.shoulder as f32;
         let gamma = self.gamma as f32;
         let c = self.contrast as f32;
+        let floor = self.floor as f32;
         let encoded = v.map(|x| {
             let mut x = x.max(0.0);
             if width > 0.0 && x > knee {
@@ -46,7 +49,8 @@ impl ToneRendering {
                 x = x.powf(gamma);
             }
             let y = colour.encode(x);
-            (y + c * y * (1.0 - y) * (2.0 * y - 1.0)).clamp(0.0, 1.0)
+            let y = (y + c * y * (1.0 - y) * (2.0 * y - 1.0)).clamp(0.0, 1.0);
+            floor + (1.0 - floor) * y
         });
         match self.jpeg_quality {
             Some(q) => jpeg_quantise(encoded, q),

@@ -47,12 +47,16 @@ pub struct InCameraRanges {
     /// Largest magnitude of each lighting-gradient component, drawn uniformly in ±it.
     #[serde(default)]
     pub gradient: Option<f64>,
+    /// Range of [`InCamera::floor`] (share of full scale).
+    #[serde(default)]
+    pub floor: Option<[f64; 2]>,
 }
 
 impl InCameraRanges {
     /// Ranges for the named groups (`exposure`: exposure target and flare; `wb`:
     /// adaptation from half to full; `wb-wide`: adaptation from none to full; `tone`: saturation, shoulder, gamma, contrast; `jpeg`: JPEG quality;
-    /// `gradient`: uneven lighting across the chart), wide enough to cover the JPEG cameras
+    /// `gradient`: uneven lighting across the chart; `floor`: a black floor under the
+    /// rendered values), wide enough to cover the JPEG cameras
     /// and photo set-ups we know of.
     pub fn for_groups(groups: &[&str]) -> Result<InCameraRanges> {
         let mut r = InCameraRanges::default();
@@ -74,11 +78,14 @@ impl InCameraRanges {
                 }
                 "jpeg" => r.jpeg_quality = Some([70, 98]),
                 "gradient" => r.gradient = Some(0.5),
+                // A black floor up to the Telelumen photos' darkest patch (about 0.15 of
+                // full scale; the Hue photos' about 0.02).
+                "floor" => r.floor = Some([0.0, 0.15]),
                 other => {
                     return Err(Error::UnknownName {
                         kind: "randomisation group",
                         name: other.to_string(),
-                        valid: "camera, exposure, wb, wb-wide, tone, jpeg, gradient".into(),
+                        valid: "camera, exposure, wb, wb-wide, tone, jpeg, gradient, floor".into(),
                     })
                 }
             }
@@ -111,6 +118,7 @@ impl InCameraRanges {
             contrast: u(self.contrast, base.contrast),
             jpeg_quality: base.jpeg_quality,
             gradient: base.gradient,
+            floor: u(self.floor, base.floor),
         };
         let drawn = match self.jpeg_quality {
             Some([lo, hi]) => InCamera {
@@ -174,6 +182,7 @@ impl Randomisation {
             ("shoulder", ranges.shoulder),
             ("gamma", ranges.gamma),
             ("contrast", ranges.contrast),
+            ("floor", ranges.floor),
         ] {
             if let Some([lo, hi]) = range {
                 let probe = |v: f64| {
@@ -185,6 +194,7 @@ impl Randomisation {
                         "saturation" => ic.saturation = v,
                         "shoulder" => ic.shoulder = v,
                         "gamma" => ic.gamma = v,
+                        "floor" => ic.floor = v,
                         _ => ic.contrast = v,
                     }
                     ic.validate()
