@@ -99,7 +99,10 @@ fn tone_stages_match_hand_computed_values() {
         ..InCamera::NEUTRAL
     };
     let out = ic.rendering().encode(&ct, [-0.2, 1.0, 0.1]);
-    assert!((out[0] - 0.1).abs() < 1e-6 && (out[1] - 1.0).abs() < 1e-6, "{out:?}");
+    assert!(
+        (out[0] - 0.1).abs() < 1e-6 && (out[1] - 1.0).abs() < 1e-6,
+        "{out:?}"
+    );
     assert!((out[2] - (0.1 + 0.9 * enc(0.1))).abs() < 1e-5, "{out:?}");
     assert!(InCamera {
         floor: 0.6,

@@ -53,8 +53,9 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "FILE.json")]
     in_camera: Option<PathBuf>,
     /// Domain randomisation per sample, comma-separated: camera (draw the camera from
-    /// --cameras), exposure, wb, tone, jpeg (draw those in-camera parameters), gradient
-    /// (uneven lighting across the chart).
+    /// --cameras), exposure, wb (or wb-wide), tone, jpeg, floor (draw those in-camera
+    /// parameters; floor: a black floor under the rendered values), gradient (uneven
+    /// lighting across the chart).
     #[arg(long, value_delimiter = ',', value_name = "GROUPS")]
     randomise: Vec<String>,
     /// Cameras to draw from with --randomise camera: a directory of sensitivity CSVs or a

@@ -330,8 +330,9 @@ pub const DEFAULT_CAMERA_VARIANTS: usize = 3;
 /// `--camera-split`, `--camera-variants`); by default none.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RandomiseRequest {
-    /// Groups: camera (draw the camera from `cameras`), exposure, wb, tone, jpeg (draw those
-    /// in-camera parameters), gradient (uneven lighting); none: no randomisation.
+    /// Groups: camera (draw the camera from `cameras`), exposure, wb (or wb-wide), tone,
+    /// jpeg, floor (draw those in-camera parameters), gradient (uneven lighting); none: no
+    /// randomisation.
     pub groups: Vec<String>,
     /// The cameras to draw from with `camera`: a directory of sensitivity CSVs or a
     /// comma-separated list of names or files.
