@@ -126,6 +126,12 @@ impl Architecture {
         }
     }
 
+    /// Whether it is trained (and fine-tuned) by gradient descent: the networks, not the
+    /// closed-form ridge nor an average of trained models.
+    pub fn trained_by_gradient(&self) -> bool {
+        matches!(self, Architecture::Cnn1d(_) | Architecture::Mlp(_))
+    }
+
     /// A short description: the name, and an average's members.
     pub fn label(&self) -> String {
         match self {

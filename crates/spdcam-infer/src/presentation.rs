@@ -295,8 +295,9 @@ fn gfc_words(expected: Option<f64>) -> String {
     }
 }
 
-/// The value of metric `key` when it is meaningful for this light, else why not.
-fn meaningful_value(estimate: &Estimate, key: &str) -> Result<f64, String> {
+/// The value of metric `key` when it is meaningful for this light, else why not (CCT and
+/// TM-30 far from white, CRI farther than CIE 13.3 allows, or undefined).
+pub fn meaningful_value(estimate: &Estimate, key: &str) -> Result<f64, String> {
     let m = &estimate.metrics;
     let undefined = || {
         let reason_key = if key == "cri_r9" { "cri_r" } else { key };

@@ -113,10 +113,7 @@ pub fn candidates(model: &Model, n: usize, seed: u64, backend: Backend) -> Vec<R
         name,
         fit: Fit::Ridge { penalty },
     });
-    if matches!(
-        model.network().architecture(),
-        Architecture::Linear { .. } | Architecture::Average { .. }
-    ) {
+    if !model.network().architecture().trained_by_gradient() {
         return std::iter::once(unchanged).chain(ridges).collect();
     }
     let mut all = vec![

@@ -15,7 +15,7 @@ use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet
 use spdcam_infer::estimate::{Colorimetry, Score};
 use spdcam_infer::estimator::EstimatedBlock;
 use spdcam_infer::plot::spds_band_svg;
-use spdcam_infer::presentation::{cct_meaningful, cri_meaningful};
+use spdcam_infer::presentation::meaningful_value;
 use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
 use spdcam_infer::stream::{
     long_header, long_rows, row_name, FeatureStream, Layout, WIDE_LAYOUT_MAX_ROWS,
@@ -827,12 +827,7 @@ fn with_bands(estimates: &[Estimate], grid: &Grid) -> Result<SpectralSet> {
 /// interval when the estimate has one: `Ra 82 ± 4 (R9 20 ± 15), …`.
 fn metrics_line(e: &Estimate, intervals: Option<&BTreeMap<String, MetricInterval>>) -> String {
     let f = |key: &str, d: usize, unit: f64| {
-        let meaningful = match key {
-            "cri_ra" | "cri_r9" => cri_meaningful(e).is_ok(),
-            "tm30_rf" | "tm30_rg" => cct_meaningful(e).is_ok(),
-            _ => true,
-        };
-        let Some(v) = e.metrics.scalar(key).filter(|_| meaningful) else {
+        let Ok(v) = meaningful_value(e, key) else {
             return "—".to_string();
         };
         match intervals.and_then(|i| i.get(key)) {

@@ -261,7 +261,6 @@ fn glare(chart: &Chart) -> Vec<f64> {
 
 /// One feature row judged: the estimate, its spread, its GFC, its self-check, and per
 /// single-number metric its spread and (with a truth) its absolute error.
-#[derive(Clone)]
 struct Judged {
     spd: Vec<f64>,
     truth: Option<Vec<f64>>,
@@ -368,39 +367,35 @@ fn residual(judged: &Judged) -> Option<f64> {
 /// The photos a calibration is fitted on: held-out virtual photos (`shots` consecutive ones
 /// per lamp) and, with `--real`, real photos of the real sets' validation split.
 struct CalibrationPhotos {
-    virtual_features: Vec<Vec<f64>>,
-    virtual_judged: Vec<Judged>,
+    /// Every photo's features, the virtual ones first.
+    features: Vec<Vec<f64>>,
+    /// Every photo judged, in the same order.
+    judged: Vec<Judged>,
+    /// How many of them are virtual.
+    virtual_count: usize,
+    /// Virtual photos per lamp.
     shots: usize,
-    real_features: Vec<Vec<f64>>,
-    real_judged: Vec<Judged>,
 }
 
 impl CalibrationPhotos {
-    /// Every photo judged, the virtual ones first.
-    fn judged(&self) -> Vec<Judged> {
-        self.virtual_judged
-            .iter()
-            .chain(&self.real_judged)
-            .cloned()
-            .collect()
+    /// The virtual photos judged.
+    fn virtual_judged(&self) -> &[Judged] {
+        &self.judged[..self.virtual_count]
     }
 
-    /// Every photo's features, in the order of [`CalibrationPhotos::judged`].
-    fn features(&self) -> Vec<Vec<f64>> {
-        self.virtual_features
-            .iter()
-            .chain(&self.real_features)
-            .cloned()
-            .collect()
-    }
-
-    /// The cross-validation group of each photo of [`CalibrationPhotos::judged`]: a lamp's
-    /// photos together (so a lamp never informs its own prediction), each real photo alone.
+    /// The cross-validation group of each photo: a lamp's photos together (so a lamp never
+    /// informs its own prediction), each real photo alone.
     fn groups(&self) -> Vec<usize> {
-        let lamps = self.virtual_judged.len().div_ceil(self.shots.max(1));
-        (0..self.virtual_judged.len())
-            .map(|i| i / self.shots.max(1))
-            .chain((0..self.real_judged.len()).map(|j| lamps + j))
+        let shots = self.shots.max(1);
+        let lamps = self.virtual_count.div_ceil(shots);
+        (0..self.judged.len())
+            .map(|i| {
+                if i < self.virtual_count {
+                    i / shots
+                } else {
+                    lamps + i - self.virtual_count
+                }
+            })
             .collect()
     }
 }
@@ -413,11 +408,10 @@ fn fit_calibration(
     photos: &CalibrationPhotos,
     method: String,
 ) -> Result<Calibration> {
-    let judged = &photos.judged();
-    let features = &photos.features();
+    let (judged, features) = (&photos.judged, &photos.features);
     let d = model.grid().count;
     let err = |j: &Judged, k: usize| (j.spd[k] - j.truth.as_ref().map_or(0.0, |t| t[k])).abs();
-    let virtual_judged = &photos.virtual_judged;
+    let virtual_judged = photos.virtual_judged();
     let checks_of = |value: fn(&SelfCheck) -> Option<f64>| -> Vec<f64> {
         virtual_judged
             .iter()
@@ -513,7 +507,7 @@ fn fit_calibration(
             .then(|| conformal_quantile(&mut glares, 0.99)),
         clipped_doubtful: conformal_quantile(&mut clipped, 0.99) as usize,
         metrics: metric_calibrations,
-        real_photos: photos.real_judged.len(),
+        real_photos: photos.judged.len() - photos.virtual_count,
     })
 }
 
@@ -640,25 +634,29 @@ fn calibrate(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
         let shots = args
             .photos
             .shots(&setup, &chart, &model, LampPart::Validation)?;
-        let virtual_judged = judge_rows(
+        let mut judged = judge_rows(
             &model,
             check.as_ref(),
             &shots.clean.features,
             Some(&shots.clean.truths),
         )?;
+        let virtual_count = judged.len();
         let real = if args.real {
             real_split(&args.thesis_data, data_dir, &model, &chart_name)?
         } else {
             Vec::new()
         };
-        let real = balanced(real, shots.clean.features.len());
-        let real_features: Vec<Vec<f64>> = real
-            .iter()
-            .flat_map(|set| set.val.features.clone())
-            .collect();
-        let real_truths: Vec<Vec<f64>> =
-            real.iter().flat_map(|set| set.val.truths.clone()).collect();
-        let real_judged = judge_rows(&model, check.as_ref(), &real_features, Some(&real_truths))?;
+        let real = balanced(real, virtual_count);
+        let mut features = shots.clean.features;
+        for set in &real {
+            judged.extend(judge_rows(
+                &model,
+                check.as_ref(),
+                &set.val.features,
+                Some(&set.val.truths),
+            )?);
+            features.extend(set.val.features.iter().cloned());
+        }
         let mut method = format!(
             "the split's {} validation lamps, {} photos each by its held-out cameras with the \
              randomised in-camera stage, patch level, seed {}; spread of {JITTER_COPIES} copies \
@@ -670,16 +668,15 @@ fn calibrate(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
         if !real.is_empty() {
             method += &format!(
                 "; and {} real photos, the validation photos of {}",
-                real_judged.len(),
+                judged.len() - virtual_count,
                 real.iter().map(|s| s.label).collect::<Vec<_>>().join(", ")
             );
         }
         let photos = CalibrationPhotos {
-            virtual_features: shots.clean.features,
-            virtual_judged,
+            features,
+            judged,
+            virtual_count,
             shots: args.photos.shots as usize,
-            real_features,
-            real_judged,
         };
         let cal = fit_calibration(&model, &chart_name, &photos, method)?;
         let out = args.output.join(format!("{chart_name}.trust.json"));

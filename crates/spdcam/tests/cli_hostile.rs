@@ -1,5 +1,7 @@
 //! Hostile and careless input on the command line (issue 15): every case gets a clear
 //! error at once — no abort, no minutes of work, no lost output, no silent overwrite.
+//! First tier: it reads no measured data (`SPDCAM_DATA` is removed, not read, so that the
+//! cases meet the program as a fresh clone has it).
 
 mod common;
 
