@@ -98,8 +98,9 @@ pub struct TrainOptions {
     pub architecture: Architecture,
     /// PCA coefficients or channel weights.
     pub target: TargetKind,
-    /// What each feature row is divided by (records from before it: the maximum).
-    #[serde(default)]
+    /// What each feature row is divided by (records from before it, and records that leave
+    /// it out: the maximum).
+    #[serde(default, skip_serializing_if = "RowScale::is_max")]
     pub row_scale: RowScale,
     /// The grid the model estimates SPDs on (a sub-grid of the dataset's).
     pub grid: Grid,

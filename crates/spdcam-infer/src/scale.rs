@@ -20,6 +20,12 @@ pub enum RowScale {
 }
 
 impl RowScale {
+    /// Whether this is the maximum, the default a file leaves unwritten: models trained
+    /// before the choice existed keep their exact bytes when rebuilt.
+    pub fn is_max(&self) -> bool {
+        *self == RowScale::Max
+    }
+
     /// The divisor of `row`: its maximum or mean, or 1 when that is not positive.
     fn divisor(self, row: &[f64]) -> f64 {
         let d = match self {
@@ -40,8 +46,9 @@ pub struct FeatureScaler {
     /// Whether each row is first divided by its own maximum or mean (`row_scale`).
     #[serde(rename = "per_sample_max")]
     pub per_row: bool,
-    /// What the row is divided by (files from before this field: the maximum).
-    #[serde(default)]
+    /// What the row is divided by (files from before this field, and files that leave it
+    /// out: the maximum).
+    #[serde(default, skip_serializing_if = "RowScale::is_max")]
     pub row_scale: RowScale,
     /// Per-feature minimum over the training rows.
     pub min: Vec<f64>,
@@ -262,6 +269,12 @@ mod tests {
         .unwrap();
         assert!(new.contains(r#""per_sample_max":true"#), "{new}");
         assert!(new.contains(r#""row_scale":"mean""#), "{new}");
+        // The default is left unwritten, so a model trained as before is written as before.
+        let default = serde_json::to_string(&s).unwrap();
+        assert_eq!(
+            default,
+            r#"{"per_sample_max":true,"min":[0.0],"max":[1.0]}"#
+        );
     }
 
     #[test]
