@@ -264,7 +264,7 @@ mod tests {
         assert_eq!(s.row_scale, RowScale::Max);
         let new = serde_json::to_string(&FeatureScaler {
             row_scale: RowScale::Mean,
-            ..s
+            ..s.clone()
         })
         .unwrap();
         assert!(new.contains(r#""per_sample_max":true"#), "{new}");
