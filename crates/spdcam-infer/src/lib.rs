@@ -25,6 +25,8 @@
 //! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
 //!   verdict); [`presentation`]: what an estimate means in words and rounded numbers;
 //!   [`plot`] and [`report`]: SVG plots and the HTML report.
+//! - [`ridge`]: closed-form ridge regression, the `linear` model's fit and the simple
+//!   learner every protocol compares against (here, so that it runs without burn).
 //! - [`error`]: the crate's error type.
 //!
 //! Estimating the light from the example photo of a ColorChecker Digital SG with the
@@ -70,6 +72,7 @@ pub mod plot;
 pub mod presentation;
 pub mod record;
 pub mod report;
+pub mod ridge;
 pub mod scale;
 pub mod shipped;
 pub mod stream;

@@ -48,11 +48,9 @@
 mod burn_net;
 pub mod error;
 pub mod evaluate;
-pub mod real_cameras;
 pub mod recipe;
-pub mod ridge;
 pub mod synthetic;
 pub mod train;
 
 pub use error::{LearnError, Result};
-pub use spdcam_infer::{model, network, pca, record, scale, target, Model};
+pub use spdcam_infer::{model, network, pca, record, ridge, scale, target, Model};

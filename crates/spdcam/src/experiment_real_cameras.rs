@@ -7,7 +7,7 @@ use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
 use spdcam_learn::model::Model;
-use spdcam_learn::real_cameras::{
+use spdcam_eval::real_cameras::{
     appearance, baseline_rows, model_row, recipes, split_sets, virtual_photos, virtual_rows,
     CameraSource, Row, DEV_SPLIT_SEED,
 };

@@ -3,19 +3,16 @@
 //! writes the parameters the `lamp:` recipes draw around; `validate` runs the validation
 //! protocol (`crate::validate_lamps`).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::lighting::lamp_families::{fit_families, LampFits};
 use spdcam_core::lighting::validation_split::LampPart;
-use spdcam_core::lighting::{LampLibrary, ValidationSplit};
+use spdcam_core::lighting::ValidationSplit;
 use spdcam_core::spectral::Grid;
-use std::path::{Path, PathBuf};
-
-/// The lamp library's files inside the data directory.
-pub const LAMP_SPDS: &str = "lamps/ies_tm30_lamps.csv";
-/// The lamp library's type table inside the data directory.
-pub const LAMP_TYPES: &str = "lamps/ies_tm30_lamps_info.csv";
+use crate::held_out_args::LibraryArgs;
+use spdcam_eval::held_out::{camera_names, in_data_dir};
+use std::path::PathBuf;
 
 /// Options of `spdcam lamps`.
 #[derive(Debug, Args)]
@@ -34,41 +31,6 @@ enum LampsCommand {
     /// The validation protocol: held-out lamps through held-out cameras (the randomised
     /// in-camera stage and an independent simple camera), and the real photo sets.
     Validate(Box<crate::validate_lamps::ValidateArgs>),
-}
-
-/// Where the lamp library is read from.
-#[derive(Debug, Args)]
-pub struct LibraryArgs {
-    /// Measured lamp SPDs (spectral CSV); default: the data directory's
-    /// lamps/ies_tm30_lamps.csv.
-    #[arg(long, value_name = "SPDS.csv")]
-    pub lamps: Option<PathBuf>,
-    /// The lamps' types (`column,type,category`); default: the data directory's
-    /// lamps/ies_tm30_lamps_info.csv.
-    #[arg(long, value_name = "INFO.csv")]
-    pub types: Option<PathBuf>,
-}
-
-impl LibraryArgs {
-    /// Reads the library on `grid`.
-    pub fn read(&self, data_dir: &DataDir, grid: &Grid) -> Result<LampLibrary> {
-        let spds = in_data_dir(self.lamps.as_deref(), LAMP_SPDS, data_dir)?;
-        let types = in_data_dir(self.types.as_deref(), LAMP_TYPES, data_dir)?;
-        Ok(LampLibrary::read(&spds, Some(&types), grid)?)
-    }
-}
-
-/// `given`, or `default` inside the data directory.
-pub fn in_data_dir(given: Option<&Path>, default: &str, data_dir: &DataDir) -> Result<PathBuf> {
-    match given {
-        Some(p) => Ok(p.to_path_buf()),
-        None => Ok(data_dir
-            .root()
-            .with_context(|| {
-                format!("give the file or a data directory (--data-dir / SPDCAM_DATA) holding {default}")
-            })?
-            .join(default)),
-    }
 }
 
 #[derive(Debug, Args)]
@@ -105,18 +67,6 @@ pub fn run(args: LampsArgs, data_dir: &DataDir) -> Result<()> {
         LampsCommand::Fit(a) => fit(a, data_dir),
         LampsCommand::Validate(a) => crate::validate_lamps::run(*a, data_dir),
     }
-}
-
-/// The file stems of the camera CSVs in `dir`, sorted.
-pub fn camera_names(dir: &Path) -> Result<Vec<String>> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .with_context(|| format!("reading {}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
-        .collect();
-    names.sort();
-    Ok(names)
 }
 
 fn split(args: SplitArgs, data_dir: &DataDir) -> Result<()> {
@@ -161,7 +111,7 @@ fn fit(args: FitArgs, data_dir: &DataDir) -> Result<()> {
              non-negative least squares, positions and widths by Levenberg–Marquardt, best of \
              several starts) to the fit lamps of its type in {} (the fit part of the split with \
              seed {})",
-            library_name(&args.library),
+            args.library.files().name(),
             split.seed
         ),
         families,
@@ -173,13 +123,4 @@ fn fit(args: FitArgs, data_dir: &DataDir) -> Result<()> {
     LampFits::from_json(&text, &args.output.display().to_string())?;
     println!("{}", args.output.display());
     Ok(())
-}
-
-/// The library's file name, for records (no directories: they differ between machines).
-pub fn library_name(args: &LibraryArgs) -> String {
-    args.lamps
-        .as_deref()
-        .and_then(|p| p.file_name())
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| LAMP_SPDS.to_string())
 }

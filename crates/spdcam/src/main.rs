@@ -22,21 +22,19 @@ mod experiment_sim2real;
 #[cfg(feature = "train")]
 mod finetune;
 mod generate;
+mod held_out_args;
 mod lamps;
 mod list;
 mod messages;
 mod metrics;
 mod photo_args;
 mod plot_file;
-#[cfg(feature = "train")]
-mod reliability;
 mod render;
 mod serve;
 #[cfg(feature = "train")]
 mod sim2real_curve;
 #[cfg(feature = "train")]
 mod train;
-#[cfg(feature = "train")]
 mod trust;
 mod validate_lamps;
 
@@ -98,7 +96,6 @@ enum Command {
     Coverage(Box<coverage::CoverageArgs>),
     /// Real lamps: the validation split, the lamp-family fits, the validation protocol.
     Lamps(lamps::LampsArgs),
-    #[cfg(feature = "train")]
     /// Calibrate and measure how far estimates can be trusted (bands, verdicts).
     Trust(trust::TrustArgs),
 }
@@ -146,7 +143,6 @@ fn main() -> ExitCode {
         Command::Serve(args) => serve::run(args, &data_dir),
         Command::Coverage(args) => coverage::run(*args, &data_dir),
         Command::Lamps(args) => lamps::run(args, &data_dir),
-        #[cfg(feature = "train")]
         Command::Trust(args) => trust::run(args, &data_dir),
     };
     match result {

@@ -5,7 +5,8 @@
 //! the average-SPD baseline, for the validation lamps (choose on these) and the test lamps
 //! (report only). (c) The real photo sets of the thesis (SG 96 models only).
 
-use crate::lamps::{camera_names, in_data_dir, LibraryArgs};
+use crate::held_out_args::HeldOutArgs;
+use spdcam_eval::held_out::{held_out_cameras, in_data_dir, on_grid};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use rand::rngs::SmallRng;
@@ -25,34 +26,11 @@ use spdcam_core::{metrics, seed};
 use spdcam_infer::Model;
 use std::path::PathBuf;
 
-/// Held-out lamps photographed by held-out cameras: the models, the split and how many
-/// photos (shared by `spdcam lamps validate` and `spdcam trust`).
-#[derive(Debug, Args)]
-pub(crate) struct HeldOutPhotos {
-    /// Models (repeatable).
-    #[arg(long, required = true)]
-    pub(crate) model: Vec<PathBuf>,
-    /// The validation split (`spdcam lamps split`).
-    #[arg(long, value_name = "SPLIT.json")]
-    pub(crate) split: PathBuf,
-    #[command(flatten)]
-    pub(crate) library: LibraryArgs,
-    /// Directory of camera sensitivity CSVs holding the split's held-out cameras; default:
-    /// the data directory's cameras/.
-    #[arg(long, value_name = "DIR")]
-    pub(crate) cameras: Option<PathBuf>,
-    /// Photos of each lamp, each by a held-out camera and in-camera settings drawn at random.
-    #[arg(long, default_value_t = 8)]
-    pub(crate) shots: u64,
-    #[arg(long, default_value_t = 1)]
-    pub(crate) seed: u64,
-}
-
 /// Options of `spdcam lamps validate`.
 #[derive(Debug, Args)]
 pub struct ValidateArgs {
     #[command(flatten)]
-    photos: HeldOutPhotos,
+    photos: HeldOutArgs,
     /// The thesis's data (holding measured/…); default: the data directory's thesis/.
     #[arg(long)]
     thesis_data: Option<PathBuf>,
@@ -206,43 +184,6 @@ fn file_name(path: &std::path::Path) -> String {
         || path.display().to_string(),
         |n| n.to_string_lossy().into(),
     )
-}
-
-/// The split's held-out cameras from `dir` (default: the data directory's cameras/); the
-/// cameras training skips (unusable curves) are skipped here too, named.
-pub(crate) fn held_out_cameras(
-    split: &ValidationSplit,
-    dir: Option<&std::path::Path>,
-    data_dir: &DataDir,
-) -> Result<Vec<Sensitivities>> {
-    let dir = in_data_dir(dir, "cameras", data_dir)?;
-    let available = camera_names(&dir)?;
-    let mut held_out: Vec<Sensitivities> = Vec::new();
-    for name in &split.cameras.held_out {
-        if !available.contains(name) {
-            bail!("held-out camera '{name}' is not in {}", dir.display());
-        }
-        let path = dir.join(format!("{name}.csv"));
-        match Sensitivities::resolve(&path.to_string_lossy(), data_dir, &GRID) {
-            Ok(s) => held_out.push(s),
-            Err(e) => eprintln!("warning: skipping held-out camera {name}: {e:#}"),
-        }
-    }
-    if held_out.is_empty() {
-        bail!("none of the split's held-out cameras could be read");
-    }
-    Ok(held_out)
-}
-
-/// Every lamp of the library on `grid` (linear interpolation), normalised by its maximum.
-pub(crate) fn on_grid(library: &LampLibrary, grid: &Grid) -> Result<Vec<Vec<f64>>> {
-    let set = SpectralSet::from_spds(library.names.clone(), &library.spds)?;
-    let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
-    Ok(set
-        .items()
-        .iter()
-        .map(|s| metrics::normalise_by_max(s))
-        .collect())
 }
 
 /// The mean of the lamps `ids`, normalised by its maximum.

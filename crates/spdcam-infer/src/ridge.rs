@@ -7,12 +7,12 @@
 //! data can be corrected by a few real photos.
 //!
 //! [`Gram`] holds `XᵀX` and `XᵀY` once for many penalties: the `linear` model
-//! ([`crate::train`]) penalises the feature weights by λ·n and leaves the bias (almost) free;
+//! (`spdcam_learn::train`) penalises the feature weights by λ·n and leaves the bias (almost) free;
 //! [`Ridge::fit`] and [`Ridge::fit_cv`] (the sim-to-real experiment) use one penalty relative
 //! to the mean diagonal of `XᵀX` on every input, chosen by k-fold cross-validation in
 //! [`Ridge::fit_cv`].
 
-use crate::error::{LearnError, Result};
+use crate::error::{InferError, Result};
 use faer::{linalg::solvers::Solve, Mat, Side};
 use spdcam_core::metrics;
 
@@ -47,7 +47,7 @@ impl Gram {
         y: impl Fn(usize, usize) -> f64,
     ) -> Result<Gram> {
         if rows == 0 || inputs == 0 || targets == 0 {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "ridge regression needs rows, inputs and targets ({rows} rows of {inputs} \
                  inputs and {targets} targets)"
             )));
@@ -64,13 +64,13 @@ impl Gram {
     /// The Gram matrices of input rows `x` and target rows `y` (as many, each of one length).
     pub fn from_rows(x: &[&[f64]], y: &[&[f64]]) -> Result<Gram> {
         let (Some(x0), Some(y0)) = (x.first(), y.first()) else {
-            return Err(LearnError::invalid(
+            return Err(InferError::invalid(
                 "ridge regression needs at least one row",
             ));
         };
         let (d, m) = (x0.len(), y0.len());
         if x.len() != y.len() || x.iter().any(|r| r.len() != d) || y.iter().any(|r| r.len() != m) {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "ridge regression needs as many input rows as target rows, each of one length \
                  ({} input rows, {} target rows)",
                 x.len(),
@@ -98,7 +98,7 @@ impl Gram {
     pub fn solve(&self, diagonal: &[f64], prior: Option<&Ridge>) -> Result<Ridge> {
         let d = self.xtx.nrows();
         if diagonal.len() != d {
-            return Err(LearnError::invalid(format!(
+            return Err(InferError::invalid(format!(
                 "{} ridge penalties for {d} inputs",
                 diagonal.len()
             )));
@@ -110,7 +110,7 @@ impl Gram {
         let mut b = self.xty.clone();
         if let Some(p) = prior {
             if p.inputs() != d || p.targets() != b.ncols() {
-                return Err(LearnError::invalid(format!(
+                return Err(InferError::invalid(format!(
                     "the prior model maps {} inputs to {} targets; the rows have {d} and {}",
                     p.inputs(),
                     p.targets(),
@@ -125,7 +125,7 @@ impl Gram {
         }
         let solved = a
             .llt(Side::Lower)
-            .map_err(|e| LearnError::Numerical(format!("ridge regression: {e:?}")))?
+            .map_err(|e| InferError::Numerical(format!("ridge regression: {e:?}")))?
             .solve(&b);
         Ok(Ridge {
             weights: solved.transpose().to_owned(),
@@ -145,7 +145,7 @@ impl Ridge {
     pub fn from_weights(weights: &[Vec<f64>]) -> Result<Ridge> {
         let d = weights.first().map_or(0, Vec::len);
         if d == 0 || weights.iter().any(|w| w.len() != d) {
-            return Err(LearnError::invalid(
+            return Err(InferError::invalid(
                 "a linear map needs at least one target row, all of one non-zero length",
             ));
         }

@@ -19,9 +19,9 @@
 //! penalty by 5-fold cross-validation). Scores: mean GFC and median Δu′v′ (CIE 1976 u′v′ of
 //! the CIE 1931 2° observer over 400–700 nm) of the estimates against the measured SPDs.
 
-use crate::error::{LearnError, Result};
-use crate::model::Model;
-use crate::ridge::Ridge;
+use crate::error::{EvalError, Result};
+use spdcam_infer::Model;
+use spdcam_infer::ridge::Ridge;
 use faer::{Mat, Side};
 use rand::rngs::SmallRng;
 use rand::seq::SliceRandom;
@@ -130,7 +130,7 @@ pub struct Score {
 /// Scores `estimates` (on [`score_grid`]) against `truths`.
 pub fn score(truths: &[Vec<f64>], estimates: &[Vec<f64>]) -> Result<Score> {
     if truths.is_empty() || truths.len() != estimates.len() {
-        return Err(LearnError::invalid(format!(
+        return Err(EvalError::invalid(format!(
             "{} truths and {} estimates to score",
             truths.len(),
             estimates.len()
@@ -174,7 +174,7 @@ pub fn constant(photos: &MeasuredPhotos) -> Vec<f64> {
 /// Ridge trained on real photos (the penalty by 5-fold cross-validation on them).
 pub fn real_ridge(photos: &MeasuredPhotos) -> Result<Ridge> {
     let x: Vec<Vec<f64>> = photos.features.iter().map(|f| ridge_inputs(f)).collect();
-    Ridge::fit_cv(&x, &targets(photos), 5, None)
+    Ok(Ridge::fit_cv(&x, &targets(photos), 5, None)?)
 }
 
 /// Estimates of a ridge for `features` rows (already through any alignment).
@@ -193,7 +193,7 @@ pub fn model_estimates(model: &Model, photos: &MeasuredPhotos) -> Result<Vec<Vec
         .iter()
         .map(|&nm| {
             grid.index_of(nm).ok_or_else(|| {
-                LearnError::invalid(format!("the model's grid {} lacks {nm} nm", grid.label()))
+                EvalError::invalid(format!("the model's grid {} lacks {nm} nm", grid.label()))
             })
         })
         .collect::<Result<_>>()?;
@@ -293,7 +293,7 @@ pub struct MeasuredPhotosOwned {
 /// from virtual to real photos: `docs/sim2real.md`).
 pub fn virtual_ridge(photos: &MeasuredPhotosOwned, penalty: f64) -> Result<Ridge> {
     let x: Vec<Vec<f64>> = photos.features.iter().map(|f| ridge_inputs(f)).collect();
-    Ridge::fit(&x, &photos.targets, penalty, None)
+    Ok(Ridge::fit(&x, &photos.targets, penalty, None)?)
 }
 
 /// A map of one camera's real feature rows onto the virtual photos' statistics, fitted on
@@ -409,7 +409,7 @@ fn covariance(rows: &[Vec<f64>], mean: &[f64], shrink: f64) -> Mat<f64> {
 fn matrix_power(c: &Mat<f64>, p: f64) -> Result<Mat<f64>> {
     let eig = c
         .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| LearnError::invalid(format!("eigendecomposition failed: {e:?}")))?;
+        .map_err(|e| EvalError::invalid(format!("eigendecomposition failed: {e:?}")))?;
     let u = eig.U();
     let s = eig.S().column_vector();
     let d = c.nrows();

@@ -5,7 +5,7 @@
 //! Statistician 32: 12–22; for intervals, Kuleshov et al. 2018, "Accurate uncertainties for
 //! deep learning using calibrated regression", ICML, fig. 1).
 
-use anyhow::Result;
+use crate::error::Result;
 use plotters::prelude::*;
 use spdcam_infer::plot::{plot_error, svg};
 

@@ -1,0 +1,408 @@
+//! The calibration of a model's trust (`spdcam trust calibrate`): the bands' floor and
+//! conformal scales, the metric intervals, the expected-GFC regression and the verdict's
+//! levels, fitted on held-out virtual photos of the split's validation lamps and, for the SG,
+//! the real photo sets' validation photos.
+
+use crate::error::{EvalError, Result};
+use crate::held_out::{HeldOutPhotos, GRID};
+use crate::trust::judged::{
+    band_z, conformal_quantile, difficulty, gfc, judge_rows, median, quantile_scales, residual,
+    Judged,
+};
+use crate::trust::real::{balanced, real_split};
+use spdcam_core::builtin::DataDir;
+use spdcam_core::chart::Chart;
+use spdcam_core::lighting::validation_split::LampPart;
+use spdcam_core::quality::SCALAR_KEYS;
+use spdcam_infer::pca::{Components, Pca};
+use spdcam_infer::ridge::{Gram, Ridge};
+use spdcam_infer::trust::{
+    self, Calibration, ChartCheck, GfcModel, MetricCalibration, SelfCheck, JITTER_COPIES,
+    JITTER_SIGMA,
+};
+use spdcam_infer::Model;
+use std::path::{Path, PathBuf};
+
+/// Fewer calibration photos defining a metric than this leave it without an interval.
+const MIN_METRIC_PHOTOS: usize = 40;
+
+/// The photos a calibration is fitted on: held-out virtual photos (`shots` consecutive ones
+/// per lamp) and, with `--real`, real photos of the real sets' validation split.
+pub struct CalibrationPhotos {
+    /// Every photo's features, the virtual ones first.
+    features: Vec<Vec<f64>>,
+    /// Every photo judged, in the same order.
+    judged: Vec<Judged>,
+    /// How many of them are virtual.
+    virtual_count: usize,
+    /// Virtual photos per lamp.
+    shots: usize,
+}
+
+impl CalibrationPhotos {
+    /// The virtual photos judged.
+    fn virtual_judged(&self) -> &[Judged] {
+        &self.judged[..self.virtual_count]
+    }
+
+    /// The cross-validation group of each photo: a lamp's photos together (so a lamp never
+    /// informs its own prediction), each real photo alone.
+    fn groups(&self) -> Vec<usize> {
+        let shots = self.shots.max(1);
+        let lamps = self.virtual_count.div_ceil(shots);
+        (0..self.judged.len())
+            .map(|i| {
+                if i < self.virtual_count {
+                    i / shots
+                } else {
+                    lamps + i - self.virtual_count
+                }
+            })
+            .collect()
+    }
+}
+
+/// Fits `model`'s calibration: the self-check's levels on the virtual photos alone (clean
+/// by construction, so that they tell bad photos), everything else on all of `photos`.
+pub fn fit_calibration(
+    model: &Model,
+    chart: &str,
+    photos: &CalibrationPhotos,
+    method: String,
+) -> Result<Calibration> {
+    let (judged, features) = (&photos.judged, &photos.features);
+    let d = model.grid().count;
+    let err = |j: &Judged, k: usize| (j.spd[k] - j.truth.as_ref().map_or(0.0, |t| t[k])).abs();
+    let virtual_judged = photos.virtual_judged();
+    let checks_of = |value: fn(&SelfCheck) -> Option<f64>| -> Vec<f64> {
+        virtual_judged
+            .iter()
+            .filter_map(|j| j.self_check.as_ref().and_then(value))
+            .collect()
+    };
+    let mut checks = checks_of(|s| Some(s.mean));
+    let all_checked = checks.len() == virtual_judged.len();
+    let residual_reference = all_checked.then(|| median(&mut checks.clone()));
+    let widenings: Vec<f64> = judged
+        .iter()
+        .map(|j| trust::widening(residual(j), residual_reference))
+        .collect();
+    let floor: Vec<f64> = (0..d)
+        .map(|k| {
+            median(
+                &mut judged
+                    .iter()
+                    .zip(&widenings)
+                    .map(|(j, w)| err(j, k) / w)
+                    .collect::<Vec<_>>(),
+            )
+            .max(1e-4)
+        })
+        .collect();
+    let z: Vec<Vec<f64>> = judged
+        .iter()
+        .zip(&widenings)
+        .map(|(j, &w)| band_z(&floor, w, j))
+        .collect();
+    let [scale68, scale95]: [Vec<f64>; 2] = quantile_scales(&z, &[0.68, 0.95])
+        .try_into()
+        .map_err(|_| EvalError::invalid("two band scales"))?;
+    let mut difficulties: Vec<f64> = judged.iter().map(difficulty).collect();
+    let mut splits = checks_of(|s| Some(s.split));
+    let mut gradients = checks_of(|s| s.colour_gradient);
+    let mut glares = checks_of(|s| Some(s.glare));
+    let metric_calibrations = SCALAR_KEYS
+        .iter()
+        .filter_map(|&key| {
+            let pairs: Vec<(f64, f64)> = judged
+                .iter()
+                .zip(&widenings)
+                .filter_map(|(j, w)| {
+                    Some((*j.metric_error.get(key)? / w, *j.metric_spread.get(key)?))
+                })
+                .collect();
+            if pairs.len() < MIN_METRIC_PHOTOS {
+                return None;
+            }
+            let floor =
+                median(&mut pairs.iter().map(|p| p.0).collect::<Vec<_>>()).max(f64::EPSILON);
+            let scale = |q: f64| {
+                conformal_quantile(
+                    &mut pairs
+                        .iter()
+                        .map(|(e, s)| e / (floor + s))
+                        .collect::<Vec<_>>(),
+                    q,
+                )
+            };
+            Some(MetricCalibration {
+                key: key.to_string(),
+                floor,
+                scale68: scale(0.68),
+                scale95: scale(0.95),
+                photos: pairs.len(),
+            })
+        })
+        .collect();
+    let mut clipped: Vec<f64> = features
+        .iter()
+        .map(|row| trust::clipped_patches(row) as f64)
+        .collect();
+    Ok(Calibration {
+        model: model.fingerprint(),
+        chart: chart.to_string(),
+        method,
+        wavelength_nm: model.grid().wavelengths(),
+        floor,
+        scale68,
+        scale95,
+        gfc_model: fit_gfc_model(judged, &photos.groups())?,
+        residual_reference,
+        difficulty_doubtful: conformal_quantile(&mut difficulties, 0.99),
+        self_check_doubtful: all_checked.then(|| conformal_quantile(&mut checks, 0.99)),
+        split_doubtful: (splits.len() == virtual_judged.len())
+            .then(|| conformal_quantile(&mut splits, 0.99)),
+        // Measured where most photos had enough unclipped neutral patches.
+        colour_gradient_doubtful: (10 * gradients.len() >= 9 * virtual_judged.len())
+            .then(|| conformal_quantile(&mut gradients, 0.99)),
+        glare_doubtful: (glares.len() == virtual_judged.len())
+            .then(|| conformal_quantile(&mut glares, 0.99)),
+        clipped_doubtful: conformal_quantile(&mut clipped, 0.99) as usize,
+        metrics: metric_calibrations,
+        real_photos: photos.judged.len() - photos.virtual_count,
+    })
+}
+
+/// Numbers of principal components the expected-GFC regression chooses among.
+const GFC_COMPONENTS: [usize; 7] = [0, 1, 2, 3, 5, 8, 12];
+/// Penalties (× each input's centred sum of squares) it chooses among.
+const GFC_PENALTIES: [f64; 7] = [1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0];
+/// Folds of its cross-validation, whole lamps at a time.
+const GFC_FOLDS: usize = 5;
+/// The smallest 1 − GFC the regression's logarithm sees (GFC is printed to 4 decimals).
+const GFC_GAP_FLOOR: f64 = 1e-5;
+
+/// The expected-GFC regression ([`GfcModel`]) of the judged calibration photos: the number
+/// of principal components and the penalty with the least squared error of ln(1 − GFC) in
+/// cross-validation over whole groups (`groups[i]` is photo i's: a lamp's photos share one,
+/// so a lamp never informs its own prediction; ties go to fewer components and the stronger
+/// penalty), then refitted on every photo. The constant is not penalised.
+pub fn fit_gfc_model(judged: &[Judged], groups: &[usize]) -> Result<GfcModel> {
+    let n = judged.len();
+    if groups.len() != n {
+        return Err(EvalError::invalid(format!(
+            "{} photos but {} cross-validation groups",
+            n,
+            groups.len()
+        )));
+    }
+    let d = judged
+        .first()
+        .ok_or_else(|| EvalError::invalid("no calibration photos"))?
+        .spd
+        .len();
+    let most = *GFC_COMPONENTS.iter().max().unwrap_or(&0);
+    let estimates: Vec<f64> = judged.iter().flat_map(|j| j.spd.iter().copied()).collect();
+    let pca = Pca::fit(&estimates, d, Components::Count(most.min(d).min(n - 1)))?;
+    let target: Vec<Vec<f64>> = judged
+        .iter()
+        .map(|j| vec![(1.0 - gfc(j)).max(GFC_GAP_FLOOR).ln()])
+        .collect();
+    let with = |k: usize| GfcModel {
+        mean: pca.mean.clone(),
+        components: pca.components[..k.min(pca.len())].to_vec(),
+        weights: Vec::new(),
+        low: Vec::new(),
+        high: Vec::new(),
+        gap_range: [0.0; 2],
+    };
+    let inputs = |m: &GfcModel| -> Vec<Vec<f64>> {
+        judged
+            .iter()
+            .map(|j| m.inputs(&j.spd, difficulty(j)))
+            .collect()
+    };
+    // Per input, the penalty's unit: its centred sum of squares, at least a millionth per
+    // row so that an input without variance is shrunk to nothing (0 for the constant).
+    let unit = |x: &[Vec<f64>], rows: &[usize]| -> Vec<f64> {
+        let p = x[0].len();
+        (0..p)
+            .map(|c| {
+                if c == p - 1 {
+                    return 0.0;
+                }
+                let mean = rows.iter().map(|&i| x[i][c]).sum::<f64>() / rows.len() as f64;
+                rows.iter()
+                    .map(|&i| (x[i][c] - mean).powi(2))
+                    .sum::<f64>()
+                    .max(1e-6 * rows.len() as f64)
+            })
+            .collect()
+    };
+    // The Gram matrices of `rows` and their penalty units, solved for any penalty.
+    let gram = |x: &[Vec<f64>], rows: &[usize]| -> Result<(Gram, Vec<f64>)> {
+        let xs: Vec<&[f64]> = rows.iter().map(|&i| x[i].as_slice()).collect();
+        let ys: Vec<&[f64]> = rows.iter().map(|&i| target[i].as_slice()).collect();
+        Ok((Gram::from_rows(&xs, &ys)?, unit(x, rows)))
+    };
+    let solve = |(gram, unit): &(Gram, Vec<f64>), penalty: f64| -> Result<Ridge> {
+        let diagonal: Vec<f64> = unit.iter().map(|u| penalty * u).collect();
+        Ok(gram.solve(&diagonal, None)?)
+    };
+    let folds: Vec<(Vec<usize>, Vec<usize>)> = (0..GFC_FOLDS)
+        .map(|f| (0..n).partition(|&i| groups[i] % GFC_FOLDS == f))
+        .filter(|(test, train): &(Vec<usize>, Vec<usize>)| !test.is_empty() && !train.is_empty())
+        .collect();
+    let mut best: Option<(f64, usize, f64)> = None;
+    for &k in GFC_COMPONENTS.iter().filter(|&&k| k <= pca.len()) {
+        let x = inputs(&with(k));
+        let mut sse = [0.0; GFC_PENALTIES.len()];
+        for (test, train) in &folds {
+            let fitted = gram(&x, train)?;
+            for (total, &penalty) in sse.iter_mut().zip(&GFC_PENALTIES) {
+                let ridge = solve(&fitted, penalty)?;
+                *total += test
+                    .iter()
+                    .map(|&i| (ridge.predict(&x[i])[0] - target[i][0]).powi(2))
+                    .sum::<f64>();
+            }
+        }
+        // The strongest penalty first, so that a tie keeps it.
+        for (&total, &penalty) in sse.iter().zip(&GFC_PENALTIES).rev() {
+            if best.is_none_or(|b| total < b.0) {
+                best = Some((total, k, penalty));
+            }
+        }
+    }
+    let (_, k, penalty) =
+        best.ok_or_else(|| EvalError::invalid("no expected-GFC regression could be fitted"))?;
+    let mut model = with(k);
+    let x = inputs(&model);
+    let ridge = solve(&gram(&x, &(0..n).collect::<Vec<_>>())?, penalty)?;
+    model.weights = (0..ridge.inputs()).map(|j| ridge.weight(0, j)).collect();
+    let range = |values: &mut dyn Iterator<Item = f64>| {
+        values.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| {
+            [lo.min(v), hi.max(v)]
+        })
+    };
+    let input_ranges: Vec<[f64; 2]> = (0..model.weights.len())
+        .map(|c| range(&mut x.iter().map(|row| row[c])))
+        .collect();
+    model.low = input_ranges.iter().map(|r| r[0]).collect();
+    model.high = input_ranges.iter().map(|r| r[1]).collect();
+    model.gap_range = range(&mut target.iter().map(|t| t[0]));
+    Ok(model)
+}
+
+/// One model's fitted calibration.
+pub struct Calibrated {
+    /// The model's file.
+    pub model: PathBuf,
+    /// The chart it reads (the calibration's file is `<chart>.trust.json`).
+    pub chart: String,
+    /// The calibration.
+    pub calibration: Calibration,
+}
+
+/// Fits the calibration of each of `photos`' models on the split's validation lamps and,
+/// with `real`, the real photo sets' validation photos (SG models only; `thesis_data` holds
+/// the sets, default the data directory's thesis/).
+pub fn calibrate(
+    photos: &HeldOutPhotos,
+    real: bool,
+    thesis_data: Option<&Path>,
+    data_dir: &DataDir,
+) -> Result<Vec<Calibrated>> {
+    let setup = photos.setup(data_dir)?;
+    let mut out = Vec::new();
+    for (path, model, chart_name) in photos.models()? {
+        let chart = Chart::resolve(&chart_name, None, data_dir, &GRID)?;
+        model.check_features(&chart.feature_names(), &chart_name)?;
+        let check = ChartCheck::for_model(&model, data_dir)?;
+        let shots = photos.shots(&setup, &chart, &model, LampPart::Validation)?;
+        let mut judged = judge_rows(
+            &model,
+            check.as_ref(),
+            &shots.clean.features,
+            Some(&shots.clean.truths),
+        )?;
+        let virtual_count = judged.len();
+        let real = if real {
+            real_split(thesis_data, data_dir, &model, &chart_name)?
+        } else {
+            Vec::new()
+        };
+        let real = balanced(real, virtual_count);
+        let mut features = shots.clean.features;
+        for set in &real {
+            judged.extend(judge_rows(
+                &model,
+                check.as_ref(),
+                &set.val.features,
+                Some(&set.val.truths),
+            )?);
+            features.extend(set.val.features.iter().cloned());
+        }
+        let mut method = format!(
+            "the split's {} validation lamps, {} photos each by its held-out cameras with the \
+             randomised in-camera stage, patch level, seed {}; spread of {JITTER_COPIES} copies \
+             perturbed by {JITTER_SIGMA}",
+            setup.split.lamps(LampPart::Validation).len(),
+            photos.shots,
+            photos.seed
+        );
+        if !real.is_empty() {
+            method += &format!(
+                "; and {} real photos, the validation photos of {}",
+                judged.len() - virtual_count,
+                real.iter().map(|s| s.label).collect::<Vec<_>>().join(", ")
+            );
+        }
+        let calibration_photos = CalibrationPhotos {
+            features,
+            judged,
+            virtual_count,
+            shots: photos.shots as usize,
+        };
+        let calibration = fit_calibration(&model, &chart_name, &calibration_photos, method)?;
+        out.push(Calibrated {
+            model: path,
+            chart: chart_name,
+            calibration,
+        });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trust::judged::fixtures::judged;
+
+    #[test]
+    fn the_expected_gfc_regression_learns_how_the_gfc_falls_with_difficulty() {
+        // 1 − GFC = 0.2 · difficulty: ln(1 − GFC) = ln 0.2 + ln(difficulty); the shapes vary
+        // a little, unrelated to the GFC. 20 lamps of 4 photos.
+        let rows: Vec<Judged> = (0..80)
+            .map(|i| {
+                let difficulty = 0.01 * (1.0 + (i * 7 % 10) as f64);
+                let spd = [1.0, 0.5 + 0.02 * (i % 5) as f64, 0.6, 0.4, 0.3];
+                judged(&spd, 1.0 - 0.2 * difficulty, difficulty)
+            })
+            .collect();
+        for r in &rows {
+            let want = 1.0 - 0.2 * difficulty(r);
+            assert!((gfc(r) - want).abs() < 1e-9, "{} {want}", gfc(r));
+        }
+        let groups: Vec<usize> = (0..rows.len()).map(|i| i / 4).collect();
+        let model = fit_gfc_model(&rows, &groups).unwrap();
+        for r in &rows {
+            let gap = 1.0 - model.expected(&r.spd, difficulty(r));
+            let want = 0.2 * difficulty(r);
+            assert!(
+                (gap / want - 1.0).abs() < 0.05,
+                "expected 1 − GFC {gap}, true {want}"
+            );
+        }
+    }
+}

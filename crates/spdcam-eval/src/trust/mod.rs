@@ -1,0 +1,17 @@
+//! The trust protocols: fitting a model's uncertainty calibration (the file
+//! `spdcam_infer::trust::Calibration` reads) and measuring how far its estimates can be
+//! trusted on held-out virtual photos, the real photo sets, photos made bad on purpose and
+//! scene photos.
+//!
+//! - [`shots`]: the held-out virtual photos, clean and made bad.
+//! - [`judged`]: photos judged as an estimate judges them, and the statistics taken of them.
+//! - [`real`]: the real photo sets' split.
+//! - [`fit`]: the calibration's fit ([`fit::calibrate`]).
+//! - [`scenes`] and [`report`]: the measurement ([`report::TrustReport`]).
+
+pub mod fit;
+pub mod judged;
+pub mod real;
+pub mod report;
+pub mod scenes;
+pub mod shots;

@@ -1,0 +1,135 @@
+//! Scene photos in the trust report: the chart in a cluttered scene, found, sampled and
+//! estimated like a user's photo, clean and made bad three ways.
+
+use crate::error::{EvalError, Result};
+use crate::held_out::{Setup, GRID};
+use crate::trust::shots::{GLARE_LEVEL, GLARE_WIDTH};
+use rand::rngs::SmallRng;
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::optics::Glow;
+use spdcam_core::camera::CameraConfig;
+use spdcam_core::chart::{Chart, KnownChart};
+use spdcam_core::dataset::randomise::camera_pool;
+use spdcam_core::lighting::validation_split::LampPart;
+use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
+use spdcam_core::photo::ChartTemplate;
+use spdcam_core::seed;
+use spdcam_core::spectral::SpectralSet;
+use spdcam_infer::estimate::{estimate_photo_bytes, PhotoOptions};
+use spdcam_infer::trust::{Calibration, Verdict};
+use spdcam_infer::{Model, ModelSet};
+
+/// Scene photos per kind in [`scene_verdicts`].
+pub const SCENES: usize = 20;
+
+/// The chart as photos show it for `model_chart` (the SG's 96 patches are read from the
+/// whole 140-patch chart).
+fn photo_chart(model_chart: &str) -> &str {
+    match KnownChart::from_name(model_chart).and_then(KnownChart::physical) {
+        Some(physical) => physical.name(),
+        None => model_chart,
+    }
+}
+
+/// Scene photos (the code of `spdcam render --scene`: the chart placed in a cluttered scene
+/// with perspective, blur, vignetting, noise and JPEG) of [`SCENES`] test lamps, each by a
+/// held-out camera, found, sampled and estimated like a user's photo: clean, of another
+/// chart (the non-grey patches in another order), the right half of the chart lit by
+/// another lamp, and with glare. Per kind: the share not `ok` (or refused: no chart found),
+/// and the share the self-check flags.
+pub fn scene_verdicts(
+    model: &Model,
+    cal: &Calibration,
+    model_chart: &str,
+    setup: &Setup,
+    data_dir: &DataDir,
+    seed: u64,
+) -> Result<[(f64, f64); 4]> {
+    let name = photo_chart(model_chart);
+    let chart = Chart::resolve(name, None, data_dir, &GRID)?;
+    let template = ChartTemplate::from_chart(&chart)?;
+    let chart = chart.with_layout(scene::scene_layout(&template))?;
+    let mut wrong = chart.clone();
+    let movable: Vec<usize> = chart
+        .feature_patches
+        .iter()
+        .copied()
+        .filter(|p| template.neutrals.iter().all(|n| n.0 != *p))
+        .collect();
+    let mut order = movable.clone();
+    order.shuffle(&mut SmallRng::seed_from_u64(seed));
+    let mut items: Vec<Vec<f64>> = chart.reflectances.items().to_vec();
+    for (&to, &from) in movable.iter().zip(&order) {
+        items[to] = chart.reflectances.item(from).to_vec();
+    }
+    wrong.reflectances = SpectralSet::on_grid(&GRID, chart.reflectances.names().to_vec(), items)?;
+    let config = CameraConfig::default();
+    let pool = camera_pool(&setup.cameras, 0, seed, &chart, config, &GRID)?;
+    let wrong_pool = camera_pool(&setup.cameras, 0, seed, &wrong, config, &GRID)?;
+    let ids = setup
+        .library
+        .positions(setup.split.lamps(LampPart::Test), "the split's test lamps")?;
+    let models = ModelSet::single(model.clone(), "model");
+    let options = PhotoOptions {
+        chart: Some(name.to_string()),
+        ..PhotoOptions::default()
+    };
+    let plain = SceneOptions {
+        width: 1200,
+        height: 900,
+        ..SceneOptions::default()
+    };
+    let glare = SceneOptions {
+        glow: Some(Glow {
+            level: GLARE_LEVEL,
+            width: GLARE_WIDTH,
+        }),
+        ..plain.clone()
+    };
+    let mut counts = [(0usize, 0usize); 4];
+    for i in 0..SCENES {
+        let lamp = ids[i * ids.len() / SCENES];
+        let other = ids[(i * ids.len() / SCENES + ids.len() / 2) % ids.len()];
+        let k = i % pool.len();
+        let shot_seed = seed::derive(seed, i as u64);
+        let (spd, other_spd) = (&setup.library.spds[lamp], &setup.library.spds[other]);
+        let half = SceneLight {
+            spd,
+            right_half: Some(other_spd),
+        };
+        let shots = [
+            (&pool[k], SceneLight::single(spd), &plain),
+            (&wrong_pool[k], SceneLight::single(spd), &plain),
+            (&pool[k], half, &plain),
+            (&pool[k], SceneLight::single(spd), &glare),
+        ];
+        for (kind, (camera, light, scene_options)) in shots.into_iter().enumerate() {
+            let shot = scene::photograph(camera, light, shot_seed, scene_options)?;
+            match estimate_photo_bytes(
+                &shot.jpeg,
+                "scene.jpg",
+                &models,
+                &options,
+                data_dir,
+                &model.grid(),
+            ) {
+                Ok(e) => {
+                    let t = e
+                        .trust
+                        .ok_or_else(|| EvalError::invalid("an estimate without a verdict"))?;
+                    counts[kind].0 += usize::from(t.verdict != Verdict::Ok);
+                    let flagged = t.self_check.as_ref().is_some_and(|s| cal.flags(s));
+                    counts[kind].1 += usize::from(flagged);
+                }
+                Err(_) => {
+                    counts[kind].0 += 1;
+                    counts[kind].1 += 1;
+                }
+            }
+        }
+    }
+    Ok(counts.map(|(n, f)| (n as f64 / SCENES as f64, f as f64 / SCENES as f64)))
+}
+
