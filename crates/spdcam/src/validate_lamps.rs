@@ -6,7 +6,6 @@
 //! (report only). (c) The real photo sets of the thesis (SG 96 models only).
 
 use crate::held_out_args::HeldOutArgs;
-use spdcam_eval::held_out::{held_out_cameras, in_data_dir, on_grid};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use rand::rngs::SmallRng;
@@ -23,6 +22,7 @@ use spdcam_core::lighting::{LampLibrary, LampType, ValidationSplit};
 use spdcam_core::simple_camera::{Shot, SimpleCamera};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_core::{metrics, seed};
+use spdcam_eval::held_out::{held_out_cameras, in_data_dir, on_grid};
 use spdcam_infer::Model;
 use std::path::PathBuf;
 

@@ -1,0 +1,254 @@
+//! What `spdcam estimate` prints and writes besides the SPDs: the estimates as text, the
+//! verdicts, the bands' columns and the HTML report.
+
+use super::features::DETAILED_MAX;
+use super::EstimateArgs;
+use anyhow::Result;
+use spdcam_core::fsio;
+use spdcam_core::spectral::{Grid, Spd, SpectralSet};
+use spdcam_infer::estimate::Colorimetry;
+use spdcam_infer::presentation::meaningful_value;
+use spdcam_infer::report::{report_html, ReportImage, ReportItem};
+use spdcam_infer::trust::{MetricInterval, Trust, Verdict};
+use spdcam_infer::Estimate;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The estimates as text: colorimetry and the SPD every 25 nm (for up to 20), the score
+/// against the truth, what each number means, and where the files went.
+pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
+    let mut models: Vec<&str> = estimates.iter().map(|e| e.model.as_str()).collect();
+    models.dedup();
+    println!("{} estimate(s) with {}", estimates.len(), models.join(", "));
+    let detailed = estimates.len() <= DETAILED_MAX;
+    for e in estimates {
+        let unusable = e
+            .trust
+            .as_ref()
+            .is_some_and(|t| t.verdict == Verdict::Unusable);
+        if unusable {
+            println!("{}: UNUSABLE, no estimate to rely on", e.name);
+        } else if detailed {
+            let intervals = e
+                .trust
+                .as_ref()
+                .and_then(|t| t.uncertainty.as_ref())
+                .map(|u| &u.metrics);
+            println!(
+                "{}: {}",
+                e.name,
+                colorimetry_line(&e.colorimetry, intervals)
+            );
+            println!("  relative SPD: {}", spd_line(&e.spd));
+            println!("  {}", metrics_line(e, intervals));
+            match (&e.absolute, e.photo.as_ref().and_then(|p| p.exposure)) {
+                (Some(Ok(a)), _) => println!(
+                    "  absolute (approximate, from {}): {:.0} lx, PPFD {}, melanopic EDI {}",
+                    a.exposure.label(),
+                    a.illuminance_lux,
+                    a.ppfd_umol_m2_s
+                        .map_or_else(|| "—".into(), |v| format!("{v:.1} µmol/m²/s")),
+                    a.melanopic_edi_lux
+                        .map_or_else(|| "—".into(), |v| format!("{v:.0} lx")),
+                ),
+                (Some(Err(reason)), Some(_)) => println!("  no absolute levels: {reason}"),
+                _ => {}
+            }
+        }
+        if let Some(t) = &e.trust {
+            println!("  {}", trust_line(t));
+            if let (Some(u), false) = (&t.uncertainty, unusable) {
+                println!(
+                    "  expected GFC {:.3}; 95 % band {:.2} wide on average (68 %: {:.2}; SPD peak 1){}",
+                    u.expected_gfc,
+                    u.band95.mean_width(),
+                    u.band68.mean_width(),
+                    if u.widening > 1.0 {
+                        format!(
+                            ", widened {:.1}× (the light found explains this photo {:.1}× worse than typical calibration photos)",
+                            u.widening, u.widening
+                        )
+                    } else {
+                        String::new()
+                    }
+                );
+            }
+        }
+        if let Some(s) = e.truth {
+            println!(
+                "  against the true SPD: GFC {:.4}, RMSE {:.4} (both peak-normalised)",
+                s.gfc, s.rmse
+            );
+        }
+    }
+    if estimates.iter().any(|e| e.photo.is_some()) {
+        println!(
+            "confidence: how sure the chart's detection is (0–1; below 0.8 check the --debug image)"
+        );
+    }
+    if detailed {
+        println!(
+            "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and gamut; \
+             M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: scotopic/photopic; \
+             PPF: µmol/s of 400–700 nm photons per klm; ± the 95 % interval when calibrated; \
+             — where not defined or not meaningful (CRI and TM-30 need a light near white); \
+             computed on the estimate's {}–{} nm only \
+             (`spdcam metrics` on a wider SPD, `--json` for every number)",
+            estimates[0].spd.grid().start_nm,
+            estimates[0].spd.grid().end_nm()
+        );
+    }
+    if estimates.iter().any(|e| e.trust.is_some()) {
+        println!(
+            "verdict: ok, doubtful (use with care) or unusable, from the detection, clipped and \
+             dark patches, the self-check (the chart re-rendered under the estimate) and the \
+             calibrated uncertainty; the bands hold the true SPD at 68 % and 95 % per wavelength"
+        );
+    }
+    if estimates.iter().any(|e| e.truth.is_some()) {
+        println!(
+            "GFC: goodness-of-fit of the spectral shape, 1 = identical (≥ 0.999 excellent, ≥ 0.99 good)"
+        );
+    }
+    if let Some(out) = &args.output {
+        println!(
+            "SPD{} → {}",
+            if estimates.len() > 1 { "s" } else { "" },
+            out.display()
+        );
+    }
+    if let Some(plot) = &args.plot {
+        println!("plot → {}", plot.display());
+    }
+    if let Some(report) = &args.report {
+        println!("report → {}", report.display());
+    }
+}
+
+/// One estimate of the report: the estimate, for a photo the photo with the chart found
+/// (the `overlay` drawn when it was analysed), and its truth.
+pub(super) fn report_item(
+    estimate: &Estimate,
+    overlay: Option<Vec<u8>>,
+    truth: Option<Vec<f64>>,
+) -> Result<ReportItem> {
+    let image = overlay.map(|bytes| ReportImage {
+        mime: "image/jpeg",
+        bytes,
+    });
+    Ok(ReportItem::new(estimate.clone(), image, truth))
+}
+
+/// Writes the report of `items` to `path` atomically.
+pub(super) fn write_report(path: &Path, title: &str, items: &[ReportItem]) -> Result<()> {
+    fsio::write_atomic(path, report_html(title, items).as_bytes())?;
+    Ok(())
+}
+
+/// With the data on standard output (`-o -`, `--json`), each estimate's verdict on standard
+/// error, so that whoever runs the command still hears that an estimate is unusable.
+pub(super) fn verdicts_to_stderr(estimates: &[Estimate]) {
+    for e in estimates {
+        if let Some(t) = &e.trust {
+            eprintln!("{}", verdict_line(&e.name, t));
+        }
+    }
+}
+
+/// `name: UNUSABLE, no estimate to rely on; verdict: unusable (reasons)`, or
+/// `name: verdict: ok` — the verdict of one estimate on one line.
+pub(super) fn verdict_line(name: &str, t: &Trust) -> String {
+    if t.verdict == Verdict::Unusable {
+        format!(
+            "{name}: UNUSABLE, no estimate to rely on; {}",
+            trust_line(t)
+        )
+    } else {
+        format!("{name}: {}", trust_line(t))
+    }
+}
+
+/// The verdict and its reasons on one line: `verdict: doubtful (2 of 24 patches are …)`.
+pub(super) fn trust_line(t: &Trust) -> String {
+    if t.reasons.is_empty() {
+        format!("verdict: {}", t.verdict.label())
+    } else {
+        format!("verdict: {} ({})", t.verdict.label(), t.reasons.join("; "))
+    }
+}
+
+/// The estimates' SPDs as a spectral set, each followed by its bands when it has them:
+/// `<name>_lower68, <name>_upper68, <name>_lower95, <name>_upper95`.
+pub(super) fn with_bands(estimates: &[Estimate], grid: &Grid) -> Result<SpectralSet> {
+    let mut names = Vec::new();
+    let mut values = Vec::new();
+    for e in estimates {
+        names.push(e.name.clone());
+        values.push(e.spd.to_vec());
+        if let Some(u) = e.trust.as_ref().and_then(|t| t.uncertainty.as_ref()) {
+            for (band, level) in [(&u.band68, "68"), (&u.band95, "95")] {
+                names.push(format!("{}_lower{level}", e.name));
+                values.push(band.lower.to_vec());
+                names.push(format!("{}_upper{level}", e.name));
+                values.push(band.upper.to_vec());
+            }
+        }
+    }
+    Ok(SpectralSet::on_grid(grid, names, values)?)
+}
+
+/// The main lighting-quality numbers on one line, `—` where undefined or not meaningful for
+/// this light (CRI and TM-30 far from white, as the report shows them), each with its 95 %
+/// interval when the estimate has one: `Ra 82 ± 4 (R9 20 ± 15), …`.
+pub(super) fn metrics_line(
+    e: &Estimate,
+    intervals: Option<&BTreeMap<String, MetricInterval>>,
+) -> String {
+    let f = |key: &str, d: usize, unit: f64| {
+        let Ok(v) = meaningful_value(e, key) else {
+            return "—".to_string();
+        };
+        match intervals.and_then(|i| i.get(key)) {
+            Some(i) => format!("{:.d$} ± {:.d$}", unit * v, unit * i.half95),
+            None => format!("{:.d$}", unit * v),
+        }
+    };
+    format!(
+        "Ra {} (R9 {}), Rf {}, Rg {}, M-EDER {}, S/P {}, PPF {}",
+        f("cri_ra", 0, 1.0),
+        f("cri_r9", 0, 1.0),
+        f("tm30_rf", 0, 1.0),
+        f("tm30_rg", 0, 1.0),
+        f("mel_der", 2, 1.0),
+        f("sp_ratio", 2, 1.0),
+        f("ppf_per_lux", 1, 1000.0),
+    )
+}
+
+/// xy, CCT and Duv of an estimate, CCT and Duv with their 95 % intervals when it has them.
+pub(super) fn colorimetry_line(
+    c: &Colorimetry,
+    intervals: Option<&BTreeMap<String, MetricInterval>>,
+) -> String {
+    let half = |key: &str| intervals.and_then(|i| i.get(key)).map(|i| i.half95);
+    match (c.cct, c.duv, half("cct_k"), half("duv")) {
+        (Some(cct), Some(duv), Some(hc), Some(hd)) => format!(
+            "xy ({:.4}, {:.4}), CCT {cct:.0} ± {hc:.0} K, Duv {duv:+.4} ± {hd:.4}",
+            c.xy[0], c.xy[1]
+        ),
+        _ => c.label(),
+    }
+}
+
+/// The SPD every 25 nm, peak-normalised, on one terminal line: `400:0.12 425:0.40 …`.
+pub(super) fn spd_line(spd: &Spd) -> String {
+    let spd = spd.normalised_by_max();
+    spd.grid()
+        .wavelengths()
+        .iter()
+        .zip(spd.iter())
+        .filter(|(w, _)| (*w % 25.0).abs() < 1e-9)
+        .map(|(w, v)| format!("{w:.0}:{v:.2}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
