@@ -348,11 +348,13 @@ impl TrustReport {
              Wrong chart: the same photos with the patches in a random order (a chart the model \
              does not read). Half-lit: the right half of the chart lit by the next lamp of the \
              split, same camera and settings, at the exposure the first lamp gives and one white \
-             balance from the chart as lit (as a camera takes two lights in one photo). Glare: veiling glare adding 40 % of the chart's mean \
-             linear level at the top-left corner, falling off as a Gaussian of 0.35 chart widths. \
+             balance from the chart as lit (as a camera takes two lights in one photo). Each half \
+             balanced: the same two lights, each half of the chart exposed and white-balanced for \
+             its own light (two photos joined), so that every neutral patch stays grey. Glare: \
+             veiling glare adding 40 % of the chart's mean linear level at the top-left corner, falling off as a Gaussian of 0.35 chart widths. \
              All patch level (no scene photo), noise-free.\n\n\
-             | model | photos | clean: flagged | clean: not ok | wrong chart: flagged | half-lit: flagged | glare: flagged | bad (all three): flagged |\n\
-             |---|---:|---:|---:|---:|---:|---:|---:|\n",
+             | model | photos | clean: flagged | clean: not ok | wrong chart: flagged | half-lit: flagged | each half balanced: flagged (not ok) | glare: flagged | bad (wrong chart, half-lit, glare): flagged |\n\
+             |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         );
         let mut scenes = format!(
             "## Scene photos\n\n\
@@ -480,7 +482,7 @@ impl TrustReport {
             metrics_md.push('\n');
             if cal.self_check_doubtful.is_none() {
                 flags += &format!(
-                    "| `{name}` | – | no self-check without the chart's reflectances | | | | | |\n"
+                    "| `{name}` | – | no self-check without the chart's reflectances | | | | | | |\n"
                 );
                 continue;
             }
@@ -492,32 +494,37 @@ impl TrustReport {
                     .count() as f64
                     / judged.len() as f64)
             };
+            let not_ok = |rows: &[Vec<f64>]| -> Result<f64> {
+                let judged = judge_rows(model, check.as_ref(), rows, None)?;
+                let mut count = 0;
+                for (j, row) in judged.iter().zip(rows) {
+                    let t = assess(
+                        model,
+                        Some(&cal),
+                        check.as_ref(),
+                        row,
+                        &j.spd,
+                        &PhotoFlags::default(),
+                    )?;
+                    count += usize::from(t.verdict != Verdict::Ok);
+                }
+                Ok(count as f64 / rows.len() as f64)
+            };
             let clean = &shots.clean.features;
-            let judged = judge_rows(model, check.as_ref(), clean, None)?;
-            let mut not_ok = 0;
-            for (j, row) in judged.iter().zip(clean) {
-                let t = assess(
-                    model,
-                    Some(&cal),
-                    check.as_ref(),
-                    row,
-                    &j.spd,
-                    &PhotoFlags::default(),
-                )?;
-                not_ok += usize::from(t.verdict != Verdict::Ok);
-            }
             let (w, h, g) = (
                 flagged(&shots.wrong_chart)?,
                 flagged(&shots.half_lit)?,
                 flagged(&shots.glare)?,
             );
             flags += &format!(
-                "| `{name}` | {} | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} % |\n",
+                "| `{name}` | {} | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} % ({:.1} %) | {:.1} % | {:.1} % |\n",
                 clean.len(),
                 100.0 * flagged(clean)?,
-                100.0 * not_ok as f64 / clean.len() as f64,
+                100.0 * not_ok(clean)?,
                 100.0 * w,
                 100.0 * h,
+                100.0 * flagged(&shots.half_balanced)?,
+                100.0 * not_ok(&shots.half_balanced)?,
                 100.0 * g,
                 100.0 * (w + h + g) / 3.0
             );

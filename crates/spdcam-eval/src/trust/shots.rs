@@ -38,6 +38,10 @@ pub struct Shots {
     pub wrong_chart: Vec<Vec<f64>>,
     /// The right half of the chart lit by the next lamp of the split.
     pub half_lit: Vec<Vec<f64>>,
+    /// The same two lights, each half of the chart exposed and white-balanced for its own
+    /// light (two photos joined, or a camera that balances each region): every neutral patch
+    /// stays grey, so only the coloured patches tell.
+    pub half_balanced: Vec<Vec<f64>>,
     /// Veiling glare from a lamp beside the chart ([`GLARE_LEVEL`], [`GLARE_WIDTH`]).
     pub glare: Vec<Vec<f64>>,
 }
@@ -84,27 +88,40 @@ impl HeldOutPhotos {
             },
             wrong_chart: Vec::new(),
             half_lit: Vec::new(),
+            half_balanced: Vec::new(),
             glare: Vec::new(),
         };
-        let (mut raw, mut a, mut b) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut raw, mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (j, &i) in ids.iter().enumerate() {
             let other = ids[(j + 1) % ids.len()];
             for k in 0..self.shots {
                 let (camera, ic) = randomisation.draw(stream, j as u64 * self.shots + k);
                 a.clear();
                 b.clear();
+                c.clear();
                 let light = camera.light(&setup.library.spds[i])?;
+                let other_light = camera.light(&setup.library.spds[other])?;
                 camera.features_fast_with(ic.as_ref(), &light, &mut raw, &mut a);
                 camera.features_fast_two_lights(
                     ic.as_ref(),
                     &light,
-                    &camera.light(&setup.library.spds[other])?,
+                    &other_light,
                     &right,
                     &mut raw,
                     &mut b,
                 );
+                camera.features_fast_with(ic.as_ref(), &other_light, &mut raw, &mut c);
                 let clean: Vec<f64> = a.iter().map(|&v| f64::from(v)).collect();
                 let half: Vec<f64> = b.iter().map(|&v| f64::from(v)).collect();
+                let balanced: Vec<f64> = chart
+                    .feature_patches
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(f, &p)| {
+                        let from = if right[p] { &c } else { &a };
+                        from[3 * f..3 * f + 3].iter().map(|&v| f64::from(v))
+                    })
+                    .collect();
                 let mut order: Vec<usize> = (0..chart.feature_patches.len()).collect();
                 order.shuffle(&mut rng);
                 let wrong: Vec<f64> = order
@@ -126,6 +143,7 @@ impl HeldOutPhotos {
                 out.clean.truths.push(truth[i].clone());
                 out.wrong_chart.push(wrong);
                 out.half_lit.push(half);
+                out.half_balanced.push(balanced);
                 out.glare.push(glared);
             }
         }
