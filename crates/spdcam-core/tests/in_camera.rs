@@ -411,3 +411,18 @@ fn two_lights_meet_at_one_exposure_and_one_white_balance() {
     let alone = fast(&cam, Some(&ic), &b);
     assert!(red_over_blue(&alone, 22) < 1.2 * red_over_blue(&alone, 19));
 }
+
+#[test]
+fn ranges_record_the_floor_only_when_it_is_drawn() {
+    // Records of runs without the floor read as before it existed (a model's header holds
+    // them, and a rebuilt model must match the committed one in every setting).
+    let without = InCameraRanges::for_groups(&["exposure", "wb"]).unwrap();
+    let json = serde_json::to_string(&without).unwrap();
+    assert!(!json.contains("floor"), "{json}");
+    let read: InCameraRanges = serde_json::from_str(&json).unwrap();
+    assert_eq!(read, without);
+    let with = InCameraRanges::for_groups(&["floor"]).unwrap();
+    let json = serde_json::to_string(&with).unwrap();
+    assert!(json.contains(r#""floor":[0.0,0.15]"#), "{json}");
+    assert_eq!(serde_json::from_str::<InCameraRanges>(&json).unwrap(), with);
+}

@@ -47,8 +47,9 @@ pub struct InCameraRanges {
     /// Largest magnitude of each lighting-gradient component, drawn uniformly in ±it.
     #[serde(default)]
     pub gradient: Option<f64>,
-    /// Range of [`InCamera::floor`] (share of full scale).
-    #[serde(default)]
+    /// Range of [`InCamera::floor`] (share of full scale); left unwritten when not drawn,
+    /// so that the records of runs without it read as before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub floor: Option<[f64; 2]>,
 }
 
