@@ -10,7 +10,6 @@
 
 use crate::absolute::Absolute;
 use crate::error::{InferError, Result};
-use crate::estimator::Estimator;
 use crate::shipped::ModelSet;
 use crate::trust::Trust;
 use serde::Serialize;
@@ -427,21 +426,6 @@ pub fn chart_templates(
         )));
     }
     Ok(out)
-}
-
-/// The estimate for one photo held in memory, labelled `name`: an [`Estimator`] built for
-/// this photo alone. Build the estimator once (and call [`Estimator::estimate_photo_bytes`])
-/// when estimating many.
-pub fn estimate_photo_bytes(
-    bytes: &[u8],
-    name: &str,
-    models: &ModelSet,
-    options: &PhotoOptions,
-    data_dir: &DataDir,
-    grid: &Grid,
-) -> Result<Estimate> {
-    Estimator::new(models.clone(), data_dir.clone(), *grid)?
-        .estimate_photo_bytes(bytes, name, options)
 }
 
 #[cfg(test)]

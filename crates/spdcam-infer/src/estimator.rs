@@ -292,7 +292,13 @@ impl Estimator {
                             analysis.source, analysis.chart
                         ))
                     })?;
-                Some(analysis_overlay_jpeg(photo, template, &analysis, width)?)
+                Some(analysis_overlay_jpeg(
+                    photo,
+                    template,
+                    &analysis.detection(),
+                    &analysis.patches,
+                    width,
+                )?)
             }
             None => None,
         };
@@ -639,6 +645,21 @@ impl RowStream<'_> {
             None,
         )
     }
+}
+
+/// The estimate for one photo held in memory, labelled `name`: an [`Estimator`] built for
+/// this photo alone. Build the estimator once (and call [`Estimator::estimate_photo_bytes`])
+/// when estimating many.
+pub fn estimate_photo_bytes(
+    bytes: &[u8],
+    name: &str,
+    models: &ModelSet,
+    options: &PhotoOptions,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<Estimate> {
+    Estimator::new(models.clone(), data_dir.clone(), *grid)?
+        .estimate_photo_bytes(bytes, name, options)
 }
 
 #[cfg(test)]

@@ -80,7 +80,7 @@ pub mod target;
 pub mod trust;
 
 pub use error::{InferError, Result};
-pub use estimate::{estimate_photo_bytes, Estimate, FeatureRows, PhotoOptions};
-pub use estimator::{AnalysedPhoto, Estimator, RowStream};
+pub use estimate::{Estimate, FeatureRows, PhotoOptions};
+pub use estimator::{estimate_photo_bytes, AnalysedPhoto, Estimator, RowStream};
 pub use model::Model;
 pub use shipped::ModelSet;

@@ -64,6 +64,18 @@ pub struct PhotoAnalysis {
     pub exposure: Option<Exposure>,
 }
 
+impl PhotoAnalysis {
+    /// The chart found, as detection gave it (what the overlay draws).
+    pub fn detection(&self) -> Detection {
+        Detection {
+            chart: self.chart.clone(),
+            corners: self.corners,
+            homography: self.homography,
+            confidence: self.confidence,
+        }
+    }
+}
+
 /// Decodes, finds the chart, samples it. Writes the debug image when asked, also when no
 /// chart is found (then the error says so).
 pub fn analyse_photo(path: &Path, options: &AnalyseOptions) -> Result<PhotoAnalysis> {

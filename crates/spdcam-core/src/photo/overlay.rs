@@ -3,7 +3,6 @@
 //! outline with its first corner marked, every sampled region with its patch number, and,
 //! when no chart was found, the patch candidates the search saw.
 
-use super::batch::PhotoAnalysis;
 use super::detect::SearchTrace;
 use super::geometry::Homography;
 use super::load::Photo;
@@ -206,22 +205,17 @@ fn draw_overlay(
         .unwrap_or_default()
 }
 
-/// The debug image of an analysed photo (its chart outline and sampled squares, as
-/// [`debug_overlay`] draws them), reduced to at most `max_width` px wide and encoded as
-/// JPEG: small enough to embed in a report.
+/// The debug image of an analysed photo (the chart found, `detection`, and its sampled
+/// `patches`, as [`debug_overlay`] draws them), reduced to at most `max_width` px wide and
+/// encoded as JPEG: small enough to embed in a report.
 pub fn analysis_overlay_jpeg(
     photo: &Photo,
     template: &ChartTemplate,
-    analysis: &PhotoAnalysis,
+    detection: &Detection,
+    patches: &[PatchSample],
     max_width: u32,
 ) -> Result<Vec<u8>> {
-    let detection = Detection {
-        chart: analysis.chart.clone(),
-        corners: analysis.corners,
-        homography: analysis.homography,
-        confidence: analysis.confidence,
-    };
-    let mut image = debug_overlay(photo, Some((template, &detection, &analysis.patches)), None);
+    let mut image = debug_overlay(photo, Some((template, detection, patches)), None);
     if image.width() > max_width && max_width > 0 {
         let height = (u64::from(image.height()) * u64::from(max_width) / u64::from(image.width()))
             .max(1) as u32;
@@ -241,7 +235,7 @@ pub fn analysis_overlay_jpeg(
             image::ExtendedColorType::Rgb8,
         )
         .map_err(|e| Error::Image {
-            context: analysis.source.clone(),
+            context: photo.source.clone(),
             message: e.to_string(),
         })?;
     Ok(bytes)

@@ -17,9 +17,9 @@ use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::seed;
 use spdcam_core::spectral::SpectralSet;
-use spdcam_infer::estimate::{estimate_photo_bytes, PhotoOptions};
+use spdcam_infer::estimate::PhotoOptions;
 use spdcam_infer::trust::{Calibration, Verdict};
-use spdcam_infer::{Model, ModelSet};
+use spdcam_infer::{Estimator, Model, ModelSet};
 
 /// Scene photos per kind in [`scene_verdicts`].
 pub const SCENES: usize = 20;
@@ -71,7 +71,11 @@ pub fn scene_verdicts(
     let ids = setup
         .library
         .positions(setup.split.lamps(LampPart::Test), "the split's test lamps")?;
-    let models = ModelSet::single(model.clone(), "model");
+    let estimator = Estimator::new(
+        ModelSet::single(model.clone(), "model"),
+        data_dir.clone(),
+        model.grid(),
+    )?;
     let options = PhotoOptions {
         chart: Some(name.to_string()),
         ..PhotoOptions::default()
@@ -107,14 +111,7 @@ pub fn scene_verdicts(
         ];
         for (kind, (camera, light, scene_options)) in shots.into_iter().enumerate() {
             let shot = scene::photograph(camera, light, shot_seed, scene_options)?;
-            match estimate_photo_bytes(
-                &shot.jpeg,
-                "scene.jpg",
-                &models,
-                &options,
-                data_dir,
-                &model.grid(),
-            ) {
+            match estimator.estimate_photo_bytes(&shot.jpeg, "scene.jpg", &options) {
                 Ok(e) => {
                     let t = e
                         .trust

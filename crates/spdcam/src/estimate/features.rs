@@ -2,7 +2,7 @@
 
 use super::print::{print_estimates, report_item, verdict_line, write_report};
 use super::truth::read_truths;
-use super::{quiet, EstimateArgs, LayoutArg};
+use super::{quiet, EstimateArgs, LayoutArg, DETAILED_MAX};
 use crate::plot_file::write_plot;
 use anyhow::{bail, Result};
 use spdcam_core::fsio;
@@ -17,9 +17,6 @@ use spdcam_infer::trust::Uncertainty;
 use spdcam_infer::{Estimate, Estimator, RowStream};
 use std::io::Write;
 use std::path::Path;
-
-/// Estimates printed in full (colorimetry, SPD, score) when there are no more than these.
-pub(super) const DETAILED_MAX: usize = 20;
 
 /// What `estimate --features` keeps while it streams: the first estimates (to print and
 /// plot), the scores against the truths, and the count.

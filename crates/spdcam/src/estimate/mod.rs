@@ -25,6 +25,9 @@ use spdcam_infer::{Estimate, Estimator, Model, ModelSet};
 use std::path::{Path, PathBuf};
 use truth::truths;
 
+/// Estimates printed in full (colorimetry, SPD, score) when there are no more than these.
+const DETAILED_MAX: usize = 20;
+
 /// Options of `spdcam estimate`.
 #[derive(Debug, Args)]
 pub struct EstimateArgs {

@@ -1,8 +1,7 @@
 //! What `spdcam estimate` prints and writes besides the SPDs: the estimates as text, the
 //! verdicts, the bands' columns and the HTML report.
 
-use super::features::DETAILED_MAX;
-use super::EstimateArgs;
+use super::{EstimateArgs, DETAILED_MAX};
 use anyhow::Result;
 use spdcam_core::fsio;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
