@@ -20,8 +20,6 @@
 //! the CIE 1931 2° observer over 400–700 nm) of the estimates against the measured SPDs.
 
 use crate::error::{EvalError, Result};
-use spdcam_infer::Model;
-use spdcam_infer::ridge::Ridge;
 use faer::{Mat, Side};
 use rand::rngs::SmallRng;
 use rand::seq::SliceRandom;
@@ -37,6 +35,8 @@ use spdcam_core::lighting::Lighting;
 use spdcam_core::metrics;
 use spdcam_core::quality::uv::xyz_to_uv1976;
 use spdcam_core::spectral::Grid;
+use spdcam_infer::ridge::Ridge;
+use spdcam_infer::Model;
 use std::path::{Path, PathBuf};
 
 /// Seed of the Telelumen/Canon set's validation/test shuffle.

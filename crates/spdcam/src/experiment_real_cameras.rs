@@ -6,11 +6,11 @@ use anyhow::{Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
-use spdcam_learn::model::Model;
 use spdcam_eval::real_cameras::{
     appearance, baseline_rows, model_row, recipes, split_sets, virtual_photos, virtual_rows,
     CameraSource, Row, DEV_SPLIT_SEED,
 };
+use spdcam_learn::model::Model;
 use std::path::PathBuf;
 
 /// Options of `spdcam experiment real-cameras`.

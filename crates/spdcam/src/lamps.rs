@@ -3,6 +3,7 @@
 //! writes the parameters the `lamp:` recipes draw around; `validate` runs the validation
 //! protocol (`crate::validate_lamps`).
 
+use crate::held_out_args::LibraryArgs;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use spdcam_core::builtin::DataDir;
@@ -10,7 +11,6 @@ use spdcam_core::lighting::lamp_families::{fit_families, LampFits};
 use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::lighting::ValidationSplit;
 use spdcam_core::spectral::Grid;
-use crate::held_out_args::LibraryArgs;
 use spdcam_eval::held_out::{camera_names, in_data_dir};
 use std::path::PathBuf;
 

@@ -127,7 +127,11 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
         .calibration
         .iter()
         .map(|c| format!(" --calibration {}", c.display()))
-        .chain(args.reliability.iter().map(|r| format!(" --reliability {}", r.display())))
+        .chain(
+            args.reliability
+                .iter()
+                .map(|r| format!(" --reliability {}", r.display())),
+        )
         .collect();
     let commands = format!(
         "spdcam trust calibrate --real{photos} -o models\nspdcam trust report{photos}{report_options} -o {}",

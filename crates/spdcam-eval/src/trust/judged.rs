@@ -178,7 +178,6 @@ pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
     cov / (va * vb).sqrt()
 }
 
-
 /// Judged photos made to order, for the tests of the calibration and its measurement.
 #[cfg(test)]
 pub(crate) mod fixtures {

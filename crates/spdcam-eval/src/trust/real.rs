@@ -77,4 +77,3 @@ pub fn real_split(
         })
         .collect())
 }
-

@@ -420,7 +420,8 @@ impl TrustReport {
             )?;
             let real = real_split(thesis_data, data_dir, model, chart_name)?;
             if cal.real_photos > 0 {
-                let calibration_real = balanced(real.clone(), calibration_shots.clean.features.len());
+                let calibration_real =
+                    balanced(real.clone(), calibration_shots.clean.features.len());
                 for set in &calibration_real {
                     calibration_photos.extend(judge_rows(
                         model,

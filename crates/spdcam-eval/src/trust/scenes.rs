@@ -132,4 +132,3 @@ pub fn scene_verdicts(
     }
     Ok(counts.map(|(n, f)| (n as f64 / SCENES as f64, f as f64 / SCENES as f64)))
 }
-

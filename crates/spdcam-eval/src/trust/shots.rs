@@ -42,11 +42,16 @@ pub struct Shots {
     pub glare: Vec<Vec<f64>>,
 }
 
-
 impl HeldOutPhotos {
     /// The lamps of `part`, `shots` photos each through the held-out cameras with the
     /// randomised in-camera stage (exposure, white balance, tone, JPEG, gradient).
-    pub fn shots(&self, setup: &Setup, chart: &Chart, model: &Model, part: LampPart) -> Result<Shots> {
+    pub fn shots(
+        &self,
+        setup: &Setup,
+        chart: &Chart,
+        model: &Model,
+        part: LampPart,
+    ) -> Result<Shots> {
         let ids = setup
             .library
             .positions(setup.split.lamps(part), "the split's lamps")?;
@@ -127,7 +132,6 @@ impl HeldOutPhotos {
         Ok(out)
     }
 }
-
 
 /// Per feature patch of `chart`: the relative glare, 1 at the top-left corner falling off
 /// as a Gaussian of [`GLARE_WIDTH`] chart widths (a lamp beside the chart, out of frame).
