@@ -292,3 +292,54 @@ fn real_scores(thesis_data: Option<&Path>, model: &Model, data_dir: &DataDir) ->
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn validation(real: Option<[f64; 3]>) -> LampValidation {
+        let scores = Scores {
+            average: 0.9,
+            pipeline: 0.95,
+            simple: 0.925,
+        };
+        LampValidation {
+            models: vec![ModelValidation {
+                model: PathBuf::from("models/sg.spdm"),
+                chart: "colorchecker_sg96".into(),
+                types: vec![
+                    TypeScores {
+                        kind: Some(LampType::Hid),
+                        lamps: [2, 0],
+                        scores: [Some(scores), None],
+                    },
+                    TypeScores {
+                        kind: None,
+                        lamps: [2, 0],
+                        scores: [Some(scores), None],
+                    },
+                ],
+                real,
+            }],
+            shots: 4,
+            cameras: 3,
+            seed: 7,
+        }
+    }
+
+    #[test]
+    fn a_part_without_lamps_of_a_type_shows_a_dash_and_the_file_name_alone() {
+        let md = validation(None).markdown();
+        assert!(md.starts_with("### `sg.spdm` (colorchecker_sg96)\n\n"));
+        assert!(md.contains("| HID | 2 / 0 | 0.9000 | 0.9500 | 0.9250 | – | – | – |\n"));
+        assert!(md.contains("| **all** | 2 / 0 |"));
+        assert!(!md.contains("(c) the real photo sets"));
+        assert!(md.ends_with("over 4 photos each), then over the lamps of a type. (a): each photo by a held-out camera of the split (3 cameras) with the randomised in-camera stage (exposure, white balance, tone, JPEG, lighting gradient), patch level, noise-free; (b): by the independent simple camera (grey-world white balance partly applied, D65-fitted colour matrix, auto exposure, a little flare and gradient, sRGB, 8 bit) with the same cameras. Average SPD: the mean of the split's fit lamps, the estimate of a model that knows nothing. Seed 7.\n"));
+    }
+
+    #[test]
+    fn the_real_sets_table_appears_only_with_real_scores() {
+        let md = validation(Some([0.8, 0.9, 0.85])).markdown();
+        assert!(md.contains("| `sg.spdm` | 0.8000 | 0.9000 | 0.8500 |\n\nMean GFC"));
+    }
+}
