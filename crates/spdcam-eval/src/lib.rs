@@ -1,6 +1,7 @@
 //! spdcam-eval: the protocols that measure spdcam's estimates and calibrate how far they can
 //! be trusted — the trust calibration's fit and its report, the real-camera study, the
-//! reliability diagram, and the held-out lamps and cameras they share. They sit between the
+//! reliability diagram, the lamp validation, the coverage of measured lamps by lighting
+//! recipes, and the held-out lamps and cameras they share. They sit between the
 //! inference crate (the estimate they measure) and the command line (which parses their
 //! options and prints their results), and need no training stack (burn): ridge regression, the
 //! one learner they fit, lives in `spdcam_infer::ridge`.
@@ -12,6 +13,11 @@
 //! - [`real_cameras`]: the real photo sets split for choosing and reporting, the simple
 //!   learners every number stands beside, virtual photos of a light prior.
 //! - [`reliability`]: the reliability diagram.
+//! - [`lamp_validation`]: held-out lamps photographed by held-out cameras and by an
+//!   independent simple camera, scored per lamp type beside the average SPD
+//!   ([`lamp_validation::LampValidation`]).
+//! - [`coverage`]: how well lighting recipes reach measured SPDs, per lamp type
+//!   ([`coverage::Coverage`]).
 //! - [`error`]: the crate's error type.
 //!
 //! The split-conformal quantile the bands are scaled by, on ten calibration errors:
@@ -26,8 +32,10 @@
 
 #![deny(missing_docs)]
 
+pub mod coverage;
 pub mod error;
 pub mod held_out;
+pub mod lamp_validation;
 pub mod real_cameras;
 pub mod reliability;
 pub mod trust;

@@ -123,7 +123,8 @@ pub fn residual(judged: &Judged) -> Option<f64> {
 
 /// A photo's band error in units of its calibrated scale: per wavelength
 /// |error(λ)| / ((f(λ) + s(λ))·w), the quantity the calibration's conformal quantiles are
-/// taken of ([`Calibration`]); `floor` is the calibration's f(λ) and `widening` the photo's w.
+/// taken of ([`trust::Calibration`]); `floor` is the calibration's f(λ) and `widening` the
+/// photo's w.
 pub fn band_z(floor: &[f64], widening: f64, judged: &Judged) -> Vec<f64> {
     let truth = judged.truth.as_deref().unwrap_or_default();
     truth
