@@ -5,6 +5,9 @@
 use crate::error::{EvalError, Result};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
+use spdcam_core::camera::CameraConfig;
+use spdcam_core::chart::Chart;
+use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
 use spdcam_core::lighting::{LampLibrary, ValidationSplit};
 use spdcam_core::metrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
@@ -17,6 +20,29 @@ pub const LAMP_SPDS: &str = "lamps/ies_tm30_lamps.csv";
 pub const LAMP_TYPES: &str = "lamps/ies_tm30_lamps_info.csv";
 /// The grid the lamps are photographed on.
 pub const GRID: Grid = Grid::SIMULATION;
+
+/// The in-camera stage every protocol over held-out lamps draws from: exposure, white
+/// balance, tone, JPEG and the light's gradient across the chart.
+pub const IN_CAMERA_GROUPS: [&str; 5] = ["exposure", "wb", "tone", "jpeg", "gradient"];
+
+/// `cameras` photographing `chart` without sensor noise, each shot with in-camera settings
+/// drawn from [`IN_CAMERA_GROUPS`] (`stream` seeds the draws): what the lamp validation and
+/// the trust protocols photograph held-out lamps with.
+pub fn randomised_cameras(
+    cameras: &[Sensitivities],
+    stream: u64,
+    chart: &Chart,
+) -> Result<Randomisation> {
+    let config = CameraConfig {
+        noise: None,
+        ..CameraConfig::default()
+    };
+    let pool = camera_pool(cameras, 0, stream, chart, config, &GRID)?;
+    Ok(Randomisation::new(
+        pool,
+        InCameraRanges::for_groups(&IN_CAMERA_GROUPS)?,
+    )?)
+}
 
 /// `given`, or `default` inside the data directory.
 ///

@@ -3,13 +3,12 @@
 //! camera (b), each model's mean GFC per lamp on them, and the average-SPD baseline.
 
 use crate::error::Result;
-use crate::held_out::GRID;
+use crate::held_out::{randomised_cameras, GRID};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use spdcam_core::camera::sensor::Sensitivities;
-use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::camera::Camera;
 use spdcam_core::chart::Chart;
-use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
 use spdcam_core::lighting::LampLibrary;
 use spdcam_core::simple_camera::{Shot, SimpleCamera};
 use spdcam_core::{metrics, seed};
@@ -52,15 +51,7 @@ pub(crate) fn pipeline_photos(
     shots: u64,
     seed: u64,
 ) -> Result<Photos> {
-    let config = CameraConfig {
-        noise: None,
-        ..CameraConfig::default()
-    };
-    let pool = camera_pool(cameras, 0, seed, chart, config, &GRID)?;
-    let randomisation = Randomisation::new(
-        pool,
-        InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg", "gradient"])?,
-    )?;
+    let randomisation = randomised_cameras(cameras, seed, chart)?;
     let width = chart.feature_names().len();
     let mut features = Vec::with_capacity(ids.len() * shots as usize * width);
     let (mut raw, mut out) = (Vec::new(), Vec::new());

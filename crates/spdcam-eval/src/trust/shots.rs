@@ -3,14 +3,12 @@
 //! (patches in another order, the right half lit by another lamp, glare).
 
 use crate::error::{EvalError, Result};
-use crate::held_out::{on_grid, HeldOutPhotos, Setup, GRID};
+use crate::held_out::{on_grid, randomised_cameras, HeldOutPhotos, Setup};
 use rand::rngs::SmallRng;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
-use spdcam_core::camera::CameraConfig;
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
-use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
 use spdcam_core::lighting::validation_split::LampPart;
 use spdcam_core::seed;
 use spdcam_infer::Model;
@@ -65,15 +63,7 @@ impl HeldOutPhotos {
             ));
         }
         let stream = seed::derive(self.seed, part as u64);
-        let config = CameraConfig {
-            noise: None,
-            ..CameraConfig::default()
-        };
-        let pool = camera_pool(&setup.cameras, 0, stream, chart, config, &GRID)?;
-        let randomisation = Randomisation::new(
-            pool,
-            InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg", "gradient"])?,
-        )?;
+        let randomisation = randomised_cameras(&setup.cameras, stream, chart)?;
         let truth = on_grid(&setup.library, &model.grid())?;
         let cols = chart.layout.cols;
         let right: Vec<bool> = (0..chart.reflectances.len())
