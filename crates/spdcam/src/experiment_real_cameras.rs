@@ -1,4 +1,4 @@
-//! `spdcam experiment real-cameras`: the real-camera study (`spdcam_learn::real_cameras`) as
+//! `spdcam experiment real-cameras`: the real-camera study (`spdcam_eval::real_cameras`) as
 //! a Markdown table: every candidate on each real set's validation and test photos, beside
 //! the constant and ridge on real photos, with the label-free look of real and virtual photos.
 
