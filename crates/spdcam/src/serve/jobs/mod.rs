@@ -5,11 +5,12 @@
 //! 24 MP photo is worked on. Each finished estimate keeps its HTML report (the one `spdcam
 //! estimate --report` writes) for the newest [`KEEP_REPORTS`] jobs.
 
+mod engine;
+
+pub use engine::Engine;
+
+use engine::Estimated;
 use spdcam_core::chart::KnownChart;
-use spdcam_core::photo;
-use spdcam_infer::presentation::Presentation;
-use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
-use spdcam_infer::{Estimator, InferError, PhotoOptions};
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::Instant;
@@ -54,142 +55,6 @@ pub enum Progress {
     Running { since: Instant },
     /// Finished.
     Finished(Outcome),
-}
-
-/// What estimates: the estimator of the models, built once for every upload.
-pub struct Engine {
-    /// The models with their calibrations and chart checks, and the output grid (that of
-    /// `spdcam estimate`'s default).
-    pub estimator: Estimator,
-}
-
-/// An estimate's outcome and, when it succeeded, its HTML report.
-pub struct Estimated {
-    /// The outcome.
-    pub outcome: Outcome,
-    /// The report of the estimate, for a successful one.
-    pub report: Option<Arc<str>>,
-}
-
-impl Engine {
-    /// The estimate of one upload, by the estimator `spdcam estimate` uses: a photo that
-    /// cannot be read or shows no chart is a 400, one with no model for its chart 422. Its
-    /// JSON carries the estimate's [`Presentation`] under `presentation`. The one place the
-    /// server estimates.
-    pub fn estimate(&self, upload: Upload) -> Estimated {
-        let failed = |status, message: String| Estimated {
-            outcome: Outcome::Failed(status, message),
-            report: None,
-        };
-        let options = PhotoOptions {
-            corners: upload.corners,
-            chart: upload.chart.map(|c| c.name().to_string()),
-            overlay_width: Some(REPORT_IMAGE_WIDTH),
-            ..PhotoOptions::default()
-        };
-        let analysed = match photo::decode_photo(&upload.bytes, &upload.name)
-            .map_err(InferError::from)
-            .and_then(|decoded| self.estimator.analyse_decoded(&decoded, &options))
-        {
-            Ok(a) => a,
-            Err(e) => return failed(400, e.to_string()),
-        };
-        drop(upload.bytes);
-        drop(upload.memory);
-        let overlay = analysed.overlay;
-        let estimate = match self
-            .estimator
-            .estimate_analysis(analysed.analysis, upload.name)
-        {
-            Ok(e) => e,
-            Err(e) => return failed(422, e.to_string()),
-        };
-        let mut json = match estimate.to_json() {
-            Ok(json) => json,
-            Err(e) => return failed(500, e.to_string()),
-        };
-        let presentation = Presentation::of(&estimate);
-        match serde_json::to_value(&presentation) {
-            Ok(p) => json["presentation"] = p,
-            Err(e) => return failed(500, e.to_string()),
-        }
-        let image = overlay.map(|bytes| ReportImage {
-            mime: "image/jpeg",
-            bytes,
-        });
-        let title = format!("The light in {}", estimate.name);
-        let report = report_html(&title, &[ReportItem::new(estimate, image, None)]);
-        Estimated {
-            outcome: Outcome::Done(json.to_string().into()),
-            report: Some(report.into()),
-        }
-    }
-}
-
-/// The message for a person (no command-line words) and a code for the page, of a failed
-/// request's `status` and `error`: `no_chart` when the chart was not found (the page then
-/// asks for its corners), else `bad_photo`, `unknown_chart`, `bad_corners`, `too_large`,
-/// `busy`, `not_found` or `failed`.
-pub fn plain_error(status: u16, error: &str) -> (&'static str, String) {
-    let (code, message) = if error.contains("no chart found") {
-        (
-            "no_chart",
-            "No colour chart was found in this photo. Click its four corners on the photo to              show where it is."
-                .to_string(),
-        )
-    } else if error.contains("not an image") || error.contains("decod") {
-        (
-            "bad_photo",
-            "This file is not a photo the page can read: use a JPEG, PNG or TIFF.".to_string(),
-        )
-    } else if error.contains("no model for chart") {
-        (
-            "unknown_chart",
-            "The chart in this photo is not one spdcam reads: use a ColorChecker 24 or a              ColorChecker Digital SG."
-                .to_string(),
-        )
-    } else if error.contains("corners") {
-        (
-            "bad_corners",
-            "The four corners could not be used: click the chart's four outer corners.".to_string(),
-        )
-    } else {
-        match status {
-            413 => (
-                "too_large",
-                "This photo is larger than this server accepts; use a smaller file.".to_string(),
-            ),
-            503 => (
-                "busy",
-                "The server is busy with other photos; try again in a moment.".to_string(),
-            ),
-            404 => (
-                "not_found",
-                "This is no longer kept on the server; add the photo again.".to_string(),
-            ),
-            _ => (
-                "failed",
-                format!("The photo could not be estimated: {}", without_flags(error)),
-            ),
-        }
-    };
-    (code, message)
-}
-
-/// `error` without the clauses (split at `;` and parentheses) that name command-line
-/// options or commands.
-fn without_flags(error: &str) -> String {
-    error
-        .split(';')
-        .map(|part| match part.find('(') {
-            Some(i) if part[i..].contains("--") || part[i..].contains("spdcam ") => &part[..i],
-            _ => part,
-        })
-        .filter(|part| !part.contains("--") && !part.contains("spdcam "))
-        .map(str::trim)
-        .filter(|part| !part.is_empty())
-        .collect::<Vec<_>>()
-        .join("; ")
 }
 
 #[derive(Default)]
@@ -349,45 +214,5 @@ impl Jobs {
         self.lock().stopping = true;
         self.changed.notify_all();
         self.finished.notify_waiters();
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn errors_for_people_name_no_command_line_words() {
-        let cases = [
-            (
-                400,
-                "room.jpg: no chart found (looked for colorchecker24); give its corners with --corners x1,y1,…,x4,y4",
-                "no_chart",
-            ),
-            (400, "notes.txt: not an image (unknown format)", "bad_photo"),
-            (
-                413,
-                "the upload is larger than the limit of 64 MB (spdcam serve --max-upload-mb)",
-                "too_large",
-            ),
-            (400, "--corners needs eight numbers x1,y1,x2,y2,x3,y3,x4,y4; got 3", "bad_corners"),
-            (503, "too many photos are waiting; try again in a moment", "busy"),
-            (500, "the model broke (try spdcam estimate --debug d.png); really", "failed"),
-        ];
-        for (status, error, want) in cases {
-            let (code, message) = plain_error(status, error);
-            assert_eq!(code, want, "{error}");
-            for word in ["--", "spdcam serve", "spdcam estimate", "corners with"] {
-                assert!(!message.contains(word), "{message}");
-            }
-        }
-        assert_eq!(
-            plain_error(
-                500,
-                "the model broke (try spdcam estimate --debug d.png); really"
-            )
-            .1,
-            "The photo could not be estimated: the model broke; really"
-        );
     }
 }

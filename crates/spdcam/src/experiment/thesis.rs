@@ -8,99 +8,23 @@
 //! of 1. Models predict PCA coefficients of the SPD (`--target weights`: the channel weights,
 //! as the thesis did for these sets).
 
+use super::sets::{channels, load_part, SetName};
 use crate::evaluate::metrics_table;
 use crate::train::{reporter, ModelKind, Preset, TargetArg};
 use anyhow::{bail, Context, Result};
-use clap::{Args, Subcommand, ValueEnum};
-use spdcam_core::dataset::{Columns, Precision, SampleBatch};
+use clap::{Args, ValueEnum};
 use spdcam_core::fsio::write_atomic;
-use spdcam_core::lighting::Channels;
-use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
-use spdcam_infer::FeatureRows;
+use spdcam_core::spectral::Grid;
 use spdcam_learn::evaluate::evaluate;
 use spdcam_learn::pca::Components;
-use spdcam_learn::record::DataInfo;
 use spdcam_learn::scale::RowScale;
 use spdcam_learn::target::TargetKind;
-use spdcam_learn::train::{train, Schedule, TrainOptions, TrainingSet};
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-
-/// Options of `spdcam experiment`.
-#[derive(Debug, Args)]
-pub struct ExperimentArgs {
-    #[command(subcommand)]
-    command: ExperimentCommand,
-}
-
-#[derive(Debug, Subcommand)]
-enum ExperimentCommand {
-    /// Train and test on the thesis's virtual datasets; compare with its Tables 4.2–4.4.
-    Thesis(ThesisArgs),
-    /// Every way of estimating on the real photo sets' validation and test photos, beside a
-    /// constant guess and ridge on real photos (`docs/real-cameras-table.md`).
-    RealCameras(crate::experiment_real_cameras::RealCamerasArgs),
-}
-
-/// One of the thesis's virtual sets.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum SetName {
-    G1,
-    G2,
-    G3,
-    G4,
-    /// All 24 Telelumen channels (the thesis's H2 used the SG chart; this set uses CC24).
-    T24,
-}
-
-impl SetName {
-    fn dir(self) -> &'static str {
-        match self {
-            SetName::G1 => "gaussian_4ch_cc24",
-            SetName::G2 => "gaussian_5ch_cc24",
-            SetName::G3 => "gaussian_6ch_cc24",
-            SetName::G4 => "gaussian_7ch_cc24",
-            SetName::T24 => "telelumen_24ch_cc24",
-        }
-    }
-
-    fn label(self) -> &'static str {
-        match self {
-            SetName::G1 => "G1",
-            SetName::G2 => "G2",
-            SetName::G3 => "G3",
-            SetName::G4 => "G4",
-            SetName::T24 => "T24",
-        }
-    }
-
-    /// The number of the thesis's Gaussian channels ([`Channels::gaussian`]); `None` for
-    /// the Telelumen set.
-    fn gaussian_channels(self) -> Option<usize> {
-        match self {
-            SetName::G1 => Some(4),
-            SetName::G2 => Some(5),
-            SetName::G3 => Some(6),
-            SetName::G4 => Some(7),
-            SetName::T24 => None,
-        }
-    }
-
-    /// Mean GFC the thesis published: (1D CNN, DNN) where it has them.
-    fn thesis_gfc(self) -> (Option<f64>, Option<f64>) {
-        match self {
-            SetName::G1 => (Some(0.9997), Some(0.9989)),
-            SetName::G2 => (Some(0.9994), Some(0.9988)),
-            SetName::G3 => (Some(0.9992), Some(0.9982)),
-            SetName::G4 => (Some(0.9990), Some(0.9972)),
-            SetName::T24 => (None, None),
-        }
-    }
-}
+use spdcam_learn::train::{train, Schedule, TrainOptions};
+use std::path::PathBuf;
 
 /// Options of `spdcam experiment thesis`.
 #[derive(Debug, Args)]
-struct ThesisArgs {
+pub(super) struct ThesisArgs {
     /// The thesis's data directory (holding `virtual/` and `telelumen_24_channels.csv`);
     /// default: `thesis` under --data-dir / $SPDCAM_DATA.
     #[arg(long, value_name = "DIR")]
@@ -142,100 +66,8 @@ struct ThesisArgs {
     grid: String,
 }
 
-/// Channel spectra of a set on the simulation grid.
-fn channels(set: SetName, root: &Path) -> Result<Vec<Vec<f64>>> {
-    let grid = Grid::SIMULATION;
-    if let Some(n) = set.gaussian_channels() {
-        return Ok(Channels::gaussian(n, &grid)?.spds);
-    }
-    let path = root.join("telelumen_24_channels.csv");
-    let raw =
-        SpectralSet::read_csv(&path).with_context(|| format!("reading {}", path.display()))?;
-    let (set, _) = raw.resample(&grid, Interpolation::Linear, Extrapolation::Zero)?;
-    // The thesis's code set the channels to 0 above 700 nm.
-    Ok((0..set.len())
-        .map(|i| {
-            set.item(i)
-                .iter()
-                .enumerate()
-                .map(|(k, v)| {
-                    if grid.wavelength(k) > 700.0 {
-                        0.0
-                    } else {
-                        v.max(0.0)
-                    }
-                })
-                .collect()
-        })
-        .collect())
-}
-
-/// One part (`train` or `val`) of a set, with SPDs made from its weights.
-fn load_part(set: SetName, part: &str, root: &Path, ch: &[Vec<f64>]) -> Result<TrainingSet> {
-    let dir = root.join("virtual").join(format!("{}_{part}", set.dir()));
-    let features = FeatureRows::read_csv(&dir.join("features.csv"))?;
-    let weights = FeatureRows::read_csv(&dir.join("weights.csv"))?;
-    if weights.rows != features.rows || weights.names.len() != ch.len() {
-        bail!(
-            "{}: {} feature rows, {} weight rows of {} channels (expected {})",
-            dir.display(),
-            features.rows,
-            weights.rows,
-            weights.names.len(),
-            ch.len()
-        );
-    }
-    let grid = Grid::SIMULATION;
-    let k = ch.len();
-    let mut samples = SampleBatch {
-        feature_count: features.names.len(),
-        spd_len: grid.count,
-        weight_count: k,
-        features: features.values.clone(),
-        weights: weights.values.clone(),
-        ..SampleBatch::default()
-    };
-    for (i, w) in weights.values.chunks_exact(k).enumerate() {
-        let mut spd: Vec<f64> = (0..grid.count)
-            .map(|j| w.iter().zip(ch).map(|(wi, c)| wi * c[j]).sum())
-            .collect();
-        let max = spd.iter().copied().fold(0.0, f64::max);
-        if max > 0.0 {
-            spd.iter_mut().for_each(|v| *v /= max);
-        }
-        samples.spds.extend(spd);
-        samples.samples.push(i as u64);
-        samples.families.push(set.label().into());
-        samples.attempts.push(1);
-    }
-    Ok(TrainingSet {
-        samples,
-        columns: Columns {
-            feature_names: features.names,
-            feature_precision: Precision::Float64,
-            spd_grid: grid,
-            weight_names: weights.names,
-        },
-        info: DataInfo {
-            path: format!("thesis virtual/{}_{part}", set.dir()),
-            samples: features.rows,
-            chart: Some("colorchecker-24".into()),
-            camera: Some("canon-eos-5d-mark-ii (thesis)".into()),
-            families: BTreeMap::from([(set.label().to_string(), features.rows as u64)]),
-            origin: None,
-        },
-    })
-}
-
-/// Runs `spdcam experiment`.
-pub fn run(args: ExperimentArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
-    match args.command {
-        ExperimentCommand::Thesis(a) => thesis(a, data_dir),
-        ExperimentCommand::RealCameras(a) => crate::experiment_real_cameras::run(a, data_dir),
-    }
-}
-
-fn thesis(args: ThesisArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
+/// Runs `spdcam experiment thesis`.
+pub(super) fn run(args: ThesisArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
     let root = match (&args.thesis_data, data_dir.root()) {
         (Some(p), _) => p.clone(),
         (None, Some(r)) => r.join("thesis"),

@@ -3,25 +3,25 @@
 //! on or off, and scored (mean GFC) on the real measured sets; steps that use real photos
 //! (calibration) are cross-validated: calibrated on a few photos outside the test fold.
 
+mod curve_table;
+mod ridge;
+
 use crate::calibrate::{photos, sensitivities_in};
-use crate::sim2real_curve::{learning_curve, CurveOptions};
 use anyhow::{Context, Result};
 use clap::Args;
+use curve_table::curve_table;
+use ridge::{real_to_real, score, train_virtual};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::in_camera::{calibrate, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
-use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
 use spdcam_core::dataset::{MeasuredPhotos, REAL_PHOTO_SETS};
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::lighting::Lighting;
-use spdcam_core::metrics;
 use spdcam_core::spectral::Grid;
-use spdcam_learn::model::Model;
-use spdcam_learn::ridge::Ridge;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Options of `spdcam sim2real`.
 #[derive(Debug, Args)]
@@ -62,72 +62,6 @@ pub struct Sim2realArgs {
 const LIGHTING: &str =
     "mix:telelumen:config1=0.3,telelumen:config2=0.3,telelumen:config3=0.2,phosphor=0.1,planck=0.1";
 const GRID: Grid = Grid::SIMULATION;
-
-/// Input vector: features divided by their mean (removes exposure), and a bias.
-fn inputs(features: &[f64]) -> Vec<f64> {
-    let mean = features.iter().sum::<f64>() / features.len() as f64;
-    let mut x: Vec<f64> = features.iter().map(|v| v / mean.max(1e-9)).collect();
-    x.push(1.0);
-    x
-}
-
-/// The SPD at 400–700 nm / 10 nm from the simulation grid, normalised to a maximum of 1.
-fn target(spd: &[f64]) -> Vec<f64> {
-    let v: Vec<f64> = (0..31)
-        .map(|k| {
-            let nm = 400.0 + 10.0 * k as f64;
-            spd[((nm - GRID.start_nm) / GRID.step_nm).round() as usize]
-        })
-        .collect();
-    metrics::normalise_by_max(&v)
-}
-
-/// Mean GFC of `model` on the photos `indices`.
-fn score(model: &Ridge, set: &MeasuredPhotos, indices: &[usize]) -> Result<f64> {
-    let mut total = 0.0;
-    for &i in indices {
-        let truth = target(&set.spds[i]);
-        let est = model.predict_non_negative(&inputs(&set.features[i]));
-        total += metrics::gfc(&truth, &est).unwrap_or(0.0);
-    }
-    Ok(total / indices.len() as f64)
-}
-
-/// Trains on `count` virtual samples of `camera` (optionally randomised).
-fn train_virtual(
-    camera: &Camera,
-    randomisation: Option<&Randomisation>,
-    lighting: &Lighting,
-    count: u64,
-    ridge: f64,
-) -> Result<Ridge> {
-    let mut options = GenerateOptions::new(count, 1);
-    options.pipeline = Pipeline::Fast;
-    let mut generator = Generator::new(camera, lighting, options)?;
-    if let Some(r) = randomisation {
-        generator = generator.with_randomisation(r)?;
-    }
-    let batch = generator.samples(0..count, None, &|_| {})?;
-    let x: Vec<Vec<f64>> = (0..batch.len())
-        .map(|i| inputs(batch.features_of(i)))
-        .collect();
-    let y: Vec<Vec<f64>> = (0..batch.len()).map(|i| target(batch.spd_of(i))).collect();
-    Ok(Ridge::fit(&x, &y, ridge, None)?)
-}
-
-/// Ridge trained and tested on real photos (k-fold; the penalty chosen by an inner
-/// cross-validation on the training folds), the reference.
-fn real_to_real(set: &MeasuredPhotos, folds: usize) -> Result<f64> {
-    let n = set.features.len();
-    let mut total = 0.0;
-    for f in 0..folds {
-        let (test, train): (Vec<usize>, Vec<usize>) = (0..n).partition(|i| i % folds == f);
-        let x: Vec<Vec<f64>> = train.iter().map(|&i| inputs(&set.features[i])).collect();
-        let y: Vec<Vec<f64>> = train.iter().map(|&i| target(&set.spds[i])).collect();
-        total += score(&Ridge::fit_cv(&x, &y, folds, None)?, set, &test)? * test.len() as f64;
-    }
-    Ok(total / n as f64)
-}
 
 /// Runs `spdcam sim2real`.
 pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
@@ -293,85 +227,6 @@ pub fn run(args: Sim2realArgs, data_dir: &DataDir) -> Result<()> {
          noise-free patch-level camera, ridge λ = {} (relative) for the rows trained on virtual \
          data.\n",
         args.count, args.ridge
-    );
-    write_atomic(&args.output, md.as_bytes())?;
-    print!("{md}");
-    Ok(())
-}
-
-/// Writes the fine-tuning learning curve of the model at `path` on every real set, beside
-/// two linear baselines on the same photos: ridge on the photos alone, and the virtual
-/// ridge `prior` corrected by the photos (shrunk towards it); both choose their penalty by
-/// cross-validation on the photos.
-fn curve_table(
-    args: &Sim2realArgs,
-    path: &Path,
-    sets: &[(&str, MeasuredPhotos)],
-    prior: &Ridge,
-) -> Result<()> {
-    let model = Model::load(path)?;
-    let options = CurveOptions {
-        sizes: args.sizes.clone(),
-        folds: args.folds.max(2),
-        seed: 1,
-        choose: args.choose,
-    };
-    const COLUMNS: [&str; 3] = ["fine-tuned", "ridge", "ridge towards virtual"];
-    let mut md = format!(
-        "| real photos used | {} |\n|---:|{}\n",
-        sets.iter()
-            .map(|(n, _)| format!("{n}: {}", COLUMNS.join(" | ")))
-            .collect::<Vec<_>>()
-            .join(" | "),
-        "---:|".repeat(COLUMNS.len() * sets.len())
-    );
-    let curves = sets
-        .iter()
-        .map(|(name, set)| {
-            let baselines = |train: &[usize], test: &[usize]| -> Result<Vec<f64>> {
-                let x: Vec<Vec<f64>> = train.iter().map(|&i| inputs(&set.features[i])).collect();
-                let y: Vec<Vec<f64>> = train.iter().map(|&i| target(&set.spds[i])).collect();
-                [None, Some(prior)]
-                    .into_iter()
-                    .map(|p| score(&Ridge::fit_cv(&x, &y, 5, p)?, set, test))
-                    .collect()
-            };
-            let curve = learning_curve(&model, set, &GRID, &options, &baselines)?;
-            eprintln!("{name}: {:?}", curve.points);
-            Ok(curve)
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let cell = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.4}"));
-    for (row, &size) in args.sizes.iter().enumerate() {
-        md += &format!("| {size} |");
-        for curve in &curves {
-            let point = &curve.points[row];
-            md += &format!(" {} |", cell(point.tuned));
-            for k in 0..COLUMNS.len() - 1 {
-                md += &format!(" {} |", cell(point.baselines.get(k).copied().flatten()));
-            }
-        }
-        md.push('\n');
-    }
-    md += &format!(
-        "\nMean GFC (400–700 nm; the model at 5 nm, ridge at 10 nm) on the photos of the test \
-         fold, {}-fold cross-validated; the photos used come from the other folds (seeded \
-         random picks). Model: `{}` ({}), fine-tuned {}. Ridge: features ÷ their mean → SPD, \
-         the penalty chosen by 5-fold cross-validation on the photos used; towards virtual: \
-         shrunk towards the ridge trained on {} virtual samples (randomised cameras, \
-         in-camera stage and lighting gradient) instead of towards zero.\n",
-        options.folds,
-        path.display(),
-        model.describe(),
-        if args.choose {
-            "as `spdcam finetune` without recipe flags: the recipe chosen by 5-fold \
-             cross-validation on the photos used among the model unchanged, the network \
-             recipes (for a network) and ridge on the photos at three penalties"
-        } else {
-            "with its output layer kept, all layers, learning rate 2e-4, batch ≤ 16, about \
-             150 steps"
-        },
-        args.count
     );
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");

@@ -1,0 +1,33 @@
+//! `spdcam experiment`: the thesis's model-selection experiment on its virtual datasets,
+//! and the real-camera study.
+
+mod sets;
+mod thesis;
+
+use anyhow::Result;
+use clap::{Args, Subcommand};
+use thesis::ThesisArgs;
+
+/// Options of `spdcam experiment`.
+#[derive(Debug, Args)]
+pub struct ExperimentArgs {
+    #[command(subcommand)]
+    command: ExperimentCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum ExperimentCommand {
+    /// Train and test on the thesis's virtual datasets; compare with its Tables 4.2–4.4.
+    Thesis(ThesisArgs),
+    /// Every way of estimating on the real photo sets' validation and test photos, beside a
+    /// constant guess and ridge on real photos (`docs/real-cameras-table.md`).
+    RealCameras(crate::experiment_real_cameras::RealCamerasArgs),
+}
+
+/// Runs `spdcam experiment`.
+pub fn run(args: ExperimentArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
+    match args.command {
+        ExperimentCommand::Thesis(a) => thesis::run(a, data_dir),
+        ExperimentCommand::RealCameras(a) => crate::experiment_real_cameras::run(a, data_dir),
+    }
+}

@@ -1,0 +1,249 @@
+//! `spdcam render`: one chart under one light through the virtual camera.
+
+mod camera_args;
+mod parse;
+mod scene_photo;
+
+pub use camera_args::CameraArgs;
+
+use crate::messages::Messages;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use parse::parse_pair;
+use scene_photo::render_scene;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::imageio;
+use spdcam_core::lighting::Lighting;
+use spdcam_core::photo::scene;
+use spdcam_core::spectral::{Grid, SpectralSet};
+use spdcam_core::{fsio, light};
+use std::path::{Path, PathBuf};
+
+/// Options of `spdcam render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// The light: D65, A, D50, cct:T, daylight:T, planck:T, or a spectral CSV (FILE.csv[:COLUMN]).
+    #[arg(
+        long,
+        required_unless_present = "lighting",
+        conflicts_with = "lighting"
+    )]
+    spd: Option<String>,
+    /// Instead of --spd: a light drawn from a lighting recipe (`spdcam list lighting`), the
+    /// one `spdcam generate --lighting RECIPE --seed SEED` draws for sample --draw.
+    #[arg(long, value_name = "RECIPE", requires = "draw")]
+    lighting: Option<String>,
+    /// Which draw of --lighting (the sample index of a generated dataset).
+    #[arg(long, value_name = "INDEX", requires = "lighting")]
+    draw: Option<u64>,
+    /// Output PNG (JPEG with --scene); `-` writes it to standard output.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also write the feature row (mean sRGB 0–255 of each patch) as CSV; `-` for standard
+    /// output.
+    #[arg(long, value_name = "FILE.csv")]
+    features: Option<PathBuf>,
+    /// Also write every intermediate stage as an image into this directory.
+    #[arg(long, value_name = "DIR")]
+    stages: Option<PathBuf>,
+    /// Seed of the noise (and of the scene).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Photograph the chart in a scene of WxH px instead: placed at a random position,
+    /// rotation and perspective on a cluttered background under the same light, with blur,
+    /// vignetting, noise, written as a JPEG (`-o photo.jpg`).
+    #[arg(long, value_name = "WxH")]
+    scene: Option<String>,
+    /// With --scene: the patch grid's width as a share of the photo's width (face-on),
+    /// e.g. 0.25 or 1/15; default: drawn between 0.3 and 0.6.
+    #[arg(long, value_name = "SHARE", requires = "scene")]
+    chart_width: Option<String>,
+    /// With --scene: the chart's centre as shares of the photo's width and height (0.5,0.5
+    /// is the middle); default: anywhere it fits.
+    #[arg(long, value_name = "X,Y", requires = "scene")]
+    chart_centre: Option<String>,
+    /// With --scene: the chart's rotation in its own plane, degrees clockwise; default:
+    /// drawn at random.
+    #[arg(
+        long,
+        value_name = "DEG",
+        requires = "scene",
+        allow_negative_numbers = true
+    )]
+    chart_rotation: Option<f64>,
+    /// With --scene: the chart's plane turned away from the camera by DEG (up to 85; a
+    /// perspective view, foreshortened by about cos DEG); default: face-on with a little
+    /// random perspective.
+    #[arg(
+        long,
+        value_name = "DEG",
+        requires = "scene",
+        allow_negative_numbers = true
+    )]
+    tilt: Option<f64>,
+    /// With --tilt: the photo's axis the chart is turned about: horizontal (a chart lying
+    /// on a table) or vertical (a chart on a side wall).
+    #[arg(
+        long,
+        value_name = "AXIS",
+        default_value = "horizontal",
+        requires = "tilt"
+    )]
+    tilt_axis: TiltAxisArg,
+    /// With --scene: a shadow over part of the chart, FACTOR (the light left in it, 0–1)
+    /// [,COVER (the share of the chart shaded, default 0.5) [,DIRECTION (degrees clockwise
+    /// from the chart's right side it comes from, default 0)]].
+    #[arg(long, value_name = "FACTOR[,COVER[,DIR]]", requires = "scene")]
+    shadow: Option<String>,
+    /// With --scene: a second light on the right half of the chart (as --spd), at the
+    /// exposure the first gives; the camera balances the photo as a whole (see
+    /// --balance-halves).
+    #[arg(long, value_name = "SPD", requires = "scene")]
+    right_light: Option<String>,
+    /// With --right-light: each half exposed and white-balanced for its own light (two
+    /// photos of the scene joined at the chart's middle).
+    #[arg(long, requires = "right_light")]
+    balance_halves: bool,
+    /// Also write the light's SPD (normalised to a maximum of 1) as spectral CSV, e.g. as
+    /// the truth beside a scene photo.
+    #[arg(long, value_name = "FILE.csv")]
+    spd_out: Option<PathBuf>,
+    #[command(flatten)]
+    camera: CameraArgs,
+}
+
+/// The axis a chart is tilted about (`--tilt-axis`).
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum TiltAxisArg {
+    /// The photo's horizontal axis.
+    Horizontal,
+    /// The photo's vertical axis.
+    Vertical,
+}
+
+/// Runs `spdcam render`.
+pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
+    let grid = Grid::SIMULATION;
+    for path in std::iter::once(&args.output).chain(&args.features) {
+        if !fsio::is_stdout(path) {
+            fsio::check_parent_dir(path)?;
+        }
+    }
+    if fsio::is_stdout(&args.output) && args.features.as_deref().is_some_and(fsio::is_stdout) {
+        bail!("only one of -o and --features can go to standard output");
+    }
+    let messages = Messages::new(
+        fsio::is_stdout(&args.output) || args.features.as_deref().is_some_and(fsio::is_stdout),
+    );
+    if let Some(dir) = &args.stages {
+        // Made here, before the render, so a bad place fails at once.
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot make the stages directory {}", dir.display()))?;
+    }
+    if let Some(path) = &args.spd_out {
+        fsio::check_parent_dir(path)?;
+    }
+    let scene = args
+        .scene
+        .as_deref()
+        .map(|s| parse_pair(s, "scene"))
+        .transpose()?;
+    if let Some((w, h)) = scene {
+        scene::check_scene_size(w, h)?;
+        args.scene_options(w, h)?;
+    }
+    let extension = args
+        .output
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match (&scene, extension.as_deref()) {
+        (Some(_), Some("jpg" | "jpeg")) | (None, Some("png")) => {}
+        _ if fsio::is_stdout(&args.output) => {}
+        (Some(_), _) => bail!("a scene is written as JPEG: name the output FILE.jpg"),
+        (None, _) => bail!("the chart is written as PNG: name the output FILE.png"),
+    }
+    let spd = match (&args.spd, &args.lighting, args.draw) {
+        (Some(spec), _, _) => light::resolve_spd(spec, data_dir, &grid)?,
+        (None, Some(recipe), Some(index)) => {
+            let draw = Lighting::parse(recipe, data_dir, &grid)?.draw(args.seed, index)?;
+            light::ResolvedSpd {
+                name: format!("{recipe} draw {index} (seed {})", args.seed),
+                spd: draw.spd,
+                resampling: None,
+            }
+        }
+        _ => bail!("give the light as --spd, or as --lighting RECIPE --draw INDEX"),
+    };
+    if let Some(report) = spd.resampling.as_ref().filter(|r| r.extrapolated()) {
+        eprintln!(
+            "warning: {}",
+            report.describe(&format!("light {}", spd.name), &grid)
+        );
+    }
+    if let Some(path) = &args.spd_out {
+        let values = spd.spd.normalised_by_max().into_values();
+        SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?.write_csv(path)?;
+        messages.say(format_args!("light SPD: {}", path.display()));
+    }
+    if let Some((width, height)) = scene {
+        return render_scene(
+            &args,
+            &spd.spd,
+            &spd.name,
+            (width, height),
+            data_dir,
+            messages,
+        );
+    }
+    let camera = args.camera.camera(data_dir, &grid)?;
+    let rendering = camera.render(&spd.spd, args.seed, args.stages.is_some())?;
+    let depth = camera.config().colour.bit_depth;
+    if let Some(dir) = &args.stages {
+        write_stages(dir, &rendering.stages)?;
+        messages.say(format_args!(
+            "stages (linear raw, 16-bit): {}",
+            dir.display()
+        ));
+    }
+    if let Some(path) = &args.features {
+        let names = camera.chart().feature_names();
+        let values: Vec<String> = rendering.features.iter().map(|v| format!("{v}")).collect();
+        let text = format!("{}\n{}\n", names.join(","), values.join(","));
+        fsio::write_output(path, text.as_bytes())?;
+        if !fsio::is_stdout(path) {
+            messages.say(format_args!("features: {}", path.display()));
+        }
+    }
+    fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
+    if fsio::is_stdout(&args.output) {
+        return Ok(());
+    }
+    let l = &camera.chart().layout;
+    messages.say(format_args!(
+        "rendered {} under {} with {} ({}×{} px, {}-bit sRGB): {}",
+        camera.chart().name,
+        spd.name,
+        camera.camera_name(),
+        l.width,
+        l.height,
+        depth,
+        args.output.display()
+    ));
+    Ok(())
+}
+
+fn write_stages(dir: &Path, stages: &spdcam_core::camera::Stages) -> Result<()> {
+    if let Some(cfa) = &stages.cfa {
+        imageio::write_mosaic_png(&dir.join("1_cfa.png"), cfa)?;
+    }
+    for (name, image) in [
+        ("2_demosaiced.png", &stages.demosaiced),
+        ("3_white_balanced.png", &stages.white_balanced),
+        ("4_aberrated.png", &stages.aberrated),
+    ] {
+        if let Some(image) = image {
+            imageio::write_png(&dir.join(name), image, 16)?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,91 @@
+//! The handlers of the API's routes: uploads to estimate, jobs polled, reports, the locus,
+//! and the answers to unknown pages and methods.
+
+use super::answer::Answer;
+use super::plain_error::plain_error;
+use super::Api;
+use crate::serve::jobs::{Outcome, Progress};
+use axum::extract::{Path, Request, State};
+use axum::http::{Method, Uri};
+use std::sync::Arc;
+
+/// `POST /api/estimate`: the estimate of the uploaded photo, once made.
+pub(super) async fn estimate(State(api): State<Arc<Api>>, request: Request) -> Answer {
+    match api.upload(request).await {
+        Ok(upload) => match api.jobs.submit(upload) {
+            Some(id) => Answer::outcome(api.jobs.wait(id).await),
+            None => busy(),
+        },
+        Err(answer) => answer,
+    }
+}
+
+/// `POST /api/jobs`: queues the uploaded photo and answers its job's id at once.
+pub(super) async fn submit(State(api): State<Arc<Api>>, request: Request) -> Answer {
+    match api.upload(request).await {
+        Ok(upload) => match api.jobs.submit(upload) {
+            Some(id) => Answer::json(202, &serde_json::json!({ "id": id.to_string() })),
+            None => busy(),
+        },
+        Err(answer) => answer,
+    }
+}
+
+/// `GET /api/locus`: the outlines of the chromaticity diagram.
+pub(super) async fn locus(State(api): State<Arc<Api>>) -> Answer {
+    Answer(200, "application/json", api.locus.clone().into())
+}
+
+/// `GET /api/jobs/ID`: where the job is, and its result once finished.
+pub(super) async fn job(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
+    let Some(progress) = id.parse::<u64>().ok().and_then(|id| api.jobs.progress(id)) else {
+        return Answer::error(
+            404,
+            format!("no job '{id}' (finished jobs are kept a while)"),
+        );
+    };
+    let value = match progress {
+        Progress::Queued { ahead } => serde_json::json!({ "state": "queued", "ahead": ahead }),
+        Progress::Running { since } => serde_json::json!({
+            "state": "running",
+            "seconds": since.elapsed().as_secs_f64(),
+        }),
+        Progress::Finished(Outcome::Done(json)) => {
+            let result: serde_json::Value =
+                serde_json::from_str(&json).unwrap_or(serde_json::Value::Null);
+            serde_json::json!({ "state": "done", "result": result })
+        }
+        Progress::Finished(Outcome::Failed(status, error)) => {
+            let (code, message) = plain_error(status, &error);
+            serde_json::json!({
+                "state": "failed", "status": status, "error": error, "code": code,
+                "message": message,
+            })
+        }
+    };
+    Answer::json(200, &value)
+}
+
+/// `GET /api/jobs/ID/report`: the finished job's HTML report, while it is kept.
+pub(super) async fn report(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
+    match id.parse::<u64>().ok().and_then(|id| api.jobs.report(id)) {
+        Some(html) => Answer(
+            200,
+            "text/html; charset=utf-8",
+            html.as_bytes().to_vec().into(),
+        ),
+        None => Answer::error(404, format!("no report of job '{id}' is kept")),
+    }
+}
+
+pub(super) async fn not_allowed(method: Method, uri: Uri) -> Answer {
+    Answer::error(405, format!("{method} is not allowed on {}", uri.path()))
+}
+
+pub(super) async fn not_found(uri: Uri) -> Answer {
+    Answer::error(404, format!("no such page or API: {}", uri.path()))
+}
+
+fn busy() -> Answer {
+    Answer::error(503, "too many photos are waiting; try again in a moment")
+}

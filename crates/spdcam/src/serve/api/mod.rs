@@ -1,0 +1,86 @@
+//! The routes: the embedded page and its assets, and the JSON API (`docs/web-api.md`).
+//! Uploads are read into memory as they stream in, up to the size limit and at a minimum
+//! pace, checked, and queued; nothing the client sends is used as a path.
+
+mod answer;
+mod chromaticity;
+mod handlers;
+mod plain_error;
+mod upload;
+
+use super::body::{Budget, Pace};
+use super::jobs::Jobs;
+use answer::Answer;
+use anyhow::Result;
+use axum::body::Body;
+use axum::routing::{get, post};
+use axum::Router;
+use chromaticity::locus_json;
+use handlers::{estimate, job, locus, not_allowed, not_found, report, submit};
+use std::sync::Arc;
+
+const INDEX_HTML: &str = include_str!("../page/index.html");
+const APP_JS: &str = include_str!("../page/app.js");
+const STYLE_CSS: &str = include_str!("../page/style.css");
+const EXAMPLE_JPG: &[u8] = include_bytes!("../../../../../examples/sg-telelumen.jpg");
+/// Room for the multipart framing and the small fields beside the photo; also the longest
+/// field other than the photo.
+const FORM_OVERHEAD: usize = 64 * 1024;
+
+/// The request handler's state, shared by the connections.
+pub struct Api {
+    jobs: Arc<Jobs>,
+    max_upload_bytes: usize,
+    pace: Pace,
+    budget: Budget,
+    locus: String,
+}
+
+impl Api {
+    /// The handler for `jobs`, refusing photos over `max_upload_bytes` and uploads slower
+    /// than `pace`, holding at most `budget_bytes` of uploads in memory.
+    pub fn new(
+        jobs: Arc<Jobs>,
+        max_upload_bytes: usize,
+        pace: Pace,
+        budget_bytes: usize,
+    ) -> Result<Api> {
+        Ok(Api {
+            jobs,
+            max_upload_bytes,
+            pace,
+            budget: Budget::new(budget_bytes.max(max_upload_bytes + FORM_OVERHEAD)),
+            locus: locus_json()?.to_string(),
+        })
+    }
+
+    /// The routes (`GET` routes answer `HEAD` too, without the body).
+    pub fn router(self: Arc<Api>) -> Router {
+        let page = |kind: &'static str, body: &'static [u8]| {
+            get(move || async move { Answer(200, kind, Body::from(body)) })
+        };
+        Router::new()
+            .route("/", page("text/html; charset=utf-8", INDEX_HTML.as_bytes()))
+            .route(
+                "/index.html",
+                page("text/html; charset=utf-8", INDEX_HTML.as_bytes()),
+            )
+            .route(
+                "/app.js",
+                page("text/javascript; charset=utf-8", APP_JS.as_bytes()),
+            )
+            .route(
+                "/style.css",
+                page("text/css; charset=utf-8", STYLE_CSS.as_bytes()),
+            )
+            .route("/example.jpg", page("image/jpeg", EXAMPLE_JPG))
+            .route("/api/locus", get(locus))
+            .route("/api/estimate", post(estimate))
+            .route("/api/jobs", post(submit))
+            .route("/api/jobs/{id}", get(job))
+            .route("/api/jobs/{id}/report", get(report))
+            .method_not_allowed_fallback(not_allowed)
+            .fallback(not_found)
+            .with_state(self)
+    }
+}

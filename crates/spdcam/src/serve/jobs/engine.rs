@@ -1,0 +1,79 @@
+//! The estimating of one upload: the estimate's JSON with its presentation, and its HTML
+//! report.
+
+use super::{Outcome, Upload};
+use spdcam_core::photo;
+use spdcam_infer::presentation::Presentation;
+use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
+use spdcam_infer::{Estimator, InferError, PhotoOptions};
+use std::sync::Arc;
+
+/// What estimates: the estimator of the models, built once for every upload.
+pub struct Engine {
+    /// The models with their calibrations and chart checks, and the output grid (that of
+    /// `spdcam estimate`'s default).
+    pub estimator: Estimator,
+}
+
+/// An estimate's outcome and, when it succeeded, its HTML report.
+pub struct Estimated {
+    /// The outcome.
+    pub outcome: Outcome,
+    /// The report of the estimate, for a successful one.
+    pub report: Option<Arc<str>>,
+}
+
+impl Engine {
+    /// The estimate of one upload, by the estimator `spdcam estimate` uses: a photo that
+    /// cannot be read or shows no chart is a 400, one with no model for its chart 422. Its
+    /// JSON carries the estimate's [`Presentation`] under `presentation`. The one place the
+    /// server estimates.
+    pub fn estimate(&self, upload: Upload) -> Estimated {
+        let failed = |status, message: String| Estimated {
+            outcome: Outcome::Failed(status, message),
+            report: None,
+        };
+        let options = PhotoOptions {
+            corners: upload.corners,
+            chart: upload.chart.map(|c| c.name().to_string()),
+            overlay_width: Some(REPORT_IMAGE_WIDTH),
+            ..PhotoOptions::default()
+        };
+        let analysed = match photo::decode_photo(&upload.bytes, &upload.name)
+            .map_err(InferError::from)
+            .and_then(|decoded| self.estimator.analyse_decoded(&decoded, &options))
+        {
+            Ok(a) => a,
+            Err(e) => return failed(400, e.to_string()),
+        };
+        drop(upload.bytes);
+        drop(upload.memory);
+        let overlay = analysed.overlay;
+        let estimate = match self
+            .estimator
+            .estimate_analysis(analysed.analysis, upload.name)
+        {
+            Ok(e) => e,
+            Err(e) => return failed(422, e.to_string()),
+        };
+        let mut json = match estimate.to_json() {
+            Ok(json) => json,
+            Err(e) => return failed(500, e.to_string()),
+        };
+        let presentation = Presentation::of(&estimate);
+        match serde_json::to_value(&presentation) {
+            Ok(p) => json["presentation"] = p,
+            Err(e) => return failed(500, e.to_string()),
+        }
+        let image = overlay.map(|bytes| ReportImage {
+            mime: "image/jpeg",
+            bytes,
+        });
+        let title = format!("The light in {}", estimate.name);
+        let report = report_html(&title, &[ReportItem::new(estimate, image, None)]);
+        Estimated {
+            outcome: Outcome::Done(json.to_string().into()),
+            report: Some(report.into()),
+        }
+    }
+}

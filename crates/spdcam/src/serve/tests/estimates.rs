@@ -1,0 +1,91 @@
+//! Estimates over HTTP: many at once, equal to the library's, and clear errors for bad
+//! uploads.
+
+use super::{expected, form, json, request, start, EXAMPLE};
+
+#[test]
+fn twenty_concurrent_uploads_are_all_answered_correctly() {
+    let server = start(16 << 20);
+    let addr = server.addr();
+    let want = expected("room-0.jpg");
+    let answers: Vec<(u16, serde_json::Value)> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..20)
+            .map(|i| {
+                s.spawn(move || {
+                    let name = format!("room-{i}.jpg");
+                    let body = form(&[("photo", Some(name.as_str()), EXAMPLE)]);
+                    let (status, body) =
+                        request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+                    (status, json(&body))
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for (i, (status, got)) in answers.iter().enumerate() {
+        assert_eq!(*status, 200, "{got}");
+        assert_eq!(got["name"], format!("room-{i}.jpg"));
+        assert_eq!(got["spd"], want["spd"]);
+        assert_eq!(got["colorimetry"], want["colorimetry"]);
+        assert_eq!(got["photo"]["corners"], want["photo"]["corners"]);
+    }
+    server.stop();
+}
+
+#[test]
+fn the_answer_equals_the_library_estimate() {
+    let server = start(16 << 20);
+    let body = form(&[("photo", Some("sg-telelumen.jpg"), EXAMPLE)]);
+    let (status, got) = request(
+        server.addr(),
+        "POST",
+        "/api/estimate",
+        Some(body.as_slice()),
+    );
+    assert_eq!(status, 200);
+    assert_eq!(json(&got), expected("sg-telelumen.jpg"));
+    server.stop();
+}
+
+#[test]
+fn bad_input_gets_a_clear_error_and_the_server_keeps_serving() {
+    let server = start(16 << 20);
+    let addr = server.addr();
+    let cases: [(Vec<u8>, u16, &str); 4] = [
+        (
+            form(&[("photo", Some("notes.txt"), b"not a photo at all")]),
+            400,
+            "not an image",
+        ),
+        (form(&[("other", None, b"x")]), 400, "no field 'photo'"),
+        (
+            form(&[
+                ("photo", Some("p.jpg"), EXAMPLE),
+                ("corners", None, b"1,2,3"),
+            ]),
+            400,
+            "eight numbers",
+        ),
+        (b"--garbage".to_vec(), 400, "multipart"),
+    ];
+    for (body, want_status, want_text) in cases {
+        let (status, got) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+        assert_eq!(status, want_status);
+        let got = json(&got);
+        let message = got["error"].as_str().unwrap().to_string();
+        assert!(message.contains(want_text), "{message}");
+        // Beside it, a message for a person, without command-line words.
+        let plain = got["message"].as_str().unwrap();
+        assert!(!plain.contains("--") && !plain.is_empty(), "{plain}");
+    }
+    let (status, got) = request(addr, "GET", "/no/such/page", None);
+    assert_eq!(status, 404);
+    assert!(json(&got)["error"].is_string());
+    let (status, _) = request(addr, "GET", "/api/estimate", None);
+    assert_eq!(status, 405);
+    let body = form(&[("photo", Some("p.jpg"), EXAMPLE)]);
+    let (status, got) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+    assert_eq!(status, 200);
+    assert_eq!(json(&got)["spd"], expected("p.jpg")["spd"]);
+    server.stop();
+}

@@ -1,0 +1,63 @@
+//! The page and its assets, `HEAD` and unknown methods, and a server on a host name.
+
+use super::{json, request, start, EXAMPLE};
+use crate::serve::{resolve, shipped_engine, Config, Server, Timeouts};
+use spdcam_core::builtin::DataDir;
+
+#[test]
+fn the_page_and_its_assets_are_embedded() {
+    let server = start(16 << 20);
+    for (path, needle) in [
+        ("/", "<html"),
+        ("/app.js", "api/jobs/"),
+        ("/style.css", "{"),
+    ] {
+        let (status, body) = request(server.addr(), "GET", path, None);
+        assert_eq!(status, 200, "{path}");
+        assert!(String::from_utf8_lossy(&body).contains(needle), "{path}");
+    }
+    let (status, body) = request(server.addr(), "GET", "/example.jpg", None);
+    assert_eq!(status, 200);
+    assert_eq!(body, EXAMPLE);
+    server.stop();
+}
+
+#[test]
+fn head_answers_like_get_without_a_body() {
+    let server = start(16 << 20);
+    for path in ["/", "/app.js", "/api/locus"] {
+        let (status, body) = request(server.addr(), "HEAD", path, None);
+        assert_eq!(status, 200, "{path}");
+        assert!(body.is_empty(), "{path}");
+    }
+    let (status, got) = request(server.addr(), "DELETE", "/", None);
+    assert_eq!(status, 405);
+    assert_eq!(json(&got)["error"], "DELETE is not allowed on /");
+    server.stop();
+}
+
+#[test]
+fn a_host_name_is_resolved() {
+    let addrs = resolve("localhost", 0).unwrap();
+    assert!(addrs.iter().all(|a| a.ip().is_loopback()), "{addrs:?}");
+    let server = Server::start(
+        Config {
+            addrs,
+            max_upload_bytes: 1 << 20,
+            workers: 1,
+            timeouts: Timeouts::default(),
+        },
+        shipped_engine(&DataDir::new(None)).unwrap(),
+    )
+    .unwrap();
+    assert!(server.addr().ip().is_loopback());
+    let (status, body) = request(server.addr(), "GET", "/", None);
+    assert_eq!(status, 200);
+    assert!(String::from_utf8_lossy(&body).contains("<html"));
+    server.stop();
+    let error = resolve("no-such-host.invalid", 0).unwrap_err();
+    assert!(
+        format!("{error:#}").starts_with("cannot resolve the host 'no-such-host.invalid'"),
+        "{error:#}"
+    );
+}
