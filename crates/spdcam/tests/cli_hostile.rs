@@ -1,13 +1,14 @@
 //! Hostile and careless input on the command line (issue 15): every case gets a clear
 //! error at once — no abort, no minutes of work, no lost output, no silent overwrite.
-//! First tier: it reads no measured data (`SPDCAM_DATA` is removed, not read, so that the
-//! cases meet the program as a fresh clone has it).
+//! First tier: it reads no measured data (every run goes through
+//! `common::fresh_clone_command`, which takes the data directory out of the environment, so
+//! that the cases meet the program as a fresh clone has it).
 
 mod common;
 
-use common::{s, scratch, spdcam};
+use common::{fresh_clone_command, s, scratch, spdcam};
+use spdcam_core::builtin::DATA_DIR_ENV;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 /// Runs spdcam, expects it to fail within a few seconds with an error (not a signal or a
@@ -117,8 +118,7 @@ fn help_names_the_files_generate_writes() {
 fn dash_writes_to_standard_output() {
     // Issue 15, item 13: `-o -` wrote a file named `-`.
     let dir = scratch("stdout");
-    let out = Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(["render", "--spd", "D65", "--noise", "off", "-o", "-"])
+    let out = fresh_clone_command(&["render", "--spd", "D65", "--noise", "off", "-o", "-"])
         .current_dir(&dir)
         .output()
         .unwrap();
@@ -129,21 +129,20 @@ fn dash_writes_to_standard_output() {
     );
     assert!(out.stdout.starts_with(b"\x89PNG"), "stdout is the PNG");
     let png = dir.join("c.png");
-    let features = Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args([
-            "render",
-            "--spd",
-            "D65",
-            "--noise",
-            "off",
-            "-o",
-            &s(&png),
-            "--features",
-            "-",
-        ])
-        .current_dir(&dir)
-        .output()
-        .unwrap();
+    let features = fresh_clone_command(&[
+        "render",
+        "--spd",
+        "D65",
+        "--noise",
+        "off",
+        "-o",
+        &s(&png),
+        "--features",
+        "-",
+    ])
+    .current_dir(&dir)
+    .output()
+    .unwrap();
     let text = String::from_utf8_lossy(&features.stdout);
     assert!(text.starts_with("p01_r,p01_g,p01_b,"), "{text}");
     assert!(!dir.join("-").exists());
@@ -370,8 +369,7 @@ fn a_truncated_jpeg_is_estimated_with_a_warning() {
 #[test]
 fn estimates_go_to_standard_output_with_dash() {
     let dir = scratch("estimate-stdout");
-    let out = Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(["estimate", &s(&example_photo()), "-o", "-"])
+    let out = fresh_clone_command(&["estimate", &s(&example_photo()), "-o", "-"])
         .current_dir(&dir)
         .output()
         .unwrap();
@@ -476,11 +474,7 @@ fn errors_about_wide_files_and_bad_cells_stay_short_and_precise() {
 /// spdcam (no data directory) with extra environment variables and, when given, a file as
 /// its standard input.
 fn spdcam_with(args: &[&str], env: &[(&str, &str)], stdin: Option<&Path>) -> std::process::Output {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_spdcam"));
-    command
-        .args(args)
-        .env_remove("SPDCAM_DATA")
-        .current_dir(env!("CARGO_MANIFEST_DIR"));
+    let mut command = fresh_clone_command(args);
     for (k, v) in env {
         command.env(k, v);
     }
@@ -1019,7 +1013,7 @@ fn errors_name_what_the_user_typed_and_how_to_go_on() {
         e.contains("chart colorchecker_sg96 needs its measured reflectances")
             && e.contains("no data directory is set")
             && e.contains("charts available without data: colorchecker24")
-            && e.contains("--data-dir DIR or SPDCAM_DATA")
+            && e.contains(&format!("--data-dir DIR or {DATA_DIR_ENV}"))
             && !e.contains("i1pro2"),
         "{e}"
     );

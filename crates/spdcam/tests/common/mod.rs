@@ -6,14 +6,21 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// The built spdcam as a fresh clone runs it: in the crate's directory, with the data
+/// directory's variable removed from its environment (never read), so a first-tier test
+/// cannot depend on the measured data.
+pub fn fresh_clone_command(args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_spdcam"));
+    command
+        .args(args)
+        .env_remove(spdcam_core::builtin::DATA_DIR_ENV)
+        .current_dir(env!("CARGO_MANIFEST_DIR"));
+    command
+}
+
 /// spdcam with no data directory: what it does here works on a fresh clone.
 pub fn spdcam(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_spdcam"))
-        .args(args)
-        .env_remove("SPDCAM_DATA")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("spdcam runs")
+    fresh_clone_command(args).output().expect("spdcam runs")
 }
 
 /// Runs spdcam, which must succeed; its standard output.
