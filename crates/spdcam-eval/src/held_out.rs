@@ -90,6 +90,15 @@ pub fn camera_names(dir: &Path) -> Result<Vec<String>> {
     Ok(names)
 }
 
+/// A file's name without its directories (they differ between machines), for the tables
+/// that name models; the whole path when it has no name.
+pub fn file_name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    )
+}
+
 /// Where the lamp library is read from: given files, or the data directory's IES TM-30
 /// library.
 #[derive(Debug, Clone, Default)]

@@ -10,6 +10,7 @@ use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
+use spdcam_eval::held_out::file_name;
 use spdcam_eval::trust::fit::calibrate as fit;
 use spdcam_eval::trust::report::TrustReport;
 use std::path::PathBuf;
@@ -113,10 +114,7 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
             plot_file::write_plot(path, &measured.diagram_svg()?)?;
             // Beside the report, the image is named by its file name alone.
             Some(match (path.parent(), args.output.parent()) {
-                (Some(a), Some(b)) if a == b => path.file_name().map_or_else(
-                    || path.display().to_string(),
-                    |n| n.to_string_lossy().into(),
-                ),
+                (Some(a), Some(b)) if a == b => file_name(path),
                 _ => path.display().to_string(),
             })
         }

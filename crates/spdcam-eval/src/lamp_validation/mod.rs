@@ -13,7 +13,7 @@ mod photos;
 pub use photos::average_spd;
 
 use crate::error::Result;
-use crate::held_out::{in_data_dir, on_grid, HeldOutPhotos, GRID};
+use crate::held_out::{file_name, in_data_dir, on_grid, HeldOutPhotos, GRID};
 use photos::{pipeline_photos, score, simple_photos};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::{Chart, KnownChart};
@@ -249,14 +249,6 @@ impl LampValidation {
         );
         md
     }
-}
-
-/// A model's file name, for the tables (directories differ between machines).
-fn file_name(path: &Path) -> String {
-    path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into(),
-    )
 }
 
 /// (c): mean GFC of `model` on each real photo set (dev; Hue train + val; tablet train + val).

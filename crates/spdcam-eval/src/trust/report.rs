@@ -4,7 +4,7 @@
 //! expected GFC, verdicts, the self-check's flags and the reliability diagram's points.
 
 use crate::error::{EvalError, Result};
-use crate::held_out::{HeldOutPhotos, GRID};
+use crate::held_out::{file_name, HeldOutPhotos, GRID};
 use crate::reliability::{self, SetReliability};
 use crate::trust::judged::{
     band_z, difficulty, gfc, judge_rows, median, quantile_scales, residual, spearman, Judged,
@@ -409,10 +409,7 @@ impl TrustReport {
             let chart = Chart::resolve(chart_name, None, data_dir, &GRID)?;
             let check = ChartCheck::for_model(model, data_dir)?;
             let shots = photos.shots(&setup, &chart, model, LampPart::Test)?;
-            let name = path.file_name().map_or_else(
-                || path.display().to_string(),
-                |n| n.to_string_lossy().into(),
-            );
+            let name = file_name(path);
             let calibration_shots = photos.shots(&setup, &chart, model, LampPart::Validation)?;
             let mut calibration_photos = judge_rows(
                 model,
@@ -486,45 +483,44 @@ impl TrustReport {
                 );
                 continue;
             }
-            let flagged = |rows: &[Vec<f64>]| -> Result<f64> {
+            // Per kind of photo, judged once: the share the self-check flags and, with
+            // `verdicts`, the share whose verdict is not `ok`.
+            let shares = |rows: &[Vec<f64>], verdicts: bool| -> Result<(f64, f64)> {
                 let judged = judge_rows(model, check.as_ref(), rows, None)?;
-                Ok(judged
-                    .iter()
-                    .filter(|j| j.self_check.as_ref().is_none_or(|s| cal.flags(s)))
-                    .count() as f64
-                    / judged.len() as f64)
-            };
-            let not_ok = |rows: &[Vec<f64>]| -> Result<f64> {
-                let judged = judge_rows(model, check.as_ref(), rows, None)?;
-                let mut count = 0;
+                let (mut flagged, mut not_ok) = (0usize, 0usize);
                 for (j, row) in judged.iter().zip(rows) {
-                    let t = assess(
-                        model,
-                        Some(&cal),
-                        check.as_ref(),
-                        row,
-                        &j.spd,
-                        &PhotoFlags::default(),
-                    )?;
-                    count += usize::from(t.verdict != Verdict::Ok);
+                    flagged += usize::from(j.self_check.as_ref().is_none_or(|s| cal.flags(s)));
+                    if verdicts {
+                        let t = assess(
+                            model,
+                            Some(&cal),
+                            check.as_ref(),
+                            row,
+                            &j.spd,
+                            &PhotoFlags::default(),
+                        )?;
+                        not_ok += usize::from(t.verdict != Verdict::Ok);
+                    }
                 }
-                Ok(count as f64 / rows.len() as f64)
+                let n = rows.len() as f64;
+                Ok((flagged as f64 / n, not_ok as f64 / n))
             };
-            let clean = &shots.clean.features;
+            let clean = shares(&shots.clean.features, true)?;
+            let balanced = shares(&shots.half_balanced, true)?;
             let (w, h, g) = (
-                flagged(&shots.wrong_chart)?,
-                flagged(&shots.half_lit)?,
-                flagged(&shots.glare)?,
+                shares(&shots.wrong_chart, false)?.0,
+                shares(&shots.half_lit, false)?.0,
+                shares(&shots.glare, false)?.0,
             );
             flags += &format!(
                 "| `{name}` | {} | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} % ({:.1} %) | {:.1} % | {:.1} % |\n",
-                clean.len(),
-                100.0 * flagged(clean)?,
-                100.0 * not_ok(clean)?,
+                shots.clean.features.len(),
+                100.0 * clean.0,
+                100.0 * clean.1,
                 100.0 * w,
                 100.0 * h,
-                100.0 * flagged(&shots.half_balanced)?,
-                100.0 * not_ok(&shots.half_balanced)?,
+                100.0 * balanced.0,
+                100.0 * balanced.1,
                 100.0 * g,
                 100.0 * (w + h + g) / 3.0
             );
