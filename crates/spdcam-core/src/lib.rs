@@ -102,6 +102,7 @@ pub mod light;
 pub mod lighting;
 pub mod limits;
 pub mod metrics;
+mod minimise;
 pub mod photo;
 pub mod quality;
 pub mod raster;

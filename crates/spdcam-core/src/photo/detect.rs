@@ -7,6 +7,7 @@ use super::geometry::{sort_corners, Homography};
 use super::lattice::{find_lattices, Lattice};
 use super::load::Photo;
 use super::pyramid::Level;
+use super::refine::refine;
 use super::segment::{find_blobs, Blob};
 use super::{ChartTemplate, Detection, MIN_CONFIDENCE};
 use crate::error::{Error, Result};
@@ -41,11 +42,16 @@ struct Candidate {
     /// Best score among the placements in the other three rotations.
     other_rotation_score: f64,
     fit_rms: f64,
+    /// Share of the grid points in the ring just outside the chart that hold a blob.
+    ring: f64,
 }
 
 impl Candidate {
+    /// Patches found, in the neutrals' order, and nothing patch-like continuing the grid
+    /// outside the chart (which a part of a larger chart has: six by four patches of the
+    /// Digital SG, grey row included, otherwise read as a ColorChecker 24).
     fn score(&self) -> f64 {
-        self.coverage + self.tau
+        self.coverage + self.tau - self.ring
     }
 
     fn confidence(&self) -> f64 {
@@ -101,7 +107,7 @@ pub fn detect_at(
     loop {
         let level = Level::new(photo, factor);
         if let Some(found) = search_traced(&level, factor as f64, templates, &mut trace) {
-            return Ok((Some(found), trace));
+            return Ok((Some(refined(photo, templates, found, finest)), trace));
         }
         // Small charts may need a finer level, down to the finest one searched.
         if factor <= finest {
@@ -113,10 +119,33 @@ pub fn detect_at(
     if factor == 1 && 4 * photo.width * photo.height <= MAX_SEARCH_PIXELS {
         let level = Level::new(photo, 1).enlarged();
         if let Some(found) = search_traced(&level, 0.5, templates, &mut trace) {
-            return Ok((Some(found), trace));
+            return Ok((Some(refined(photo, templates, found, finest)), trace));
         }
     }
     Ok((None, trace))
+}
+
+/// `found` with its corners refined on the photo ([`refine`]).
+fn refined(
+    photo: &Photo,
+    templates: &[ChartTemplate],
+    found: Detection,
+    finest: usize,
+) -> Detection {
+    let Some(t) = templates.iter().find(|t| t.name == found.chart) else {
+        return found;
+    };
+    let map = refine(
+        photo,
+        t,
+        &Homography(Matrix3::from_fn(|r, c| found.homography[r][c])),
+        finest,
+    );
+    Detection {
+        corners: t.corners().map(|p| map.apply(p)),
+        homography: map.to_rows(),
+        ..found
+    }
 }
 
 /// Searches one level whose pixels are `scale` photo pixels wide, noting what it saw in
@@ -262,6 +291,7 @@ fn place(
                     coverage,
                     other_rotation_score: -1.0,
                     fit_rms,
+                    ring: ring_share(blobs, t, &map),
                 };
                 if slot.as_ref().is_none_or(|s| c.score() > s.score()) {
                     *slot = Some(c);
@@ -284,6 +314,38 @@ fn place(
     best.other_rotation_score = other;
     Some(best)
 }
+
+/// The share of the grid points one step outside the chart's patch grid (the ring around
+/// it) that lie within [`RING_SNAP`] of a blob's centre, mapped back through `map` (chart →
+/// level). Near 0 for a whole chart on its background, near 1 for a part of a larger grid.
+fn ring_share(blobs: &[Blob], t: &ChartTemplate, map: &Homography) -> f64 {
+    let Some(back) = map.inverse() else {
+        return 0.0;
+    };
+    let (cols, rows) = (t.cols as i32, t.rows as i32);
+    let half = t.patch_fraction / 2.0;
+    let mut hit = std::collections::HashSet::new();
+    for b in blobs {
+        let q = back.apply(b.centre);
+        let (u, v) = (q[0] - half, q[1] - half);
+        let (c, r) = (u.round(), v.round());
+        if (u - c).hypot(v - r) > RING_SNAP {
+            continue;
+        }
+        let (c, r) = (c as i32, r as i32);
+        let on_ring = (-1..=cols).contains(&c)
+            && (-1..=rows).contains(&r)
+            && (c == -1 || c == cols || r == -1 || r == rows);
+        if on_ring {
+            hit.insert((c, r));
+        }
+    }
+    hit.len() as f64 / (2 * (cols + rows) + 4) as f64
+}
+
+/// Largest distance (in patch pitches) from a ring point to a blob that counts as a patch
+/// continuing the grid there.
+const RING_SNAP: f64 = 0.25;
 
 /// Mean grid pitch (level px) of a lattice map around the given grid points.
 fn lattice_pitch(map: &Homography, points: &[[f64; 2]]) -> f64 {
@@ -502,6 +564,48 @@ fn lerp(a: [f64; 2], b: [f64; 2], t: f64) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_part_of_a_larger_grid_is_surrounded_by_patches() {
+        // Issue 28: six by four patches of a Digital SG (its grey row among them) were read
+        // as a ColorChecker 24; the blobs continuing the grid around them tell them apart.
+        let t = ChartTemplate {
+            name: "six_by_four".into(),
+            rows: 4,
+            cols: 6,
+            patch_fraction: 0.84,
+            feature_patches: (0..24).collect(),
+            feature_names: Vec::new(),
+            neutrals: Vec::new(),
+        };
+        let pitch = 20.0;
+        let blob = |c: i32, r: i32| Blob {
+            centre: [
+                100.0 + pitch * (f64::from(c) + 0.42),
+                80.0 + pitch * (f64::from(r) + 0.42),
+            ],
+            area: 280.0,
+            colour: [0.5; 3],
+            moments: [24.0, 0.0, 24.0],
+        };
+        let map = Homography(Matrix3::new(
+            pitch, 0.0, 100.0, 0.0, pitch, 80.0, 0.0, 0.0, 1.0,
+        ));
+        let alone: Vec<Blob> = (0..4)
+            .flat_map(|r| (0..6).map(move |c| blob(c, r)))
+            .collect();
+        assert_eq!(ring_share(&alone, &t, &map), 0.0);
+        let within: Vec<Blob> = (-3..7)
+            .flat_map(|r| (-4..10).map(move |c| blob(c, r)))
+            .collect();
+        assert_eq!(ring_share(&within, &t, &map), 1.0);
+        // A chart at the edge of the larger grid: the ring's two sides inside it.
+        let corner: Vec<Blob> = (0..7)
+            .flat_map(|r| (0..10).map(move |c| blob(c, r)))
+            .collect();
+        let share = ring_share(&corner, &t, &map);
+        assert!((share - 11.0 / 24.0).abs() < 1e-12, "{share}");
+    }
 
     #[test]
     fn the_finest_level_searched_stays_small() {

@@ -21,6 +21,7 @@ mod lattice;
 mod load;
 mod overlay;
 mod pyramid;
+mod refine;
 mod sample;
 pub mod scene;
 mod segment;

@@ -21,7 +21,17 @@ impl Level {
     /// The photo reduced by `factor` (≥ 1).
     pub fn new(photo: &Photo, factor: usize) -> Level {
         let k = factor.max(1);
-        let (w, h) = (photo.width / k, photo.height / k);
+        Level::window(photo, k, [0, 0], [photo.width / k, photo.height / k])
+    }
+
+    /// The part of the photo reduced by `factor` (≥ 1) whose level pixels start at `origin`
+    /// and span `size` (clipped to the photo): level pixel (i, j) of the window is pixel
+    /// (origin + (i, j)) of [`Level::new`]. Refining a chart's corners needs only the chart.
+    pub fn window(photo: &Photo, factor: usize, origin: [usize; 2], size: [usize; 2]) -> Level {
+        let k = factor.max(1);
+        let (full_w, full_h) = (photo.width / k, photo.height / k);
+        let (x0, y0) = (origin[0].min(full_w), origin[1].min(full_h));
+        let (w, h) = (size[0].min(full_w - x0), size[1].min(full_h - y0));
         let norm = 1.0 / (k * k) as f32;
         let mut interleaved = vec![[0.0f32; 3]; w * h];
         interleaved
@@ -29,9 +39,10 @@ impl Level {
             .enumerate()
             .for_each(|(y, row)| {
                 for dy in 0..k {
-                    let py = y * k + dy;
+                    let py = (y0 + y) * k + dy;
                     for (x, out) in row.iter_mut().enumerate() {
-                        let s = photo.row_sum(py, x * k, x * k + k);
+                        let px = (x0 + x) * k;
+                        let s = photo.row_sum(py, px, px + k);
                         for c in 0..3 {
                             out[c] += s[c];
                         }
