@@ -13,9 +13,14 @@
 //!   divided by their sums: p = (f_i + ε) / Σ (f_i + ε).
 //!
 //! A spectrum that is zero everywhere has no direction: its GFC with anything is 0 (SAM π/2).
+//!
+//! Each metric comes in two forms: the typed one ([`gfc_spd`], [`rmse_spd`],
+//! [`compare_spd`]) takes two [`Spd`]s and refuses spectra on different grids, for scoring an
+//! estimate against its truth; the row-level one ([`gfc`], [`rmse`], [`compare`]) takes bare
+//! slices of the same length, for inner loops over rows of model output that share one grid.
 
 use crate::error::{Error, Result};
-use crate::spectral::normalise_peak;
+use crate::spectral::{normalise_peak, Spd};
 use serde::{Deserialize, Serialize};
 
 /// Added to every band of a max-normalised spectrum before SID turns it into a distribution.
@@ -86,7 +91,23 @@ fn check_pair(truth: &[f64], estimate: &[f64]) -> Result<()> {
     Ok(())
 }
 
-/// RMSE of two spectra as they are (no normalisation).
+/// Checks that `truth` and `estimate` are sampled on the same grid: comparing spectra
+/// value by value means nothing otherwise.
+fn check_same_grid(truth: &Spd, estimate: &Spd) -> Result<()> {
+    if truth.grid() != estimate.grid() {
+        return Err(Error::invalid(format!(
+            "cannot compare spectra on different grids: the truth is on {}, the estimate on {}; \
+             resample one onto the other's grid",
+            truth.grid(),
+            estimate.grid()
+        )));
+    }
+    Ok(())
+}
+
+/// RMSE of two spectra as they are (no normalisation): the row-level form over bare values
+/// of one grid, for inner loops over model output rows; [`rmse_spd`] is the typed form that
+/// checks the grids.
 pub fn rmse(truth: &[f64], estimate: &[f64]) -> Result<f64> {
     check_pair(truth, estimate)?;
     let sum: f64 = truth
@@ -97,7 +118,9 @@ pub fn rmse(truth: &[f64], estimate: &[f64]) -> Result<f64> {
     Ok((sum / truth.len() as f64).sqrt())
 }
 
-/// GFC of two spectra as they are (no normalisation; scale does not change it).
+/// GFC of two spectra as they are (no normalisation; scale does not change it): the
+/// row-level form over bare values of one grid, for inner loops over model output rows;
+/// [`gfc_spd`] is the typed form that checks the grids.
 ///
 /// ```
 /// use spdcam_core::metrics::gfc;
@@ -141,7 +164,9 @@ pub fn sid(truth: &[f64], estimate: &[f64]) -> Result<f64> {
     Ok(d.max(0.0))
 }
 
-/// All four metrics, each spectrum normalised by its own maximum first (thesis section 4.3).
+/// All four metrics, each spectrum normalised by its own maximum first (thesis section
+/// 4.3): the row-level form over bare values of one grid; [`compare_spd`] is the typed form
+/// that checks the grids.
 ///
 /// ```
 /// use spdcam_core::illuminant::StandardIlluminant;
@@ -166,6 +191,50 @@ pub fn compare(truth: &[f64], estimate: &[f64]) -> Result<SpectralMetrics> {
         sam: sam(&t, &e)?,
         sid: sid(&t, &e)?,
     })
+}
+
+/// [`rmse`] of two spectra on the same grid; an error, not a panic, when their grids differ.
+///
+/// ```
+/// use spdcam_core::metrics::rmse_spd;
+/// use spdcam_core::spectral::{Grid, Spd};
+///
+/// let grid = Grid::parse("400-700:100")?;
+/// let truth = Spd::new(grid, vec![0.0, 1.0, 1.0, 0.0])?;
+/// let estimate = Spd::new(grid, vec![0.0, 1.0, 0.0, 0.0])?;
+/// assert_eq!(rmse_spd(&truth, &estimate)?, 0.5);
+/// let coarse = Spd::new(Grid::parse("400-700:150")?, vec![0.0, 1.0, 0.0])?;
+/// assert!(rmse_spd(&truth, &coarse).is_err());
+/// # Ok::<(), spdcam_core::Error>(())
+/// ```
+pub fn rmse_spd(truth: &Spd, estimate: &Spd) -> Result<f64> {
+    check_same_grid(truth, estimate)?;
+    rmse(truth.values(), estimate.values())
+}
+
+/// [`gfc`] of two spectra on the same grid; an error, not a panic, when their grids differ.
+///
+/// ```
+/// use spdcam_core::illuminant::StandardIlluminant;
+/// use spdcam_core::metrics::gfc_spd;
+/// use spdcam_core::spectral::Grid;
+///
+/// let a = StandardIlluminant::A.spd(&Grid::ESTIMATION)?;
+/// assert!((gfc_spd(&a, &a)? - 1.0).abs() < 1e-12);
+/// let d65 = StandardIlluminant::D65.spd(&Grid::SIMULATION)?;
+/// assert!(gfc_spd(&a, &d65).is_err()); // 400–700 nm against 380–780 nm
+/// # Ok::<(), spdcam_core::Error>(())
+/// ```
+pub fn gfc_spd(truth: &Spd, estimate: &Spd) -> Result<f64> {
+    check_same_grid(truth, estimate)?;
+    gfc(truth.values(), estimate.values())
+}
+
+/// [`compare`] of two spectra on the same grid (each normalised by its own maximum first);
+/// an error, not a panic, when their grids differ.
+pub fn compare_spd(truth: &Spd, estimate: &Spd) -> Result<SpectralMetrics> {
+    check_same_grid(truth, estimate)?;
+    compare(truth.values(), estimate.values())
 }
 
 /// Mean, standard deviation, median, minimum and maximum of `values`; an error when empty
@@ -302,5 +371,37 @@ mod tests {
         assert_eq!((s.min, s.max), (1.0, 4.0));
         assert_eq!(summarise(&[3.0, 1.0, 2.0]).unwrap().median, 2.0);
         assert!(summarise(&[]).is_err());
+    }
+
+    #[test]
+    fn typed_metrics_equal_the_row_level_ones_on_one_grid() {
+        let grid = crate::spectral::Grid::ESTIMATION;
+        let (t, e) = (gaussian(550.0, 40.0), gaussian(580.0, 60.0));
+        let (ts, es) = (
+            Spd::new(grid, t.clone()).unwrap(),
+            Spd::new(grid, e.clone()).unwrap(),
+        );
+        assert_eq!(gfc_spd(&ts, &es).unwrap(), gfc(&t, &e).unwrap());
+        assert_eq!(rmse_spd(&ts, &es).unwrap(), rmse(&t, &e).unwrap());
+        assert_eq!(compare_spd(&ts, &es).unwrap(), compare(&t, &e).unwrap());
+    }
+
+    #[test]
+    fn typed_metrics_refuse_spectra_on_different_grids_of_one_length() {
+        let grid = crate::spectral::Grid::ESTIMATION;
+        // As many values, shifted by one step: the slices would compare, the spectra must not.
+        let shifted = crate::spectral::Grid::from_parts(405.0, 5.0, grid.count).unwrap();
+        let truth = Spd::new(grid, gaussian(550.0, 40.0)).unwrap();
+        let estimate = Spd::new(shifted, gaussian(550.0, 40.0)).unwrap();
+        for err in [
+            gfc_spd(&truth, &estimate).unwrap_err(),
+            rmse_spd(&truth, &estimate).unwrap_err(),
+            compare_spd(&truth, &estimate).unwrap_err(),
+        ] {
+            let message = err.to_string();
+            assert!(message.contains("different grids"), "{message}");
+            assert!(message.contains(&grid.to_string()), "{message}");
+            assert!(message.contains(&shifted.to_string()), "{message}");
+        }
     }
 }

@@ -11,7 +11,9 @@ use spdcam_core::camera::white_balance;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry;
-use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
+use spdcam_core::dataset::randomise::{
+    camera_pool, InCameraRanges, Randomisation, IN_CAMERA_AND_GRADIENT_GROUPS, IN_CAMERA_GROUPS,
+};
 use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
 use spdcam_core::illuminant::StandardIlluminant;
 use spdcam_core::lighting::Lighting;
@@ -259,7 +261,7 @@ fn randomised_generation_is_deterministic_per_seed_and_sample() {
         .collect();
     let pool = camera_pool(&sens, 2, 7, &chart, config, &GRID).unwrap();
     assert_eq!(pool.len(), sens.len() * 3);
-    let ranges = InCameraRanges::for_groups(&["exposure", "wb", "tone", "jpeg"]).unwrap();
+    let ranges = InCameraRanges::for_groups(&IN_CAMERA_GROUPS).unwrap();
     assert!(InCameraRanges::for_groups(&["nonsense"]).is_err());
     let randomisation = Randomisation::new(pool, ranges).unwrap();
     let lighting =
@@ -425,4 +427,19 @@ fn ranges_record_the_floor_only_when_it_is_drawn() {
     let json = serde_json::to_string(&with).unwrap();
     assert!(json.contains(r#""floor":[0.0,0.15]"#), "{json}");
     assert_eq!(serde_json::from_str::<InCameraRanges>(&json).unwrap(), with);
+}
+
+#[test]
+fn the_named_group_lists_differ_by_the_gradient_alone() {
+    let stage = InCameraRanges::for_groups(&IN_CAMERA_GROUPS).unwrap();
+    let with_gradient = InCameraRanges::for_groups(&IN_CAMERA_AND_GRADIENT_GROUPS).unwrap();
+    assert!(stage.gradient.is_none() && with_gradient.gradient.is_some());
+    assert_eq!(
+        InCameraRanges {
+            gradient: None,
+            ..with_gradient
+        },
+        stage
+    );
+    assert_eq!(IN_CAMERA_AND_GRADIENT_GROUPS[..4], IN_CAMERA_GROUPS);
 }

@@ -7,7 +7,9 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::CameraConfig;
 use spdcam_core::chart::Chart;
-use spdcam_core::dataset::randomise::{camera_pool, InCameraRanges, Randomisation};
+use spdcam_core::dataset::randomise::{
+    camera_pool, InCameraRanges, Randomisation, IN_CAMERA_AND_GRADIENT_GROUPS,
+};
 use spdcam_core::lighting::{LampLibrary, ValidationSplit};
 use spdcam_core::metrics;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
@@ -22,8 +24,9 @@ pub const LAMP_TYPES: &str = "lamps/ies_tm30_lamps_info.csv";
 pub const GRID: Grid = Grid::SIMULATION;
 
 /// The in-camera stage every protocol over held-out lamps draws from: exposure, white
-/// balance, tone, JPEG and the light's gradient across the chart.
-pub const IN_CAMERA_GROUPS: [&str; 5] = ["exposure", "wb", "tone", "jpeg", "gradient"];
+/// balance, tone, JPEG and the light's gradient across the chart (the core's
+/// [`IN_CAMERA_AND_GRADIENT_GROUPS`]).
+pub const IN_CAMERA_GROUPS: [&str; 5] = IN_CAMERA_AND_GRADIENT_GROUPS;
 
 /// `cameras` photographing `chart` without sensor noise, each shot with in-camera settings
 /// drawn from [`IN_CAMERA_GROUPS`] (`stream` seeds the draws): what the lamp validation and
@@ -128,17 +131,44 @@ impl LampFiles {
     }
 }
 
+/// A held-out camera left out because its curves could not be read (unusable curves, as
+/// training skips them too).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SkippedCamera {
+    /// The camera's name in the split.
+    pub name: String,
+    /// Why it was left out.
+    pub reason: String,
+}
+
+impl std::fmt::Display for SkippedCamera {
+    /// The warning a command prints: `skipping held-out camera NAME: REASON`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "skipping held-out camera {}: {}", self.name, self.reason)
+    }
+}
+
+/// The split's held-out cameras that could be read, and those left out.
+#[derive(Debug, Clone)]
+pub struct HeldOutCameras {
+    /// The cameras read, in the split's order.
+    pub cameras: Vec<Sensitivities>,
+    /// The cameras left out, named with why; for the caller to report.
+    pub skipped: Vec<SkippedCamera>,
+}
+
 /// The split's held-out cameras, read from `dir` (default: the data directory's cameras/);
-/// cameras training skips (unusable curves) are skipped here too, named; none readable is an
-/// error.
+/// cameras training skips (unusable curves) are left out and returned named, with why, in
+/// [`HeldOutCameras::skipped`]; a camera missing from `dir` or none readable is an error.
 pub fn held_out_cameras(
     split: &ValidationSplit,
     dir: Option<&Path>,
     data_dir: &DataDir,
-) -> Result<Vec<Sensitivities>> {
+) -> Result<HeldOutCameras> {
     let dir = in_data_dir(dir, "cameras", data_dir)?;
     let available = camera_names(&dir)?;
-    let mut held_out: Vec<Sensitivities> = Vec::new();
+    let mut cameras: Vec<Sensitivities> = Vec::new();
+    let mut skipped = Vec::new();
     for name in &split.cameras.held_out {
         if !available.contains(name) {
             return Err(EvalError::invalid(format!(
@@ -148,16 +178,19 @@ pub fn held_out_cameras(
         }
         let path = dir.join(format!("{name}.csv"));
         match Sensitivities::resolve(&path.to_string_lossy(), data_dir, &GRID) {
-            Ok(s) => held_out.push(s),
-            Err(e) => eprintln!("warning: skipping held-out camera {name}: {e:#}"),
+            Ok(s) => cameras.push(s),
+            Err(e) => skipped.push(SkippedCamera {
+                name: name.clone(),
+                reason: format!("{e:#}"),
+            }),
         }
     }
-    if held_out.is_empty() {
+    if cameras.is_empty() {
         return Err(EvalError::invalid(
             "none of the split's held-out cameras could be read",
         ));
     }
-    Ok(held_out)
+    Ok(HeldOutCameras { cameras, skipped })
 }
 
 /// Every lamp of the library on `grid` (linear interpolation), normalised by its maximum.
@@ -199,6 +232,8 @@ pub struct Setup {
     pub split: ValidationSplit,
     /// The split's held-out cameras.
     pub cameras: Vec<Sensitivities>,
+    /// The held-out cameras left out (unreadable curves), for the caller to report.
+    pub skipped: Vec<SkippedCamera>,
 }
 
 impl HeldOutPhotos {
@@ -208,10 +243,14 @@ impl HeldOutPhotos {
             return Err(EvalError::invalid("--shots must be at least 1"));
         }
         let split = ValidationSplit::read(&self.split)?;
+        let library = self.library.read(data_dir, &GRID)?;
+        let HeldOutCameras { cameras, skipped } =
+            held_out_cameras(&split, self.cameras.as_deref(), data_dir)?;
         Ok(Setup {
-            library: self.library.read(data_dir, &GRID)?,
-            cameras: held_out_cameras(&split, self.cameras.as_deref(), data_dir)?,
+            library,
             split,
+            cameras,
+            skipped,
         })
     }
 
@@ -227,5 +266,52 @@ impl HeldOutPhotos {
                 Ok((p.clone(), m, chart))
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use spdcam_core::lighting::validation_split::{CameraSplit, LampSplit};
+
+    #[test]
+    fn unreadable_held_out_cameras_are_returned_not_printed() {
+        let dir = std::env::temp_dir().join(format!("spdcam-held-out-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // Gaussian r, g, b curves over 380–780 nm, and a file with one column too few.
+        let mut good = String::from("wavelength_nm,r,g,b\n");
+        for nm in (380..=780).step_by(5) {
+            let g = |peak: f64| (-((nm as f64 - peak) / 40.0).powi(2)).exp();
+            good += &format!("{nm},{},{},{}\n", g(600.0), g(540.0), g(460.0));
+        }
+        std::fs::write(dir.join("good.csv"), good).unwrap();
+        std::fs::write(dir.join("bad.csv"), "wavelength_nm,r,g\n400,1,1\n700,1,1\n").unwrap();
+        let split = |held_out: &[&str]| ValidationSplit {
+            method: String::new(),
+            seed: 0,
+            lamps: LampSplit {
+                fit: Vec::new(),
+                validation: Vec::new(),
+                test: Vec::new(),
+            },
+            cameras: CameraSplit {
+                training: Vec::new(),
+                held_out: held_out.iter().map(|s| s.to_string()).collect(),
+            },
+        };
+        let data = DataDir::new(None);
+        let found = held_out_cameras(&split(&["bad", "good"]), Some(&dir), &data).unwrap();
+        assert_eq!(found.cameras.len(), 1);
+        assert_eq!(found.skipped.len(), 1);
+        assert_eq!(found.skipped[0].name, "bad");
+        let warning = found.skipped[0].to_string();
+        assert!(
+            warning.starts_with("skipping held-out camera bad: "),
+            "{warning}"
+        );
+        // None readable, or one missing from the directory, is an error.
+        assert!(held_out_cameras(&split(&["bad"]), Some(&dir), &data).is_err());
+        assert!(held_out_cameras(&split(&["absent"]), Some(&dir), &data).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -234,7 +234,8 @@ pub struct Score {
 }
 
 impl Score {
-    /// The score of `estimate` against `truth` (same grid).
+    /// The score of `estimate` against `truth`, bare values of one grid: the row-level form
+    /// for rows of model output; [`Score::of_spd`] is the typed form that checks the grids.
     ///
     /// ```
     /// use spdcam_infer::estimate::Score;
@@ -250,6 +251,28 @@ impl Score {
         Ok(Score {
             gfc: metrics::gfc(&t, &e)?,
             rmse: metrics::rmse(&t, &e)?,
+        })
+    }
+
+    /// The score of `estimate` against `truth`; an error when they are on different grids.
+    ///
+    /// ```
+    /// use spdcam_core::spectral::{Grid, Spd};
+    /// use spdcam_infer::estimate::Score;
+    ///
+    /// let grid = Grid::parse("400-600:100")?;
+    /// let truth = Spd::new(grid, vec![0.5, 1.0, 0.25])?;
+    /// let score = Score::of_spd(&truth, &Spd::new(grid, vec![1.0, 2.0, 0.5])?)?;
+    /// assert_eq!((score.gfc, score.rmse), (1.0, 0.0));
+    /// let elsewhere = Spd::new(Grid::parse("500-700:100")?, vec![0.5, 1.0, 0.25])?;
+    /// assert!(Score::of_spd(&truth, &elsewhere).is_err());
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
+    pub fn of_spd(truth: &Spd, estimate: &Spd) -> Result<Score> {
+        let (t, e) = (truth.normalised_by_max(), estimate.normalised_by_max());
+        Ok(Score {
+            gfc: metrics::gfc_spd(&t, &e)?,
+            rmse: metrics::rmse_spd(&t, &e)?,
         })
     }
 }
@@ -332,10 +355,10 @@ impl Estimate {
         Ok(v)
     }
 
-    /// Compares the estimate with `truth` (on the estimate's grid) and keeps the score.
+    /// Compares the estimate with `truth` (on the estimate's grid; an error otherwise) and
+    /// keeps the score.
     pub fn score_against(&mut self, truth: &Spd) -> Result<()> {
-        let truth = truth.on(self.spd.grid(), "scoring an estimate")?;
-        self.truth = Some(Score::of(truth, &self.spd)?);
+        self.truth = Some(Score::of_spd(truth, &self.spd)?);
         Ok(())
     }
 }
@@ -447,5 +470,28 @@ mod tests {
             err.to_string(),
             "x row 2, column b: NaN is not a finite number"
         );
+    }
+
+    #[test]
+    fn the_typed_score_equals_the_row_level_one_and_checks_the_grids() {
+        let grid = Grid::ESTIMATION;
+        let bump = |mu: f64| -> Vec<f64> {
+            grid.wavelengths()
+                .iter()
+                .map(|l| (-((l - mu) / 50.0).powi(2)).exp())
+                .collect()
+        };
+        let (t, e) = (bump(520.0), bump(560.0));
+        let typed = Score::of_spd(
+            &Spd::new(grid, t.clone()).unwrap(),
+            &Spd::new(grid, e.clone()).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(typed, Score::of(&t, &e).unwrap());
+        assert!(typed.gfc < 1.0 && typed.rmse > 0.0);
+        let shifted = Grid::from_parts(405.0, 5.0, grid.count).unwrap();
+        let err =
+            Score::of_spd(&Spd::new(grid, t).unwrap(), &Spd::new(shifted, e).unwrap()).unwrap_err();
+        assert!(err.to_string().contains("different grids"), "{err}");
     }
 }

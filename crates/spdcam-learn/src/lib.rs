@@ -12,6 +12,9 @@
 //!   `linear` model; fine-tuning a trained model on a new dataset.
 //! - [`recipe`]: choosing a fine-tuning recipe for a few photos by cross-validation.
 //! - [`evaluate`]: scoring a model on a dataset (RMSE, GFC, SAM, SID; plots).
+//! - [`experiment`]: the thesis's model-selection experiment on its virtual datasets.
+//! - [`sim2real`]: the sim-to-real ablation (ridge on virtual data scored on the real photo
+//!   sets) and the learning curve of fine-tuning on real photos.
 //! - [`error`]: the crate's error type.
 //!
 //! Training the ridge baseline on a synthetic dataset and checking it on fresh samples:
@@ -48,7 +51,9 @@
 mod burn_net;
 pub mod error;
 pub mod evaluate;
+pub mod experiment;
 pub mod recipe;
+pub mod sim2real;
 pub mod synthetic;
 pub mod train;
 

@@ -6,7 +6,7 @@ use crate::render::CameraArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
-use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, InCamera};
+use spdcam_core::camera::in_camera::{calibrate, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::Camera;
 use spdcam_core::chart::Chart;
@@ -55,17 +55,6 @@ pub fn warn_skipped(path: &Path, error: &spdcam_core::Error) {
     eprintln!("warning: skipping camera {}: {error}", path.display());
 }
 
-/// The photos `indices` of a measured set as calibration photos.
-pub fn photos(measured: &MeasuredPhotos, indices: &[usize]) -> Vec<CalibrationPhoto> {
-    indices
-        .iter()
-        .map(|&i| CalibrationPhoto {
-            features: measured.features[i].clone(),
-            spd: measured.spds[i].clone(),
-        })
-        .collect()
-}
-
 /// Reads an in-camera stage written by `spdcam calibrate` (or a bare in-camera JSON object).
 pub fn read_in_camera(path: &Path) -> Result<InCamera> {
     let text = spdcam_core::fsio::read_text(path)?;
@@ -92,7 +81,7 @@ pub fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
     let indices: Vec<usize> = (0..n).collect();
     let fit = calibrate(
         &camera,
-        &photos(&measured, &indices),
+        &measured.calibration_photos(&indices),
         InCamera::NEUTRAL,
         args.evaluations,
     )?;

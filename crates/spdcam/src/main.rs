@@ -32,8 +32,6 @@ mod plot_file;
 mod render;
 mod serve;
 #[cfg(feature = "train")]
-mod sim2real_curve;
-#[cfg(feature = "train")]
 mod train;
 mod trust;
 mod validate_lamps;

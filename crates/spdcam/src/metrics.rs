@@ -61,7 +61,7 @@ fn lights(spec: &str, data_dir: &DataDir) -> Result<Vec<Row>> {
             .collect());
     }
     let spd = resolve_spd(spec, data_dir, &QUALITY_GRID)?;
-    let metrics = LightingMetrics::from_samples(&QUALITY_GRID.wavelengths(), &spd.spd);
+    let metrics = LightingMetrics::of_spd(&spd.spd);
     Ok(vec![Row {
         name: spd.name,
         metrics,

@@ -86,7 +86,10 @@ fn calibrate(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
         args.thesis_data.as_deref(),
         data_dir,
     )?;
-    for c in fitted {
+    for skipped in &fitted.skipped {
+        eprintln!("warning: {skipped}");
+    }
+    for c in fitted.models {
         let out = args.output.join(format!("{}.trust.json", c.chart));
         let json = serde_json::to_string_pretty(&c.calibration)?;
         write_atomic(&out, format!("{json}\n").as_bytes())?;
@@ -109,6 +112,9 @@ fn report(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
         data_dir,
         &mut |model| eprintln!("{}: measured", model.display()),
     )?;
+    for skipped in measured.skipped() {
+        eprintln!("warning: {skipped}");
+    }
     let diagram = match &args.reliability {
         Some(path) => {
             plot_file::write_plot(path, &measured.diagram_svg()?)?;

@@ -40,6 +40,9 @@ pub fn run(args: ValidateArgs, data_dir: &DataDir) -> Result<()> {
         LampValidation::measure(&args.photos.protocol(), &options, data_dir, &mut |model| {
             eprintln!("{}: done", model.display())
         })?;
+    for skipped in &validation.skipped {
+        eprintln!("warning: {skipped}");
+    }
     let md = validation.markdown();
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");

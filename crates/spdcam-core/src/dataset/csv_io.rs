@@ -97,6 +97,24 @@ pub struct MeasuredPhotos {
 }
 
 impl MeasuredPhotos {
+    /// The photos `indices` as photos an in-camera stage is calibrated on
+    /// ([`crate::camera::in_camera::calibrate`]).
+    ///
+    /// # Panics
+    /// If an index is out of range.
+    pub fn calibration_photos(
+        &self,
+        indices: &[usize],
+    ) -> Vec<crate::camera::in_camera::CalibrationPhoto> {
+        indices
+            .iter()
+            .map(|&i| crate::camera::in_camera::CalibrationPhoto {
+                features: self.features[i].clone(),
+                spd: self.spds[i].clone(),
+            })
+            .collect()
+    }
+
     /// Reads `features` (one row per photo) and `spds` (one row per photo, the header the
     /// wavelengths in nm); the SPDs are resampled onto `grid` by linear interpolation, zero
     /// outside their range. Errors name the file and line.

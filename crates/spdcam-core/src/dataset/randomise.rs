@@ -24,6 +24,14 @@ const RANDOMISE_STREAM: u64 = 0x5241_4E44_0000_0001;
 /// Stream of the camera perturbations.
 const PERTURB_STREAM: u64 = 0x5045_5254_0000_0001;
 
+/// The randomisation groups ([`InCameraRanges::for_groups`]) of a JPEG camera's own
+/// processing: exposure, white balance, tone and JPEG.
+pub const IN_CAMERA_GROUPS: [&str; 4] = ["exposure", "wb", "tone", "jpeg"];
+
+/// [`IN_CAMERA_GROUPS`] and the light's gradient across the chart: the in-camera stage the
+/// protocols over held-out lamps and the sim-to-real ablation's last rows draw from.
+pub const IN_CAMERA_AND_GRADIENT_GROUPS: [&str; 5] = ["exposure", "wb", "tone", "jpeg", "gradient"];
+
 /// Ranges `[low, high]` the in-camera parameters are drawn from, uniformly; a parameter
 /// whose range is `None` keeps the base camera's value.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]

@@ -188,6 +188,9 @@ impl LightingMetrics {
 
     /// The metrics of a spectrum sampled at `wavelengths`; a spectrum the metrics cannot take
     /// (no visible light, malformed) gives every value undefined with the error as reason.
+    /// The row-level form, for rows of model output sharing one set of wavelengths;
+    /// [`LightingMetrics::of_spd`] is the typed form that takes the wavelengths from the
+    /// spectrum's grid.
     pub fn from_samples(wavelengths: &[f64], values: &[f64]) -> LightingMetrics {
         match LightSpectrum::from_samples(wavelengths, values) {
             Ok(light) => LightingMetrics::of(&light),

@@ -13,7 +13,7 @@ mod photos;
 pub use photos::average_spd;
 
 use crate::error::Result;
-use crate::held_out::{file_name, in_data_dir, on_grid, HeldOutPhotos, GRID};
+use crate::held_out::{file_name, in_data_dir, on_grid, HeldOutPhotos, SkippedCamera, GRID};
 use photos::{pipeline_photos, score, simple_photos};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::{Chart, KnownChart};
@@ -83,6 +83,8 @@ pub struct LampValidation {
     pub cameras: usize,
     /// The seed of the draws.
     pub seed: u64,
+    /// The split's held-out cameras left out (unreadable curves), for the caller to report.
+    pub skipped: Vec<SkippedCamera>,
 }
 
 impl LampValidation {
@@ -188,6 +190,7 @@ impl LampValidation {
             shots,
             cameras: setup.cameras.len(),
             seed: photos.seed,
+            skipped: setup.skipped,
         })
     }
 
@@ -316,6 +319,7 @@ mod tests {
             shots: 4,
             cameras: 3,
             seed: 7,
+            skipped: Vec::new(),
         }
     }
 

@@ -4,7 +4,7 @@
 //! the real photo sets' validation photos.
 
 use crate::error::{EvalError, Result};
-use crate::held_out::{HeldOutPhotos, GRID};
+use crate::held_out::{HeldOutPhotos, SkippedCamera, GRID};
 use crate::trust::judged::{
     band_z, conformal_quantile, difficulty, gfc, judge_rows, median, quantile_scales, residual,
     Judged,
@@ -304,6 +304,14 @@ pub struct Calibrated {
     pub calibration: Calibration,
 }
 
+/// The calibrations [`calibrate`] fitted, and the held-out cameras it left out.
+pub struct Calibrations {
+    /// Each model's calibration, in the order of the models.
+    pub models: Vec<Calibrated>,
+    /// The split's held-out cameras left out (unreadable curves), for the caller to report.
+    pub skipped: Vec<SkippedCamera>,
+}
+
 /// Fits the calibration of each of `photos`' models on the split's validation lamps and,
 /// with `real`, the real photo sets' validation photos (SG models only; `thesis_data` holds
 /// the sets, default the data directory's thesis/).
@@ -312,7 +320,7 @@ pub fn calibrate(
     real: bool,
     thesis_data: Option<&Path>,
     data_dir: &DataDir,
-) -> Result<Vec<Calibrated>> {
+) -> Result<Calibrations> {
     let setup = photos.setup(data_dir)?;
     let mut out = Vec::new();
     for (path, model, chart_name) in photos.models()? {
@@ -371,7 +379,10 @@ pub fn calibrate(
             calibration,
         });
     }
-    Ok(out)
+    Ok(Calibrations {
+        models: out,
+        skipped: setup.skipped,
+    })
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! expected GFC, verdicts, the self-check's flags and the reliability diagram's points.
 
 use crate::error::{EvalError, Result};
-use crate::held_out::{file_name, HeldOutPhotos, GRID};
+use crate::held_out::{file_name, HeldOutPhotos, SkippedCamera, GRID};
 use crate::reliability::{self, SetReliability};
 use crate::trust::judged::{
     band_z, difficulty, gfc, judge_rows, median, quantile_scales, residual, spearman, Judged,
@@ -307,6 +307,8 @@ pub struct TrustReport {
     sections: String,
     /// The reliability diagram's sets, every model's in order.
     diagram: Vec<SetReliability>,
+    /// The split's held-out cameras left out (unreadable curves).
+    skipped: Vec<SkippedCamera>,
 }
 
 impl TrustReport {
@@ -556,7 +558,14 @@ impl TrustReport {
             coverage: md,
             sections,
             diagram,
+            skipped: setup.skipped,
         })
+    }
+
+    /// The split's held-out cameras left out because their curves could not be read, for
+    /// the caller to report.
+    pub fn skipped(&self) -> &[SkippedCamera] {
+        &self.skipped
     }
 
     /// The reliability diagram (SVG) of every set measured.

@@ -1,7 +1,6 @@
 //! `spdcam experiment`: the thesis's model-selection experiment on its virtual datasets,
 //! and the real-camera study.
 
-mod sets;
 mod thesis;
 
 use anyhow::Result;

@@ -6,21 +6,45 @@
 //! is the test set (the thesis's own test parts are kept aside). SPDs are made from the
 //! weights with the thesis's channels (`THESIS-PARAMETERS.md`), then normalised to a maximum
 //! of 1. Models predict PCA coefficients of the SPD (`--target weights`: the channel weights,
-//! as the thesis did for these sets).
+//! as the thesis did for these sets). The protocol is `spdcam_learn::experiment`'s; this
+//! parses its options and prints and writes its results.
 
-use super::sets::{channels, load_part, SetName};
 use crate::evaluate::metrics_table;
 use crate::train::{reporter, ModelKind, Preset, TargetArg};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::spectral::Grid;
-use spdcam_learn::evaluate::evaluate;
+use spdcam_learn::experiment::sets;
+use spdcam_learn::experiment::thesis::{train_options, SetParts, ThesisRow};
 use spdcam_learn::pca::Components;
-use spdcam_learn::scale::RowScale;
 use spdcam_learn::target::TargetKind;
-use spdcam_learn::train::{train, Schedule, TrainOptions};
+use spdcam_learn::train::Schedule;
 use std::path::PathBuf;
+
+/// One of the thesis's virtual sets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(super) enum SetName {
+    G1,
+    G2,
+    G3,
+    G4,
+    /// All 24 Telelumen channels (the thesis's H2 used the SG chart; this set uses CC24).
+    T24,
+}
+
+impl SetName {
+    /// The library's set.
+    fn set(self) -> sets::SetName {
+        match self {
+            SetName::G1 => sets::SetName::G1,
+            SetName::G2 => sets::SetName::G2,
+            SetName::G3 => sets::SetName::G3,
+            SetName::G4 => sets::SetName::G4,
+            SetName::T24 => sets::SetName::T24,
+        }
+    }
+}
 
 /// Options of `spdcam experiment thesis`.
 #[derive(Debug, Args)]
@@ -86,9 +110,7 @@ pub(super) fn run(args: ThesisArgs, data_dir: &spdcam_core::builtin::DataDir) ->
     let mut results = Vec::new();
     let mut details = String::new();
     for &set in &args.sets {
-        let ch = channels(set, &root)?;
-        let train_set = load_part(set, "train", &root, &ch)?;
-        let test_set = load_part(set, "val", &root, &ch)?;
+        let parts = SetParts::read(set.set(), &root)?;
         for &kind in &args.models {
             let architecture = kind.architecture();
             let mut schedule = match args.preset {
@@ -98,73 +120,35 @@ pub(super) fn run(args: ThesisArgs, data_dir: &spdcam_core::builtin::DataDir) ->
             if let Some(e) = args.epochs {
                 schedule.epochs = e;
             }
-            let options = TrainOptions {
-                architecture,
-                row_scale: RowScale::Max,
-                target: match args.target {
-                    TargetArg::Weights => TargetKind::Weights,
-                    TargetArg::Pca => TargetKind::Pca(Components::default()),
-                },
-                grid,
-                schedule,
-                seed: args.seed,
-                val_split: 0.1,
-                backend: spdcam_learn::train::Backend::Cpu,
+            let target = match args.target {
+                TargetArg::Weights => TargetKind::Weights,
+                TargetArg::Pca => TargetKind::Pca(Components::default()),
             };
+            let options = train_options(architecture, schedule, target, grid, args.seed);
             let name = kind
                 .to_possible_value()
                 .map(|v| v.get_name().to_string())
                 .unwrap_or_default();
             eprintln!(
                 "{} {name}: training on {} samples",
-                set.label(),
-                train_set.samples.len()
+                parts.set.label(),
+                parts.train.samples.len()
             );
             let (mut report, bar) = reporter(options.schedule.epochs);
-            let trained = train(&train_set, None, &options, &mut report)?;
+            let row = ThesisRow::measure(&parts, &name, &options, &mut report);
             if let Some(bar) = bar {
                 bar.finish_and_clear();
             }
-            let e = evaluate(&trained.model, &test_set)?;
-            let t = trained.model.training();
-            let per_epoch = if trained.log.is_empty() {
-                0.0
-            } else {
-                trained.log.iter().map(|r| r.seconds).sum::<f64>() / trained.log.len() as f64
-            };
-            let thesis = match kind {
-                ModelKind::Cnn1d => set.thesis_gfc().0,
-                ModelKind::Mlp => set.thesis_gfc().1,
-                ModelKind::Linear => None,
-            };
-            let s = &e.summary;
-            let line = format!(
-                "| {} | {name} | {:.5} | {:.5} | {:.4} | {:.4} | {:.4} | {} | {} ({}) | {:.0} | {:.2} |\n",
-                set.label(),
-                s.gfc.mean,
-                s.gfc.std,
-                s.rmse.mean,
-                s.sam.mean,
-                s.sid.mean,
-                thesis.map_or("–".to_string(), |g| format!("{g:.4}")),
-                t.epochs_run,
-                t.best_epoch,
-                t.seconds,
-                per_epoch
-            );
+            let row = row?;
+            let line = row.table_line();
             eprint!("{line}");
             table.push_str(&line);
             details.push_str(&format!(
                 "\n## {} — {name}\n\n{}",
-                set.label(),
-                metrics_table(&e)
+                parts.set.label(),
+                metrics_table(&row.evaluation)
             ));
-            results.push(serde_json::json!({
-                "set": set.label(), "model": name, "metrics": e.summary,
-                "thesis_gfc": thesis, "epochs_run": t.epochs_run, "best_epoch": t.best_epoch,
-                "train_seconds": t.seconds, "seconds_per_epoch": per_epoch,
-                "train_samples": t.train_samples, "test_samples": e.per_sample.len(),
-            }));
+            results.push(row.json());
         }
     }
     let md = format!(

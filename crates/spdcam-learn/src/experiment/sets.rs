@@ -1,23 +1,26 @@
 //! The thesis's virtual sets (Gaussian G1–G4 and the 24-channel Telelumen set, ColorChecker
 //! 24): their names, channel spectra and parts, read with SPDs made from their weights.
 
-use anyhow::{bail, Context, Result};
-use clap::ValueEnum;
+use crate::error::{LearnError, Result};
+use crate::train::TrainingSet;
 use spdcam_core::dataset::{Columns, Precision, SampleBatch};
 use spdcam_core::lighting::Channels;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_infer::record::DataInfo;
 use spdcam_infer::FeatureRows;
-use spdcam_learn::record::DataInfo;
-use spdcam_learn::train::TrainingSet;
 use std::collections::BTreeMap;
 use std::path::Path;
 
 /// One of the thesis's virtual sets.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub(super) enum SetName {
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SetName {
+    /// Gaussian, 4 channels.
     G1,
+    /// Gaussian, 5 channels.
     G2,
+    /// Gaussian, 6 channels.
     G3,
+    /// Gaussian, 7 channels.
     G4,
     /// All 24 Telelumen channels (the thesis's H2 used the SG chart; this set uses CC24).
     T24,
@@ -34,7 +37,8 @@ impl SetName {
         }
     }
 
-    pub(super) fn label(self) -> &'static str {
+    /// The set's name in the tables (`G1`…`T24`).
+    pub fn label(self) -> &'static str {
         match self {
             SetName::G1 => "G1",
             SetName::G2 => "G2",
@@ -57,7 +61,7 @@ impl SetName {
     }
 
     /// Mean GFC the thesis published: (1D CNN, DNN) where it has them.
-    pub(super) fn thesis_gfc(self) -> (Option<f64>, Option<f64>) {
+    pub fn thesis_gfc(self) -> (Option<f64>, Option<f64>) {
         match self {
             SetName::G1 => (Some(0.9997), Some(0.9989)),
             SetName::G2 => (Some(0.9994), Some(0.9988)),
@@ -68,15 +72,16 @@ impl SetName {
     }
 }
 
-/// Channel spectra of a set on the simulation grid.
-pub(super) fn channels(set: SetName, root: &Path) -> Result<Vec<Vec<f64>>> {
+/// Channel spectra of a set on the simulation grid (`root`: the thesis's data, holding
+/// `telelumen_24_channels.csv`).
+pub fn channels(set: SetName, root: &Path) -> Result<Vec<Vec<f64>>> {
     let grid = Grid::SIMULATION;
     if let Some(n) = set.gaussian_channels() {
         return Ok(Channels::gaussian(n, &grid)?.spds);
     }
     let path = root.join("telelumen_24_channels.csv");
-    let raw =
-        SpectralSet::read_csv(&path).with_context(|| format!("reading {}", path.display()))?;
+    let raw = SpectralSet::read_csv(&path)
+        .map_err(|e| LearnError::invalid(format!("reading {}: {e}", path.display())))?;
     let (set, _) = raw.resample(&grid, Interpolation::Linear, Extrapolation::Zero)?;
     // The thesis's code set the channels to 0 above 700 nm.
     Ok((0..set.len())
@@ -96,25 +101,21 @@ pub(super) fn channels(set: SetName, root: &Path) -> Result<Vec<Vec<f64>>> {
         .collect())
 }
 
-/// One part (`train` or `val`) of a set, with SPDs made from its weights.
-pub(super) fn load_part(
-    set: SetName,
-    part: &str,
-    root: &Path,
-    ch: &[Vec<f64>],
-) -> Result<TrainingSet> {
+/// One part (`train` or `val`) of a set under `root`'s `virtual/`, with SPDs made from its
+/// weights and the channels `ch` ([`channels`]), normalised to a maximum of 1.
+pub fn load_part(set: SetName, part: &str, root: &Path, ch: &[Vec<f64>]) -> Result<TrainingSet> {
     let dir = root.join("virtual").join(format!("{}_{part}", set.dir()));
     let features = FeatureRows::read_csv(&dir.join("features.csv"))?;
     let weights = FeatureRows::read_csv(&dir.join("weights.csv"))?;
     if weights.rows != features.rows || weights.names.len() != ch.len() {
-        bail!(
+        return Err(LearnError::invalid(format!(
             "{}: {} feature rows, {} weight rows of {} channels (expected {})",
             dir.display(),
             features.rows,
             weights.rows,
             weights.names.len(),
             ch.len()
-        );
+        )));
     }
     let grid = Grid::SIMULATION;
     let k = ch.len();
