@@ -3,7 +3,6 @@
 
 use super::detect::{detect_traced, from_corners, from_corners_any, no_chart};
 use super::exposure::Exposure;
-use super::geometry::Homography;
 use super::load::{load_photo, Photo};
 use super::overlay::{debug_overlay_full, write_overlay};
 use super::sample::{sample, PatchSample};
@@ -123,9 +122,7 @@ fn analyse_decoded(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnaly
         .iter()
         .find(|t| t.name == detection.chart)
         .ok_or_else(|| Error::invalid("detected chart has no template"))?;
-    let h = Homography(nalgebra::Matrix3::from_fn(|r, c| {
-        detection.homography[r][c]
-    }));
+    let h = detection.map();
     let patches = sample(photo, template, &h)?;
     if let Some(path) = &options.debug {
         let image = debug_overlay_full(photo, Some((template, &detection, &patches)), None);

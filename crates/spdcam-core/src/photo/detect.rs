@@ -135,12 +135,7 @@ fn refined(
     let Some(t) = templates.iter().find(|t| t.name == found.chart) else {
         return found;
     };
-    let map = refine(
-        photo,
-        t,
-        &Homography(Matrix3::from_fn(|r, c| found.homography[r][c])),
-        finest,
-    );
+    let map = refine(photo, t, &found.map(), finest);
     Detection {
         corners: t.corners().map(|p| map.apply(p)),
         homography: map.to_rows(),
@@ -284,15 +279,20 @@ fn place(
                     let pitch = lattice_pitch(&lattice.map, &from);
                     lattice.map.rms_error(&from, &to) / pitch.max(1e-9)
                 };
-                let c = Candidate {
+                let mut c = Candidate {
                     template: ti,
                     map,
                     tau,
                     coverage,
                     other_rotation_score: -1.0,
                     fit_rms,
-                    ring: ring_share(blobs, t, &map),
+                    ring: 0.0,
                 };
+                // The ring only lowers the score: measured only where it could still win.
+                if slot.as_ref().is_some_and(|s| c.score() <= s.score()) {
+                    continue;
+                }
+                c.ring = ring_share(blobs, t, &map);
                 if slot.as_ref().is_none_or(|s| c.score() > s.score()) {
                     *slot = Some(c);
                 }

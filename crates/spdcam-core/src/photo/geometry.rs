@@ -32,6 +32,11 @@ impl Homography {
         Homography(normalise(scale * self.0))
     }
 
+    /// The map of row-major entries (the inverse of [`Homography::to_rows`]).
+    pub fn from_rows(rows: &[[f64; 3]; 3]) -> Homography {
+        Homography(Matrix3::from_fn(|r, c| rows[r][c]))
+    }
+
     /// Row-major entries.
     pub fn to_rows(&self) -> [[f64; 3]; 3] {
         std::array::from_fn(|r| std::array::from_fn(|c| self.0[(r, c)]))

@@ -196,5 +196,12 @@ pub struct Detection {
     pub confidence: f64,
 }
 
+impl Detection {
+    /// Chart → image coordinates as a map.
+    pub fn map(&self) -> Homography {
+        Homography::from_rows(&self.homography)
+    }
+}
+
 /// Lowest confidence [`detect`] accepts; below it the photo shows no chart it can trust.
 pub const MIN_CONFIDENCE: f64 = 0.5;

@@ -4,7 +4,6 @@
 //! when no chart was found, the patch candidates the search saw.
 
 use super::detect::SearchTrace;
-use super::geometry::Homography;
 use super::load::Photo;
 use super::pyramid::Level;
 use super::sample::PatchSample;
@@ -180,9 +179,7 @@ fn draw_overlay(
         }
     }
     if let Some((template, detection, samples)) = found {
-        let h = Homography(nalgebra::Matrix3::from_fn(|r, c| {
-            detection.homography[r][c]
-        }));
+        let h = detection.map();
         let pitch = {
             let a = down(h.apply([0.0, 0.0]));
             let b = down(h.apply([1.0, 0.0]));

@@ -27,6 +27,15 @@ pub enum SetName {
 }
 
 impl SetName {
+    /// Every set, in the thesis's order.
+    pub const ALL: [SetName; 5] = [
+        SetName::G1,
+        SetName::G2,
+        SetName::G3,
+        SetName::G4,
+        SetName::T24,
+    ];
+
     fn dir(self) -> &'static str {
         match self {
             SetName::G1 => "gaussian_4ch_cc24",
@@ -69,6 +78,25 @@ impl SetName {
             SetName::G4 => (Some(0.9990), Some(0.9972)),
             SetName::T24 => (None, None),
         }
+    }
+}
+
+impl std::str::FromStr for SetName {
+    type Err = LearnError;
+
+    /// A set by its label, in any case (`g1`, `T24`).
+    fn from_str(name: &str) -> Result<SetName> {
+        SetName::ALL
+            .into_iter()
+            .find(|set| set.label().eq_ignore_ascii_case(name))
+            .ok_or_else(|| {
+                LearnError::invalid(format!(
+                    "unknown thesis set '{name}' (known: {})",
+                    SetName::ALL
+                        .map(|set| set.label().to_lowercase())
+                        .join(", ")
+                ))
+            })
     }
 }
 
@@ -157,4 +185,22 @@ pub fn load_part(set: SetName, part: &str, root: &Path, ch: &[Vec<f64>]) -> Resu
             origin: None,
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sets_are_named_by_their_labels_in_any_case() {
+        for set in SetName::ALL {
+            assert_eq!(set.label().to_lowercase().parse::<SetName>().unwrap(), set);
+            assert_eq!(set.label().parse::<SetName>().unwrap(), set);
+        }
+        let err = "h2".parse::<SetName>().unwrap_err().to_string();
+        assert!(
+            err.contains("'h2'") && err.contains("g1, g2, g3, g4, t24"),
+            "{err}"
+        );
+    }
 }
