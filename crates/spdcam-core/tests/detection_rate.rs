@@ -84,13 +84,10 @@ fn both_charts_are_found_tilted_small_and_shadowed_among_each_other() {
     let (cc24, t24) = camera(Chart::colorchecker24(&GRID).unwrap());
     let (sg, tsg) = camera(Chart::resolve("colorchecker_sg140", None, &data, &GRID).unwrap());
     let templates = [tsg, t24];
-    // The SG's patches, 14 across, are 6–7 px at 1/15 of 1600 px and 3 px tall at 70°:
-    // not yet found reliably there (docs/detection.md).
-    every_bucket_found(
-        &sg,
-        &templates,
-        &["1/8", "1/12", "1/15", "70°", "25 % light"],
-    );
+    // The SG's patches, 14 across, are 14 px at 1/8 of 1600 px and 6–7 px at 1/15: not
+    // yet found reliably there (docs/detection.md: 90, 20 and 15 %; 70° tilt 65 %, here
+    // 3 of 3).
+    every_bucket_found(&sg, &templates, &["1/8", "1/12", "1/15"]);
     every_bucket_found(&cc24, &templates, &[]);
 }
 
@@ -162,4 +159,58 @@ fn corners_of_a_colorchecker24_choose_it_over_a_chart_with_another_grid() {
     let a = analyse(&photo, &options).unwrap();
     assert_eq!(a.chart, "colorchecker24");
     let _ = DataDir::new(None);
+}
+
+/// The part of scene photo `seed` (a ColorChecker 24 at 1/8 of the width, anywhere) beside
+/// the chart, at least a third of the photo's width: cluttered background and no chart.
+fn background_only(camera: &Camera, seed: u64) -> spdcam_core::photo::Photo {
+    let bucket = &detection_rate::buckets()[1];
+    let shot = bucket.photograph(camera, seed, SIZE).unwrap();
+    let image = image::load_from_memory(&shot.jpeg).unwrap().to_rgb8();
+    let xs = shot.corners.map(|c| c[0]);
+    let (lo, hi) = (
+        xs.iter().copied().fold(f64::INFINITY, f64::min),
+        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    );
+    let margin = 10.0;
+    let (x0, x1) = if SIZE.0 as f64 - hi > lo {
+        ((hi + margin) as u32, SIZE.0 as u32)
+    } else {
+        (0, (lo - margin).max(0.0) as u32)
+    };
+    assert!(x1 - x0 >= SIZE.0 as u32 / 3, "seed {seed}: {x0}..{x1}");
+    let part = image::imageops::crop_imm(&image, x0, 0, x1 - x0, SIZE.1 as u32).to_image();
+    let mut png = std::io::Cursor::new(Vec::new());
+    part.write_to(&mut png, image::ImageFormat::Png).unwrap();
+    decode_photo(png.get_ref(), &format!("background-{seed}.png")).unwrap()
+}
+
+/// No chart is found in any of `photos` background-only photos.
+fn nothing_found_beside_the_chart(camera: &Camera, templates: &[ChartTemplate], photos: u64) {
+    for seed in 0..photos {
+        let photo = background_only(camera, seed);
+        if let Ok(d) = spdcam_core::photo::detect(&photo, templates) {
+            panic!(
+                "{}: {} found at {:?} (confidence {:.2})",
+                photo.source, d.chart, d.corners, d.confidence
+            );
+        }
+    }
+}
+
+#[test]
+fn no_chart_is_found_in_a_photo_without_one() {
+    // Issue 28: placements found by the photo's support for their grid (few patches
+    // segmented) must not turn clutter into a chart.
+    let (cc24, t24) = camera(Chart::colorchecker24(&GRID).unwrap());
+    nothing_found_beside_the_chart(&cc24, &[t24], 6);
+}
+
+#[cfg(feature = "measured-data")]
+#[test]
+fn neither_chart_is_found_in_a_photo_without_one() {
+    let data = DataDir::new(Some(shared_data::data_dir()));
+    let (cc24, t24) = camera(Chart::colorchecker24(&GRID).unwrap());
+    let (_, tsg) = camera(Chart::resolve("colorchecker_sg140", None, &data, &GRID).unwrap());
+    nothing_found_beside_the_chart(&cc24, &[tsg, t24], 12);
 }

@@ -34,6 +34,17 @@ pub struct DetectionArgs {
         default_value = "colorchecker24,colorchecker_sg140"
     )]
     charts: Vec<String>,
+    /// Photograph only these of --charts (each photo is still searched for all of them);
+    /// default: every chart of --charts.
+    #[arg(long, value_delimiter = ',', value_name = "CHARTS")]
+    photograph: Vec<String>,
+    /// Only the buckets of these difficulties: size, tilt, rotation, shadow; default: all.
+    #[arg(long, value_delimiter = ',', value_name = "DIFFICULTIES")]
+    difficulty: Vec<String>,
+    /// Also write every photo whose chart was not found into this directory, as
+    /// `CHART-DIFFICULTY-BUCKET-SEED.jpg`, to look at.
+    #[arg(long, value_name = "DIR")]
+    misses: Option<PathBuf>,
     /// Camera sensitivities (a built-in name, a data-directory name or FILE.csv).
     #[arg(long, default_value = "nikon_d5100_npl")]
     camera: String,
@@ -54,6 +65,36 @@ pub fn run(args: DetectionArgs, data_dir: &DataDir) -> Result<()> {
         .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
         .with_context(|| format!("--size '{}' is not of the form WxH", args.size))?;
     scene::check_scene_size(w, h)?;
+    let known: Vec<&str> = detection_rate::buckets()
+        .iter()
+        .map(|b| b.difficulty.label())
+        .collect();
+    if let Some(d) = args
+        .difficulty
+        .iter()
+        .find(|d| !known.contains(&d.as_str()))
+    {
+        bail!(
+            "--difficulty '{d}' is not one of {}",
+            known
+                .iter()
+                .copied()
+                .collect::<std::collections::BTreeSet<_>>()
+                .into_iter()
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    if let Some(c) = args.photograph.iter().find(|c| !args.charts.contains(c)) {
+        bail!(
+            "--photograph '{c}' is not one of --charts ({})",
+            args.charts.join(", ")
+        );
+    }
+    if let Some(dir) = &args.misses {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create --misses directory {}", dir.display()))?;
+    }
     let grid = Grid::SIMULATION;
     let sensitivities = Sensitivities::resolve(&args.camera, data_dir, &grid)?;
     let mut cameras = Vec::new();
@@ -72,8 +113,15 @@ pub fn run(args: DetectionArgs, data_dir: &DataDir) -> Result<()> {
     }
     let started = std::time::Instant::now();
     let mut rates: Vec<BucketRate> = Vec::new();
-    for bucket in detection_rate::buckets() {
-        for camera in &cameras {
+    let buckets = detection_rate::buckets().into_iter().filter(|b| {
+        args.difficulty.is_empty() || args.difficulty.iter().any(|d| d == b.difficulty.label())
+    });
+    for bucket in buckets {
+        let photographed = cameras
+            .iter()
+            .zip(&args.charts)
+            .filter(|(_, name)| args.photograph.is_empty() || args.photograph.contains(name));
+        for (camera, _) in photographed {
             let r = detection_rate::measure(
                 camera,
                 &templates,
@@ -82,17 +130,35 @@ pub fn run(args: DetectionArgs, data_dir: &DataDir) -> Result<()> {
                 args.seed,
                 (w, h),
             )?;
+            let error = if r.found == 0 {
+                "–".to_string()
+            } else {
+                format!("{:.1} %", 100.0 * r.mean_corner_error)
+            };
             eprintln!(
-                "{} {} {}: found {}/{}, corner error {:.1} %",
+                "{} {} {}: found {}/{}, corner error {error}",
                 r.chart,
                 bucket.difficulty.label(),
                 bucket.label,
                 r.found,
                 r.photos,
-                100.0 * r.mean_corner_error
             );
             for (seed, why) in &r.misses {
                 eprintln!("  missed seed {seed}: {why}");
+                if let Some(dir) = &args.misses {
+                    let shot = bucket.photograph(camera, *seed, (w, h))?;
+                    let label: String = bucket
+                        .label
+                        .chars()
+                        .filter(|c| c.is_ascii_alphanumeric())
+                        .collect();
+                    let file = dir.join(format!(
+                        "{}-{}-{label}-{seed}.jpg",
+                        r.chart,
+                        bucket.difficulty.label()
+                    ));
+                    fsio::write_atomic(&file, &shot.jpeg)?;
+                }
             }
             rates.push(r);
         }
@@ -134,8 +200,12 @@ fn document(
          patch's area in the photo), over the photos found. The corners are those of the grid \
          fitted to the patch candidates, refined where the patches are at least 20 px apart: \
          moved to where the patch edges are sharpest in the green channel (a Nelder–Mead \
-         search on pairs of points across every patch edge). Goals: at least 99 % found down \
-         to 1/15 of the width and 70° tilt, mean corner error at most 2 %.\n\n",
+         search on pairs of points across every patch edge). Where too few patches are \
+         segmented for the chart to be found by them (a small or steep chart), the grid \
+         extrapolated from those found is accepted when the photo supports it: flat inside \
+         the patches, not so when moved by half a patch, and no patches continuing outside \
+         the chart; such a grid is refined at any size. Goals: at least 99 % found down to \
+         1/15 of the width and 70° tilt, mean corner error at most 2 %.\n\n",
         args.photos,
         args.seed,
         args.camera,
@@ -167,9 +237,16 @@ fn document(
         md += &misses.join("\n");
         md.push('\n');
     }
+    let mut filters = String::new();
+    if !args.photograph.is_empty() {
+        let _ = write!(filters, " --photograph {}", args.photograph.join(","));
+    }
+    if !args.difficulty.is_empty() {
+        let _ = write!(filters, " --difficulty {}", args.difficulty.join(","));
+    }
     let _ = write!(
         md,
-        "\n```sh\nspdcam detection --photos {} --size {w}x{h} --seed {} --charts {} -o docs/detection.md\n```\n",
+        "\n```sh\nspdcam detection --photos {} --size {w}x{h} --seed {} --charts {}{filters} -o docs/detection.md\n```\n",
         args.photos,
         args.seed,
         args.charts.join(",")

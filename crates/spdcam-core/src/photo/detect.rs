@@ -7,7 +7,7 @@ use super::geometry::{sort_corners, Homography};
 use super::lattice::{find_lattices, Lattice};
 use super::load::Photo;
 use super::pyramid::Level;
-use super::refine::refine;
+use super::refine::{refine, Start};
 use super::segment::{find_blobs, Blob};
 use super::{ChartTemplate, Detection, MIN_CONFIDENCE};
 use crate::error::{Error, Result};
@@ -21,6 +21,8 @@ pub const DETECTION_SIZE: usize = 1000;
 const MAX_SEARCH_PIXELS: usize = 8_000_000;
 /// Fewest blobs a lattice needs before it is placed on a template.
 const MIN_LATTICE: usize = 6;
+/// Smallest share of a template's patches a placement's lattice must cover.
+const MIN_INLIER_SHARE: f64 = 0.1;
 
 /// What the search saw, for the debug image when it fails.
 #[derive(Debug, Clone, Default)]
@@ -44,6 +46,10 @@ struct Candidate {
     fit_rms: f64,
     /// Share of the grid points in the ring just outside the chart that hold a blob.
     ring: f64,
+    /// How much better the photo fits the patch grid here than shifted by half a patch
+    /// ([`grid_support`]); measured only where the blobs alone do not reach
+    /// [`MIN_CONFIDENCE`], else 0.
+    support: f64,
 }
 
 impl Candidate {
@@ -55,7 +61,9 @@ impl Candidate {
     }
 
     fn confidence(&self) -> f64 {
-        let cov = (self.coverage / 0.6).min(1.0);
+        let cov = (self.coverage / 0.6)
+            .max(self.support / FULL_SUPPORT)
+            .min(1.0);
         let order = self.tau.max(0.0);
         let margin = (0.5 + (self.score() - self.other_rotation_score)).clamp(0.0, 1.0);
         let fit = (1.0 - self.fit_rms / 0.25).clamp(0.0, 1.0);
@@ -104,10 +112,30 @@ pub fn detect_at(
     let finest = finest_factor(photo.width, photo.height);
     let mut factor = Level::factor_for(photo.width, photo.height, size.max(1)).max(finest);
     let mut trace = SearchTrace::default();
+    // A placement found by its support in the photo is kept aside while a finer level may
+    // still find the chart by its patches (whose grid is the more exact).
+    let mut extrapolated: Option<Detection> = None;
+    let mut keep = |found: Option<(Detection, Start)>| -> Option<Detection> {
+        match found? {
+            (d, Start::Fitted) => Some(d),
+            (d, Start::Extrapolated) => {
+                if extrapolated
+                    .as_ref()
+                    .is_none_or(|e| d.confidence > e.confidence)
+                {
+                    extrapolated = Some(d);
+                }
+                None
+            }
+        }
+    };
     loop {
         let level = Level::new(photo, factor);
-        if let Some(found) = search_traced(&level, factor as f64, templates, &mut trace) {
-            return Ok((Some(refined(photo, templates, found, finest)), trace));
+        if let Some(found) = keep(search_traced(&level, factor as f64, templates, &mut trace)) {
+            return Ok((
+                Some(refined(photo, templates, found, finest, Start::Fitted)),
+                trace,
+            ));
         }
         // Small charts may need a finer level, down to the finest one searched.
         if factor <= finest {
@@ -118,11 +146,15 @@ pub fn detect_at(
     // Charts whose patches are only a few pixels wide: the full-resolution photo enlarged.
     if factor == 1 && 4 * photo.width * photo.height <= MAX_SEARCH_PIXELS {
         let level = Level::new(photo, 1).enlarged();
-        if let Some(found) = search_traced(&level, 0.5, templates, &mut trace) {
-            return Ok((Some(refined(photo, templates, found, finest)), trace));
+        if let Some(found) = keep(search_traced(&level, 0.5, templates, &mut trace)) {
+            return Ok((
+                Some(refined(photo, templates, found, finest, Start::Fitted)),
+                trace,
+            ));
         }
     }
-    Ok((None, trace))
+    let found = extrapolated.map(|d| refined(photo, templates, d, finest, Start::Extrapolated));
+    Ok((found, trace))
 }
 
 /// `found` with its corners refined on the photo ([`refine`]).
@@ -131,11 +163,12 @@ fn refined(
     templates: &[ChartTemplate],
     found: Detection,
     finest: usize,
+    start: Start,
 ) -> Detection {
     let Some(t) = templates.iter().find(|t| t.name == found.chart) else {
         return found;
     };
-    let map = refine(photo, t, &found.map(), finest);
+    let map = refine(photo, t, &found.map(), finest, start);
     Detection {
         corners: t.corners().map(|p| map.apply(p)),
         homography: map.to_rows(),
@@ -144,33 +177,62 @@ fn refined(
 }
 
 /// Searches one level whose pixels are `scale` photo pixels wide, noting what it saw in
-/// `trace`; the detection when one reaches [`MIN_CONFIDENCE`].
+/// `trace`; the detection when one reaches [`MIN_CONFIDENCE`], and whether its grid was
+/// fitted to patches over the chart or extrapolated from a few of them.
 fn search_traced(
     level: &Level,
     scale: f64,
     templates: &[ChartTemplate],
     trace: &mut SearchTrace,
-) -> Option<Detection> {
-    let (best, blobs) = search_level(level, templates);
-    if trace.blobs.is_empty() || best.is_some() {
+) -> Option<(Detection, Start)> {
+    let (mut candidates, blobs) = search_level(level, templates);
+    if trace.blobs.is_empty() || !candidates.is_empty() {
         trace.blobs = blobs
             .iter()
             .map(|b| ([b.centre[0] * scale, b.centre[1] * scale], b.side() * scale))
             .collect();
     }
-    let c = best?;
-    let map = c.map.scaled_output(scale);
+    for c in &mut candidates {
+        if c.confidence() < MIN_CONFIDENCE {
+            // Too few patches segmented (a small or steep chart): let the photo itself say
+            // whether the grid sits on patches, and whether patches go on outside it.
+            let t = &templates[c.template];
+            c.support = grid_support(level, &t.patch_squares(), &c.map);
+            let ring = grid_support(level, &ring_squares(t), &c.map);
+            c.ring = c.ring.max((ring / FULL_SUPPORT).clamp(0.0, 1.0));
+        }
+    }
+    // The confident placement that scores best, else the most confident one (for the trace).
+    let confident = candidates
+        .iter()
+        .filter(|c| c.confidence() >= MIN_CONFIDENCE)
+        .max_by(|a, b| a.score().total_cmp(&b.score()));
+    let c = match confident {
+        Some(c) => c,
+        None => candidates
+            .iter()
+            .max_by(|a, b| a.confidence().total_cmp(&b.confidence()))?,
+    };
     let t = &templates[c.template];
+    let map = c.map.scaled_output(scale);
     let corners = t.corners().map(|p| map.apply(p));
     let confidence = c.confidence();
     if trace.best.as_ref().is_none_or(|b| confidence >= b.1) {
         trace.best = Some((corners, confidence));
     }
-    (confidence >= MIN_CONFIDENCE).then(|| Detection {
-        chart: t.name.clone(),
-        corners,
-        homography: map.to_rows(),
-        confidence,
+    let start = if c.support > 0.0 {
+        Start::Extrapolated
+    } else {
+        Start::Fitted
+    };
+    (confidence >= MIN_CONFIDENCE).then(|| {
+        let found = Detection {
+            chart: t.name.clone(),
+            corners,
+            homography: map.to_rows(),
+            confidence,
+        };
+        (found, start)
     })
 }
 
@@ -181,21 +243,21 @@ fn finest_factor(width: usize, height: usize) -> usize {
     (pixels / MAX_SEARCH_PIXELS as f64).sqrt().ceil().max(1.0) as usize
 }
 
-/// The best placement on one level, and the level's blobs.
-fn search_level(level: &Level, templates: &[ChartTemplate]) -> (Option<Candidate>, Vec<Blob>) {
+/// The best placement of each template on one level, and the level's blobs.
+fn search_level(level: &Level, templates: &[ChartTemplate]) -> (Vec<Candidate>, Vec<Blob>) {
     let blobs = find_blobs(level);
     let lattices = find_lattices(&blobs, MIN_LATTICE);
-    let mut best: Option<Candidate> = None;
+    let mut best: Vec<Option<Candidate>> = vec![None; templates.len()];
     for lattice in &lattices {
         for (ti, t) in templates.iter().enumerate() {
             if let Some(c) = place(level, &blobs, lattice, ti, t) {
-                if best.as_ref().is_none_or(|b| c.score() > b.score()) {
-                    best = Some(c);
+                if best[ti].as_ref().is_none_or(|b| c.score() > b.score()) {
+                    best[ti] = Some(c);
                 }
             }
         }
     }
-    (best, blobs)
+    (best.into_iter().flatten().collect(), blobs)
 }
 
 /// Grid position (i, j) of a lattice → patch (column, row) of the chart for rotation `k`
@@ -249,7 +311,7 @@ fn place(
                     })
                     .collect();
                 let inliers = inside.len();
-                if inliers < MIN_LATTICE || (inliers as f64) < 0.25 * n {
+                if inliers < MIN_LATTICE || (inliers as f64) < MIN_INLIER_SHARE * n {
                     continue;
                 }
                 let outside = rotated.len() - inliers;
@@ -287,6 +349,7 @@ fn place(
                     other_rotation_score: -1.0,
                     fit_rms,
                     ring: 0.0,
+                    support: 0.0,
                 };
                 // The ring only lowers the score: measured only where it could still win.
                 if slot.as_ref().is_some_and(|s| c.score() <= s.score()) {
@@ -476,7 +539,7 @@ fn corner_placements(
             let aspect_error = ((across / down) / (w / h)).ln().abs();
             let on_level = map.scaled_output(1.0 / factor as f64);
             let tau = neutral_order(&level, template, &on_level).unwrap_or(-1.0);
-            let fit = template_fit(&level, template, &on_level);
+            let fit = template_fit(&level, &template.patch_squares(), &on_level);
             ways.push((map, tau, aspect_error, fit));
         }
         let best_fit = ways.iter().map(|w| w.3).fold(f64::NEG_INFINITY, f64::max);
@@ -509,15 +572,15 @@ fn corner_placements(
     Ok(out)
 }
 
-/// How well `t`'s patches fit the photo through `map` (chart → level): 5 × 5 points in
-/// the centre half of every patch, and the share of their brightness variance that lies
-/// between the patches' means (the coefficient of determination of the partition into
-/// patches, an analysis-of-variance R²). Near 1 when every square falls inside one flat
+/// How well squares of a chart (chart coordinates) fit the photo through `map` (chart →
+/// level): 5 × 5 points in each square, and the share of their brightness variance that
+/// lies between the squares' means (the coefficient of determination of the partition
+/// into squares, an analysis-of-variance R²). With the centre half of every patch
+/// ([`ChartTemplate::patch_squares`]): near 1 when every square falls inside one flat
 /// patch; low when squares straddle patch edges.
-fn template_fit(level: &Level, t: &ChartTemplate, map: &Homography) -> f64 {
-    let mut values: Vec<Vec<f64>> = Vec::with_capacity(t.patch_count());
-    for p in 0..t.patch_count() {
-        let square = t.patch_square(p, 0.5);
+fn template_fit(level: &Level, squares: &[[[f64; 2]; 4]], map: &Homography) -> f64 {
+    let mut values: Vec<Vec<f64>> = Vec::with_capacity(squares.len());
+    for square in squares {
         let mut patch = Vec::with_capacity(25);
         for j in 0..5 {
             for i in 0..5 {
@@ -556,6 +619,51 @@ fn template_fit(level: &Level, t: &ChartTemplate, map: &Homography) -> f64 {
     }
     1.0 - within / total
 }
+
+/// A grid's support in the photo: [`template_fit`] of `squares` through `map` less the
+/// best of the fits with the grid moved by half a patch pitch left, right, up or down.
+/// Where the squares sit on a chart's patches they are flat (fit near 1) and moved by half
+/// a pitch they straddle the patch edges (about 0.5 on a blurred Digital SG); on a flat or
+/// textured background a grid fits as well moved as not (support near 0).
+fn grid_support(level: &Level, squares: &[[[f64; 2]; 4]], map: &Homography) -> f64 {
+    let here = template_fit(level, squares, map);
+    let moved = [[0.5, 0.0], [-0.5, 0.0], [0.0, 0.5], [0.0, -0.5]]
+        .iter()
+        .map(|d| {
+            let shift = Matrix3::new(1.0, 0.0, d[0], 0.0, 1.0, d[1], 0.0, 0.0, 1.0);
+            template_fit(level, squares, &Homography(map.0 * shift))
+        })
+        .fold(f64::NEG_INFINITY, f64::max);
+    here - moved
+}
+
+/// The centre halves of the cells one pitch outside the chart's patch grid (the ring that
+/// [`ring_share`] counts blobs on): patches there mean a part of a larger chart.
+fn ring_squares(t: &ChartTemplate) -> Vec<[[f64; 2]; 4]> {
+    let (cols, rows) = (t.cols as i32, t.rows as i32);
+    let h = t.patch_fraction / 4.0;
+    let mut out = Vec::new();
+    for r in -1..=rows {
+        for c in -1..=cols {
+            if c == -1 || c == cols || r == -1 || r == rows {
+                let (x, y) = (
+                    f64::from(c) + t.patch_fraction / 2.0,
+                    f64::from(r) + t.patch_fraction / 2.0,
+                );
+                out.push([
+                    [x - h, y - h],
+                    [x + h, y - h],
+                    [x + h, y + h],
+                    [x - h, y + h],
+                ]);
+            }
+        }
+    }
+    out
+}
+
+/// The grid support that counts as much as patches found on 60 % of the chart.
+const FULL_SUPPORT: f64 = 0.25;
 
 fn lerp(a: [f64; 2], b: [f64; 2], t: f64) -> [f64; 2] {
     [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
@@ -605,6 +713,69 @@ mod tests {
             .collect();
         let share = ring_share(&corner, &t, &map);
         assert!((share - 11.0 / 24.0).abs() < 1e-12, "{share}");
+    }
+
+    /// A level showing a grid of flat patches of alternating greys (pitch 10 px, gaps of 2
+    /// px at 0.1) with its top-left patch corner at (20, 20); the rest is `background`.
+    fn grid_level(background: f32) -> Level {
+        let (w, h) = (160, 140);
+        let plane: Vec<f32> = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as i32 - 20, (i / w) as i32 - 20);
+                if !(0..100).contains(&x) || !(0..80).contains(&y) {
+                    return background;
+                }
+                let (c, r, u, v) = (x / 10, y / 10, x % 10, y % 10);
+                if u >= 8 || v >= 8 {
+                    0.1
+                } else {
+                    0.3 + 0.05 * ((c * 7 + r * 3) % 10) as f32
+                }
+            })
+            .collect();
+        Level {
+            width: w,
+            height: h,
+            planes: [plane.clone(), plane.clone(), plane],
+        }
+    }
+
+    #[test]
+    fn a_grid_on_patches_is_supported_and_one_off_them_is_not() {
+        // Issue 28: a small chart's blobs cover too little of it; the photo itself must
+        // tell a grid on the patches from one on the background or between patches.
+        let t = ChartTemplate {
+            name: "ten_by_eight".into(),
+            rows: 8,
+            cols: 10,
+            patch_fraction: 0.8,
+            feature_patches: (0..80).collect(),
+            feature_names: Vec::new(),
+            neutrals: Vec::new(),
+        };
+        let at =
+            |x: f64, y: f64| Homography(Matrix3::new(10.0, 0.0, x, 0.0, 10.0, y, 0.0, 0.0, 1.0));
+        let level = grid_level(0.5);
+        let on = grid_support(&level, &t.patch_squares(), &at(20.0, 20.0));
+        assert!(on > 0.3, "on the patches: {on}");
+        // Half a patch off: the squares straddle the edges and the gaps.
+        let off = grid_support(&level, &t.patch_squares(), &at(25.0, 25.0));
+        assert!(off < 0.0, "between the patches: {off}");
+        // On the flat background beside the chart.
+        let beside = grid_support(&level, &t.patch_squares(), &at(125.0, 55.0));
+        assert!(beside.abs() < 0.05, "beside the chart: {beside}");
+        // The ring of a whole chart on a flat background holds no patches; that of a
+        // four-by-three part of it does.
+        let ring = grid_support(&level, &ring_squares(&t), &at(20.0, 20.0));
+        assert!(ring < 0.05, "ring of the whole chart: {ring}");
+        let part = ChartTemplate {
+            rows: 3,
+            cols: 4,
+            feature_patches: (0..12).collect(),
+            ..t.clone()
+        };
+        let ring = grid_support(&level, &ring_squares(&part), &at(40.0, 40.0));
+        assert!(ring > 0.3, "ring of a part: {ring}");
     }
 
     #[test]

@@ -9,7 +9,7 @@
 
 use super::detect::detect;
 use super::load::decode_photo;
-use super::scene::{self, SceneLight, SceneOptions, Shadow, Tilt, TiltAxis};
+use super::scene::{self, SceneLight, SceneOptions, ScenePhoto, Shadow, Tilt, TiltAxis};
 use super::ChartTemplate;
 use crate::camera::Camera;
 use crate::error::Result;
@@ -150,6 +150,22 @@ impl Bucket {
     }
 }
 
+impl Bucket {
+    /// Photo `seed` of this bucket at `width × height`, taken with `camera` under the
+    /// scene's Planckian light: the photo [`measure`] searches, so that a miss can be
+    /// looked at.
+    pub fn photograph(
+        &self,
+        camera: &Camera,
+        seed: u64,
+        (width, height): (usize, usize),
+    ) -> Result<ScenePhoto> {
+        let (options, cct) = self.scene(seed, width, height);
+        let spd = illuminant::planck(cct, &Grid::SIMULATION)?;
+        scene::photograph(camera, SceneLight::single(&spd), seed, &options)
+    }
+}
+
 /// What one bucket gave for one chart.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BucketRate {
@@ -192,9 +208,7 @@ pub fn measure(
         .into_par_iter()
         .map(|i| {
             let s = seed::derive(seed, i);
-            let (options, cct) = bucket.scene(s, width, height);
-            let spd = illuminant::planck(cct, &Grid::SIMULATION)?;
-            let shot = scene::photograph(camera, SceneLight::single(&spd), s, &options)?;
+            let shot = bucket.photograph(camera, s, (width, height))?;
             let photo = decode_photo(&shot.jpeg, &format!("scene-{s}.jpg"))?;
             let outcome = match detect(&photo, templates) {
                 Ok(d) if d.chart != chart => Err(format!("found {} instead", d.chart)),

@@ -23,6 +23,10 @@ pub struct Lattice {
 
 /// Largest distance (in grid units) from a blob to its grid point.
 const SNAP: f64 = 0.22;
+/// How many grid steps (in each direction) a blob may lie from the lattice's members and
+/// still join it: 2 bridges one missing patch, which small, blurred charts have between
+/// every few found ones.
+const REACH: i32 = 2;
 /// Most seeds tried.
 const MAX_SEEDS: usize = 40;
 
@@ -146,8 +150,8 @@ fn grow(blobs: &[Blob], neighbours: &[usize], seed: usize) -> Option<Lattice> {
             if r > SNAP {
                 continue;
             }
-            let near =
-                (-1..=1).any(|di| (-1..=1).any(|dj| known.contains(&[n[0] + di, n[1] + dj])));
+            let near = (-REACH..=REACH)
+                .any(|di| (-REACH..=REACH).any(|dj| known.contains(&[n[0] + di, n[1] + dj])));
             if !near {
                 continue;
             }

@@ -167,6 +167,14 @@ impl ChartTemplate {
         [(i % self.cols) as f64 + half, (i / self.cols) as f64 + half]
     }
 
+    /// The centre half (`patch_square(i, 0.5)`) of every patch, row-major: where a patch
+    /// is flat even when blurred.
+    pub fn patch_squares(&self) -> Vec<[[f64; 2]; 4]> {
+        (0..self.patch_count())
+            .map(|i| self.patch_square(i, 0.5))
+            .collect()
+    }
+
     /// Corners (TL, TR, BR, BL) of the centred square of side `fraction` × the patch side
     /// in patch `i`, in chart coordinates.
     pub fn patch_square(&self, i: usize, fraction: f64) -> [[f64; 2]; 4] {
