@@ -129,3 +129,59 @@ fn scene_placements_out_of_range_are_refused_by_name() {
     let err = fails(&["render", "--spd", "D65", "-o", &photo, "--tilt", "30"]);
     assert!(err.contains("--scene"), "{err}");
 }
+
+#[test]
+fn detection_rates_of_one_difficulty_keep_the_missed_photos_to_look_at() {
+    let dir = scratch("detection");
+    let md = dir.join("detection.md");
+    let misses = dir.join("misses");
+    let out = common::ok(&[
+        "detection",
+        "--photos",
+        "2",
+        "--size",
+        "400x300",
+        "--charts",
+        "colorchecker24",
+        "--difficulty",
+        "size",
+        "--misses",
+        &s(&misses),
+        "-o",
+        &s(&md),
+    ]);
+    assert!(out.contains("detection rates:"), "{out}");
+    let text = std::fs::read_to_string(&md).unwrap();
+    for bucket in ["| size | 1/4 |", "| size | 1/15 |"] {
+        assert!(text.contains(bucket), "{bucket} missing:\n{text}");
+    }
+    assert!(!text.contains("| tilt |"), "only sizes asked for:\n{text}");
+    assert!(text.contains("--difficulty size -o"), "{text}");
+    // A 1/15 chart is 27 px wide in a 400 px photo: every photo missed is kept as a file.
+    let listed = text.lines().filter(|l| l.starts_with("- colorchecker24")).count();
+    assert!(listed > 0, "{text}");
+    let kept = std::fs::read_dir(&misses).unwrap().count();
+    assert_eq!(kept, listed, "{text}");
+    let e = fails(&[
+        "detection",
+        "--difficulty",
+        "colour",
+        "-o",
+        &s(&dir.join("x.md")),
+    ]);
+    assert!(
+        e.contains("'colour'") && e.contains("rotation, shadow, size, tilt"),
+        "{e}"
+    );
+    let e = fails(&[
+        "detection",
+        "--charts",
+        "colorchecker24",
+        "--photograph",
+        "colorchecker_sg140",
+        "-o",
+        &s(&dir.join("x.md")),
+    ]);
+    assert!(e.contains("--photograph 'colorchecker_sg140'"), "{e}");
+    assert!(!dir.join("x.md").exists());
+}
