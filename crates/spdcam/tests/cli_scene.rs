@@ -158,7 +158,10 @@ fn detection_rates_of_one_difficulty_keep_the_missed_photos_to_look_at() {
     assert!(!text.contains("| tilt |"), "only sizes asked for:\n{text}");
     assert!(text.contains("--difficulty size -o"), "{text}");
     // A 1/15 chart is 27 px wide in a 400 px photo: every photo missed is kept as a file.
-    let listed = text.lines().filter(|l| l.starts_with("- colorchecker24")).count();
+    let listed = text
+        .lines()
+        .filter(|l| l.starts_with("- colorchecker24"))
+        .count();
     assert!(listed > 0, "{text}");
     let kept = std::fs::read_dir(&misses).unwrap().count();
     assert_eq!(kept, listed, "{text}");

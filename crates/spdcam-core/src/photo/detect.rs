@@ -4,6 +4,7 @@
 //! candidates wins. Or, from four corners the user gives, the rotation by the same rule.
 
 use super::geometry::{sort_corners, Homography};
+use super::lateral_ca::{self, ChannelScales};
 use super::lattice::{find_lattices, Lattice};
 use super::load::Photo;
 use super::pyramid::Level;
@@ -129,8 +130,19 @@ pub fn detect_at(
             }
         }
     };
+    // The lens's colour fringes, measured once (a relative magnification holds at every
+    // level) and taken out of every level searched.
+    let mut fringes: Option<ChannelScales> = None;
+    let mut aligned = |level: Level| {
+        let scales = *fringes.get_or_insert_with(|| lateral_ca::measure(&level));
+        if scales.is_negligible() {
+            level
+        } else {
+            lateral_ca::undo(&level, scales)
+        }
+    };
     loop {
-        let level = Level::new(photo, factor);
+        let level = aligned(Level::new(photo, factor));
         if let Some(found) = keep(search_traced(&level, factor as f64, templates, &mut trace)) {
             return Ok((
                 Some(refined(photo, templates, found, finest, Start::Fitted)),
@@ -145,7 +157,7 @@ pub fn detect_at(
     }
     // Charts whose patches are only a few pixels wide: the full-resolution photo enlarged.
     if factor == 1 && 4 * photo.width * photo.height <= MAX_SEARCH_PIXELS {
-        let level = Level::new(photo, 1).enlarged();
+        let level = aligned(Level::new(photo, 1)).enlarged();
         if let Some(found) = keep(search_traced(&level, 0.5, templates, &mut trace)) {
             return Ok((
                 Some(refined(photo, templates, found, finest, Start::Fitted)),

@@ -17,6 +17,7 @@ mod detect;
 pub mod detection_rate;
 pub mod exposure;
 mod geometry;
+mod lateral_ca;
 mod lattice;
 mod load;
 mod overlay;

@@ -154,7 +154,7 @@ fn gradient(level: &Level) -> Vec<f32> {
 }
 
 /// 3 × 3 box filter (edges replicated).
-fn box3(plane: &[f32], w: usize, h: usize) -> Vec<f32> {
+pub(super) fn box3(plane: &[f32], w: usize, h: usize) -> Vec<f32> {
     let mut rows = vec![0.0f32; w * h];
     for y in 0..h {
         let r = &plane[y * w..(y + 1) * w];
