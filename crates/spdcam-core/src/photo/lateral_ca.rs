@@ -14,6 +14,7 @@
 
 use super::pyramid::Level;
 use super::segment::box3;
+use rayon::prelude::*;
 
 /// Largest relative magnification tried, either way (a strong lens: 1 % is 10 px at the
 /// corner of a 2000 px wide level).
@@ -21,7 +22,10 @@ const MOST: f64 = 0.01;
 /// Magnifications tried between −[`MOST`] and +[`MOST`].
 const STEPS: usize = 41;
 /// Green edge pixels the alignment is measured on (the strongest).
-const EDGE_SAMPLES: usize = 20_000;
+const EDGE_SAMPLES: usize = 10_000;
+/// The search tries every COARSE-th magnification, then every one around the best of those
+/// (the alignment is smooth in the magnification: one peak).
+const COARSE: usize = 4;
 /// A magnification smaller than this (at most a fifth of a pixel at the corner of a 1000
 /// px level) is left alone.
 const NEGLIGIBLE: f64 = 0.0004;
@@ -43,8 +47,8 @@ impl ChannelScales {
 }
 
 /// Red's and blue's magnifications relative to green in `level`, each the best aligned of
-/// [`STEPS`] tried within ±[`MOST`], refined by a parabola through its neighbours; 0 where
-/// the level has too few edges to tell.
+/// [`STEPS`] within ±[`MOST`] (searched coarse to fine), refined by a parabola through its
+/// neighbours; 0 where the level has too few edges to tell.
 pub fn measure(level: &Level) -> ChannelScales {
     let (w, h) = (level.width, level.height);
     if w < 8 || h < 8 {
@@ -73,41 +77,55 @@ pub fn measure(level: &Level) -> ChannelScales {
         return ChannelScales::default();
     }
     let centre = [w as f64 / 2.0, h as f64 / 2.0];
+    let score = |plane: &[f32], k: f64| -> f64 {
+        let (dot, energy) = edges
+            .iter()
+            .map(|&(_, i)| {
+                let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+                let p = [
+                    centre[0] + (x - centre[0]) * (1.0 + k),
+                    centre[1] + (y - centre[1]) * (1.0 + k),
+                ];
+                let cx = sample(plane, w, h, [p[0] + 1.0, p[1]])
+                    - sample(plane, w, h, [p[0] - 1.0, p[1]]);
+                let cy = sample(plane, w, h, [p[0], p[1] + 1.0])
+                    - sample(plane, w, h, [p[0], p[1] - 1.0]);
+                let gx = f64::from(green[i + 1] - green[i - 1]);
+                let gy = f64::from(green[i + w] - green[i - w]);
+                (gx * cx + gy * cy, cx * cx + cy * cy)
+            })
+            .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+        // Normalised by the channel's own gradient energy there: interpolating between
+        // pixels blurs, which would favour no magnification at all.
+        dot / energy.max(1e-12).sqrt()
+    };
     let best = |channel: usize| {
         let plane = &smooth[channel];
-        let scores: Vec<f64> = (0..STEPS)
-            .map(|s| {
-                let k = magnification(s);
-                let (dot, energy) = edges
-                    .iter()
-                    .map(|&(_, i)| {
-                        let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
-                        let p = [
-                            centre[0] + (x - centre[0]) * (1.0 + k),
-                            centre[1] + (y - centre[1]) * (1.0 + k),
-                        ];
-                        let cx = sample(plane, w, h, [p[0] + 1.0, p[1]])
-                            - sample(plane, w, h, [p[0] - 1.0, p[1]]);
-                        let cy = sample(plane, w, h, [p[0], p[1] + 1.0])
-                            - sample(plane, w, h, [p[0], p[1] - 1.0]);
-                        let gx = f64::from(green[i + 1] - green[i - 1]);
-                        let gy = f64::from(green[i + w] - green[i - w]);
-                        (gx * cx + gy * cy, cx * cx + cy * cy)
-                    })
-                    .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
-                // Normalised by the channel's own gradient energy there: interpolating
-                // between pixels blurs, which would favour no magnification at all.
-                dot / energy.max(1e-12).sqrt()
-            })
+        // Every COARSE-th magnification first, then every one around the best of those.
+        let coarse: Vec<usize> = (0..STEPS).step_by(COARSE).collect();
+        let coarse_scores: Vec<f64> = coarse
+            .par_iter()
+            .map(|&s| score(plane, magnification(s)))
             .collect();
-        let s = (0..STEPS)
-            .max_by(|&a, &b| scores[a].total_cmp(&scores[b]))
-            .unwrap_or(STEPS / 2);
-        if s == 0 || s == STEPS - 1 {
+        let around = coarse[(0..coarse.len())
+            .max_by(|&a, &b| coarse_scores[a].total_cmp(&coarse_scores[b]))
+            .unwrap_or(0)];
+        let lo = around.saturating_sub(COARSE);
+        let hi = (around + COARSE).min(STEPS - 1);
+        let scores: Vec<(usize, f64)> = (lo..=hi)
+            .into_par_iter()
+            .map(|s| (s, score(plane, magnification(s))))
+            .collect();
+        let at = |s: usize| scores.iter().find(|v| v.0 == s).map_or(f64::MIN, |v| v.1);
+        let s = scores
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(STEPS / 2, |v| v.0);
+        if s == 0 || s == STEPS - 1 || s == lo || s == hi {
             return magnification(s);
         }
         // The parabola's vertex through the best and its two neighbours.
-        let (a, b, c) = (scores[s - 1], scores[s], scores[s + 1]);
+        let (a, b, c) = (at(s - 1), at(s), at(s + 1));
         let curvature = a - 2.0 * b + c;
         let offset = if curvature < 0.0 {
             (0.5 * (a - c) / curvature).clamp(-0.5, 0.5)

@@ -83,8 +83,8 @@ fn edge_contrast(level: &Level, t: &ChartTemplate, map: &Homography, delta: f64)
             for (a, b) in pairs {
                 let (qa, qb) = (map.apply(a), map.apply(b));
                 if inside_level(qa) && inside_level(qb) {
-                    sum += (f64::from(level.bilinear(qa)[1]) - f64::from(level.bilinear(qb)[1]))
-                        .powi(2);
+                    let (a, b) = (level.bilinear_channel(qa, 1), level.bilinear_channel(qb, 1));
+                    sum += f64::from(a - b).powi(2);
                     n += 1;
                 }
             }
