@@ -12,7 +12,7 @@
 //! Only detection sees the corrected level; patches are sampled at their centres, where
 //! the fringes do not reach.
 
-use super::pyramid::Level;
+use super::pyramid::{bilinear_plane, Level};
 use super::segment::box3;
 use rayon::prelude::*;
 
@@ -172,17 +172,9 @@ fn magnification(s: usize) -> f64 {
     -MOST + s as f64 * step()
 }
 
-/// Bilinear value of one plane at a continuous point (pixel centres at +0.5), clamped.
+/// [`bilinear_plane`] in f64.
 fn sample(plane: &[f32], w: usize, h: usize, p: [f64; 2]) -> f64 {
-    let x = (p[0] - 0.5).clamp(0.0, (w - 1) as f64);
-    let y = (p[1] - 0.5).clamp(0.0, (h - 1) as f64);
-    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-    let (fx, fy) = (x - x0 as f64, y - y0 as f64);
-    let at = |xx: usize, yy: usize| f64::from(plane[yy * w + xx]);
-    let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
-    let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
-    top * (1.0 - fy) + bottom * fy
+    f64::from(bilinear_plane(plane, w, h, p))
 }
 
 #[cfg(test)]

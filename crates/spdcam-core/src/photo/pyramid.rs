@@ -88,19 +88,24 @@ impl Level {
     /// Bilinear value of channel `c` alone at a continuous point, as [`Level::bilinear`]:
     /// a third of the work where one channel is wanted.
     pub fn bilinear_channel(&self, p: [f64; 2], c: usize) -> f32 {
-        let x = (p[0] - 0.5).clamp(0.0, (self.width - 1) as f64);
-        let y = (p[1] - 0.5).clamp(0.0, (self.height - 1) as f64);
-        let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-        let (x1, y1) = ((x0 + 1).min(self.width - 1), (y0 + 1).min(self.height - 1));
-        let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
-        let p = &self.planes[c];
-        let top = p[y0 * self.width + x0] * (1.0 - fx) + p[y0 * self.width + x1] * fx;
-        let bottom = p[y1 * self.width + x0] * (1.0 - fx) + p[y1 * self.width + x1] * fx;
-        top * (1.0 - fy) + bottom * fy
+        bilinear_plane(&self.planes[c], self.width, self.height, p)
     }
 
     /// Bilinear value at a continuous point (pixel centres at +0.5), clamped to the image.
     pub fn bilinear(&self, p: [f64; 2]) -> [f32; 3] {
         std::array::from_fn(|c| self.bilinear_channel(p, c))
     }
+}
+
+/// Bilinear value of a row-major `width × height` plane at a continuous point (pixel
+/// centres at +0.5), clamped to the plane.
+pub(super) fn bilinear_plane(plane: &[f32], width: usize, height: usize, p: [f64; 2]) -> f32 {
+    let x = (p[0] - 0.5).clamp(0.0, (width - 1) as f64);
+    let y = (p[1] - 0.5).clamp(0.0, (height - 1) as f64);
+    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+    let (x1, y1) = ((x0 + 1).min(width - 1), (y0 + 1).min(height - 1));
+    let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
+    let top = plane[y0 * width + x0] * (1.0 - fx) + plane[y0 * width + x1] * fx;
+    let bottom = plane[y1 * width + x0] * (1.0 - fx) + plane[y1 * width + x1] * fx;
+    top * (1.0 - fy) + bottom * fy
 }
