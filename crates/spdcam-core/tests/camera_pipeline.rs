@@ -246,3 +246,50 @@ fn thesis_white_balance_statistics_see_demosaicing_overshoot() {
     assert!(demosaiced[2] < raw[2] * 0.97, "{demosaiced:?} vs {raw:?}");
     assert_eq!(raw[1], 1.0);
 }
+
+/// The typical camera colour matrix with which detection undoes the lens's colour fringes
+/// (`spdcam_core::photo::TYPICAL_CAMERA_TO_SRGB`) is the element-wise median of the D65-fitted
+/// matrices of the measured cameras, each row scaled to sum to 1 (white stays white).
+#[cfg(feature = "measured-data")]
+#[test]
+fn the_typical_camera_matrix_is_the_median_of_the_measured_cameras() {
+    use spdcam_core::camera::colour::xyz_to_srgb_matrix;
+    use spdcam_core::photo::TYPICAL_CAMERA_TO_SRGB;
+    let dir = shared_data::data_dir().join("cameras");
+    let data = DataDir::new(Some(shared_data::data_dir()));
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .collect();
+    names.sort();
+    let mut matrices = Vec::new();
+    for path in &names {
+        // Tables the camera cannot use (too few bands) are left out, as training does.
+        let Ok(s) = Sensitivities::resolve(&path.to_string_lossy(), &data, &GRID) else {
+            continue;
+        };
+        let chart = Chart::colorchecker24(&GRID).unwrap();
+        let camera = Camera::new(&s, chart, noise_free(), &GRID).unwrap();
+        let m = xyz_to_srgb_matrix() * camera.correction_matrix().unwrap();
+        let rows: [[f64; 3]; 3] = std::array::from_fn(|i| {
+            let sum: f64 = (0..3).map(|j| m[(i, j)]).sum();
+            std::array::from_fn(|j| m[(i, j)] / sum)
+        });
+        matrices.push(rows);
+    }
+    assert!(matrices.len() >= 40, "{} cameras", matrices.len());
+    for i in 0..3 {
+        for j in 0..3 {
+            let mut v: Vec<f64> = matrices.iter().map(|m| m[i][j]).collect();
+            v.sort_by(f64::total_cmp);
+            let median = 0.5 * (v[(v.len() - 1) / 2] + v[v.len() / 2]);
+            println!("({i}, {j}): median {median:.3} over {} cameras", v.len());
+            assert!(
+                (TYPICAL_CAMERA_TO_SRGB[i][j] - median).abs() < 0.0015,
+                "({i}, {j}): {} against the median {median:.4}",
+                TYPICAL_CAMERA_TO_SRGB[i][j]
+            );
+        }
+    }
+}

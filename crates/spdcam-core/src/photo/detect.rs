@@ -133,12 +133,17 @@ pub fn detect_at(
     // The lens's colour fringes, measured once (a relative magnification holds at every
     // level) and taken out of every level searched.
     let mut fringes: Option<ChannelScales> = None;
+    // They are measured and undone in the camera's own RGB (see `lateral_ca`).
     let mut aligned = |level: Level| {
-        let scales = *fringes.get_or_insert_with(|| lateral_ca::measure(&level));
+        if fringes.is_some_and(|s| s.is_negligible()) {
+            return level;
+        }
+        let camera = lateral_ca::to_camera(&level);
+        let scales = *fringes.get_or_insert_with(|| lateral_ca::measure(&camera));
         if scales.is_negligible() {
             level
         } else {
-            lateral_ca::undo(&level, scales)
+            lateral_ca::to_display(&lateral_ca::undo(&camera, scales))
         }
     };
     loop {

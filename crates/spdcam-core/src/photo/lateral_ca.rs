@@ -11,9 +11,17 @@
 //! removal of chromatic aberration from a single image", CVPR), then undone by resampling.
 //! Only detection sees the corrected level; patches are sampled at their centres, where
 //! the fringes do not reach.
+//!
+//! The lens magnifies the sensor's own channels, and the camera's colour matrix then mixes
+//! them: each channel of the photo holds all three magnifications, so its fringes are no
+//! single magnification (a matrix with −0.8 off the diagonal makes them stronger and
+//! two-sided). Measuring and undoing them in the camera's RGB, reached by inverting a
+//! typical camera's matrix ([`TYPICAL_CAMERA_TO_SRGB`]), takes this mixing out.
 
 use super::pyramid::{bilinear_plane, Level};
 use super::segment::box3;
+use crate::colorimetry::{srgb_decode, srgb_encode};
+use nalgebra::Matrix3;
 use rayon::prelude::*;
 
 /// Largest relative magnification tried, either way (a strong lens: 1 % is 10 px at the
@@ -29,6 +37,97 @@ const COARSE: usize = 4;
 /// A magnification smaller than this (at most a fifth of a pixel at the corner of a 1000
 /// px level) is left alone.
 const NEGLIGIBLE: f64 = 0.0004;
+
+/// A typical camera's colour matrix, white-balanced camera RGB → linear sRGB: the
+/// element-wise median of the D65-fitted matrices (thesis 3.1.6) of the 55 usable measured
+/// cameras of the data directory's cameras/, each with its rows first scaled to sum to 1
+/// (white stays white); recomputed and compared by the second-tier test in
+/// `tests/camera_pipeline.rs`.
+pub const TYPICAL_CAMERA_TO_SRGB: [[f64; 3]; 3] = [
+    [1.734, -0.692, -0.071],
+    [-0.144, 1.584, -0.407],
+    [0.050, -0.554, 1.497],
+];
+
+/// Steps of the sRGB decoding table over encoded values 0…1.
+const DECODE_STEPS: usize = 4096;
+/// Steps of the sRGB encoding table over linear values 0…1 (the curve is steepest at 0).
+const ENCODE_STEPS: usize = 16384;
+
+/// The sRGB curve both ways as tables read by linear interpolation (within 1e-5 of the
+/// curve, below any level's rounding): per pixel and channel a power is too slow here.
+struct SrgbTables {
+    decode: Vec<f32>,
+    encode: Vec<f32>,
+}
+
+impl SrgbTables {
+    fn get() -> &'static SrgbTables {
+        static TABLES: std::sync::OnceLock<SrgbTables> = std::sync::OnceLock::new();
+        TABLES.get_or_init(|| SrgbTables {
+            decode: (0..=DECODE_STEPS)
+                .map(|k| srgb_decode(k as f64 / DECODE_STEPS as f64) as f32)
+                .collect(),
+            encode: (0..=ENCODE_STEPS)
+                .map(|k| srgb_encode(k as f64 / ENCODE_STEPS as f64) as f32)
+                .collect(),
+        })
+    }
+}
+
+/// `table` (sampled at `steps` equal steps over 0…1) at `v`, clamped to 0…1.
+fn lookup(table: &[f32], steps: usize, v: f32) -> f32 {
+    let x = v.clamp(0.0, 1.0) * steps as f32;
+    let i = (x as usize).min(steps - 1);
+    let t = x - i as f32;
+    table[i] + t * (table[i + 1] - table[i])
+}
+
+/// `level` with `matrix` applied to every pixel, `before` on each value first and `after`
+/// on each result.
+fn per_pixel(
+    level: &Level,
+    matrix: &[[f32; 3]; 3],
+    before: &(dyn Fn(f32) -> f32 + Sync),
+    after: &(dyn Fn(f32) -> f32 + Sync),
+) -> Level {
+    let mut out = level.clone();
+    let [r, g, b] = &mut out.planes;
+    r.par_iter_mut()
+        .zip(g.par_iter_mut())
+        .zip(b.par_iter_mut())
+        .for_each(|((r, g), b)| {
+            let v = [before(*r), before(*g), before(*b)];
+            let m = |row: &[f32; 3]| after(row[0] * v[0] + row[1] * v[1] + row[2] * v[2]);
+            (*r, *g, *b) = (m(&matrix[0]), m(&matrix[1]), m(&matrix[2]));
+        });
+    out
+}
+
+/// `level` (encoded sRGB) in a typical camera's linear RGB: decoded, then the inverse of
+/// [`TYPICAL_CAMERA_TO_SRGB`].
+pub fn to_camera(level: &Level) -> Level {
+    let inverse = Matrix3::from_fn(|i, j| TYPICAL_CAMERA_TO_SRGB[i][j])
+        .try_inverse()
+        .unwrap_or_else(Matrix3::identity);
+    let matrix = std::array::from_fn(|i| std::array::from_fn(|j| inverse[(i, j)] as f32));
+    let tables = SrgbTables::get();
+    per_pixel(
+        level,
+        &matrix,
+        &|v| lookup(&tables.decode, DECODE_STEPS, v),
+        &|v| v,
+    )
+}
+
+/// A level of [`to_camera`] back in encoded sRGB (clipped to 0…1).
+pub fn to_display(level: &Level) -> Level {
+    let matrix = TYPICAL_CAMERA_TO_SRGB.map(|row| row.map(|v| v as f32));
+    let tables = SrgbTables::get();
+    per_pixel(level, &matrix, &|v| v, &|v| {
+        lookup(&tables.encode, ENCODE_STEPS, v)
+    })
+}
 
 /// The magnifications of red and blue relative to green ([`measure`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -233,6 +332,37 @@ mod tests {
             "{} → {}",
             error(&level),
             error(&fixed)
+        );
+    }
+
+    #[test]
+    fn camera_rgb_and_back_is_the_level_itself() {
+        let level = fringed(0.0, 0.0);
+        let back = to_display(&to_camera(&level));
+        for c in 0..3 {
+            for (a, b) in level.planes[c].iter().zip(&back.planes[c]) {
+                assert!((a - b).abs() < 2e-3, "{a} → {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn fringes_mixed_by_the_colour_matrix_are_measured_in_camera_rgb() {
+        // The lens magnifies the sensor's channels, the camera's matrix then mixes them.
+        // Linear camera values of 0.23–0.47, which the matrix keeps within 0…1 (no clipping).
+        let mut raw = fringed(0.006, -0.004);
+        raw.planes
+            .iter_mut()
+            .for_each(|p| p.iter_mut().for_each(|v| *v = 0.35 + 0.3 * (*v - 0.5)));
+        let photo = to_display(&raw);
+        let s = measure(&to_camera(&photo));
+        assert!((s.red - 0.006).abs() < 0.0008, "{s:?}");
+        assert!((s.blue + 0.004).abs() < 0.0008, "{s:?}");
+        // Measured on the mixed channels, the magnifications come out wrong.
+        let mixed = measure(&photo);
+        assert!(
+            (mixed.red - 0.006).abs() > 0.0015 && (mixed.blue + 0.004).abs() > 0.0015,
+            "{mixed:?}"
         );
     }
 

@@ -36,6 +36,7 @@ pub use detect::{
 };
 pub use exposure::Exposure;
 pub use geometry::{sort_corners, Homography};
+pub use lateral_ca::TYPICAL_CAMERA_TO_SRGB;
 pub use load::{decode_photo, jpeg_end, load_photo, JpegEnd, Photo, MIN_PHOTO_SIDE};
 pub use overlay::{
     analysis_overlay_jpeg, debug_factor, debug_overlay, debug_overlay_full, write_overlay,
