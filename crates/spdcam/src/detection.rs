@@ -198,11 +198,12 @@ fn document(
          also the right way round). Corner error: the mean distance of the four corners of \
          the patch grid from the true ones, in % of a patch side (the square root of a \
          patch's area in the photo), over the photos found. The search runs on the photo with \
-         the lens's colour fringes taken out (red's and blue's magnification against green \
-         measured on the strongest edges and undone). The corners are those of the grid \
-         fitted to the patch candidates, refined where the patches are at least 12 px apart: \
-         moved to where the patch edges are sharpest in the green channel (a Nelder–Mead \
-         search on pairs of points across every patch edge). Where too few patches are \
+         the lens's colour fringes taken out in the camera's own RGB (a typical camera's \
+         colour matrix undone, then red's and blue's magnification against green measured \
+         on the strongest edges and undone). The corners are those of the grid fitted to \
+         the patch candidates, refined where the patches are at least 12 px apart: moved to \
+         where the patch edges are sharpest in the camera's green (a Nelder–Mead search on \
+         pairs of points across every patch edge). Where too few patches are \
          segmented for the chart to be found by them (a small or steep chart), the grid \
          extrapolated from those found is accepted when the photo supports it: flat inside \
          the patches, not so when moved by half a patch, and no patches continuing outside \
