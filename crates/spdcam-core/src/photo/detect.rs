@@ -11,6 +11,7 @@ use super::pyramid::Level;
 use super::refine::{refine, Start};
 use super::segment::{find_blobs, Blob};
 use super::{ChartTemplate, Detection, MIN_CONFIDENCE};
+use crate::colorimetry::srgb_decode_f32;
 use crate::error::{Error, Result};
 use nalgebra::Matrix3;
 
@@ -41,6 +42,8 @@ struct Candidate {
     /// Chart → level coordinates.
     map: Homography,
     tau: f64,
+    /// How grey the neutral patches are ([`greyness`]).
+    greyness: f64,
     coverage: f64,
     /// Best score among the placements in the other three rotations.
     other_rotation_score: f64,
@@ -54,11 +57,13 @@ struct Candidate {
 }
 
 impl Candidate {
-    /// Patches found, in the neutrals' order, and nothing patch-like continuing the grid
-    /// outside the chart (which a part of a larger chart has: six by four patches of the
-    /// Digital SG, grey row included, otherwise read as a ColorChecker 24).
+    /// Patches found, in the neutrals' order, grey where the neutrals are (which tells the
+    /// right way round from the wrong even where a shadow upsets the order), and nothing
+    /// patch-like continuing the grid outside the chart (which a part of a larger chart
+    /// has: six by four patches of the Digital SG, grey row included, otherwise read as a
+    /// ColorChecker 24).
     fn score(&self) -> f64 {
-        self.coverage + self.tau - self.ring
+        self.coverage + self.tau + self.greyness - self.ring
     }
 
     fn confidence(&self) -> f64 {
@@ -340,7 +345,7 @@ fn place(
                 let to_patch = rotation_matrix(k, [tc, tr]);
                 let patch_to_lattice = to_patch.try_inverse()?;
                 let map = Homography(lattice.map.0 * patch_to_lattice * chart_to_patch);
-                let Some(tau) = neutral_order(level, t, &map) else {
+                let Some(neutral) = neutral_evidence(level, t, &map) else {
                     continue;
                 };
                 let fit_rms = {
@@ -361,7 +366,8 @@ fn place(
                 let mut c = Candidate {
                     template: ti,
                     map,
-                    tau,
+                    tau: neutral.tau,
+                    greyness: neutral.greyness,
                     coverage,
                     other_rotation_score: -1.0,
                     fit_rms,
@@ -468,11 +474,32 @@ fn patch_colours(level: &Level, t: &ChartTemplate, map: &Homography) -> Option<V
         .collect()
 }
 
+/// What the neutral patches of a placement say of it: their lightness order and how grey
+/// they are, from one sampling of the patches ([`patch_colours`]).
+#[derive(Debug, Clone, Copy)]
+struct NeutralEvidence {
+    /// Kendall's τ between the neutral patches' reflectances and their measured lightness
+    /// ([`lightness_order`]).
+    tau: f64,
+    /// How much more alike in colour the neutral patches are than the chart's patches as a
+    /// whole ([`greyness`]).
+    greyness: f64,
+}
+
+/// [`NeutralEvidence`] of the placement `map` (chart → level) of `t`; `None` when a patch
+/// lies outside the level or the chart has no pair of neutrals to order.
+fn neutral_evidence(level: &Level, t: &ChartTemplate, map: &Homography) -> Option<NeutralEvidence> {
+    let colours = patch_colours(level, t, map)?;
+    Some(NeutralEvidence {
+        tau: lightness_order(&colours, t)?,
+        greyness: greyness(&colours, t),
+    })
+}
+
 /// Kendall's τ between the neutral patches' reflectances and their measured lightness
 /// (sum of the channels): +1 when the photo orders them as the chart does. Pairs whose
 /// lightness differs by less than the quantisation (clipped or black) count as ties.
-fn neutral_order(level: &Level, t: &ChartTemplate, map: &Homography) -> Option<f64> {
-    let colours = patch_colours(level, t, map)?;
+fn lightness_order(colours: &[[f32; 3]], t: &ChartTemplate) -> Option<f64> {
     let light: Vec<(f64, f64)> = t
         .neutrals
         .iter()
@@ -493,6 +520,31 @@ fn neutral_order(level: &Level, t: &ChartTemplate, map: &Homography) -> Option<f
         }
     }
     (pairs > 0).then(|| s / pairs as f64)
+}
+
+/// 1 when the neutral patches share one colour (the light's), 0 when they differ in colour
+/// as much as the chart's patches do: one minus the ratio of their off-axis shares, where a
+/// set's off-axis share is the part of its linear RGB vectors' energy not along their
+/// principal direction through the origin (1 − λ₁ / trace of the uncentred scatter matrix,
+/// Jolliffe, *Principal Component Analysis*, 2002, §14.2.3). Unlike the lightness order it
+/// holds in a shadow, which dims a patch without changing its colour.
+fn greyness(colours: &[[f32; 3]], t: &ChartTemplate) -> f64 {
+    let off_axis = |patches: &mut dyn Iterator<Item = usize>| {
+        let mut scatter = Matrix3::<f64>::zeros();
+        for p in patches {
+            let v = nalgebra::Vector3::from(colours[p].map(|c| f64::from(srgb_decode_f32(c))));
+            scatter += v * v.transpose();
+        }
+        let trace = scatter.trace();
+        let largest = scatter.symmetric_eigenvalues().max();
+        (trace > 0.0).then(|| 1.0 - largest / trace)
+    };
+    let neutrals = off_axis(&mut t.neutrals.iter().map(|n| n.0));
+    let all = off_axis(&mut (0..colours.len()));
+    match (neutrals, all) {
+        (Some(n), Some(a)) if a > 1e-6 => (1.0 - n / a).clamp(0.0, 1.0),
+        _ => 0.0,
+    }
 }
 
 /// The chart's placement from four outer corners given in any order (photo pixels): the
@@ -555,16 +607,20 @@ fn corner_placements(
             let down = 0.5 * (side(image[1], image[2]) + side(image[3], image[0]));
             let aspect_error = ((across / down) / (w / h)).ln().abs();
             let on_level = map.scaled_output(1.0 / factor as f64);
-            let tau = neutral_order(&level, template, &on_level).unwrap_or(-1.0);
+            let (tau, greyness) = neutral_evidence(&level, template, &on_level)
+                .map_or((-1.0, 0.0), |n| (n.tau, n.greyness));
             let fit = template_fit(&level, &template.patch_squares(), &on_level);
-            ways.push((map, tau, aspect_error, fit));
+            ways.push((map, tau, greyness, aspect_error, fit));
         }
-        let best_fit = ways.iter().map(|w| w.3).fold(f64::NEG_INFINITY, f64::max);
+        let best_fit = ways.iter().map(|w| w.4).fold(f64::NEG_INFINITY, f64::max);
         // Orientations that fit the grid clearly worse than the best are out of the running
-        // (a quarter turn of a 6 × 4 grid); among the rest the neutral order decides.
+        // (a quarter turn of a 6 × 4 grid); among the rest the neutrals' order and greyness
+        // decide.
         let scores: Vec<f64> = ways
             .iter()
-            .map(|(_, tau, aspect, fit)| tau - 2.0 * aspect - 4.0 * (best_fit - fit))
+            .map(|(_, tau, greyness, aspect, fit)| {
+                tau + greyness - 2.0 * aspect - 4.0 * (best_fit - fit)
+            })
             .collect();
         let chosen = (0..4)
             .max_by(|&a, &b| scores[a].total_cmp(&scores[b]))
@@ -573,7 +629,7 @@ fn corner_placements(
             .filter(|&s| s != chosen)
             .map(|s| scores[s])
             .fold(-1.0, f64::max);
-        let (map, tau, _, fit) = ways.swap_remove(chosen);
+        let (map, tau, _, _, fit) = ways.swap_remove(chosen);
         let confidence = tau.max(0.0) * (0.5 + scores[chosen] - other).clamp(0.0, 1.0);
         out.push((
             fit,
@@ -689,6 +745,7 @@ fn lerp(a: [f64; 2], b: [f64; 2], t: f64) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::colorimetry::srgb_encode_f32;
 
     #[test]
     fn a_part_of_a_larger_grid_is_surrounded_by_patches() {
@@ -730,6 +787,57 @@ mod tests {
             .collect();
         let share = ring_share(&corner, &t, &map);
         assert!((share - 11.0 / 24.0).abs() < 1e-12, "{share}");
+    }
+
+    #[test]
+    fn neutrals_are_grey_in_a_shadow_and_not_the_wrong_way_round() {
+        // Issue 28: a ColorChecker 24 with a quarter of the light over its left half was
+        // missed, its neutrals' lightness order upset; their colour is not.
+        let chart =
+            crate::chart::Chart::colorchecker24(&crate::spectral::Grid::SIMULATION).unwrap();
+        let t = ChartTemplate::from_chart(&chart).unwrap();
+        // A camera of three flat bands (blue below 490 nm, green to 580, red above) under
+        // an equal-energy light, encoded: the neutral patches are grey.
+        let wavelengths = chart.reflectances.wavelengths();
+        let colours: Vec<[f32; 3]> = chart
+            .reflectances
+            .items()
+            .iter()
+            .map(|r| {
+                let band = |lo: f64, hi: f64| {
+                    let inside: Vec<f64> = wavelengths
+                        .iter()
+                        .zip(r)
+                        .filter(|(w, _)| (lo..hi).contains(*w))
+                        .map(|(_, v)| *v)
+                        .collect();
+                    srgb_encode_f32((inside.iter().sum::<f64>() / inside.len() as f64) as f32)
+                };
+                [band(580.0, 800.0), band(490.0, 580.0), band(300.0, 490.0)]
+            })
+            .collect();
+        assert!(greyness(&colours, &t) > 0.95, "{}", greyness(&colours, &t));
+        // The left half in a shadow leaving a quarter of the light (linear).
+        let shadowed: Vec<[f32; 3]> = colours
+            .iter()
+            .enumerate()
+            .map(|(p, c)| {
+                if p % 6 < 3 {
+                    c.map(|v| srgb_encode_f32(0.25 * srgb_decode_f32(v)))
+                } else {
+                    *c
+                }
+            })
+            .collect();
+        assert!(lightness_order(&shadowed, &t).unwrap() < 0.8);
+        assert!(
+            greyness(&shadowed, &t) > 0.95,
+            "{}",
+            greyness(&shadowed, &t)
+        );
+        // Turned half round, the neutrals' places hold the top row's colours.
+        let turned: Vec<[f32; 3]> = (0..24).map(|p| colours[23 - p]).collect();
+        assert!(greyness(&turned, &t) < 0.3, "{}", greyness(&turned, &t));
     }
 
     /// A level showing a grid of flat patches of alternating greys (pitch 10 px, gaps of 2
