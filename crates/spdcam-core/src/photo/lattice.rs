@@ -30,8 +30,41 @@ const REACH: i32 = 2;
 /// Most seeds tried.
 const MAX_SEEDS: usize = 40;
 
+/// Pixels the lens's blur and the segmentation's edge threshold take off each side of a
+/// patch: a small chart's patches segment as blobs well under their pitch (a third to a
+/// half of it at 7 px a patch), so sizes are compared with the pitch as if restored.
+const EROSION_PX: f64 = 1.0;
+
+/// `blob` grown by [`EROSION_PX`] on each side along its own axes (the eigenvectors of its
+/// second moments: a rectangle of sides l has variances l²/12 along them).
+fn restored(blob: &Blob) -> Blob {
+    let [a, b, c] = blob.moments;
+    let (mean, half_gap) = (0.5 * (a + c), (0.25 * (a - c).powi(2) + b * b).sqrt());
+    let (large, small) = (mean + half_gap, (mean - half_gap).max(1e-9));
+    let grow = |variance: f64| ((12.0 * variance).sqrt() + 2.0 * EROSION_PX).powi(2) / 12.0;
+    let (g_large, g_small) = (grow(large), grow(small));
+    // Σ = small·I + (large − small)·e eᵀ with e the major axis; the same with grown values.
+    let scale = if large - small > 1e-12 {
+        (g_large - g_small) / (large - small)
+    } else {
+        0.0
+    };
+    let moments = [
+        g_small + scale * (a - small),
+        scale * b,
+        g_small + scale * (c - small),
+    ];
+    Blob {
+        area: blob.area * (g_large * g_small / (large * small)).sqrt(),
+        moments,
+        ..blob.clone()
+    }
+}
+
 /// Lattices of at least `min_members` blobs, largest first.
 pub fn find_lattices(blobs: &[Blob], min_members: usize) -> Vec<Lattice> {
+    let restored: Vec<Blob> = blobs.iter().map(restored).collect();
+    let blobs = &restored[..];
     let neighbours = neighbour_lists(blobs);
     let mut order: Vec<usize> = (0..blobs.len())
         .filter(|&i| neighbours[i].len() >= 2)
@@ -244,4 +277,68 @@ fn fit_affine(from: &[[f64; 2]], to: &[[f64; 2]]) -> Option<Homography> {
     Some(Homography(Matrix3::new(
         px[0], px[1], px[2], py[0], py[1], py[2], 0.0, 0.0, 1.0,
     )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A blob of a `w` × `h` rectangle turned by `angle` radians.
+    fn rectangle(w: f64, h: f64, angle: f64) -> Blob {
+        let (s, c) = angle.sin_cos();
+        let (vw, vh) = (w * w / 12.0, h * h / 12.0);
+        Blob {
+            centre: [50.0, 40.0],
+            area: w * h,
+            colour: [0.5; 3],
+            moments: [
+                vw * c * c + vh * s * s,
+                (vw - vh) * s * c,
+                vw * s * s + vh * c * c,
+            ],
+        }
+    }
+
+    #[test]
+    fn a_restored_blob_is_the_rectangle_grown_on_every_side() {
+        for (w, h, angle) in [
+            (6.0, 6.0, 0.0),
+            (9.0, 4.0, 0.0),
+            (9.0, 4.0, 0.7),
+            (3.0, 12.0, -1.2),
+        ] {
+            let got = restored(&rectangle(w, h, angle));
+            let want = rectangle(w + 2.0 * EROSION_PX, h + 2.0 * EROSION_PX, angle);
+            assert!(
+                (got.area - want.area).abs() < 1e-9,
+                "{w}×{h}: area {}",
+                got.area
+            );
+            for k in 0..3 {
+                assert!(
+                    (got.moments[k] - want.moments[k]).abs() < 1e-9,
+                    "{w}×{h} at {angle}: {:?} against {:?}",
+                    got.moments,
+                    want.moments
+                );
+            }
+            assert_eq!(got.centre, want.centre);
+        }
+    }
+
+    #[test]
+    fn a_small_blurred_grid_is_found_as_one_lattice() {
+        // Patches 7 px apart that segment as 3.5 px blobs (a chart a fifteenth of the
+        // frame wide, blurred): unrestored they are neither neighbours nor fill their cell.
+        let blobs: Vec<Blob> = (0..10)
+            .flat_map(|r| (0..14).map(move |c| (c, r)))
+            .map(|(c, r)| Blob {
+                centre: [100.0 + 7.0 * f64::from(c), 60.0 + 7.0 * f64::from(r)],
+                ..rectangle(3.5, 3.5, 0.0)
+            })
+            .collect();
+        let lattices = find_lattices(&blobs, 6);
+        assert_eq!(lattices.len(), 1);
+        assert_eq!(lattices[0].members.len(), 140);
+    }
 }
