@@ -21,8 +21,10 @@ const WORKING_PITCH_PX: f64 = 32.0;
 /// demosaicing and JPEG blocks. On the detection protocol's photos (docs/detection.md),
 /// with the lens's colour fringes taken out of the search, refining from 12 px on brought
 /// the ColorChecker 24 at 1/15 of the width (18 px) from 5.9 % of a patch side to 2.9 %
-/// and the SG at 1/8 (14 px) from 4.4 % to 3.7 %.
-const MIN_PITCH_PX: f64 = 12.0;
+/// and the SG at 1/8 (14 px) from 4.4 % to 3.7 %; from 7 px on, the SG at 1/12 (9.5 px)
+/// from 3.5 % to 2.0 % (seed 1) and 3.4 % to 1.9 % (seed 2), at 1/15 (7.6 px) from 3.5 %
+/// to 3.2 % and 3.9 % to 3.7 %.
+const MIN_PITCH_PX: f64 = 7.0;
 /// Points along each edge of a patch.
 const EDGE_POINTS: usize = 5;
 /// First step of the search, in patch pitches per corner coordinate (each later pass takes
