@@ -200,8 +200,12 @@ fn document(
          patch's area in the photo), over the photos found. The search runs on the photo with \
          the lens's colour fringes taken out in the camera's own RGB (a typical camera's \
          colour matrix undone, then red's and blue's magnification against green measured \
-         on the strongest edges and undone). The corners are those of the grid fitted to \
-         the patch candidates, refined where the patches are at least 12 px apart: moved to \
+         on the strongest edges and undone). The patch candidates (regions of nearly constant \
+         colour) are grouped into grids, their sizes compared with the grid's pitch as if \
+         the pixel that blur takes off each side were restored; a grid is laid on the chart \
+         the way round in which its neutral patches are grey and in the chart's order of \
+         lightness. The corners are those of the grid fitted to the patch candidates, \
+         refined where the patches are at least 7 px apart: moved to \
          where the patch edges are sharpest in the camera's green (a Nelder–Mead search on \
          pairs of points across every patch edge). Where too few patches are \
          segmented for the chart to be found by them (a small or steep chart), the grid \
