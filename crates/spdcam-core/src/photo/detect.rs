@@ -529,12 +529,12 @@ fn lightness_order(colours: &[[f32; 3]], t: &ChartTemplate) -> Option<f64> {
 /// Jolliffe, *Principal Component Analysis*, 2002, §14.2.3). Unlike the lightness order it
 /// holds in a shadow, which dims a patch without changing its colour.
 fn greyness(colours: &[[f32; 3]], t: &ChartTemplate) -> f64 {
+    let linear: Vec<nalgebra::Vector3<f64>> = colours
+        .iter()
+        .map(|c| nalgebra::Vector3::from(c.map(|v| f64::from(srgb_decode_f32(v)))))
+        .collect();
     let off_axis = |patches: &mut dyn Iterator<Item = usize>| {
-        let mut scatter = Matrix3::<f64>::zeros();
-        for p in patches {
-            let v = nalgebra::Vector3::from(colours[p].map(|c| f64::from(srgb_decode_f32(c))));
-            scatter += v * v.transpose();
-        }
+        let scatter: Matrix3<f64> = patches.map(|p| linear[p] * linear[p].transpose()).sum();
         let trace = scatter.trace();
         let largest = scatter.symmetric_eigenvalues().max();
         (trace > 0.0).then(|| 1.0 - largest / trace)
@@ -607,20 +607,21 @@ fn corner_placements(
             let down = 0.5 * (side(image[1], image[2]) + side(image[3], image[0]));
             let aspect_error = ((across / down) / (w / h)).ln().abs();
             let on_level = map.scaled_output(1.0 / factor as f64);
-            let (tau, greyness) = neutral_evidence(&level, template, &on_level)
-                .map_or((-1.0, 0.0), |n| (n.tau, n.greyness));
+            let neutral =
+                neutral_evidence(&level, template, &on_level).unwrap_or(NeutralEvidence {
+                    tau: -1.0,
+                    greyness: 0.0,
+                });
             let fit = template_fit(&level, &template.patch_squares(), &on_level);
-            ways.push((map, tau, greyness, aspect_error, fit));
+            ways.push((map, neutral, aspect_error, fit));
         }
-        let best_fit = ways.iter().map(|w| w.4).fold(f64::NEG_INFINITY, f64::max);
+        let best_fit = ways.iter().map(|w| w.3).fold(f64::NEG_INFINITY, f64::max);
         // Orientations that fit the grid clearly worse than the best are out of the running
         // (a quarter turn of a 6 × 4 grid); among the rest the neutrals' order and greyness
         // decide.
         let scores: Vec<f64> = ways
             .iter()
-            .map(|(_, tau, greyness, aspect, fit)| {
-                tau + greyness - 2.0 * aspect - 4.0 * (best_fit - fit)
-            })
+            .map(|(_, n, aspect, fit)| n.tau + n.greyness - 2.0 * aspect - 4.0 * (best_fit - fit))
             .collect();
         let chosen = (0..4)
             .max_by(|&a, &b| scores[a].total_cmp(&scores[b]))
@@ -629,8 +630,8 @@ fn corner_placements(
             .filter(|&s| s != chosen)
             .map(|s| scores[s])
             .fold(-1.0, f64::max);
-        let (map, tau, _, _, fit) = ways.swap_remove(chosen);
-        let confidence = tau.max(0.0) * (0.5 + scores[chosen] - other).clamp(0.0, 1.0);
+        let (map, neutral, _, fit) = ways.swap_remove(chosen);
+        let confidence = neutral.tau.max(0.0) * (0.5 + scores[chosen] - other).clamp(0.0, 1.0);
         out.push((
             fit,
             Detection {

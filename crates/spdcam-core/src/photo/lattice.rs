@@ -8,7 +8,7 @@
 //! blob far from every grid point never enters, so outliers do not bend the fit.
 
 use super::geometry::Homography;
-use super::segment::Blob;
+use super::segment::{principal_variances, Blob};
 use nalgebra::Matrix3;
 
 /// Blobs on one grid.
@@ -39,8 +39,8 @@ const EROSION_PX: f64 = 1.0;
 /// second moments: a rectangle of sides l has variances l²/12 along them).
 fn restored(blob: &Blob) -> Blob {
     let [a, b, c] = blob.moments;
-    let (mean, half_gap) = (0.5 * (a + c), (0.25 * (a - c).powi(2) + b * b).sqrt());
-    let (large, small) = (mean + half_gap, (mean - half_gap).max(1e-9));
+    let (large, small) = principal_variances(blob.moments);
+    let small = small.max(1e-9);
     let grow = |variance: f64| ((12.0 * variance).sqrt() + 2.0 * EROSION_PX).powi(2) / 12.0;
     let (g_large, g_small) = (grow(large), grow(small));
     // Σ = small·I + (large − small)·e eᵀ with e the major axis; the same with grown values.
@@ -107,8 +107,7 @@ fn neighbour_lists(blobs: &[Blob]) -> Vec<Vec<usize>> {
     let mut out = vec![Vec::new(); blobs.len()];
     for &i in &idx {
         let bi = &blobs[i];
-        let [a, b, c] = bi.moments;
-        let largest = 0.5 * (a + c) + (0.25 * (a - c).powi(2) + b * b).sqrt();
+        let (largest, _) = principal_variances(bi.moments);
         let reach = NEIGHBOUR_METRIC.1 * largest.max(0.0).sqrt();
         let lo = xs.partition_point(|&x| x < bi.centre[0] - reach);
         for &j in &idx[lo..] {

@@ -46,6 +46,13 @@ impl Blob {
     }
 }
 
+/// The variances (largest, smallest) of second moments (σxx, σxy, σyy) along their principal
+/// axes: the eigenvalues of the symmetric 2 × 2 matrix, (tr/2 ± √(tr²/4 − det)).
+pub fn principal_variances([a, b, c]: [f64; 3]) -> (f64, f64) {
+    let half_gap = (0.25 * (a - c).powi(2) + b * b).sqrt();
+    (0.5 * (a + c) + half_gap, 0.5 * (a + c) - half_gap)
+}
+
 /// Gradient thresholds (on the brightness-normalised image) tried in turn.
 const THRESHOLDS: [f32; 4] = [0.02, 0.04, 0.08, 0.16];
 /// Smallest area of a candidate, in level pixels.
@@ -203,9 +210,8 @@ fn measure(level: &Level, pixels: &[usize]) -> Option<(f64, Blob)> {
     }
     // A parallelogram of area A has 12·sqrt(det Σ) = A.
     let squareness = n / (12.0 * det.sqrt());
-    let tr = sxx + syy;
-    let disc = ((tr * tr / 4.0) - det).max(0.0).sqrt();
-    let elongation = ((tr / 2.0 + disc) / (tr / 2.0 - disc).max(1e-9)).sqrt();
+    let (largest, smallest) = principal_variances([sxx, sxy, syy]);
+    let elongation = (largest / smallest.max(1e-9)).sqrt();
     if !(0.88..=1.12).contains(&squareness) || elongation > MAX_ELONGATION {
         return None;
     }
