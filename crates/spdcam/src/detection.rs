@@ -207,7 +207,8 @@ fn document(
          lightness. The corners are those of the grid fitted to the patch candidates, \
          refined where the patches are at least 7 px apart: moved to \
          where the patch edges are sharpest in the camera's green (a Nelder–Mead search on \
-         pairs of points across every patch edge). Where too few patches are \
+         pairs of points across every patch edge, ending a fiftieth of a patch either side \
+         of it, where the brightness gradient peaks). Where too few patches are \
          segmented for the chart to be found by them (a small or steep chart), the grid \
          extrapolated from those found is accepted when the photo supports it: flat inside \
          the patches, not so when moved by half a patch, and no patches continuing outside \
