@@ -208,7 +208,8 @@ fn document(
          refined where the patches are at least 7 px apart: moved to \
          where the patch edges are sharpest in the camera's green (a Nelder–Mead search on \
          pairs of points across every patch edge, ending a fiftieth of a patch either side \
-         of it, where the brightness gradient peaks). Where too few patches are \
+         of it, where each pair reads the brightness gradient across the edge). Where too \
+         few patches are \
          segmented for the chart to be found by them (a small or steep chart), the grid \
          extrapolated from those found is accepted when the photo supports it: flat inside \
          the patches, not so when moved by half a patch, and no patches continuing outside \

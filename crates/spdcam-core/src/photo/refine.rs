@@ -62,12 +62,13 @@ const WIDE_PAIRS: f64 = 0.15;
 const MIDDLE_PAIRS_PX: f64 = 2.0;
 /// Distance of the point pairs from the edges in the last pass, in pitches (at most half
 /// the gap): pairs this close read the brightness gradient across each edge rather than
-/// the contrast between a patch and what lies a pixel beyond it. Chosen on the detection protocol's seed 3 (20 photos per bucket; seeds 1 and 2 are
-/// those reported) against the earlier 1 level pixel: the Digital SG at 1/15 of the width
-/// 2.4 → 1.3 % of a patch side, at 70° tilt 1.3 → 0.9 %, at 1/4 0.51 → 0.40 %; the
-/// ColorChecker 24 at 1/4 0.53 → 0.43 %, under 25 % light 1.07 → 0.95 %, at 70° tilt
-/// 1.02 → 1.30 %. 0.03 pitches gave the SG at 1/15 1.6 %; a fixed 0.15 level px, better
-/// for the SG, left the ColorChecker 24 at 70° at 2.1–2.4 %.
+/// the contrast between a patch and what lies a pixel beyond it. Chosen on the detection
+/// protocol's seed 3 (20 photos per bucket; seeds 1 and 2 are those reported) against the
+/// earlier 1 level pixel: the Digital SG at 1/15 of the width 2.4 → 1.3 % of a patch side,
+/// at 70° tilt 1.3 → 0.9 %, at 1/4 0.51 → 0.40 %; the ColorChecker 24 at 1/4 0.53 →
+/// 0.43 %, under 25 % light 1.07 → 0.95 %, at 70° tilt 1.02 → 1.30 %. 0.03 pitches gave
+/// the SG at 1/15 1.6 %; a fixed 0.15 level px, better for the SG, left the ColorChecker
+/// 24 at 70° at 2.1–2.4 %.
 const NARROW_PAIRS: f64 = 0.02;
 
 /// Mean squared difference of the green channel between points `delta` (chart units, patch
