@@ -508,6 +508,35 @@ fn a_photo_of_another_chart_is_unusable() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A chart lit half by daylight and half by a bulb, each half exposed and white-balanced for
+/// its own light (every grey patch stays grey): the reasons name two lights; the same scene
+/// under daylight alone does not.
+#[test]
+fn a_chart_lit_by_two_lights_each_half_balanced_is_named_so() {
+    let dir = scratch("two-lights");
+    let second: [&[&str]; 2] = [&[], &["--right-light", "A", "--balance-halves"]];
+    for (lights, extra) in second.iter().enumerate() {
+        let photo = dir.join(format!("lights-{lights}.jpg"));
+        let mut args = vec![
+            "render", "--spd", "D65", "--scene", "1200x900", "--seed", "2", "-o",
+        ];
+        let shown = s(&photo);
+        args.push(&shown);
+        args.extend_from_slice(extra);
+        ok(&args);
+        let json: serde_json::Value =
+            serde_json::from_str(&ok(&["estimate", &s(&photo), "--json"])).unwrap();
+        let names_two = json[0]["reasons"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|r| r.as_str().unwrap().contains("two different lights"));
+        assert_eq!(names_two, lights == 1, "{}", json[0]["reasons"]);
+        assert!(json[0]["self_check"]["two_lights"].as_f64().is_some());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// `jpeg` with an EXIF segment (APP1, CIPA DC-008) right after its start-of-image marker
 /// giving aperture `f_number`, exposure time 1/`per_second` s and `iso`.
 fn with_exif(jpeg: &[u8], f_number: u32, per_second: u32, iso: u16) -> Vec<u8> {

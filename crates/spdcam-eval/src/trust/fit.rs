@@ -111,6 +111,7 @@ pub fn fit_calibration(
     let mut splits = checks_of(|s| Some(s.split));
     let mut gradients = checks_of(|s| s.colour_gradient);
     let mut glares = checks_of(|s| Some(s.glare));
+    let mut two_lights = checks_of(|s| Some(s.two_lights));
     let metric_calibrations = SCALAR_KEYS
         .iter()
         .filter_map(|&key| {
@@ -167,6 +168,8 @@ pub fn fit_calibration(
             .then(|| conformal_quantile(&mut gradients, 0.99)),
         glare_doubtful: (glares.len() == virtual_judged.len())
             .then(|| conformal_quantile(&mut glares, 0.99)),
+        two_lights_doubtful: (two_lights.len() == virtual_judged.len())
+            .then(|| conformal_quantile(&mut two_lights, 0.99)),
         clipped_doubtful: conformal_quantile(&mut clipped, 0.99) as usize,
         metrics: metric_calibrations,
         real_photos: photos.judged.len() - photos.virtual_count,

@@ -36,8 +36,14 @@ the chart on its neutral patches (a linear gain and a flare per channel fitted t
 `spdcam_core::uneven_light`; one light falling off brightens all alike, two lights do not); \
 `glare`: the share of the residual that an additive light changing linearly across the chart \
 (two more columns of the map per channel) removes, a nested-model comparison: glare, a \
-reflection or flare from a light beside the chart adds light to one side of it. \
-The ColorChecker 24's reflectances are built in; the SG's come from the \
+reflection or flare from a light beside the chart adds light to one side of it; \
+`two_lights`: with the map's matrix held, an F ratio of how much better the patches are \
+explained when one half of the chart (left/right, top/bottom) has a light of its own — a \
+change along the first K cosine spectra (DCT-II; K a quarter of the usable patches, at most \
+16, chosen on the validation lamps' photos among 3–25) shared by the three channels, beside \
+that half's own gain and flare per channel — than when the whole chart shares one change: \
+two lights, each half balanced to grey by the camera, change the coloured patches in a way \
+no white balance does. The ColorChecker 24's reflectances are built in; the SG's come from the \
 data directory, so without it an SG estimate has no self-check (the reasons say so).\n\
 - **Bands.** The model is run on 16 copies of the features, each perturbed by 2 % \
 (log-normal); the spread s(λ) of the peak-normalised SPDs plus a floor f(λ) (the median \
@@ -65,7 +71,7 @@ widening (w or w², as 1 − GFC ≈ θ²/2 for an error angle θ) made the Tele
 median expected 1 − GFC 0.29 or 0.63 against an actual 0.15; without it, 0.13: not done.\n- **Verdict** (constants in `spdcam_infer::trust`, levels in the calibration file): `doubtful` \
 when the detection confidence is below 0.8, more feature patches are clipped than in 99 % of \
 the calibration photos, more than a quarter are nearly black, the self-check's mean or split \
-residual, colour gradient or glare exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
+residual, colour gradient, glare or two-lights ratio exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
 99th percentile (many lights give nearly this photo, or it is unlike the training lights), \
 or the expected GFC is below 0.95; `unusable` when more than half the patches are clipped, \
 the self-check cannot be made (too few usable patches) or a self-check residual exceeds \
@@ -89,6 +95,15 @@ to 81.3 %.\n";
 
 /// Corrections measured once and left off, with their numbers (the shipped models and
 /// calibrations of this report, the same photos).
+/// The bins of [`Shots::balanced_change`] (8-bit levels) the two-lights table reports.
+const CHANGE_BINS: [(f64, f64); 5] = [
+    (0.0, 2.0),
+    (2.0, 4.0),
+    (4.0, 8.0),
+    (8.0, 16.0),
+    (16.0, f64::INFINITY),
+];
+
 const CORRECTIONS_TRIED: &str = "\nAlso tried, and left off (measured on the SG network \
 shipped before the average): the self-check's own map (3×3 \
 matrix, flare, the light's gradient and an additive light changing linearly across the \
@@ -344,8 +359,8 @@ impl TrustReport {
         );
         let mut flags = String::from(
             "## The self-check on clean and bad photos\n\n\
-             Share of photos whose self-check residual, half-to-half residual, colour gradient or \
-             glare exceeds the calibration's doubtful level \
+             Share of photos whose self-check residual, half-to-half residual, colour gradient, \
+             glare or two-lights ratio exceeds the calibration's doubtful level \
              (flagged), and share whose verdict is not `ok`. Clean: the test lamps' photos above. \
              Wrong chart: the same photos with the patches in a random order (a chart the model \
              does not read). Half-lit: the right half of the chart lit by the next lamp of the \
@@ -358,6 +373,22 @@ impl TrustReport {
              | model | photos | clean: flagged | clean: not ok | wrong chart: flagged | half-lit: flagged | each half balanced: flagged (not ok) | glare: flagged | bad (wrong chart, half-lit, glare): flagged |\n\
              |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         );
+        let mut by_change = String::from(
+            "\nEach half balanced, by how far apart the two lights are: the mean absolute change of \
+             the right half's coloured patches (8-bit levels) between the two-light photo and the \
+             first lamp's alone. Share flagged (photos).\n\n\
+             | model |",
+        );
+        for (lo, hi) in CHANGE_BINS {
+            by_change += &if hi.is_finite() {
+                format!(" {lo}–{hi} levels |")
+            } else {
+                format!(" ≥ {lo} levels |")
+            };
+        }
+        by_change += "\n|---|";
+        by_change += &"---:|".repeat(CHANGE_BINS.len());
+        by_change.push('\n');
         let mut scenes = format!(
             "## Scene photos\n\n\
              Photos made with the code of `spdcam render --scene` ({SCENES} test lamps, one photo each \
@@ -485,13 +516,13 @@ impl TrustReport {
                 );
                 continue;
             }
-            // Per kind of photo, judged once: the share the self-check flags and, with
+            // Per kind of photo, judged once: which photos the self-check flags and, with
             // `verdicts`, the share whose verdict is not `ok`.
-            let shares = |rows: &[Vec<f64>], verdicts: bool| -> Result<(f64, f64)> {
+            let shares = |rows: &[Vec<f64>], verdicts: bool| -> Result<(Vec<bool>, f64)> {
                 let judged = judge_rows(model, check.as_ref(), rows, None)?;
-                let (mut flagged, mut not_ok) = (0usize, 0usize);
+                let (mut flagged, mut not_ok) = (Vec::new(), 0usize);
                 for (j, row) in judged.iter().zip(rows) {
-                    flagged += usize::from(j.self_check.as_ref().is_none_or(|s| cal.flags(s)));
+                    flagged.push(j.self_check.as_ref().is_none_or(|s| cal.flags(s)));
                     if verdicts {
                         let t = assess(
                             model,
@@ -504,16 +535,31 @@ impl TrustReport {
                         not_ok += usize::from(t.verdict != Verdict::Ok);
                     }
                 }
-                let n = rows.len() as f64;
-                Ok((flagged as f64 / n, not_ok as f64 / n))
+                Ok((flagged, not_ok as f64 / rows.len() as f64))
             };
-            let clean = shares(&shots.clean.features, true)?;
-            let balanced = shares(&shots.half_balanced, true)?;
+            let share = |flagged: &[bool]| {
+                flagged.iter().filter(|&&f| f).count() as f64 / flagged.len().max(1) as f64
+            };
+            let (clean_flags, clean_not_ok) = shares(&shots.clean.features, true)?;
+            let (balanced_flags, balanced_not_ok) = shares(&shots.half_balanced, true)?;
+            let clean = (share(&clean_flags), clean_not_ok);
+            let balanced = (share(&balanced_flags), balanced_not_ok);
             let (w, h, g) = (
-                shares(&shots.wrong_chart, false)?.0,
-                shares(&shots.half_lit, false)?.0,
-                shares(&shots.glare, false)?.0,
+                share(&shares(&shots.wrong_chart, false)?.0),
+                share(&shares(&shots.half_lit, false)?.0),
+                share(&shares(&shots.glare, false)?.0),
             );
+            by_change += &format!("| `{name}` |");
+            for (lo, hi) in CHANGE_BINS {
+                let inside: Vec<bool> = balanced_flags
+                    .iter()
+                    .zip(&shots.balanced_change)
+                    .filter(|(_, &c)| c >= lo && c < hi)
+                    .map(|(&f, _)| f)
+                    .collect();
+                by_change += &format!(" {:.0} % ({}) |", 100.0 * share(&inside), inside.len());
+            }
+            by_change.push('\n');
             flags += &format!(
                 "| `{name}` | {} | {:.1} % | {:.1} % | {:.1} % | {:.1} % | {:.1} % ({:.1} %) | {:.1} % | {:.1} % |\n",
                 shots.clean.features.len(),
@@ -546,6 +592,7 @@ impl TrustReport {
         sections += CORRECTIONS_TRIED;
         sections.push('\n');
         sections += &flags;
+        sections += &by_change;
         sections.push('\n');
         sections += &scenes;
         sections += &format!(

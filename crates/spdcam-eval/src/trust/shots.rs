@@ -40,6 +40,10 @@ pub struct Shots {
     /// light (two photos joined, or a camera that balances each region): every neutral patch
     /// stays grey, so only the coloured patches tell.
     pub half_balanced: Vec<Vec<f64>>,
+    /// Per photo, how far apart its two lights are: the mean absolute change (feature
+    /// units, 0–255) of the right half's coloured patches between [`Shots::half_balanced`]
+    /// and the photo lit by its first lamp alone.
+    pub balanced_change: Vec<f64>,
     /// Veiling glare from a lamp beside the chart ([`GLARE_LEVEL`], [`GLARE_WIDTH`]).
     pub glare: Vec<Vec<f64>>,
 }
@@ -79,8 +83,19 @@ impl HeldOutPhotos {
             wrong_chart: Vec::new(),
             half_lit: Vec::new(),
             half_balanced: Vec::new(),
+            balanced_change: Vec::new(),
             glare: Vec::new(),
         };
+        let neutral: Vec<bool> = {
+            let mut n = vec![false; chart.feature_patches.len()];
+            for (f, _) in chart.neutral_features() {
+                n[f] = true;
+            }
+            n
+        };
+        let coloured_right: Vec<usize> = (0..chart.feature_patches.len())
+            .filter(|&f| right[chart.feature_patches[f]] && !neutral[f])
+            .collect();
         let (mut raw, mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (j, &i) in ids.iter().enumerate() {
             let other = ids[(j + 1) % ids.len()];
@@ -129,10 +144,16 @@ impl HeldOutPhotos {
                         255.0 * srgb_encode(lin.min(1.0))
                     })
                     .collect();
+                let change = coloured_right
+                    .iter()
+                    .flat_map(|&f| (3 * f..3 * f + 3).map(|v| (balanced[v] - clean[v]).abs()))
+                    .sum::<f64>()
+                    / (3 * coloured_right.len()).max(1) as f64;
                 out.clean.features.push(clean);
                 out.clean.truths.push(truth[i].clone());
                 out.wrong_chart.push(wrong);
                 out.half_lit.push(half);
+                out.balanced_change.push(change);
                 out.half_balanced.push(balanced);
                 out.glare.push(glared);
             }

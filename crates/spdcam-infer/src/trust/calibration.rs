@@ -139,6 +139,11 @@ pub struct Calibration {
     /// calibration photos; above it the estimate is doubtful (absent from older files).
     #[serde(default)]
     pub glare_doubtful: Option<f64>,
+    /// The 99th percentile of the self-check's two-lights ratio ([`SelfCheck::two_lights`])
+    /// on the calibration photos; above it the estimate is doubtful (absent from older
+    /// files).
+    #[serde(default)]
+    pub two_lights_doubtful: Option<f64>,
     /// The 99th percentile of the number of clipped feature patches on the calibration
     /// photos (saturated colours clip a channel under narrow-band light, and the model was
     /// trained with them); more make the estimate doubtful.
@@ -230,7 +235,8 @@ pub fn widening(residual: Option<f64>, reference: Option<f64>) -> f64 {
 
 impl Calibration {
     /// Whether the self-check `check` exceeds any of this calibration's doubtful levels:
-    /// the residual, the half-to-half residual, the colour gradient or the glare.
+    /// the residual, the half-to-half residual, the colour gradient, the glare or the
+    /// two-lights ratio.
     pub fn flags(&self, check: &SelfCheck) -> bool {
         let above =
             |value: Option<f64>, level: Option<f64>| value.zip(level).is_some_and(|(v, l)| v > l);
@@ -238,6 +244,7 @@ impl Calibration {
             || above(Some(check.split), self.split_doubtful)
             || above(check.colour_gradient, self.colour_gradient_doubtful)
             || above(Some(check.glare), self.glare_doubtful)
+            || above(Some(check.two_lights), self.two_lights_doubtful)
     }
 
     /// Reads a calibration from JSON (`shown` names it in errors), its arrays checked to
@@ -442,6 +449,7 @@ mod tests {
             split_doubtful: None,
             colour_gradient_doubtful: None,
             glare_doubtful: None,
+            two_lights_doubtful: None,
             clipped_doubtful: 0,
             real_photos: 0,
         };

@@ -40,6 +40,10 @@ pub struct SelfCheck {
     /// chart removes: large when glare, a reflection or flare from a light beside the chart
     /// adds light to one side of it.
     pub glare: f64,
+    /// How much better the photo is explained when one half of the chart (left or right,
+    /// top or bottom; the larger) is lit by a light of its own, as an F ratio: large when two
+    /// different lights each light a half, even when the camera balanced each half to grey.
+    pub two_lights: f64,
 }
 
 /// The chart's feature patches seen by a reference camera, ready to be lit by an SPD.
@@ -51,6 +55,9 @@ pub struct ChartCheck {
     centres: Vec<[f64; 2]>,
     /// The neutral feature patches and their mean reflectances.
     neutrals: Vec<(usize, f64)>,
+    /// Per feature patch: its raw RGB under each of the [`LIGHT_CHANGES`] cosine spectra,
+    /// `[change][channel]`, the ways the light of one half may differ from the other's.
+    changes: Vec<Vec<[f64; 3]>>,
     grid: Grid,
 }
 
@@ -59,7 +66,7 @@ impl ChartCheck {
     pub fn new(chart: &Chart, camera: &Sensitivities, grid: &Grid) -> Result<ChartCheck> {
         chart.reflectances.require_grid(grid, "chart")?;
         camera.curves.require_grid(grid, "camera")?;
-        let weights = chart
+        let weights: Vec<[Vec<f64>; 3]> = chart
             .feature_patches
             .iter()
             .map(|&p| {
@@ -71,10 +78,21 @@ impl ChartCheck {
             })
             .collect();
         let centres = chart.feature_centres();
+        let basis = cosine_basis(grid.count, LIGHT_CHANGES);
+        let changes = weights
+            .iter()
+            .map(|w| {
+                basis
+                    .iter()
+                    .map(|b| std::array::from_fn(|c| w[c].iter().zip(b).map(|(a, b)| a * b).sum()))
+                    .collect()
+            })
+            .collect();
         Ok(ChartCheck {
             weights,
             centres,
             neutrals: chart.neutral_features(),
+            changes,
             grid: *grid,
         })
     }
@@ -204,6 +222,7 @@ impl ChartCheck {
         let mut fitted = MapFit {
             design,
             target,
+            level: pl,
             mean_length,
             global: DMatrix::zeros(0, 0),
             residuals: Vec::new(),
@@ -269,6 +288,7 @@ impl ChartCheck {
         }
         let mean = fitted.mean;
         Ok(SelfCheck {
+            two_lights: self.two_lights(fitted, used)?,
             glare: if mean > 0.0 {
                 (1.0 - glare_mean / mean).max(0.0)
             } else {
@@ -288,6 +308,115 @@ impl ChartCheck {
     }
 }
 
+impl ChartCheck {
+    /// [`SelfCheck::two_lights`]: with the best map's 3×3 matrix M held, each patch's target
+    /// is fitted per channel by M·prediction with a gain, a flare and a gradient in x and y,
+    /// a second gain and flare on one half (its own exposure and white balance) and the
+    /// light changed along the first K cosine spectra (raw RGB through M) on the whole chart;
+    /// the F ratio of the same K changes added on that half alone, a nested-model comparison
+    /// (Seber & Lee 2003, "Linear Regression Analysis", section 4.3; Chow 1960, Econometrica
+    /// 28: 591–605). The changes are shared by the three channels: a different light, not a
+    /// different colour map. K is a quarter of the usable patches, at most [`LIGHT_CHANGES`].
+    fn two_lights(&self, fitted: &MapFit, used: &[usize]) -> Result<f64> {
+        let k = LIGHT_CHANGES.min(used.len() / PATCHES_PER_CHANGE);
+        if k == 0 {
+            return Ok(0.0);
+        }
+        let m = &fitted.global;
+        let map = |v: [f64; 3]| -> [f64; 3] {
+            std::array::from_fn(|c| (0..3).map(|j| v[j] * m[(j, c)]).sum())
+        };
+        let mapped: Vec<[f64; 3]> = used
+            .iter()
+            .map(|&i| {
+                let d = fitted.design[i];
+                map([d[0], d[1], d[2]])
+            })
+            .collect();
+        let changes: Vec<Vec<[f64; 3]>> = used
+            .iter()
+            .map(|&i| {
+                self.changes[i][..k]
+                    .iter()
+                    .map(|q| map(q.map(|v| v / fitted.level)))
+                    .collect()
+            })
+            .collect();
+        let rows = 3 * used.len();
+        let shared = SHARED_COLUMNS + k;
+        let columns = shared + k;
+        if rows <= columns {
+            return Ok(0.0);
+        }
+        let floor = (RESIDUAL_FLOOR * fitted.mean_length).powi(2);
+        let mut most = 0.0f64;
+        for axis in 0..2 {
+            let side: Vec<f64> = used
+                .iter()
+                .map(|&i| f64::from(u8::from(self.centres[i][axis] >= 0.0)))
+                .collect();
+            let on = side.iter().filter(|&&s| s > 0.0).count();
+            if on < MIN_HALF_PATCHES || used.len() - on < MIN_HALF_PATCHES {
+                continue;
+            }
+            let a = DMatrix::from_fn(rows, columns, |r, col| {
+                let (u, c) = (r / 3, r % 3);
+                let [x, y] = self.centres[used[u]];
+                let channel = |v: f64, of: usize| if of == c { v } else { 0.0 };
+                match col {
+                    0..=2 => channel(mapped[u][c], col),
+                    3..=5 => channel(1.0, col - 3),
+                    6..=8 => channel(x * mapped[u][c], col - 6),
+                    9..=11 => channel(y * mapped[u][c], col - 9),
+                    12..=14 => channel(side[u] * mapped[u][c], col - 12),
+                    15..=17 => channel(side[u], col - 15),
+                    col if col < shared => changes[u][col - SHARED_COLUMNS][c],
+                    col => side[u] * changes[u][col - shared][c],
+                }
+            });
+            let b = DMatrix::from_fn(rows, 1, |r, _| fitted.target[used[r / 3]][r % 3]);
+            let rss = |cols: usize| -> Result<f64> {
+                let a = a.columns(0, cols).into_owned();
+                let x = a
+                    .clone()
+                    .svd(true, true)
+                    .solve(&b, 1e-10)
+                    .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))?;
+                Ok((&a * x - &b).norm_squared())
+            };
+            let (one, two) = (rss(shared)?, rss(columns)?);
+            let noise = (two / (rows - columns) as f64).max(floor);
+            most = most.max((one - two).max(0.0) / k as f64 / noise);
+        }
+        Ok(most)
+    }
+}
+
+/// The most cosine spectra one half's light may change along ([`SelfCheck::two_lights`]).
+const LIGHT_CHANGES: usize = 16;
+/// Usable patches per light change: K is the usable patches over this, at most
+/// [`LIGHT_CHANGES`] (chosen on the validation lamps' photos among 3–25 changes).
+const PATCHES_PER_CHANGE: usize = 4;
+/// The two-lights fit's columns before the light changes: per channel a gain, a flare, a
+/// gradient in x and y, and the half's own gain and flare.
+const SHARED_COLUMNS: usize = 18;
+/// The smallest residual, relative to the chart's mean RGB length, the two-lights ratio
+/// divides by (a noise-free photo's residual is rounding).
+const RESIDUAL_FLOOR: f64 = 1e-4;
+
+/// The first `k` spectra of the DCT-II basis on `count` wavelengths, cos(π·j·(l + ½)/count)
+/// (Ahmed, Natarajan & Rao 1974, "Discrete cosine transform", IEEE Trans. Computers C-23:
+/// 90–93): smooth changes of a light, the coarsest first.
+fn cosine_basis(count: usize, k: usize) -> Vec<Vec<f64>> {
+    (0..k)
+        .map(|j| {
+            (0..count)
+                .map(|l| (std::f64::consts::PI * j as f64 * (l as f64 + 0.5) / count as f64).cos())
+                .collect()
+        })
+        .collect()
+}
+
 /// Columns of the self-check's map: 3×3 matrix, flare, and the light's gradient in x and y.
 const MAP_COLUMNS: usize = 6;
 /// The map's columns with the additive light changing across the chart (glare).
@@ -301,6 +430,8 @@ const HALF_COLUMNS: usize = 4;
 struct MapFit {
     design: Vec<[f64; GLARE_COLUMNS]>,
     target: Vec<[f64; 3]>,
+    /// The predicted raw RGB's mean level the design is divided by.
+    level: f64,
     /// The mean RGB length of the targets, the residuals' unit.
     mean_length: f64,
     global: DMatrix<f64>,
@@ -422,6 +553,50 @@ pub(super) mod tests {
         );
         assert_eq!(bad.worst_patches.len(), WORST_NAMED);
         assert!(bad.worst >= bad.mean);
+    }
+
+    #[test]
+    fn two_lights_one_on_each_half_are_told_from_one() {
+        let grid = Grid::parse("400-700:5").unwrap();
+        let check = cc24_check(&grid);
+        let daylight = StandardIlluminant::D65.spd(&grid).unwrap();
+        let bulb = StandardIlluminant::A.spd(&grid).unwrap();
+        let peak = |s: &[f64]| s.iter().copied().fold(0.0, f64::max);
+        let (pd, pb) = (peak(&daylight), peak(&bulb));
+        let mean: Vec<f64> = daylight
+            .iter()
+            .zip(bulb.iter())
+            .map(|(a, b)| a / pd + b / pb)
+            .collect();
+        let skip = vec![false; check.patches()];
+        // Each light alone, the estimate right: a second light adds little (what it adds is
+        // the map's gradient, which is not quite the photo's).
+        let one_light = [&daylight[..], &bulb[..], &mean[..]].map(|spd| {
+            check
+                .check(spd, &features_of(&check, spd), 255.0, &skip)
+                .unwrap()
+                .two_lights
+        });
+        let most_for_one = one_light.iter().copied().fold(0.0, f64::max);
+        assert!(most_for_one < 4.0, "one light: {one_light:?}");
+        // The right half under the bulb, the left under daylight; each half's exposure and
+        // white balance differ too, which the fit allows. The estimate is their mean.
+        let (left, right) = (features_of(&check, &daylight), features_of(&check, &bulb));
+        let two: Vec<f64> = (0..check.patches())
+            .flat_map(|p| {
+                let from = if check.centres[p][0] >= 0.0 {
+                    &right
+                } else {
+                    &left
+                };
+                from[3 * p..3 * p + 3].to_vec()
+            })
+            .collect();
+        let both = check.check(&mean, &two, 255.0, &skip).unwrap().two_lights;
+        assert!(
+            both > 2.5 * most_for_one.max(1.0),
+            "two lights: {both}, one light: {one_light:?}"
+        );
     }
 
     #[test]

@@ -243,6 +243,18 @@ pub fn assess(
             );
         }
     }
+    if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.two_lights_doubtful)) {
+        if s.two_lights > level {
+            lower(
+                Verdict::Doubtful,
+                format!(
+                    "the chart looks lit by two different lights, one on each half (even if the camera balanced each half to grey): giving one half a light of its own explains {:.1} times more of the patches than noise would (clean photos stay below {level:.1})",
+                    s.two_lights
+                ),
+                &mut reasons,
+            );
+        }
+    }
     if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.glare_doubtful)) {
         if s.glare > level {
             lower(
@@ -316,6 +328,8 @@ mod tests {
     use crate::estimator::Estimator;
     use crate::shipped::ModelSet;
     use spdcam_core::builtin::DataDir;
+    use spdcam_core::chart::Chart;
+    use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
     use spdcam_core::illuminant::StandardIlluminant;
 
     #[test]
@@ -372,5 +386,60 @@ mod tests {
             assert!(0.0 <= l95 && l95 <= l68 && l68 <= e.spd[k] + 1e-9, "at {k}");
             assert!(e.spd[k] <= u68 + 1e-9 && u68 <= u95, "at {k}");
         }
+    }
+
+    #[test]
+    fn a_chart_lit_by_two_lights_each_half_balanced_says_so() {
+        let models = ModelSet::shipped().unwrap();
+        let model = &models.for_chart("colorchecker24").unwrap().model;
+        let grid = model.grid();
+        let check = cc24_check(&grid);
+        let daylight = features_of(&check, &StandardIlluminant::D65.spd(&grid).unwrap());
+        let bulb = features_of(&check, &StandardIlluminant::A.spd(&grid).unwrap());
+        let centres = Chart::colorchecker24(&grid).unwrap().feature_centres();
+        // Left half under daylight, right half under the bulb, each balanced to grey.
+        let balance = |row: &[f64], p: usize| -> Vec<f64> {
+            let white: Vec<f64> = row[3 * 18..3 * 18 + 3].to_vec();
+            (0..3)
+                .map(|c| {
+                    let lin = srgb_decode(row[3 * p + c] / 255.0) / srgb_decode(white[c] / 255.0);
+                    255.0 * srgb_encode((0.9 * lin).min(1.0))
+                })
+                .collect()
+        };
+        let two: Vec<f64> = (0..centres.len())
+            .flat_map(|p| {
+                balance(
+                    if centres[p][0] >= 0.0 {
+                        &bulb
+                    } else {
+                        &daylight
+                    },
+                    p,
+                )
+            })
+            .collect();
+        let one: Vec<f64> = (0..centres.len())
+            .flat_map(|p| balance(&daylight, p))
+            .collect();
+        let rows =
+            FeatureRows::from_values(model.feature_names().to_vec(), [one, two].concat(), "test")
+                .unwrap();
+        let estimator = Estimator::new(models.clone(), DataDir::new(None), grid).unwrap();
+        let estimates = estimator.estimate_rows(&rows, "test").unwrap();
+        let says = |k: usize| {
+            let t = estimates[k].trust.as_ref().unwrap();
+            t.reasons.iter().any(|r| r.contains("two different lights"))
+        };
+        assert!(
+            !says(0),
+            "{:?}",
+            estimates[0].trust.as_ref().unwrap().reasons
+        );
+        assert!(
+            says(1),
+            "{:?}",
+            estimates[1].trust.as_ref().unwrap().reasons
+        );
     }
 }
