@@ -401,9 +401,11 @@ impl TrustReport {
              another test lamp in the scene, at one exposure and white balance. Glare: a bright \
              light beside the chart glowing into the lens, adding 40 % of the chart's mean raw \
              level at the grid's top-left corner and falling off as a Gaussian of 0.35 grid \
-             widths.\n\n\
-             | model | photos per kind | clean | another chart | half-lit | glare |\n\
-             |---|---:|---:|---:|---:|---:|\n"
+             widths. Each half balanced: the same two lights as half-lit, each half of the chart \
+             exposed and white-balanced for its own light (two photos of the scene joined at the \
+             chart's middle).\n\n\
+             | model | photos per kind | clean | another chart | half-lit | glare | each half balanced |\n\
+             |---|---:|---:|---:|---:|---:|---:|\n"
         );
         let mut metrics_md = String::from(
             "## Metric intervals\n\n\
@@ -572,10 +574,10 @@ impl TrustReport {
                 100.0 * g,
                 100.0 * (w + h + g) / 3.0
             );
-            let [c, w, h, g] =
+            let [c, w, h, g, b] =
                 scene_verdicts(model, &cal, chart_name, &setup, data_dir, photos.seed)?;
             scenes += &format!(
-                "| `{name}` | {SCENES} | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) |\n",
+                "| `{name}` | {SCENES} | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) | {:.0} % ({:.0} %) |\n",
                 100.0 * c.0,
                 100.0 * c.1,
                 100.0 * w.0,
@@ -583,7 +585,9 @@ impl TrustReport {
                 100.0 * h.0,
                 100.0 * h.1,
                 100.0 * g.0,
-                100.0 * g.1
+                100.0 * g.1,
+                100.0 * b.0,
+                100.0 * b.1
             );
             progress(path);
         }

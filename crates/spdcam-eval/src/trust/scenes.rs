@@ -1,5 +1,5 @@
 //! Scene photos in the trust report: the chart in a cluttered scene, found, sampled and
-//! estimated like a user's photo, clean and made bad three ways.
+//! estimated like a user's photo, clean and made bad four ways.
 
 use crate::error::{EvalError, Result};
 use crate::held_out::{Setup, GRID};
@@ -37,7 +37,7 @@ fn photo_chart(model_chart: &str) -> &str {
 /// with perspective, blur, vignetting, noise and JPEG) of [`SCENES`] test lamps, each by a
 /// held-out camera, found, sampled and estimated like a user's photo: clean, of another
 /// chart (the non-grey patches in another order), the right half of the chart lit by
-/// another lamp, and with glare. Per kind: the share not `ok` (or refused: no chart found),
+/// another lamp (one exposure and white balance, or each half its own), and with glare. Per kind: the share not `ok` (or refused: no chart found),
 /// and the share the self-check flags.
 pub fn scene_verdicts(
     model: &Model,
@@ -46,7 +46,7 @@ pub fn scene_verdicts(
     setup: &Setup,
     data_dir: &DataDir,
     seed: u64,
-) -> Result<[(f64, f64); 4]> {
+) -> Result<[(f64, f64); 5]> {
     let name = photo_chart(model_chart);
     let chart = Chart::resolve(name, None, data_dir, &GRID)?;
     let template = ChartTemplate::from_chart(&chart)?;
@@ -85,6 +85,10 @@ pub fn scene_verdicts(
         height: 900,
         ..SceneOptions::default()
     };
+    let balanced = SceneOptions {
+        balance_halves: true,
+        ..plain.clone()
+    };
     let glare = SceneOptions {
         glow: Some(Glow {
             level: GLARE_LEVEL,
@@ -92,7 +96,7 @@ pub fn scene_verdicts(
         }),
         ..plain.clone()
     };
-    let mut counts = [(0usize, 0usize); 4];
+    let mut counts = [(0usize, 0usize); 5];
     for i in 0..SCENES {
         let lamp = ids[i * ids.len() / SCENES];
         let other = ids[(i * ids.len() / SCENES + ids.len() / 2) % ids.len()];
@@ -108,6 +112,7 @@ pub fn scene_verdicts(
             (&wrong_pool[k], SceneLight::single(spd), &plain),
             (&pool[k], half, &plain),
             (&pool[k], SceneLight::single(spd), &glare),
+            (&pool[k], half, &balanced),
         ];
         for (kind, (camera, light, scene_options)) in shots.into_iter().enumerate() {
             let shot = scene::photograph(camera, light, shot_seed, scene_options)?;
