@@ -7,8 +7,10 @@
 //! lateral chromatic aberration in images", Pattern Recognition Letters 28(1)): each of red
 //! and blue is the green image magnified about the image centre by its own factor 1 + k.
 //! Each k is found as the magnification that best aligns that channel's gradients with
-//! green's on the strongest green edges (their normalised correlation) (the edge alignment of Kang 2007, "Automatic
-//! removal of chromatic aberration from a single image", CVPR), then undone by resampling.
+//! green's on the strongest green edges (the magnitudes of their dot products, normalised by
+//! the channel's gradient energy: an edge lines up whatever the sign of its colour
+//! contrast) (the edge alignment of Kang 2007, "Automatic removal of chromatic aberration
+//! from a single image", CVPR), then undone by resampling.
 //! Only detection sees the corrected level; patches are sampled at their centres, where
 //! the fringes do not reach.
 //!
@@ -170,7 +172,11 @@ pub fn measure(level: &Level) -> ChannelScales {
                     - sample(plane, w, h, [p[0], p[1] - 1.0]);
                 let gx = f64::from(green[i + 1] - green[i - 1]);
                 let gy = f64::from(green[i + w] - green[i - w]);
-                (gx * cx + gy * cy, cx * cx + cy * cy)
+                // Each edge counts by how well the gradients line up, whatever the sign of
+                // its colour contrast: an edge where red falls as green rises (red against
+                // green) lines up as much as a grey one, and summed with its sign it would
+                // favour a magnification that moves it off.
+                ((gx * cx + gy * cy).abs(), cx * cx + cy * cy)
             })
             .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
         // Normalised by the channel's own gradient energy there: interpolating between
@@ -262,17 +268,28 @@ mod tests {
     /// A level of squares of random greys on a grid, the same in every channel, then red
     /// magnified by `red` and blue by `blue` about the centre.
     fn fringed(red: f64, blue: f64) -> Level {
+        coloured(red, blue, 0)
+    }
+
+    /// [`fringed`] with every `opposed`-th square's red the negative of its green (red
+    /// falls where green rises across its edges); 0: none.
+    fn coloured(red: f64, blue: f64, opposed: i64) -> Level {
         let (w, h) = (400, 300);
-        let value = |x: f64, y: f64| {
+        let value = |x: f64, y: f64, channel: usize| {
             let (c, r) = ((x / 20.0).floor() as i64, (y / 20.0).floor() as i64);
             let (u, v) = (x.rem_euclid(20.0), y.rem_euclid(20.0));
-            if u < 3.0 || v < 3.0 {
+            let grey = if u < 3.0 || v < 3.0 {
                 0.1
             } else {
                 0.2 + 0.07 * ((c * 7 + r * 13).rem_euclid(11)) as f32 as f64
+            };
+            if channel == 0 && opposed > 0 && (c * 3 + r * 5).rem_euclid(opposed) == 0 {
+                1.0 - grey
+            } else {
+                grey
             }
         };
-        let plane = |k: f64| -> Vec<f32> {
+        let plane = |k: f64, channel: usize| -> Vec<f32> {
             (0..w * h)
                 .map(|i| {
                     let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
@@ -281,15 +298,25 @@ mod tests {
                         200.0 + (x - 200.0) / (1.0 + k),
                         150.0 + (y - 150.0) / (1.0 + k),
                     );
-                    value(sx, sy) as f32
+                    value(sx, sy, channel) as f32
                 })
                 .collect()
         };
         Level {
             width: w,
             height: h,
-            planes: [plane(red), plane(0.0), plane(blue)],
+            planes: [plane(red, 0), plane(0.0, 1), plane(blue, 2)],
         }
+    }
+
+    #[test]
+    fn edges_of_opposite_colour_contrast_line_up_too() {
+        // A third of the squares red against green: their edges line up at the same
+        // magnification as the grey ones, and must not pull the measure off it.
+        let level = coloured(0.006, -0.004, 3);
+        let s = measure(&level);
+        assert!((s.red - 0.006).abs() < 0.0008, "{s:?}");
+        assert!((s.blue + 0.004).abs() < 0.0008, "{s:?}");
     }
 
     #[test]
