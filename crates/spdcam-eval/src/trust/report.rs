@@ -93,8 +93,6 @@ photos); Hue photos `ok` 0 → 40 % (their mean GFC 0.971); the 95 % band on hel
 photos 95.3 % → 91.3 %. Uncut (1,085 real photos, 711 of them Hue's) the virtual band fell \
 to 81.3 %.\n";
 
-/// Corrections measured once and left off, with their numbers (the shipped models and
-/// calibrations of this report, the same photos).
 /// The bins of [`Shots::balanced_change`] (8-bit levels) the two-lights table reports.
 const CHANGE_BINS: [(f64, f64); 5] = [
     (0.0, 2.0),
@@ -104,6 +102,8 @@ const CHANGE_BINS: [(f64, f64); 5] = [
     (16.0, f64::INFINITY),
 ];
 
+/// Corrections measured once and left off, with their numbers (the shipped models and
+/// calibrations of this report, the same photos).
 const CORRECTIONS_TRIED: &str = "\nAlso tried, and left off (measured on the SG network \
 shipped before the average): the self-check's own map (3×3 \
 matrix, flare, the light's gradient and an additive light changing linearly across the \

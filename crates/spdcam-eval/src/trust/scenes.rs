@@ -37,8 +37,9 @@ fn photo_chart(model_chart: &str) -> &str {
 /// with perspective, blur, vignetting, noise and JPEG) of [`SCENES`] test lamps, each by a
 /// held-out camera, found, sampled and estimated like a user's photo: clean, of another
 /// chart (the non-grey patches in another order), the right half of the chart lit by
-/// another lamp (one exposure and white balance, or each half its own), and with glare. Per kind: the share not `ok` (or refused: no chart found),
-/// and the share the self-check flags.
+/// another lamp (one exposure and white balance, or each half its own), and with glare.
+/// Per kind: the share not `ok` (or refused: no chart found), and the share the self-check
+/// flags.
 pub fn scene_verdicts(
     model: &Model,
     cal: &Calibration,

@@ -306,9 +306,7 @@ impl ChartCheck {
                 .collect(),
         })
     }
-}
 
-impl ChartCheck {
     /// [`SelfCheck::two_lights`]: with the best map's 3×3 matrix M held, each patch's target
     /// is fitted per channel by M·prediction with a gain, a flare and a gradient in x and y,
     /// a second gain and flare on one half (its own exposure and white balance) and the
@@ -376,13 +374,13 @@ impl ChartCheck {
             });
             let b = DMatrix::from_fn(rows, 1, |r, _| fitted.target[used[r / 3]][r % 3]);
             let rss = |cols: usize| -> Result<f64> {
-                let a = a.columns(0, cols).into_owned();
-                let x = a
-                    .clone()
+                let first = a.columns(0, cols);
+                let x = first
+                    .clone_owned()
                     .svd(true, true)
                     .solve(&b, 1e-10)
                     .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))?;
-                Ok((&a * x - &b).norm_squared())
+                Ok((first * x - &b).norm_squared())
             };
             let (one, two) = (rss(shared)?, rss(columns)?);
             let noise = (two / (rows - columns) as f64).max(floor);

@@ -332,12 +332,18 @@ mod tests {
     use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
     use spdcam_core::illuminant::StandardIlluminant;
 
+    /// The shipped models and the ColorChecker 24's self-check on their model's grid.
+    fn cc24_setup() -> (ModelSet, ChartCheck) {
+        let models = ModelSet::shipped().unwrap();
+        let grid = models.for_chart("colorchecker24").unwrap().model.grid();
+        (models, cc24_check(&grid))
+    }
+
     #[test]
     fn a_wrong_charts_features_are_not_ok_and_bands_hold_the_estimate() {
-        let models = ModelSet::shipped().unwrap();
+        let (models, check) = cc24_setup();
         let model = &models.for_chart("colorchecker24").unwrap().model;
         let grid = model.grid();
-        let check = cc24_check(&grid);
         let row = features_of(&check, &StandardIlluminant::D65.spd(&grid).unwrap());
         let mut wrong = Vec::new();
         for p in (0..check.patches()).rev() {
@@ -390,10 +396,9 @@ mod tests {
 
     #[test]
     fn a_chart_lit_by_two_lights_each_half_balanced_says_so() {
-        let models = ModelSet::shipped().unwrap();
+        let (models, check) = cc24_setup();
         let model = &models.for_chart("colorchecker24").unwrap().model;
         let grid = model.grid();
-        let check = cc24_check(&grid);
         let daylight = features_of(&check, &StandardIlluminant::D65.spd(&grid).unwrap());
         let bulb = features_of(&check, &StandardIlluminant::A.spd(&grid).unwrap());
         let centres = Chart::colorchecker24(&grid).unwrap().feature_centres();
