@@ -116,7 +116,7 @@ pub fn check_output_apart(output: &Path, inputs: &[&Path]) -> Result<()> {
 
 /// `path` canonicalised; when it does not exist yet, its nearest existing ancestor
 /// canonicalised with the rest of the path appended (`new/../ds` is `ds`).
-fn canonical_or_planned(path: &Path) -> PathBuf {
+pub(crate) fn canonical_or_planned(path: &Path) -> PathBuf {
     use std::path::Component;
     let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
     let parts: Vec<Component> = absolute.components().collect();
@@ -142,21 +142,96 @@ fn canonical_or_planned(path: &Path) -> PathBuf {
 /// Checks, before long work, that a file can later be written at `path`: its directory
 /// exists, `path` is not a directory, and a file can be created beside it (the check file
 /// is removed at once). Catches an unwritable path before hours of training, not after.
+/// A device or a pipe is written in place: it is only checked to be one.
 pub fn check_writable(path: &Path) -> Result<()> {
-    check_parent_dir(path)?;
-    if path.is_dir() {
-        return Err(Error::invalid(format!(
-            "cannot write {}: it is a directory; name a file",
-            path.display()
-        )));
-    }
-    let probe = temporary_path(path);
+    let file = match OutputTarget::resolve(path)? {
+        OutputTarget::InPlace(_) => return Ok(()),
+        OutputTarget::Replace(file) => file,
+    };
+    check_parent_dir(&file)?;
+    let probe = temporary_path(&file);
     std::fs::OpenOptions::new()
         .write(true)
         .create_new(true)
         .open(&probe)
         .map_err(|e| Error::io(path, e))?;
     std::fs::remove_file(&probe).map_err(|e| Error::io(&probe, e))
+}
+
+/// Where the bytes for an output path go.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum OutputTarget {
+    /// A regular file (or none yet): written beside it, then renamed over it. A symbolic
+    /// link is followed, so the link stays and its target gets the new content.
+    Replace(PathBuf),
+    /// A character device or a named pipe (`/dev/null`, a FIFO, `/dev/stdout`): opened and
+    /// written as it is, never replaced by a regular file.
+    InPlace(PathBuf),
+}
+
+impl OutputTarget {
+    /// Resolves `path` (through symbolic links, even to a target not made yet) and refuses
+    /// what cannot take a file's bytes: a directory, a block device, a socket.
+    fn resolve(path: &Path) -> Result<OutputTarget> {
+        let target = follow_links(path)?;
+        let meta = match std::fs::metadata(&target) {
+            Ok(meta) => meta,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Ok(OutputTarget::Replace(target))
+            }
+            Err(e) => return Err(Error::io(path, e)),
+        };
+        if meta.is_file() {
+            return Ok(OutputTarget::Replace(target));
+        }
+        let what = if meta.is_dir() {
+            "a directory"
+        } else if is_stream(&meta) {
+            return Ok(OutputTarget::InPlace(target));
+        } else {
+            "neither a file, a character device nor a pipe (a block device or a socket)"
+        };
+        Err(Error::invalid(format!(
+            "cannot write {}: it is {what}; name a file",
+            path.display()
+        )))
+    }
+}
+
+/// Whether `meta` is a character device or a named pipe: outputs written in place.
+#[cfg(unix)]
+fn is_stream(meta: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    let kind = meta.file_type();
+    kind.is_char_device() || kind.is_fifo()
+}
+
+/// Whether `meta` is a character device or a named pipe: outputs written in place.
+#[cfg(not(unix))]
+fn is_stream(_meta: &std::fs::Metadata) -> bool {
+    false
+}
+
+/// `path` with every symbolic link along its last component followed (a link to a link
+/// too), even where the final target does not exist yet; at most 40 links, as Linux allows.
+fn follow_links(path: &Path) -> Result<PathBuf> {
+    let mut current = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&current) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                let link = std::fs::read_link(&current).map_err(|e| Error::io(&current, e))?;
+                current = match current.parent() {
+                    Some(dir) if link.is_relative() => dir.join(link),
+                    _ => link,
+                };
+            }
+            _ => return Ok(current),
+        }
+    }
+    Err(Error::invalid(format!(
+        "cannot write {}: too many symbolic links (a loop?)",
+        path.display()
+    )))
 }
 
 /// Whether `path` names standard output (`-`, as Unix tools read it).
@@ -191,25 +266,46 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Writes to `path` atomically with a writer callback; on any error nothing is left behind.
+/// A symbolic link is followed (the link stays, its target is replaced); a character
+/// device or a named pipe is written in place, never replaced by a file.
 pub fn write_atomic_with(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> Result<()> {
-    check_parent_dir(path)?;
-    let tmp = temporary_path(path);
+    let file = match OutputTarget::resolve(path)? {
+        OutputTarget::InPlace(stream) => return write_in_place(path, &stream, write),
+        OutputTarget::Replace(file) => file,
+    };
+    check_parent_dir(&file)?;
+    let tmp = temporary_path(&file);
     let result = (|| {
-        let file = std::fs::File::create(&tmp)?;
-        let mut writer = std::io::BufWriter::new(file);
+        let created = std::fs::File::create(&tmp)?;
+        let mut writer = std::io::BufWriter::new(created);
         write(&mut writer)?;
-        let file = writer.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
+        let created = writer.into_inner().map_err(|e| e.into_error())?;
+        created.sync_all()?;
+        std::fs::rename(&tmp, &file)
     })();
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
         return Err(Error::io(path, e));
     }
     Ok(())
+}
+
+/// Writes to a device or a pipe as it is (opened for writing, not created or replaced).
+fn write_in_place(
+    path: &Path,
+    stream: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> Result<()> {
+    let result = (|| {
+        let opened = std::fs::OpenOptions::new().write(true).open(stream)?;
+        let mut writer = std::io::BufWriter::new(opened);
+        write(&mut writer)?;
+        writer.flush()
+    })();
+    result.map_err(|e| Error::io(path, e))
 }
 
 #[cfg(test)]
@@ -254,6 +350,60 @@ mod tests {
         assert!(res.is_err());
         assert!(!target.exists());
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_is_followed_and_a_device_or_pipe_written_in_place() {
+        // Issue 39, defect 2: `-o` naming a link, a FIFO or a device replaced it with a file.
+        use std::os::unix::fs::FileTypeExt;
+        let dir = std::env::temp_dir().join(format!("spdcam-fsio-kinds-{}", std::process::id()));
+        std::fs::remove_dir_all(&dir).ok();
+        std::fs::create_dir_all(&dir).unwrap();
+        let target = dir.join("target.csv");
+        std::fs::write(&target, b"old").unwrap();
+        let link = dir.join("link.csv");
+        std::os::unix::fs::symlink("target.csv", &link).unwrap();
+        write_atomic(&link, b"new").unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        // A dangling link gets its target made, as a shell's `>` does.
+        let dangling = dir.join("dangling.csv");
+        std::os::unix::fs::symlink("made.csv", &dangling).unwrap();
+        write_atomic(&dangling, b"made").unwrap();
+        assert_eq!(std::fs::read(dir.join("made.csv")).unwrap(), b"made");
+
+        write_atomic(Path::new("/dev/null"), b"gone").unwrap();
+        assert!(std::fs::metadata("/dev/null")
+            .unwrap()
+            .file_type()
+            .is_char_device());
+        let e = write_atomic(Path::new("/dev/full"), &[0u8; 1 << 17])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("/dev/full") && e.contains("space"), "{e}");
+        assert!(std::fs::metadata("/dev/full")
+            .unwrap()
+            .file_type()
+            .is_char_device());
+
+        let fifo = dir.join("fifo");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.unwrap().success(), "mkfifo");
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(&fifo).unwrap())
+        };
+        write_atomic(&fifo, b"through the pipe").unwrap();
+        assert_eq!(reader.join().unwrap(), b"through the pipe");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        check_writable(&fifo).unwrap();
+        let e = write_atomic(&dir, b"x").unwrap_err().to_string();
+        assert!(e.contains("is a directory"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

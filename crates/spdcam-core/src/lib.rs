@@ -22,8 +22,8 @@
 //!   feature row; [`feature_check`] rejects rows that cannot say anything about the light.
 //! - [`metrics`] (RMSE, GFC, SAM, SID between spectra), [`colorimetry`] (XYZ, CCT/Duv,
 //!   sRGB, CIELAB) and [`quality`] (CRI, TM-30, α-opic and other metrics of a light).
-//! - [`error`], [`fsio`] (atomic file writes) and [`limits`] (resource limits) serve all of
-//!   them.
+//! - [`error`], [`fsio`] (atomic file writes), [`output_guard`] (no output onto an input)
+//!   and [`limits`] (resource limits) serve all of them.
 //!
 //! Rendering the ColorChecker 24 under CIE D65 through the built-in Nikon D5100:
 //!
@@ -103,6 +103,7 @@ pub mod lighting;
 pub mod limits;
 pub mod metrics;
 mod minimise;
+pub mod output_guard;
 pub mod photo;
 pub mod quality;
 pub mod raster;

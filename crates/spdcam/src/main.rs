@@ -7,6 +7,7 @@
 #[cfg(feature = "train")]
 mod average;
 mod calibrate;
+mod command_paths;
 mod coverage;
 mod dataset;
 mod detection;
@@ -36,7 +37,7 @@ mod train;
 mod trust;
 mod validate_lamps;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -111,7 +112,13 @@ fn exit_quietly_on_closed_pipe() {
 fn main() -> ExitCode {
     #[cfg(unix)]
     exit_quietly_on_closed_pipe();
-    let cli = Cli::parse();
+    let command = Cli::command();
+    let matches = command.clone().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    if let Err(e) = command_paths::check(&command, &matches) {
+        eprintln!("error: {}", error_text(&e));
+        return ExitCode::FAILURE;
+    }
     let data_dir = spdcam_core::builtin::DataDir::new(cli.data_dir);
     if let Err(e) = data_dir.check() {
         eprintln!("error: {e}");

@@ -104,8 +104,8 @@ pub struct RenderArgs {
     /// photos of the scene joined at the chart's middle).
     #[arg(long, requires = "right_light")]
     balance_halves: bool,
-    /// Also write the light's SPD (normalised to a maximum of 1) as spectral CSV, e.g. as
-    /// the truth beside a scene photo.
+    /// Also write the light's SPD (normalised to a maximum of 1) as spectral CSV (`-`: to
+    /// standard output), e.g. as the truth beside a scene photo.
     #[arg(long, value_name = "FILE.csv")]
     spd_out: Option<PathBuf>,
     #[command(flatten)]
@@ -124,24 +124,22 @@ enum TiltAxisArg {
 /// Runs `spdcam render`.
 pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
     let grid = Grid::SIMULATION;
-    for path in std::iter::once(&args.output).chain(&args.features) {
+    // The command line's output guard has checked that at most one of them is `-`.
+    let files = || {
+        std::iter::once(&args.output)
+            .chain(&args.features)
+            .chain(&args.spd_out)
+    };
+    for path in files() {
         if !fsio::is_stdout(path) {
             fsio::check_parent_dir(path)?;
         }
     }
-    if fsio::is_stdout(&args.output) && args.features.as_deref().is_some_and(fsio::is_stdout) {
-        bail!("only one of -o and --features can go to standard output");
-    }
-    let messages = Messages::new(
-        fsio::is_stdout(&args.output) || args.features.as_deref().is_some_and(fsio::is_stdout),
-    );
+    let messages = Messages::new(files().any(|p| fsio::is_stdout(p)));
     if let Some(dir) = &args.stages {
         // Made here, before the render, so a bad place fails at once.
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot make the stages directory {}", dir.display()))?;
-    }
-    if let Some(path) = &args.spd_out {
-        fsio::check_parent_dir(path)?;
     }
     let scene = args
         .scene
@@ -182,8 +180,11 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
     }
     if let Some(path) = &args.spd_out {
         let values = spd.spd.normalised_by_max().into_values();
-        SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?.write_csv(path)?;
-        messages.say(format_args!("light SPD: {}", path.display()));
+        let set = SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?;
+        fsio::write_output(path, set.to_csv_string().as_bytes())?;
+        if !fsio::is_stdout(path) {
+            messages.say(format_args!("light SPD: {}", path.display()));
+        }
     }
     if let Some((width, height)) = scene {
         return render_scene(
