@@ -14,6 +14,7 @@ use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, Layout, THESIS_PATCH_PX};
 use spdcam_core::dataset::randomise::RandomiseRequest;
 use spdcam_core::dataset::{GenerateEvent, GenerateOptions, GenerateRequest, Pipeline};
+use spdcam_core::output_guard::{check_outputs, file_output, named};
 use spdcam_core::photo::{load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
@@ -569,6 +570,7 @@ fn train(
     let reporter = Reporter::new(progress);
     let models = py
         .allow_threads(|| -> Result<_, spdcam_learn::LearnError> {
+            check_outputs(&[named("data=", &data)], &[file_output("output=", &output)])?;
             fsio::check_writable(&output)?;
             let set = TrainingSet::load(&data)?;
             let mut schedule = Schedule::default_for(&architecture);
@@ -615,6 +617,10 @@ fn finetune(
     let reporter = Reporter::new(progress);
     let models = py
         .allow_threads(|| -> Result<_, spdcam_learn::LearnError> {
+            check_outputs(
+                &[named("model=", &model), named("data=", &data)],
+                &[file_output("output=", &output)],
+            )?;
             fsio::check_writable(&output)?;
             let pretrained = Model::load(&model)?;
             let set = TrainingSet::load(&data)?;

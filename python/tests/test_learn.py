@@ -172,3 +172,19 @@ def test_choosing_a_recipe_needs_four_samples(mlp, tmp_path):
     three = spdcam.generate(tmp_path / "three", LIGHTING, 3, fast=True, progress=False)
     with pytest.raises(spdcam.SpdcamError, match="3 sample.*at least 4"):
         spdcam.finetune(path, three, tmp_path / "t.spdm", progress=False)
+
+
+def test_an_output_onto_an_input_is_refused_and_the_input_kept(mlp, tmp_path):
+    """Issue 39: the one output guard of the command line holds in Python too."""
+    path, _, _ = mlp
+    before = path.read_bytes()
+    small = spdcam.generate(tmp_path / "small", "gaussian:2", 40, seed=8, fast=True,
+                            progress=False)
+    with pytest.raises(spdcam.SpdcamError, match="output= .* is the input model="):
+        spdcam.finetune(path, small, path, epochs=1, progress=False)
+    assert path.read_bytes() == before
+    manifest = tmp_path / "small" / "manifest.json"
+    kept = manifest.read_bytes()
+    with pytest.raises(spdcam.SpdcamError, match="lies inside the input data="):
+        spdcam.train(small, manifest, "linear", progress=False)
+    assert manifest.read_bytes() == kept
