@@ -123,11 +123,13 @@ fn compare(set: &SpectralSet, reference: &BTreeMap<String, Row>) -> (usize, Vec<
                     if dev > entry.0 {
                         *entry = (dev, format!("{name}: {g} vs {w}"));
                     }
-                    if !(dev <= *limit) {
+                    if dev.is_nan() || dev > *limit {
                         failures.push(format!("{name}: {key} = {g}, reference {w}"));
                     }
                 }
-                (Some(w), Err(e)) => failures.push(format!("{name}: {key} refused ({e}), reference {w}")),
+                (Some(w), Err(e)) => {
+                    failures.push(format!("{name}: {key} refused ({e}), reference {w}"))
+                }
                 (None, Ok(g)) if *key != "cri_r15" => failures.push(format!(
                     "{name}: {key} = {g}, but the reference deems it undefined"
                 )),

@@ -155,8 +155,7 @@ pub(crate) fn special_indices(
             ];
             let t = uvw(adapted, xyz_t[1], refr.white_uv);
             let q = uvw(xyz_to_uv1960(xyz_r), xyz_r[1], refr.white_uv);
-            let de =
-                ((t[0] - q[0]).powi(2) + (t[1] - q[1]).powi(2) + (t[2] - q[2]).powi(2)).sqrt();
+            let de = ((t[0] - q[0]).powi(2) + (t[1] - q[1]).powi(2) + (t[2] - q[2]).powi(2)).sqrt();
             100.0 - 4.6 * de
         })
         .collect())

@@ -175,8 +175,8 @@ pub fn dominant_wavelength(xy: [f64; 2], white_xy: [f64; 2]) -> Result<DominantW
             boundary_xy,
         });
     }
-    let (_, back_segment, back_s) = first_hit(white_xy, [-dir[0], -dir[1]])
-        .expect("a ray from inside meets the boundary");
+    let (_, back_segment, back_s) =
+        first_hit(white_xy, [-dir[0], -dir[1]]).expect("a ray from inside meets the boundary");
     Ok(DominantWavelength {
         wavelength_nm: wavelength_at(back_segment, back_s),
         complementary: true,
@@ -238,7 +238,10 @@ mod tests {
         let d = dominant_wavelength_of(&light, ILLUMINANT_E_XY).unwrap();
         assert!(d.complementary, "{d:?}");
         assert!(d.signed_nm() < 0.0 && (495.0..570.0).contains(&d.wavelength_nm));
-        assert!(d.excitation_purity > 0.0 && d.excitation_purity < 1.0, "{d:?}");
+        assert!(
+            d.excitation_purity > 0.0 && d.excitation_purity < 1.0,
+            "{d:?}"
+        );
         // Halfway between the white point and the boundary point: purity one half.
         let w = ILLUMINANT_E_XY;
         let b = d.boundary_xy;

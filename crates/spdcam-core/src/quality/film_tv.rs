@@ -60,7 +60,9 @@ pub fn special_rendering_indices_r1_r15(
 ) -> Result<[f64; TCS_COUNT + 1]> {
     let r = colour_rendering_cie1995(light, cct)?.r;
     let r15 = special_rendering_index_r15(light, cct)?;
-    Ok(std::array::from_fn(|i| if i < TCS_COUNT { r[i] } else { r15 }))
+    Ok(std::array::from_fn(
+        |i| if i < TCS_COUNT { r[i] } else { r15 },
+    ))
 }
 
 /// The reference an SSI compares a light with.
@@ -216,7 +218,10 @@ pub struct CctCorrection {
 /// # Ok::<(), spdcam_core::Error>(())
 /// ```
 pub fn cct_correction(cct_k: f64, duv: f64, target_k: f64) -> Result<CctCorrection> {
-    for (what, t) in [("light's CCT", cct_k), ("target colour temperature", target_k)] {
+    for (what, t) in [
+        ("light's CCT", cct_k),
+        ("target colour temperature", target_k),
+    ] {
         if !(CCT_MIN_K..=CCT_MAX_K).contains(&t) {
             return Err(Error::invalid(format!(
                 "the {what} {t} K is outside {CCT_MIN_K}–{CCT_MAX_K} K; a mired correction \
@@ -276,7 +281,11 @@ mod tests {
         v[700 - 360] = 1.0;
         let red = LightSpectrum::on_grid(&QUALITY_GRID, &v).unwrap();
         let e = spectral_similarity_index(&red, &SsiReference::Planckian(3200.0)).unwrap_err();
-        assert!(e.to_string().contains("test spectrum has no power in 375–675 nm"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("test spectrum has no power in 375–675 nm"),
+            "{e}"
+        );
         let e = spectral_similarity_index(&planckian(3200.0), &SsiReference::Spectrum(red));
         assert!(e.unwrap_err().to_string().contains("reference spectrum"));
         let e = spectral_similarity_index(&planckian(3200.0), &SsiReference::Daylight(3000.0));
@@ -290,8 +299,13 @@ mod tests {
         let mut v = vec![0.0; QUALITY_GRID.count];
         v[525 - 360] = 1.0;
         let green = LightSpectrum::on_grid(&QUALITY_GRID, &v).unwrap();
-        let e = cct_correction_of(&green, DAYLIGHT_K).unwrap_err().to_string();
-        assert!(e.contains("dominant wavelength") && e.contains("±0.05"), "{e}");
+        let e = cct_correction_of(&green, DAYLIGHT_K)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("dominant wavelength") && e.contains("±0.05"),
+            "{e}"
+        );
         let e = spectral_similarity_index(&green, &SsiReference::CctMatched).unwrap_err();
         assert!(e.to_string().contains("CCT-matched SSI reference"), "{e}");
         // Against a fixed reference the SSI is still defined.
@@ -311,11 +325,17 @@ mod tests {
         let green = cct_correction(4000.0, 0.004, 4000.0).unwrap();
         assert_eq!((green.mired_shift, green.green_magenta_duv), (0.0, 0.004));
         let e = cct_correction(3200.0, 0.0, 0.0).unwrap_err();
-        assert!(e.to_string().contains("target colour temperature 0 K"), "{e}");
+        assert!(
+            e.to_string().contains("target colour temperature 0 K"),
+            "{e}"
+        );
         assert!(cct_correction(f64::NAN, 0.0, 3200.0).is_err());
         assert!(cct_correction(3200.0, f64::INFINITY, 3200.0).is_err());
         let light = planckian(3200.0);
         let c = cct_correction_of(&light, TUNGSTEN_K).unwrap();
-        assert!(c.mired_shift.abs() < 0.1 && c.green_magenta_duv.abs() < 1e-4, "{c:?}");
+        assert!(
+            c.mired_shift.abs() < 0.1 && c.green_magenta_duv.abs() < 1e-4,
+            "{c:?}"
+        );
     }
 }
