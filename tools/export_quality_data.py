@@ -6,10 +6,10 @@ Usage (from the repository root):
     pip install --no-deps pysilsub==0.1.1
     python tools/export_quality_data.py
 
-Writes data/cie_1964_10deg_cmf.csv, data/cie_1995_tcs14.csv, data/cie_1951_scotopic.csv,
-data/cie_s026_alpha_opic.csv, data/blue_light_hazard.csv and data/LICENSE-pysilsub.txt, and
-replaces the lighting-quality section of data/PROVENANCE.md (everything from QUALITY_MARKER
-on; tools/export_data.py keeps that section when it rewrites the file).
+Writes data/cie_1964_10deg_cmf.csv, data/cie_1995_tcs14.csv, data/cie_2024_tcs15.csv,
+data/cie_1951_scotopic.csv, data/cie_s026_alpha_opic.csv, data/blue_light_hazard.csv and
+data/LICENSE-pysilsub.txt, and replaces the lighting-quality section of data/PROVENANCE.md
+(everything from QUALITY_MARKER on; tools/export_data.py keeps that section when it rewrites the file).
 
 Sources: colour-science (BSD-3-Clause) for the CIE observers and test colour samples;
 pysilsub (MIT) for the CIE S 026:2018 action spectra, cross-checked here against the CIE 2006
@@ -156,6 +156,22 @@ def blue_light_hazard() -> str:
     )
 
 
+def tcs15(src: str) -> str:
+    """Test colour sample No. 15 (JIS Z 8726:1990, Japanese skin), as published by the CIE."""
+    sd = SDS_TCS["CIE 2024"]["TCS15"]
+    s = write_csv("cie_2024_tcs15.csv", sd.wavelengths, {"tcs15": sd.values})
+    return (
+        "## cie_2024_tcs15.csv\n\n"
+        "- Columns: `wavelength_nm,tcs15`\n"
+        f"- Source: {src}, `colour.quality.datasets.tcs.SDS_TCS['CIE 2024']['TCS15']`: test colour "
+        "sample No. 15 of JIS Z 8726:1990 (Japanese skin complexion), spectral radiance factors as "
+        "published by the CIE (2024), data set doi:10.25039/CIE.DS.7chm7z5h; gives the special "
+        "colour rendering index R15.\n"
+        f"- Sampling: native, {s}.\n"
+        "- Processing: none.\n"
+    )
+
+
 def main() -> None:
     assert colour.__version__ == EXPECTED_COLOUR, f"need colour-science {EXPECTED_COLOUR}"
     src = f"colour-science {EXPECTED_COLOUR} (PyPI)"
@@ -192,6 +208,8 @@ def main() -> None:
         f"- Sampling: native, {s}.\n"
         "- Processing: none.\n"
     )
+
+    prov.append(tcs15(src))
 
     vprime = SDS_LEFS_SCOTOPIC["CIE 1951 Scotopic Standard Observer"]
     s = write_csv("cie_1951_scotopic.csv", vprime.wavelengths, {"v_prime": vprime.values})

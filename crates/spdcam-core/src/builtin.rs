@@ -72,6 +72,14 @@ pub const CIE1995_TCS14: BuiltinTable = BuiltinTable {
     csv: include_str!("../../../data/cie_1995_tcs14.csv"),
 };
 
+/// Test colour sample No. 15 of JIS Z 8726:1990 (Japanese skin complexion) as published by the
+/// CIE in 2024 (380–780 nm, 5 nm): the sample of the special colour rendering index R15.
+pub const CIE2024_TCS15: BuiltinTable = BuiltinTable {
+    name: "cie_2024_tcs15",
+    description: "JIS Z 8726 test colour sample No. 15 (Japanese skin), CIE 2024",
+    csv: include_str!("../../../data/cie_2024_tcs15.csv"),
+};
+
 /// The CIE 1951 scotopic spectral luminous efficiency V′(λ) (380–780 nm, 1 nm).
 pub const CIE1951_SCOTOPIC: BuiltinTable = BuiltinTable {
     name: "cie_1951_scotopic",
@@ -220,6 +228,7 @@ mod tests {
         let quality = [
             &CIE1964_10DEG_CMF,
             &CIE1995_TCS14,
+            &CIE2024_TCS15,
             &CIE1951_SCOTOPIC,
             &CIE_S026_ALPHA_OPIC,
             &BLUE_LIGHT_HAZARD,
@@ -233,6 +242,7 @@ mod tests {
             assert!(!set.is_empty(), "{}", t.name);
         }
         assert_eq!(CIE1995_TCS14.load().unwrap().len(), 14);
+        assert_eq!(CIE2024_TCS15.load().unwrap().names(), ["tcs15"]);
         assert_eq!(
             CIE_S026_ALPHA_OPIC.load().unwrap().names(),
             ["sc", "mc", "lc", "rh", "mel"]

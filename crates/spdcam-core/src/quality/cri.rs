@@ -39,50 +39,58 @@ fn references() -> &'static ReferenceIlluminants {
     })
 }
 
-/// The test colour samples times each CIE 1931 CMF on [`QUALITY_GRID`], function
-/// `3·sample + channel`.
+/// The CIE 13.3 test colour samples TCS01–TCS14 times each CIE 1931 CMF on [`QUALITY_GRID`].
 fn sample_weights() -> &'static BandWeights {
     static W: OnceLock<BandWeights> = OnceLock::new();
-    W.get_or_init(|| {
-        let (tcs, _) = builtin::CIE1995_TCS14
-            .load()
-            .and_then(|t| {
-                t.resample(
-                    &QUALITY_GRID,
-                    Interpolation::Sprague1880,
-                    Extrapolation::HoldEdge,
-                )
-            })
-            .expect("the shipped CIE 13.3 samples cover 360–780 nm");
-        let obs = observer_2deg();
-        let functions: Vec<Vec<f64>> = tcs
-            .items()
-            .iter()
-            .flat_map(|r| {
-                (0..3).map(move |c| r.iter().zip(obs.cmf(c)).map(|(r, c)| r * c).collect())
-            })
-            .collect();
-        BandWeights::new(&functions)
-    })
+    W.get_or_init(|| sample_weights_of(&builtin::CIE1995_TCS14))
 }
 
-/// The colorimetry of the 14 samples under one light: white (u, v) and each sample's XYZ
+/// The samples of a shipped reflectance `table` times each CIE 1931 CMF on [`QUALITY_GRID`],
+/// function `3·sample + channel`: the samples Sprague-interpolated to 1 nm (CIE 167:2005) and
+/// held at their end values outside their range, as colour-science aligns them.
+///
+/// # Panics
+/// If the shipped table does not parse (a build defect, caught by the crate's tests).
+pub(crate) fn sample_weights_of(table: &builtin::BuiltinTable) -> BandWeights {
+    let (tcs, _) = table
+        .load()
+        .and_then(|t| {
+            t.resample(
+                &QUALITY_GRID,
+                Interpolation::Sprague1880,
+                Extrapolation::HoldEdge,
+            )
+        })
+        .expect("the shipped test colour samples resample to 360–780 nm");
+    let obs = observer_2deg();
+    let functions: Vec<Vec<f64>> = tcs
+        .items()
+        .iter()
+        .flat_map(|r| (0..3).map(move |c| r.iter().zip(obs.cmf(c)).map(|(r, c)| r * c).collect()))
+        .collect();
+    BandWeights::new(&functions)
+}
+
+/// The colorimetry of the samples under one light: white (u, v) and each sample's XYZ
 /// (Y of the white = 100).
 struct SampleColours {
     white_uv: [f64; 2],
-    samples: [[f64; 3]; TCS_COUNT],
+    samples: Vec<[f64; 3]>,
 }
 
-fn sample_colours(spd: &[f64]) -> SampleColours {
+fn sample_colours(spd: &[f64], weights: &BandWeights) -> SampleColours {
     let obs = observer_2deg();
     let white = obs.spd_to_xyz(spd);
     // The samples' sums lack the Δλ that spd_to_xyz includes.
     let k = 100.0 / white[1] * QUALITY_GRID.step_nm;
-    let mut sums = [0.0; 3 * TCS_COUNT];
-    sample_weights().apply(spd, &mut sums);
+    let mut sums = vec![0.0; weights.functions()];
+    weights.apply(spd, &mut sums);
     SampleColours {
         white_uv: xyz_to_uv1960(white),
-        samples: std::array::from_fn(|i| std::array::from_fn(|c| k * sums[3 * i + c])),
+        samples: sums
+            .chunks_exact(3)
+            .map(|s| [k * s[0], k * s[1], k * s[2]])
+            .collect(),
     }
 }
 
@@ -112,30 +120,45 @@ fn c_d(uv: [f64; 2]) -> (f64, f64) {
 /// defined (CCT above 25,000 K). CIE 13.3 deems the result meaningless when the light's
 /// chromaticity lies more than 5.4e-3 from the Planckian locus; that is the caller's check.
 pub fn colour_rendering_cie1995(light: &LightSpectrum, cct: f64) -> Result<ColourRendering> {
-    let reference = references().cie1995(cct)?;
-    let test = sample_colours(light.values());
-    let refr = sample_colours(&reference);
-    let (c_k, d_k) = c_d(test.white_uv);
-    let (c_r, d_r) = c_d(refr.white_uv);
-    let (cr_ck, dr_dk) = (c_r / c_k, d_r / d_k);
-    let r: [f64; TCS_COUNT] = std::array::from_fn(|i| {
-        let xyz_t = test.samples[i];
-        let (c_ki, d_ki) = c_d(xyz_to_uv1960(xyz_t));
-        let den = 16.518 + 1.481 * cr_ck * c_ki - dr_dk * d_ki;
-        let adapted = [
-            (10.872 + 0.404 * cr_ck * c_ki - 4.0 * dr_dk * d_ki) / den,
-            5.520 / den,
-        ];
-        let t = uvw(adapted, xyz_t[1], refr.white_uv);
-        let xyz_r = refr.samples[i];
-        let q = uvw(xyz_to_uv1960(xyz_r), xyz_r[1], refr.white_uv);
-        let de = ((t[0] - q[0]).powi(2) + (t[1] - q[1]).powi(2) + (t[2] - q[2]).powi(2)).sqrt();
-        100.0 - 4.6 * de
-    });
+    let special = special_indices(light, cct, sample_weights())?;
+    let r: [f64; TCS_COUNT] = std::array::from_fn(|i| special[i]);
     Ok(ColourRendering {
         ra: r[..8].iter().sum::<f64>() / 8.0,
         r,
     })
+}
+
+/// The CIE 13.3-1995 special colour rendering index R_i = 100 − 4.6 ΔE_i of each sample of
+/// `weights` (built by [`sample_weights_of`]) under `light` at `cct`, by the method described
+/// at the top of this module; errors where the reference illuminant is not defined.
+pub(crate) fn special_indices(
+    light: &LightSpectrum,
+    cct: f64,
+    weights: &BandWeights,
+) -> Result<Vec<f64>> {
+    let reference = references().cie1995(cct)?;
+    let test = sample_colours(light.values(), weights);
+    let refr = sample_colours(&reference, weights);
+    let (c_k, d_k) = c_d(test.white_uv);
+    let (c_r, d_r) = c_d(refr.white_uv);
+    let (cr_ck, dr_dk) = (c_r / c_k, d_r / d_k);
+    Ok(test
+        .samples
+        .iter()
+        .zip(&refr.samples)
+        .map(|(&xyz_t, &xyz_r)| {
+            let (c_ki, d_ki) = c_d(xyz_to_uv1960(xyz_t));
+            let den = 16.518 + 1.481 * cr_ck * c_ki - dr_dk * d_ki;
+            let adapted = [
+                (10.872 + 0.404 * cr_ck * c_ki - 4.0 * dr_dk * d_ki) / den,
+                5.520 / den,
+            ];
+            let t = uvw(adapted, xyz_t[1], refr.white_uv);
+            let q = uvw(xyz_to_uv1960(xyz_r), xyz_r[1], refr.white_uv);
+            let de = ((t[0] - q[0]).powi(2) + (t[1] - q[1]).powi(2) + (t[2] - q[2]).powi(2)).sqrt();
+            100.0 - 4.6 * de
+        })
+        .collect())
 }
 
 #[cfg(test)]

@@ -11,7 +11,12 @@
 //!   ([`tm30`], with CIECAM02/CAM02-UCS in [`cam02`]);
 //! - CIE S 026:2018 α-opic efficacies and daylight efficacy ratios, M-EDER ([`alpha_opic`]);
 //! - S/P ratio, photosynthetic photon flux per lumen, blue-light hazard efficacy
-//!   ([`photobiology`]).
+//!   ([`photobiology`]);
+//! - for coloured light, the dominant or complementary wavelength and excitation purity
+//!   (CIE 015:2018), and the peak wavelength ([`dominant`]);
+//! - for film and television, R15 (JIS Z 8726) beside R1–R14, the Academy Spectral
+//!   Similarity Index and the mired and green–magenta correction to a target CCT
+//!   ([`film_tv`]).
 //!
 //! [`LightingMetrics`] gathers every number; a value that is not defined for a light is `None`
 //! with the reason in [`LightingMetrics::reasons`]. The results match colour-science 0.4.7
@@ -21,6 +26,8 @@
 pub mod alpha_opic;
 pub mod cam02;
 pub mod cri;
+pub mod dominant;
+pub mod film_tv;
 pub mod photobiology;
 pub mod reference;
 mod spectrum;
@@ -29,6 +36,14 @@ pub mod uv;
 
 pub use alpha_opic::{alpha_opic_cie_s026, AlphaOpic, AlphaValues};
 pub use cri::{colour_rendering_cie1995, ColourRendering};
+pub use dominant::{
+    dominant_wavelength, dominant_wavelength_of, peak_wavelength_nm, DominantWavelength,
+    ILLUMINANT_E_XY,
+};
+pub use film_tv::{
+    cct_correction, cct_correction_of, special_rendering_index_r15,
+    special_rendering_indices_r1_r15, spectral_similarity_index, CctCorrection, SsiReference,
+};
 pub use photobiology::{blue_light_hazard_efficacy, ppf_per_lumen, scotopic_photopic_ratio};
 pub use spectrum::{LightSpectrum, QUALITY_GRID};
 pub use tm30::{colour_fidelity_cie2017, ColourFidelity, HueBin};

@@ -171,6 +171,11 @@ impl BandWeights {
         }
     }
 
+    /// How many weighting functions there are.
+    pub(crate) fn functions(&self) -> usize {
+        self.functions
+    }
+
     /// Σ_band w_f(band)·spd(band) for every function f, into `out` (one value per function).
     ///
     /// # Panics
