@@ -121,16 +121,17 @@ impl MeasuredPhotos {
     pub fn read(features: &Path, spds: &Path, grid: &Grid) -> Result<MeasuredPhotos> {
         let (_, feature_rows) = read_rows(features)?;
         let (header, spd_rows) = read_rows(spds)?;
+        let wavelengths = wavelength_columns(&header, spds)?;
         if feature_rows.len() != spd_rows.len() {
             return Err(Error::invalid(format!(
-                "{} has {} photos but {} has {} SPDs",
+                "{} has {} photos but {} has {} SPDs; the two files need one row per photo, \
+                 in the same order",
                 features.display(),
                 feature_rows.len(),
                 spds.display(),
                 spd_rows.len()
             )));
         }
-        let wavelengths = wavelength_columns(&header, spds)?;
         let names = (0..spd_rows.len()).map(|i| format!("s{i}")).collect();
         let set = SpectralSet::new(wavelengths, names, spd_rows)?;
         let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
@@ -338,8 +339,23 @@ pub fn import_csv(
     })
 }
 
-/// The wavelengths named by an SPD file's header.
+/// The wavelengths named by an SPD file's header. A spectral CSV (one wavelength per row,
+/// `wavelength_nm` first) is told apart and refused with the layout expected.
 fn wavelength_columns(header: &[String], path: &Path) -> Result<Vec<f64>> {
+    if header.first().is_some_and(|h| {
+        h.eq_ignore_ascii_case("wavelength_nm") || h.eq_ignore_ascii_case("wavelength")
+    }) {
+        return Err(Error::parse(
+            path.display().to_string(),
+            format!(
+                "line 1 starts with '{}': the file is a spectral CSV, one wavelength per row \
+                 and one column per SPD; SPDs here are one per row: a header of the \
+                 wavelengths in nm (380,385,…,780), then one row per photo, in the order of \
+                 the features; transpose the table",
+                header[0]
+            ),
+        ));
+    }
     let wavelengths: Vec<f64> = header
         .iter()
         .map(|h| {
