@@ -7,8 +7,9 @@ use super::manifest::{ImportSource, Manifest, Origin, FEATURE_SCALE};
 use super::reader::Dataset;
 use super::spd_map::SpdMap;
 use super::writer::{prepare_output, DatasetWriter};
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::fsio;
+use crate::light::SPD_NEGATIVE_TOLERANCE;
 use crate::lighting::Lighting;
 use crate::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use std::io::Write;
@@ -399,19 +400,23 @@ fn wavelength_columns(header: &[String], path: &Path) -> Result<Vec<f64>> {
 /// has 0.38–0.78).
 const MIN_WAVELENGTH_NM: f64 = 100.0;
 
-/// The SPD of one row, as `render --spd` accepts one: negative values beyond 1 % of the
-/// peak are refused (small ones, measurement noise, become zero), and so is an SPD that is
+/// The SPD of one row, as `render --spd` accepts one: negative values beyond
+/// [`SPD_NEGATIVE_TOLERANCE`] of the peak are refused (small ones, measurement noise, become zero), and so is an SPD that is
 /// zero everywhere.
 fn physical_spd(values: &[f64], wavelengths: &[f64]) -> Result<Vec<f64>> {
     let peak = values.iter().cloned().fold(0.0f64, f64::max);
     if let Some((i, v)) = values
         .iter()
         .enumerate()
-        .find(|(_, v)| **v < -0.01 * peak.max(f64::MIN_POSITIVE))
+        .find(|(_, v)| **v < -SPD_NEGATIVE_TOLERANCE * peak.max(f64::MIN_POSITIVE))
     {
         return Err(Error::invalid(format!(
-            "the SPD is negative ({v}) at {} nm; light cannot be negative",
-            wavelengths[i]
+            "the SPD is negative ({}) at {} nm, beyond {} % of its peak ({}); light cannot be \
+             negative (smaller negatives are taken as noise and set to 0): correct that value",
+            short_number(*v),
+            short_number(wavelengths[i]),
+            short_number(100.0 * SPD_NEGATIVE_TOLERANCE),
+            short_number(peak)
         )));
     }
     if peak <= 0.0 {
