@@ -179,7 +179,8 @@ pub fn looks_like_path(spec: &str) -> bool {
     spec.contains('/') || spec.contains('\\') || spec.ends_with(".csv")
 }
 
-/// Resolves `spec` as: an existing file path; a built-in table; a CSV under the data directory.
+/// Resolves `spec` as: an existing file path (or a pipe or device, see
+/// [`crate::fsio::is_input`]); a built-in table; a CSV under the data directory.
 /// Unknown names list the valid ones.
 pub fn resolve_table(
     spec: &str,
@@ -190,8 +191,13 @@ pub fn resolve_table(
 ) -> Result<(String, SpectralSet)> {
     if looks_like_path(spec) {
         let path = Path::new(spec);
-        if !path.is_file() {
-            return Err(Error::invalid(format!("{kind} file {spec} does not exist")));
+        if !crate::fsio::is_input(path) {
+            let what = if path.is_dir() {
+                "is a directory; name a spectral CSV file"
+            } else {
+                "does not exist"
+            };
+            return Err(Error::invalid(format!("{kind} file {spec} {what}")));
         }
         let name = path
             .file_stem()

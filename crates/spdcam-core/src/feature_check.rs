@@ -42,7 +42,8 @@ pub fn check_feature_row(values: &[f64], names: &[String], scale: f64) -> Result
     let brightest = values.iter().cloned().fold(0.0f64, f64::max);
     if brightest <= MIN_LEVEL_SHARE * scale {
         return Err(Error::invalid(format!(
-            "every feature is black (at most {brightest} of 0–{scale}): the chart shows no light"
+            "every feature is black (at most {} of 0–{scale}): the chart shows no light",
+            short_number(brightest)
         )));
     }
     let chroma = values
@@ -85,6 +86,9 @@ mod tests {
         let n = names(6);
         let e = |row: &[f64]| check_feature_row(row, &n, 255.0).unwrap_err().to_string();
         assert!(e(&[0.0; 6]).contains("black"));
+        // Issue 39: a 300-digit number in the message.
+        let tiny = e(&[1e-300, 2e-300, 0.0, 0.0, 0.0, 0.0]);
+        assert!(tiny.contains("at most 2e-300 of"), "{tiny}");
         let neg = e(&[200.0, -3.0, 40.0, 30.0, 90.0, 180.0]);
         assert!(neg.contains("p01_g") && neg.contains("-3"), "{neg}");
         let high = e(&[200.0, 120.0, 40.0, 30.0, 90.0, 300.0]);

@@ -20,18 +20,61 @@ pub fn check_parent_dir(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Whether `path` names something that can be read as an input: a file, a pipe
+/// (`/dev/stdin`, a shell's `<(…)`), a device — anything that exists and is not a directory
+/// (symbolic links followed). Inputs are then read through [`read_limited`] or [`read_text`],
+/// which bound what any of them may cost.
+pub fn is_input(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_dir())
+}
+
+/// Bytes of the start of an input looked at before the rest is read (see
+/// [`read_limited_checked`]).
+pub const HEAD_BYTES: usize = 4096;
+
+/// The image format whose signature `head` (the first bytes of a file) starts with: JPEG
+/// (`FF D8 FF`), PNG (`89 'PNG' 0D 0A 1A 0A`) or TIFF (`'II' 2A 00` or `'MM' 00 2A`), the
+/// formats spdcam reads (signatures: ISO/IEC 10918-1 Annex B, ISO/IEC 15948 §5.2, TIFF 6.0
+/// §2).
+pub fn image_format(head: &[u8]) -> Option<&'static str> {
+    if head.starts_with(&[0xFF, 0xD8, 0xFF]) {
+        Some("JPEG")
+    } else if head.starts_with(b"\x89PNG\r\n\x1a\n") {
+        Some("PNG")
+    } else if head.starts_with(b"II*\0") || head.starts_with(b"MM\0*") {
+        Some("TIFF")
+    } else {
+        None
+    }
+}
+
 /// Reads a whole text file whose size is within [`limits::TEXT_FILE_BYTES`] (a pipe or a
-/// device too, through the same cap).
+/// device too, through the same cap). Its first bytes are looked at before the rest is
+/// read: an image or anything holding NUL bytes (a binary file, `/dev/zero`) is refused at
+/// once, not after reading up to the limit.
 pub fn read_text(path: &Path) -> Result<String> {
-    let bytes = read_limited(path, &limits::TEXT_FILE_BYTES)?;
-    String::from_utf8(bytes).map_err(|_| {
-        Error::io(
-            path,
-            std::io::Error::new(
-                std::io::ErrorKind::InvalidData,
-                "stream did not contain valid UTF-8",
-            ),
-        )
+    let bytes = read_limited_checked(path, &limits::TEXT_FILE_BYTES, HEAD_BYTES, |head| {
+        if let Some(format) = image_format(head) {
+            return Err(Error::invalid(format!(
+                "{} is a {format} image, not a text file; give the CSV (or JSON) file here",
+                path.display()
+            )));
+        }
+        if head.contains(&0) {
+            return Err(Error::invalid(format!(
+                "{} is not a text file (it holds NUL bytes: a binary file, UTF-16 text or \
+                 a device such as /dev/zero); give the CSV (or JSON) file here",
+                path.display()
+            )));
+        }
+        Ok(())
+    })?;
+    String::from_utf8(bytes).map_err(|e| {
+        Error::invalid(format!(
+            "{} is not UTF-8 text (byte {} is not UTF-8); save it as UTF-8 text",
+            path.display(),
+            e.utf8_error().valid_up_to() + 1
+        ))
     })
 }
 
@@ -40,6 +83,18 @@ pub fn read_text(path: &Path) -> Result<String> {
 /// else is read through a cap of `limit + 1` bytes and refused once it passes the limit, so
 /// that an endless stream (`/dev/zero`) costs no more memory than the limit.
 pub fn read_limited(path: &Path, limit: &limits::Limit) -> Result<Vec<u8>> {
+    read_limited_checked(path, limit, 0, |_| Ok(()))
+}
+
+/// [`read_limited`], with `check` given the first `head` bytes (all of the input when it is
+/// shorter) as soon as they are read: its error stops the reading, so that an input whose
+/// first bytes show it is the wrong kind (`/dev/zero` for a photo) costs no more than them.
+pub fn read_limited_checked(
+    path: &Path,
+    limit: &limits::Limit,
+    head: usize,
+    check: impl FnOnce(&[u8]) -> Result<()>,
+) -> Result<Vec<u8>> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let meta = file.metadata().map_err(|e| Error::io(path, e))?;
     if meta.is_dir() {
@@ -48,7 +103,7 @@ pub fn read_limited(path: &Path, limit: &limits::Limit) -> Result<Vec<u8>> {
             path.display()
         )));
     }
-    let max = limit.value();
+    let max = limit.value()?;
     let context = path.display().to_string();
     if meta.is_file() {
         limit.check_against(meta.len(), max, &context)?;
@@ -62,7 +117,13 @@ pub fn read_limited(path: &Path, limit: &limits::Limit) -> Result<Vec<u8>> {
     };
     let mut bytes = Vec::with_capacity(hint.min(capped) as usize);
     let mut chunk = vec![0u8; 1 << 16];
+    let mut check = Some(check);
     loop {
+        if bytes.len() >= head {
+            if let Some(check) = check.take() {
+                check(&bytes)?;
+            }
+        }
         let n = match reader.read(&mut chunk) {
             Ok(0) => break,
             Ok(n) => n,
@@ -78,6 +139,9 @@ pub fn read_limited(path: &Path, limit: &limits::Limit) -> Result<Vec<u8>> {
             bytes.reserve_exact(target - bytes.len());
         }
         bytes.extend_from_slice(&chunk[..n]);
+    }
+    if let Some(check) = check {
+        check(&bytes)?;
     }
     if bytes.len() as u64 > max {
         return Err(limit.exceeded(&context));

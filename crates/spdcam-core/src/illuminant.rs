@@ -7,7 +7,7 @@
 //! S0, S1, S2 basis, shipped as `data/cie_daylight_basis.csv`); the CIE tables of D65, D50
 //! and the CIE formula for A, shipped as `data/illuminants_cie.csv` (see `data/PROVENANCE.md`).
 
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
@@ -38,7 +38,8 @@ pub(crate) fn planck_radiance(lambda_nm: f64, t_kelvin: f64) -> f64 {
 pub fn planck(t_kelvin: f64, grid: &Grid) -> Result<Spd> {
     if !(t_kelvin.is_finite() && t_kelvin > 0.0) {
         return Err(Error::invalid(format!(
-            "blackbody temperature {t_kelvin} K is not a positive number"
+            "blackbody temperature {} K is not a positive number",
+            short_number(t_kelvin)
         )));
     }
     if grid.start_nm <= 0.0 {
@@ -63,7 +64,8 @@ pub fn planck(t_kelvin: f64, grid: &Grid) -> Result<Spd> {
 pub fn daylight_xy(cct: f64) -> Result<[f64; 2]> {
     if !(DAYLIGHT_CCT_MIN_K..=DAYLIGHT_CCT_MAX_K).contains(&cct) {
         return Err(Error::invalid(format!(
-            "daylight CCT {cct} K is outside the CIE daylight range {DAYLIGHT_CCT_MIN_K}–{DAYLIGHT_CCT_MAX_K} K"
+            "daylight CCT {} K is outside the CIE daylight range {DAYLIGHT_CCT_MIN_K}–{DAYLIGHT_CCT_MAX_K} K",
+            short_number(cct)
         )));
     }
     let t = cct;

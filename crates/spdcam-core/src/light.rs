@@ -2,7 +2,7 @@
 //! spectral CSV, resolved to an SPD on the simulation grid.
 
 use crate::builtin::{self, DataDir};
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::illuminant::{self, StandardIlluminant};
 use crate::spectral::{Extrapolation, Grid, Interpolation, ResampleReport, Spd};
 
@@ -20,15 +20,33 @@ pub struct ResolvedSpd {
     pub spd: Spd,
     /// Present when the light came from a file: how it was resampled.
     pub resampling: Option<ResampleReport>,
+    /// What was done to the file's values that its user should know (small negatives set
+    /// to zero), one line each; empty for named lights.
+    pub notes: Vec<String>,
 }
 
-/// Resolves `spec` (see [`SPD_FORMS`]) to an SPD on `grid`.
+/// Negative values of a light's SPD file down to this fraction of its peak (1 %) are taken
+/// as measurement noise and set to zero, with a note; more negative ones are refused.
+/// Measured spectra carry such noise at their ends (a spectrometer's dark current
+/// subtracted), and a real light has no negative power.
+pub const SPD_NEGATIVE_TOLERANCE: f64 = 0.01;
+
+/// The peaks a light's SPD file may have: the camera computes in single precision (whose
+/// range ends near 1e±38, with sums over the bands and the sensitivities on top), so a
+/// file in units far beyond these overflows or vanishes there. Only the SPD's shape (and,
+/// for two lights, their ratio) matters, so such a file is refused with the advice to
+/// rescale it.
+pub const SPD_PEAK_RANGE: (f64, f64) = (1e-30, 1e30);
+
+/// Resolves `spec` (see [`SPD_FORMS`]) to an SPD on `grid`. A file's small negatives are
+/// set to zero (see [`SPD_NEGATIVE_TOLERANCE`]; the notes say so), larger ones refused.
 pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<ResolvedSpd> {
     if let Ok(ill) = StandardIlluminant::parse(spec) {
         return Ok(ResolvedSpd {
             name: ill.name().to_string(),
             spd: ill.spd(grid)?,
             resampling: None,
+            notes: Vec::new(),
         });
     }
     if let Some((kind, value)) = spec.split_once(':') {
@@ -49,6 +67,7 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
                 name: spec.to_string(),
                 spd,
                 resampling: None,
+                notes: Vec::new(),
             });
         }
     }
@@ -80,7 +99,26 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
             )))
         }
     };
-    let one = set.select(&[index]).require_non_negative("SPD", 0.01)?;
+    let (one, notes) =
+        set.select(&[index])
+            .clamp_negative_noise("SPD", Some(&file), SPD_NEGATIVE_TOLERANCE)?;
+    let peak = one.item(0).iter().fold(0.0f64, |m, &v| m.max(v));
+    let (lowest, highest) = SPD_PEAK_RANGE;
+    if peak > highest || (peak > 0.0 && peak < lowest) {
+        let what = if peak > highest {
+            "overflows"
+        } else {
+            "is below the range of"
+        };
+        return Err(Error::invalid(format!(
+            "{file}, column '{}': the SPD's peak {} {what} the camera's arithmetic ({}…{}); \
+             only the SPD's shape matters: rescale it (divide the values by their peak)",
+            one.names()[0],
+            short_number(peak),
+            short_number(lowest),
+            short_number(highest)
+        )));
+    }
     let (resampled, report) = one.resample(grid, Interpolation::Auto, Extrapolation::Zero)?;
     let spd = Spd::new(*grid, resampled.item(0).to_vec())?;
     if spd.iter().all(|&v| v == 0.0) {
@@ -93,6 +131,7 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
         name: format!("{name}:{}", one.names()[0]),
         spd,
         resampling: Some(report),
+        notes,
     })
 }
 

@@ -131,29 +131,41 @@ pub const ALL: [Limit; 12] = [
 ];
 
 impl Limit {
-    /// The limit in force: the environment variable's value when it is set to a whole
-    /// number, else [`Limit::default`].
-    pub fn value(&self) -> u64 {
-        std::env::var(self.env)
-            .ok()
-            .and_then(|v| v.trim().replace('_', "").parse::<u64>().ok())
-            .unwrap_or(self.default)
+    /// The limit in force: the environment variable's value when it is set (see
+    /// [`parse_count`] for the forms it may take), else [`Limit::default`]. A value that is
+    /// not a whole number is an error naming the variable, not silently the default.
+    pub fn value(&self) -> Result<u64> {
+        match std::env::var(self.env) {
+            Ok(text) if text.trim().is_empty() => Ok(self.default),
+            Ok(text) => parse_count(&text).map_err(|why| {
+                Error::invalid(format!(
+                    "{}={text:?} is not a number of {}: {why}; write a whole number such as \
+                     {}, 1e6, 1,000,000 or 1_000_000",
+                    self.env, self.what, self.default
+                ))
+            }),
+            Err(std::env::VarError::NotPresent) => Ok(self.default),
+            Err(std::env::VarError::NotUnicode(_)) => Err(Error::invalid(format!(
+                "{} is not valid text; write a whole number such as {}",
+                self.env, self.default
+            ))),
+        }
     }
 
     /// Checks that `requested` stays within the limit; the error names `context`, the
     /// request, the limit and the environment variable that raises it.
     pub fn check(&self, requested: u64, context: &str) -> Result<()> {
-        self.check_against(requested, self.value(), context)
+        self.check_against(requested, self.value()?, context)
     }
 
     /// As [`Limit::check`] for a real-valued request (rounded up).
     pub fn check_f64(&self, requested: f64, context: &str) -> Result<()> {
-        let limit = self.value();
+        let limit = self.value()?;
         if requested.is_nan() || requested > limit as f64 {
             let text = if requested.fract() == 0.0 && requested < u64::MAX as f64 {
                 group_digits(requested as u64)
             } else {
-                format!("{requested}")
+                crate::error::short_number(requested)
             };
             return Err(self.error(&text, limit, requested.ceil(), context));
         }
@@ -169,12 +181,17 @@ impl Limit {
     }
 
     /// The error for an input of unknown size (a pipe, a device, a header line still being
-    /// read) found to hold more than the limit: "{context}: more than N {what} …".
+    /// read) found to hold more than the limit: "{context}: more than N {what} …" (or the
+    /// error of an unreadable environment variable).
     pub fn exceeded(&self, context: &str) -> Error {
+        let limit = match self.value() {
+            Ok(limit) => limit,
+            Err(e) => return e,
+        };
         Error::invalid(format!(
             "{context}: more than {} {} (the limit; set {}=N to allow more, if the machine \
              has the memory and time)",
-            group_digits(self.value()),
+            group_digits(limit),
             self.what,
             self.env
         ))
@@ -198,6 +215,42 @@ impl Limit {
 /// Checks the number of columns of a CSV header (of `source`) against [`CSV_COLUMNS`].
 pub fn check_csv_columns(columns: usize, source: &str) -> Result<()> {
     CSV_COLUMNS.check(columns as u64, &format!("{source}, line 1"))
+}
+
+/// A count as a person writes it: `1000000`, `1e6` (or `2.5E6`), `1,000,000` (as spdcam
+/// prints limits) or `1_000_000`, surrounding spaces ignored. The reason is given when the
+/// text is not a whole number from 0 to `u64::MAX`.
+pub fn parse_count(text: &str) -> std::result::Result<u64, String> {
+    let digits: String = text
+        .trim()
+        .chars()
+        .filter(|c| !matches!(c, ',' | '_'))
+        .collect();
+    if digits.is_empty() {
+        return Err("no digits".into());
+    }
+    if let Ok(n) = digits.parse::<u64>() {
+        return Ok(n);
+    }
+    if digits.starts_with('-') {
+        return Err("it is negative".into());
+    }
+    let is_number = digits
+        .chars()
+        .all(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '+' | '-'));
+    match digits.parse::<f64>() {
+        Ok(v) if is_number && v.is_finite() => {
+            if v.fract() != 0.0 {
+                Err("it is not a whole number".into())
+            } else if v >= u64::MAX as f64 {
+                Err("it is too large".into())
+            } else {
+                Ok(v as u64)
+            }
+        }
+        Ok(_) if is_number => Err("it is too large".into()),
+        _ => Err("it is not a number".into()),
+    }
 }
 
 /// `1234567` as `1,234,567`.
@@ -264,6 +317,63 @@ mod tests {
         assert!(names.iter().all(|n| n.starts_with("SPDCAM_MAX_")));
         let e = DRAWS.exceeded("coverage").to_string();
         assert!(e.contains("more than 1,000,000 draws") && e.contains("SPDCAM_MAX_DRAWS=N"));
+    }
+
+    #[test]
+    fn counts_are_read_in_every_form_spdcam_prints_or_people_write() {
+        for text in [
+            "1000000",
+            "1e6",
+            "1E6",
+            "1.0e6",
+            " 1,000,000 ",
+            "1_000_000",
+            "+1e+6",
+        ] {
+            assert_eq!(parse_count(text), Ok(1_000_000), "{text}");
+        }
+        assert_eq!(parse_count("0"), Ok(0));
+        assert_eq!(parse_count("2.5e6"), Ok(2_500_000));
+        assert_eq!(parse_count(&group_digits(u64::MAX)), Ok(u64::MAX));
+        for (text, why) in [
+            ("1.5", "whole"),
+            ("-5", "negative"),
+            ("-1e6", "negative"),
+            ("1e300", "too large"),
+            ("99999999999999999999", "too large"),
+            ("lots", "not a number"),
+            ("inf", "not a number"),
+            ("NaN", "not a number"),
+            ("", "no digits"),
+            (",", "no digits"),
+        ] {
+            let e = parse_count(text).unwrap_err();
+            assert!(e.contains(why), "{text}: {e}");
+        }
+    }
+
+    #[test]
+    fn an_unreadable_variable_is_an_error_naming_it() {
+        // A variable no other test reads: the environment is shared by the test threads.
+        const PROBE: Limit = Limit {
+            what: "probes",
+            env: "SPDCAM_MAX_TEST_PROBE_OF_THE_PARSER",
+            default: 7,
+        };
+        assert_eq!(PROBE.value().unwrap(), 7);
+        std::env::set_var(PROBE.env, "1,000,000");
+        assert_eq!(PROBE.value().unwrap(), 1_000_000);
+        std::env::set_var(PROBE.env, "1e6");
+        assert_eq!(PROBE.value().unwrap(), 1_000_000);
+        std::env::set_var(PROBE.env, "a million");
+        let e = PROBE.value().unwrap_err().to_string();
+        assert!(
+            e.contains(PROBE.env) && e.contains("a million") && e.contains("1e6"),
+            "{e}"
+        );
+        assert_eq!(PROBE.exceeded("x").to_string(), e);
+        assert!(PROBE.check(1, "x").is_err());
+        std::env::remove_var(PROBE.env);
     }
 
     #[test]

@@ -69,7 +69,7 @@ impl FeatureRows {
             .map_err(|e| InferError::invalid(format!("{shown}: {e}")))?;
         spdcam_core::limits::check_csv_columns(header.len(), shown)?;
         let names: Vec<String> = header.iter().map(str::to_string).collect();
-        let max_rows = spdcam_core::limits::CSV_ROWS.value();
+        let max_rows = spdcam_core::limits::CSV_ROWS.value()?;
         if names.iter().all(String::is_empty) {
             return Err(InferError::invalid(format!("{shown}: the file is empty")));
         }
@@ -286,10 +286,12 @@ pub struct Estimate {
     pub model: String,
     /// The relative SPD, peak 1, on the estimator's wavelengths.
     pub spd: Spd,
-    /// xy, CCT, Duv of the SPD.
+    /// xy, CCT, Duv of the model's whole estimate (on the model's wavelengths, whatever
+    /// part of them [`Estimate::spd`] shows).
     pub colorimetry: Colorimetry,
-    /// The lighting-quality metrics of the SPD (CRI, TM-30, α-opic, S/P, PPF, blue-light
-    /// hazard; `spdcam_core::quality`), computed on the SPD's grid only.
+    /// The lighting-quality metrics (CRI, TM-30, α-opic, S/P, PPF, blue-light hazard;
+    /// `spdcam_core::quality`) of the model's whole estimate, computed on the model's
+    /// wavelengths only.
     pub metrics: LightingMetrics,
     /// The score against a true SPD, when one was given.
     pub truth: Option<Score>,

@@ -49,6 +49,9 @@ struct Prepared {
     /// The charts photos are searched for without `PhotoOptions::chart`; `None` when they
     /// cannot be made (the error is made again when a photo needs them).
     templates: Option<Vec<ChartTemplate>>,
+    /// Per model of `models`, in order: its chart on the model's grid, for the absolute
+    /// levels; `None` when its reflectances are not at hand.
+    charts: Vec<Option<Arc<Chart>>>,
     data_dir: DataDir,
 }
 
@@ -58,9 +61,6 @@ struct OnGrid {
     /// The model's wavelengths to the output's; `None` when the output lies outside them
     /// (the error is made again when an estimate needs the model).
     map: Option<GridMap>,
-    /// The model's chart on the output grid, for the absolute levels; `None` when its
-    /// reflectances are not at hand.
-    chart: Option<Arc<Chart>>,
 }
 
 /// Turns photos and feature rows into judged estimates of the light (see the module's
@@ -108,10 +108,20 @@ impl Estimator {
             })
             .collect::<Result<Vec<_>>>()?;
         let templates = chart_templates(&models, None, &data_dir).ok();
+        let charts = models
+            .models()
+            .iter()
+            .map(|m| {
+                let name = m.model.header().chart.as_deref()?;
+                let chart = Chart::resolve(name, None, &data_dir, &m.model.grid()).ok()?;
+                Some(Arc::new(chart))
+            })
+            .collect();
         let prepared = Arc::new(Prepared {
             models,
             trust,
             templates,
+            charts,
             data_dir,
         });
         Estimator::with(prepared, grid)
@@ -122,21 +132,32 @@ impl Estimator {
         Estimator::new(ModelSet::shipped()?, data_dir, grid)
     }
 
+    /// The estimator of `prepared` on the output grid `grid`, which must hold two or more
+    /// wavelengths within one model's at least (an SPD is not one wavelength's value, and
+    /// no model says anything outside its own range).
     fn with(prepared: Arc<Prepared>, grid: Grid) -> Result<Estimator> {
-        let on_grid = prepared
+        if grid.count < 2 {
+            return Err(InferError::invalid(format!(
+                "the range {}: a single wavelength is not a spectrum; give START-END[:STEP] \
+                 with END above START (e.g. 400-700:5)",
+                grid.label()
+            )));
+        }
+        let maps: Vec<Result<GridMap>> = prepared
             .models
             .models()
             .iter()
-            .map(|m| OnGrid {
-                map: GridMap::new(&m.model.grid(), &grid).ok(),
-                chart: m
-                    .model
-                    .header()
-                    .chart
-                    .as_deref()
-                    .and_then(|name| Chart::resolve(name, None, &prepared.data_dir, &grid).ok())
-                    .map(Arc::new),
-            })
+            .map(|m| GridMap::new(&m.model.grid(), &grid))
+            .collect();
+        if maps.iter().all(Result::is_err) {
+            if let Some(Err(e)) = maps.into_iter().next() {
+                return Err(e);
+            }
+            return Err(InferError::invalid("no model to estimate with"));
+        }
+        let on_grid = maps
+            .into_iter()
+            .map(|map| OnGrid { map: map.ok() })
             .collect();
         Ok(Estimator {
             prepared,
@@ -498,8 +519,11 @@ impl Estimator {
             flags,
         )?;
         self.bands_on_grid(&mut trust, map)?;
+        // The colorimetry, the metrics and the absolute level are of the model's whole
+        // estimate, whatever part of it the output grid shows.
+        let full = Spd::new(chosen.model.grid(), model_spd.clone())?;
         let spd = Spd::new(self.grid, map.apply(model_spd))?;
-        let metrics = LightingMetrics::of_spd(&spd);
+        let metrics = LightingMetrics::of_spd(&full);
         let absolute = match &photo {
             Some(analysis) => {
                 let unusable: Vec<bool> = (0..flags.clipped.len())
@@ -510,8 +534,8 @@ impl Estimator {
                     Some(chart) => absolute_level(
                         analysis,
                         chart,
-                        self.on_grid[index].chart.as_deref(),
-                        &spd,
+                        self.prepared.charts[index].as_deref(),
+                        &full,
                         &metrics,
                         &unusable,
                     )?,
@@ -523,7 +547,7 @@ impl Estimator {
         Ok(Estimate {
             name,
             model: chosen.name.clone(),
-            colorimetry: Colorimetry::of(&spd)?,
+            colorimetry: Colorimetry::of(&full)?,
             metrics,
             spd,
             truth: None,
@@ -727,21 +751,39 @@ mod tests {
         for (k, v) in e.spd.iter().enumerate() {
             assert!((v - fine.spd[2 * k]).abs() < 1e-12, "at {k}");
         }
-        let u = e.trust.unwrap().uncertainty.unwrap();
+        let u = e.trust.as_ref().unwrap().uncertainty.as_ref().unwrap();
         assert_eq!(u.band95.lower.grid(), coarse.grid());
         assert_eq!(u.band68.upper.len(), 31);
+        // Issue 39: the colorimetry, the metrics and the verdict are the whole estimate's,
+        // whatever range is shown.
+        let narrow = estimator
+            .on_grid(Grid::parse("500-600:5").unwrap())
+            .unwrap()
+            .estimate_photo(&path, &PhotoOptions::default())
+            .unwrap();
+        for other in [&e, &narrow] {
+            assert_eq!(other.colorimetry, fine.colorimetry);
+            assert_eq!(other.metrics, fine.metrics);
+            assert_eq!(
+                other.trust.as_ref().unwrap().verdict,
+                fine.trust.as_ref().unwrap().verdict
+            );
+        }
     }
 
     #[test]
-    fn a_range_beyond_the_model_is_named_when_estimating() {
-        let wide = shipped()
-            .on_grid(Grid::parse("380-780:5").unwrap())
-            .unwrap();
-        let err = wide
-            .estimate_photo(&example_photo(), &PhotoOptions::default())
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("the model estimates"), "{err}");
+    fn a_range_beyond_the_model_or_of_one_wavelength_is_refused() {
+        for (range, expected) in [
+            ("380-780:5", "the model estimates"),
+            ("550-550", "single wavelength"),
+        ] {
+            let err = shipped()
+                .on_grid(Grid::parse(range).unwrap())
+                .err()
+                .unwrap_or_else(|| panic!("{range} was taken"))
+                .to_string();
+            assert!(err.contains(expected), "{err}");
+        }
     }
 
     #[test]

@@ -103,6 +103,13 @@ impl Gram {
                 diagonal.len()
             )));
         }
+        if let Some(bad) = diagonal.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            return Err(InferError::invalid(format!(
+                "ridge penalty {} is not a finite number ≥ 0 (too large a penalty overflows); \
+                 use a smaller one",
+                spdcam_core::error::short_number(*bad)
+            )));
+        }
         let mut a = self.xtx.clone();
         for (j, &shift) in diagonal.iter().enumerate() {
             a[(j, j)] += shift;
@@ -125,7 +132,13 @@ impl Gram {
         }
         let solved = a
             .llt(Side::Lower)
-            .map_err(|e| InferError::Numerical(format!("ridge regression: {e:?}")))?
+            .map_err(|e| {
+                InferError::Numerical(format!(
+                    "ridge regression: XᵀX + Λ is not positive definite ({e:?}): the inputs are \
+                     not finite, too large, or linearly dependent without a penalty; scale the \
+                     inputs or give a positive penalty"
+                ))
+            })?
             .solve(&b);
         Ok(Ridge {
             weights: solved.transpose().to_owned(),

@@ -9,7 +9,7 @@
 
 use crate::error::{InferError, Result};
 use rayon::prelude::*;
-use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
+use spdcam_core::spectral::{clamp_undershoot, Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_core::{feature_check, limits};
 use std::io::{Read, Write};
 use std::path::Path;
@@ -63,7 +63,7 @@ impl FeatureStream {
             line: 1,
             finished: false,
         };
-        let max_columns = limits::CSV_COLUMNS.value();
+        let max_columns = limits::CSV_COLUMNS.value()?;
         // Bytes of the header looked at so far, and the separators among them.
         let (mut scanned, mut separators) = (0, 0u64);
         let header = loop {
@@ -127,7 +127,7 @@ impl FeatureStream {
     /// [`limits::TEXT_FILE_BYTES`]: a stream without line breaks (`/dev/zero`) must not
     /// fill the memory.
     fn check_line_length(&self, line: usize) -> Result<()> {
-        if self.pending.len() as u64 > limits::TEXT_FILE_BYTES.value() {
+        if self.pending.len() as u64 > limits::TEXT_FILE_BYTES.value()? {
             return Err(limits::TEXT_FILE_BYTES
                 .exceeded(&format!("{} line {line} (one line)", self.source))
                 .into());
@@ -246,7 +246,8 @@ fn parse_row(line: &[u8], names: &[String], out: &mut Vec<f64>) -> std::result::
 
 /// SPDs of the model's grid taken to another grid (within it) by the interpolation
 /// [`SpectralSet::resample`] uses, precomputed as a matrix: resampling is linear in the
-/// values, so row `j` of the matrix is the resampled unit spectrum `eⱼ`.
+/// values, so row `j` of the matrix is the resampled unit spectrum `eⱼ`; as in
+/// [`SpectralSet::resample`], a non-negative SPD's undershoots are then set to zero.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GridMap {
     from: usize,
@@ -281,7 +282,8 @@ impl GridMap {
             .collect();
         let names = (0..from.count).map(|j| format!("e{j}")).collect();
         let set = SpectralSet::on_grid(from, names, units)?;
-        let (resampled, _) = set.resample(to, Interpolation::Auto, Extrapolation::HoldEdge)?;
+        let (resampled, _) =
+            set.resample_unclamped(to, Interpolation::Auto, Extrapolation::HoldEdge)?;
         let matrix = (0..from.count)
             .flat_map(|j| resampled.item(j).to_vec())
             .collect();
@@ -306,6 +308,7 @@ impl GridMap {
                         *o += v * w;
                     }
                 }
+                clamp_undershoot(s, o);
             });
         out
     }

@@ -124,6 +124,15 @@ fn main() -> ExitCode {
         eprintln!("error: {e}");
         return ExitCode::FAILURE;
     }
+    // A limit's variable that is not a number is named before any work, whichever limits
+    // the command meets.
+    if let Some(e) = spdcam_core::limits::ALL
+        .iter()
+        .find_map(|l| l.value().err())
+    {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Render(args) => render::run(*args, &data_dir),
         Command::Generate(args) => generate::run(*args, &data_dir),

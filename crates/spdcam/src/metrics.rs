@@ -5,6 +5,7 @@ use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use spdcam_core::builtin::DataDir;
+use spdcam_core::fsio;
 use spdcam_core::light::resolve_spd;
 use spdcam_core::quality::{LightSpectrum, LightingMetrics, QUALITY_GRID};
 use spdcam_core::spectral::SpectralSet;
@@ -48,7 +49,7 @@ pub fn run(args: MetricsArgs, data_dir: &DataDir) -> Result<()> {
 /// The lights `spec` names, with their metrics: every column of a CSV file, or one light.
 fn lights(spec: &str, data_dir: &DataDir) -> Result<Vec<Row>> {
     let path = Path::new(spec);
-    if path.is_file() {
+    if fsio::is_input(path) {
         let set = SpectralSet::read_csv(path)?;
         return Ok((0..set.len())
             .map(|i| Row {

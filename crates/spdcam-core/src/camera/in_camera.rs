@@ -22,7 +22,7 @@ use super::scene::UnevenLighting;
 use super::sensor::AutoExposure;
 use super::tone::ToneRendering;
 use super::Camera;
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::minimise::nelder_mead;
 use crate::spectral::Spd;
 use serde::{Deserialize, Serialize};
@@ -143,7 +143,8 @@ impl InCamera {
             }
             if !(x.is_finite() && x >= lo && x <= hi) {
                 return Err(Error::invalid(format!(
-                    "in-camera {name} {x} is outside [{lo}, {hi}]"
+                    "in-camera {name} {} is outside [{lo}, {hi}]",
+                    short_number(x)
                 )));
             }
         }

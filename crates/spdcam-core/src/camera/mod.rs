@@ -32,7 +32,7 @@ pub mod white_balance;
 
 use crate::chart::Chart;
 use crate::colorimetry::Observer;
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::illuminant::StandardIlluminant;
 use crate::raster::{Mosaic, RgbImage};
 use crate::sampler::{self, SampleBuffers};
@@ -308,7 +308,8 @@ impl Camera {
             .find(|(_, v)| !v.is_finite() || **v < 0.0)
         {
             return Err(Error::invalid(format!(
-                "the SPD is {v} at {} nm; it must be finite and non-negative",
+                "the SPD is {} at {} nm; it must be finite and non-negative",
+                short_number(*v),
                 self.grid.wavelength(i)
             )));
         }

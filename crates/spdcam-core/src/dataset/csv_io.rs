@@ -7,8 +7,9 @@ use super::manifest::{ImportSource, Manifest, Origin, FEATURE_SCALE};
 use super::reader::Dataset;
 use super::spd_map::SpdMap;
 use super::writer::{prepare_output, DatasetWriter};
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::fsio;
+use crate::light::SPD_NEGATIVE_TOLERANCE;
 use crate::lighting::Lighting;
 use crate::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use std::io::Write;
@@ -121,16 +122,17 @@ impl MeasuredPhotos {
     pub fn read(features: &Path, spds: &Path, grid: &Grid) -> Result<MeasuredPhotos> {
         let (_, feature_rows) = read_rows(features)?;
         let (header, spd_rows) = read_rows(spds)?;
+        let wavelengths = wavelength_columns(&header, spds)?;
         if feature_rows.len() != spd_rows.len() {
             return Err(Error::invalid(format!(
-                "{} has {} photos but {} has {} SPDs",
+                "{} has {} photos but {} has {} SPDs; the two files need one row per photo, \
+                 in the same order",
                 features.display(),
                 feature_rows.len(),
                 spds.display(),
                 spd_rows.len()
             )));
         }
-        let wavelengths = wavelength_columns(&header, spds)?;
         let names = (0..spd_rows.len()).map(|i| format!("s{i}")).collect();
         let set = SpectralSet::new(wavelengths, names, spd_rows)?;
         let (set, _) = set.resample(grid, Interpolation::Linear, Extrapolation::Zero)?;
@@ -338,8 +340,23 @@ pub fn import_csv(
     })
 }
 
-/// The wavelengths named by an SPD file's header.
+/// The wavelengths named by an SPD file's header. A spectral CSV (one wavelength per row,
+/// `wavelength_nm` first) is told apart and refused with the layout expected.
 fn wavelength_columns(header: &[String], path: &Path) -> Result<Vec<f64>> {
+    if header.first().is_some_and(|h| {
+        h.eq_ignore_ascii_case("wavelength_nm") || h.eq_ignore_ascii_case("wavelength")
+    }) {
+        return Err(Error::parse(
+            path.display().to_string(),
+            format!(
+                "line 1 starts with '{}': the file is a spectral CSV, one wavelength per row \
+                 and one column per SPD; SPDs here are one per row: a header of the \
+                 wavelengths in nm (380,385,…,780), then one row per photo, in the order of \
+                 the features; transpose the table",
+                header[0]
+            ),
+        ));
+    }
     let wavelengths: Vec<f64> = header
         .iter()
         .map(|h| {
@@ -383,19 +400,23 @@ fn wavelength_columns(header: &[String], path: &Path) -> Result<Vec<f64>> {
 /// has 0.38–0.78).
 const MIN_WAVELENGTH_NM: f64 = 100.0;
 
-/// The SPD of one row, as `render --spd` accepts one: negative values beyond 1 % of the
-/// peak are refused (small ones, measurement noise, become zero), and so is an SPD that is
+/// The SPD of one row, as `render --spd` accepts one: negative values beyond
+/// [`SPD_NEGATIVE_TOLERANCE`] of the peak are refused (small ones, measurement noise, become zero), and so is an SPD that is
 /// zero everywhere.
 fn physical_spd(values: &[f64], wavelengths: &[f64]) -> Result<Vec<f64>> {
     let peak = values.iter().cloned().fold(0.0f64, f64::max);
     if let Some((i, v)) = values
         .iter()
         .enumerate()
-        .find(|(_, v)| **v < -0.01 * peak.max(f64::MIN_POSITIVE))
+        .find(|(_, v)| **v < -SPD_NEGATIVE_TOLERANCE * peak.max(f64::MIN_POSITIVE))
     {
         return Err(Error::invalid(format!(
-            "the SPD is negative ({v}) at {} nm; light cannot be negative",
-            wavelengths[i]
+            "the SPD is negative ({}) at {} nm, beyond {} % of its peak ({}); light cannot be \
+             negative (smaller negatives are taken as noise and set to 0): correct that value",
+            short_number(*v),
+            short_number(wavelengths[i]),
+            short_number(100.0 * SPD_NEGATIVE_TOLERANCE),
+            short_number(peak)
         )));
     }
     if peak <= 0.0 {

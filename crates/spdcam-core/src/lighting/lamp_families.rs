@@ -573,8 +573,9 @@ impl LampDraws {
             })?;
         if !(spread.is_finite() && (0.0..=10.0).contains(&spread)) {
             return Err(Error::invalid(format!(
-                "lamp:{}: spread {spread} is outside 0–10",
-                family.name()
+                "lamp:{}: spread {} is outside 0–10",
+                family.name(),
+                crate::error::short_number(spread)
             )));
         }
         let params = family.params();

@@ -223,7 +223,7 @@ pub fn sort_corners(corners: &[[f64; 2]], width: usize, height: usize) -> Result
             "corners {} do not form a convex quadrilateral with sides of at least 4 px",
             corners
                 .iter()
-                .map(|p| format!("({}, {})", p[0], p[1]))
+                .map(|p| format!("({}, {})", short_number(p[0]), short_number(p[1])))
                 .collect::<Vec<_>>()
                 .join(" ")
         )));

@@ -189,10 +189,38 @@ fn drop_alpha<T: Copy>(mut rgba: Vec<T>) -> Vec<T> {
 }
 
 /// Reads a photo (JPEG, PNG 8/16-bit, TIFF; format from the content) from a file, a pipe
-/// or a device, at most [`limits::PHOTO_BYTES`] of it, applying its EXIF orientation.
+/// or a device, at most [`limits::PHOTO_BYTES`] of it, applying its EXIF orientation. Its
+/// first bytes are checked for the signature of one of those formats before the rest is
+/// read, so that anything else (`/dev/zero`, a CSV) is refused at once.
 pub fn load_photo(path: &Path) -> Result<Photo> {
-    let bytes = fsio::read_limited(path, &limits::PHOTO_BYTES)?;
-    decode_photo(&bytes, &path.display().to_string())
+    let source = path.display().to_string();
+    let bytes =
+        fsio::read_limited_checked(
+            path,
+            &limits::PHOTO_BYTES,
+            8,
+            |head| match fsio::image_format(head) {
+                Some(_) => Ok(()),
+                None => Err(Error::Image {
+                    context: source.clone(),
+                    message: format!(
+                        "not a JPEG, PNG or TIFF image ({}); spdcam reads photos \
+                     in those formats",
+                        describe_head(head)
+                    ),
+                }),
+            },
+        )?;
+    decode_photo(&bytes, &source)
+}
+
+/// The first bytes of a file for a message: that it is empty, else up to 8 bytes in hex.
+fn describe_head(head: &[u8]) -> String {
+    if head.is_empty() {
+        return "it is empty".into();
+    }
+    let shown: Vec<String> = head.iter().take(8).map(|b| format!("{b:02X}")).collect();
+    format!("it starts with the bytes {}", shown.join(" "))
 }
 
 /// Decodes a photo held in memory; `source` names it in messages. The pixel count is read
@@ -211,7 +239,7 @@ pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
             "not an image in a supported format (JPEG, PNG, TIFF)".into(),
         ));
     };
-    let max_pixels = limits::IMAGE_PIXELS.value();
+    let max_pixels = limits::IMAGE_PIXELS.value()?;
     let mut decode_limits = image::Limits::default();
     decode_limits.max_alloc = Some(max_pixels.saturating_mul(DECODE_BYTES_PER_PIXEL));
     reader.limits(decode_limits);

@@ -12,7 +12,7 @@ use super::ChartTemplate;
 use crate::camera::optics::{Glow, LensBlur, Vignetting};
 use crate::camera::{self, Camera};
 use crate::chart::Layout;
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::imageio;
 use crate::limits;
 use crate::raster::RgbImage;
@@ -526,8 +526,10 @@ fn check_placement(options: &SceneOptions) -> Result<()> {
     if let Some([x, y]) = options.centre {
         if !((0.0..=1.0).contains(&x) && (0.0..=1.0).contains(&y)) {
             return Err(Error::invalid(format!(
-                "the chart's centre {x},{y} must lie in the photo: shares of its width and \
-                 height, 0…1"
+                "the chart's centre {},{} must lie in the photo: shares of its width and \
+                 height, 0…1",
+                short_number(x),
+                short_number(y)
             )));
         }
     }

@@ -1,6 +1,6 @@
 //! Regular wavelength grids.
 
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::limits;
 use serde::{Deserialize, Serialize};
 
@@ -35,20 +35,21 @@ impl Grid {
 
     /// A grid from `start` to `end` inclusive in steps of `step` nanometres.
     pub fn new(start: f64, end: f64, step: f64) -> Result<Grid> {
+        let (a, b, s) = (short_number(start), short_number(end), short_number(step));
         if !(start.is_finite() && end.is_finite() && step.is_finite()) || step <= 0.0 || end < start
         {
             return Err(Error::invalid(format!(
-                "wavelength range {start}-{end} nm at {step} nm is not a valid grid (need start <= end, step > 0)"
+                "wavelength range {a}-{b} nm at {s} nm is not a valid grid (need start <= end, step > 0)"
             )));
         }
         let steps = (end - start) / step;
         limits::GRID_BANDS.check_f64(
             steps.round() + 1.0,
-            &format!("wavelength range {start}-{end} nm at {step} nm"),
+            &format!("wavelength range {a}-{b} nm at {s} nm"),
         )?;
         if (steps - steps.round()).abs() > 1e-6 {
             return Err(Error::invalid(format!(
-                "wavelength range {start}-{end} nm is not a whole number of {step} nm steps"
+                "wavelength range {a}-{b} nm is not a whole number of {s} nm steps"
             )));
         }
         Ok(Grid {

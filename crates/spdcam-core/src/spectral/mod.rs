@@ -7,6 +7,6 @@ mod set;
 mod spd;
 
 pub use grid::Grid;
-pub use resample::{Extrapolation, Interpolation, ResampleReport};
+pub use resample::{clamp_undershoot, Extrapolation, Interpolation, ResampleReport};
 pub use set::SpectralSet;
 pub use spd::{normalise_peak, Spd};

@@ -86,12 +86,38 @@ const SPRAGUE_BOUNDARY: [[f64; 6]; 4] = [
 
 impl SpectralSet {
     /// Resamples every item onto `grid`. Target wavelengths outside the source range get
-    /// `extrapolation`; the report says how many did.
+    /// `extrapolation`; the report says how many did. An item with no negative value stays
+    /// non-negative: Sprague's quintic overshoots below zero beside a spike or a zero end
+    /// (a fluorescent lamp's lines, a table ending in 0 at 780 nm), and those undershoots,
+    /// which the data never held, are set to zero.
     pub fn resample(
         &self,
         grid: &Grid,
         interpolation: Interpolation,
         extrapolation: Extrapolation,
+    ) -> Result<(SpectralSet, ResampleReport)> {
+        self.resample_with(grid, interpolation, extrapolation, true)
+    }
+
+    /// [`SpectralSet::resample`] without setting the undershoots of non-negative items to
+    /// zero: linear in the values, so that a resampling matrix can be built from it (the
+    /// resampled unit spectra are its rows). Apply [`clamp_undershoot`] to what the matrix
+    /// gives to have [`SpectralSet::resample`]'s result.
+    pub fn resample_unclamped(
+        &self,
+        grid: &Grid,
+        interpolation: Interpolation,
+        extrapolation: Extrapolation,
+    ) -> Result<(SpectralSet, ResampleReport)> {
+        self.resample_with(grid, interpolation, extrapolation, false)
+    }
+
+    fn resample_with(
+        &self,
+        grid: &Grid,
+        interpolation: Interpolation,
+        extrapolation: Extrapolation,
+        clamp: bool,
     ) -> Result<(SpectralSet, ResampleReport)> {
         let x = self.wavelengths();
         if x.len() < 2 {
@@ -125,7 +151,7 @@ impl SpectralSet {
             .iter()
             .map(|y| {
                 let padded = (method == Interpolation::Sprague1880).then(|| sprague_pad(y));
-                targets
+                let mut out: Vec<f64> = targets
                     .iter()
                     .map(|&t| {
                         if t < lo - eps {
@@ -140,7 +166,11 @@ impl SpectralSet {
                             None => linear_at(x, y, t),
                         }
                     })
-                    .collect()
+                    .collect();
+                if clamp {
+                    clamp_undershoot(y, &mut out);
+                }
+                out
             })
             .collect();
         let set = SpectralSet::on_grid(grid, self.names().to_vec(), values)?;
@@ -154,6 +184,18 @@ impl SpectralSet {
                 extrapolation,
             },
         ))
+    }
+}
+
+/// Sets the negative values of `resampled` to zero when its `source` has none: an
+/// interpolation's undershoot, not the data's.
+pub fn clamp_undershoot(source: &[f64], resampled: &mut [f64]) {
+    if source.iter().all(|&v| v >= 0.0) {
+        // Not `max`, which would make a NaN 0: a non-finite value is left to be refused.
+        resampled
+            .iter_mut()
+            .filter(|v| **v < 0.0)
+            .for_each(|v| *v = 0.0);
     }
 }
 
@@ -267,6 +309,41 @@ mod tests {
                 .to_string();
             assert!(e.contains("550 nm") && e.contains("at least two"), "{e}");
         }
+    }
+
+    #[test]
+    fn a_non_negative_spectrum_stays_non_negative() {
+        // Issue 39: a lamp at 5 nm with a spike and 0 at 780 nm rang below zero on 1 nm.
+        let x: Vec<f64> = (0..81).map(|i| 380.0 + 5.0 * i as f64).collect();
+        let mut y: Vec<f64> = x.iter().map(|w| 0.02 * (780.0 - w) / 400.0).collect();
+        y[34] = 1.0; // 550 nm
+        y[80] = 0.0;
+        let set = SpectralSet::new(x, vec!["lamp".into()], vec![y]).unwrap();
+        let grid = Grid::new(380.0, 780.0, 1.0).unwrap();
+        let (raw, _) = set
+            .resample_unclamped(&grid, Interpolation::Sprague1880, Extrapolation::Zero)
+            .unwrap();
+        assert!(
+            raw.item(0).iter().any(|&v| v < 0.0),
+            "no undershoot to test"
+        );
+        let (out, _) = set
+            .resample(&grid, Interpolation::Sprague1880, Extrapolation::Zero)
+            .unwrap();
+        assert!(out.item(0).iter().all(|&v| v >= 0.0));
+        for (a, b) in out.item(0).iter().zip(raw.item(0)) {
+            assert!(*b < 0.0 || a == b);
+        }
+        // Negative data keeps its negatives (it is refused or accepted by what holds it).
+        let signed = line_set((0..=10).map(|i| 10.0 + 10.0 * i as f64).collect());
+        let (out, _) = signed
+            .resample(
+                &Grid::new(10.0, 110.0, 1.0).unwrap(),
+                Interpolation::Auto,
+                Extrapolation::Zero,
+            )
+            .unwrap();
+        assert!(out.item(0)[0] < 0.0);
     }
 
     #[test]

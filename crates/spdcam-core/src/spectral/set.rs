@@ -1,6 +1,6 @@
 //! Named spectra sharing one list of wavelengths, and the spectral CSV layout.
 
-use crate::error::{Error, Result};
+use crate::error::{short_number, Error, Result};
 use crate::spectral::{Grid, Spd};
 use crate::{fsio, limits};
 use std::collections::HashSet;
@@ -138,7 +138,7 @@ impl SpectralSet {
         let mut wavelengths = Vec::new();
         let mut values = vec![Vec::new(); names.len()];
         let max_rows = if limited {
-            limits::CSV_ROWS.value()
+            limits::CSV_ROWS.value()?
         } else {
             u64::MAX
         };
@@ -186,6 +186,7 @@ impl SpectralSet {
         if wavelengths.len() < 2 {
             return Err(err("fewer than two wavelength rows".into()));
         }
+        check_nanometres(&wavelengths).map_err(err)?;
         SpectralSet::new(wavelengths, names, values).map_err(|e| err(e.to_string()))
     }
 
@@ -337,23 +338,95 @@ impl SpectralSet {
     /// Rejects values below `-tolerance × max` of their item (physically meaningless for
     /// `kind`, e.g. a reflectance) and clamps the remaining small negatives (measurement
     /// noise) to zero.
-    pub fn require_non_negative(mut self, kind: &str, tolerance: f64) -> Result<Self> {
+    pub fn require_non_negative(self, kind: &str, tolerance: f64) -> Result<Self> {
+        self.clamp_negative_noise(kind, None, tolerance)
+            .map(|(set, _)| set)
+    }
+
+    /// [`SpectralSet::require_non_negative`] for a set read from `source` (a file, named
+    /// in the messages with the column): negatives no larger than `tolerance` × the item's
+    /// peak are measurement noise (a spectrometer's dark-subtracted ends) and set to zero,
+    /// each item so changed given a note saying so; a larger negative is refused, naming
+    /// the column, the wavelength, the value and the tolerance.
+    pub fn clamp_negative_noise(
+        mut self,
+        kind: &str,
+        source: Option<&str>,
+        tolerance: f64,
+    ) -> Result<(Self, Vec<String>)> {
+        let mut notes = Vec::new();
+        let percent = short_number(100.0 * tolerance);
         for (name, v) in self.names.iter().zip(self.values.iter_mut()) {
-            let max = v.iter().cloned().fold(0.0f64, f64::max);
-            if let Some((i, x)) = v
-                .iter()
-                .enumerate()
-                .find(|(_, x)| **x < -tolerance * max.max(f64::MIN_POSITIVE))
-            {
+            let whose = match source {
+                Some(source) => format!("{source}, column '{name}'"),
+                None => format!("{kind} '{name}'"),
+            };
+            let peak = v.iter().cloned().fold(0.0f64, f64::max);
+            let floor = -tolerance * peak.max(f64::MIN_POSITIVE);
+            if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| **x < floor) {
                 return Err(Error::invalid(format!(
-                    "{kind} '{name}' is negative ({x}) at {} nm; a {kind} cannot be negative",
-                    self.wavelengths[i]
+                    "{whose}: the {kind} is {} at {} nm, more negative than −{percent} % of \
+                     its peak ({}); a {kind} cannot be negative (negatives within {percent} % \
+                     of the peak are taken as noise and set to 0): correct that value",
+                    short_number(*x),
+                    short_number(self.wavelengths[i]),
+                    short_number(peak)
                 )));
+            }
+            let negative: Vec<usize> = (0..v.len()).filter(|&i| v[i] < 0.0).collect();
+            if let Some(&lowest) = negative.iter().min_by(|&&a, &&b| v[a].total_cmp(&v[b])) {
+                notes.push(format!(
+                    "{whose}: {} negative value(s) of the {kind}, down to {} at {} nm, within \
+                     {percent} % of its peak ({}), set to 0 as measurement noise",
+                    negative.len(),
+                    short_number(v[lowest]),
+                    short_number(self.wavelengths[lowest]),
+                    short_number(peak)
+                ));
             }
             v.iter_mut().for_each(|x| *x = x.max(0.0));
         }
-        Ok(self)
+        Ok((self, notes))
     }
+}
+
+/// Wavelengths in nm lie somewhere within this range (nm): the ultraviolet from UV-C to
+/// the near infrared of silicon and InGaAs sensors.
+const PLAUSIBLE_NM: (f64, f64) = (200.0, 2500.0);
+
+/// Refuses wavelengths (sorted) of which none lies within [`PLAUSIBLE_NM`]: they are not in
+/// nanometres (micrometres, 0.38–0.78, or ångström, 3800–7800, most likely), and read as
+/// nm they would describe no visible light at all, a confident answer to a mistake.
+fn check_nanometres(wavelengths: &[f64]) -> std::result::Result<(), String> {
+    let (lo, hi) = (wavelengths[0], wavelengths[wavelengths.len() - 1]);
+    if hi >= PLAUSIBLE_NM.0 && lo <= PLAUSIBLE_NM.1 {
+        return Ok(());
+    }
+    let found = format!(
+        "the wavelengths run from {} to {}",
+        crate::error::short_number(lo),
+        crate::error::short_number(hi)
+    );
+    let guess = if lo >= 0.1 && hi <= 2.5 {
+        format!(
+            "; they look like micrometres (µm): multiply them by 1000 ({}–{} nm)",
+            crate::error::short_number(lo * 1000.0),
+            crate::error::short_number(hi * 1000.0)
+        )
+    } else if lo >= 2000.0 && hi <= 25000.0 {
+        format!(
+            "; they look like ångström (Å): divide them by 10 ({}–{} nm)",
+            crate::error::short_number(lo / 10.0),
+            crate::error::short_number(hi / 10.0)
+        )
+    } else {
+        String::new()
+    };
+    Err(format!(
+        "{found}, none within {}–{} nm{guess}; the first column holds wavelengths in \
+         nanometres (nm)",
+        PLAUSIBLE_NM.0, PLAUSIBLE_NM.1
+    ))
 }
 
 /// Shortest text that reads back to the same `f64`.
@@ -432,6 +505,22 @@ mod tests {
     }
 
     #[test]
+    fn wavelengths_not_in_nanometres_are_named() {
+        let e = parse_err("wavelength_nm,a\n0.38,1\n0.58,2\n0.78,1\n");
+        assert!(
+            e.contains("0.38 to 0.78") && e.contains("micrometres") && e.contains("380–780 nm"),
+            "{e}"
+        );
+        let e = parse_err("wavelength_nm,a\n3800,1\n7800,1\n");
+        assert!(e.contains("ångström") && e.contains("380–780 nm"), "{e}");
+        let e = parse_err("wavelength_nm,a\n1e9,1\n2e9,1\n");
+        assert!(e.contains("1e9 to 2e9") && e.contains("nanometres"), "{e}");
+        // Ultraviolet and near-infrared data are nanometres.
+        assert!(SpectralSet::from_csv_str("wavelength_nm,a\n250,1\n350,1\n", "uv").is_ok());
+        assert!(SpectralSet::from_csv_str("wavelength_nm,a\n900,1\n2400,1\n", "ir").is_ok());
+    }
+
+    #[test]
     fn negative_values_rejected_small_noise_clamped() {
         let set = SpectralSet::from_csv_str("wavelength_nm,a\n400,-0.5\n410,1\n", "f").unwrap();
         let e = set.require_non_negative("reflectance", 0.01).unwrap_err();
@@ -439,6 +528,27 @@ mod tests {
         let set = SpectralSet::from_csv_str("wavelength_nm,a\n400,-0.001\n410,1\n", "f").unwrap();
         let ok = set.require_non_negative("reflectance", 0.01).unwrap();
         assert_eq!(ok.item(0), [0.0, 1.0]);
+        // Issue 39: the file, the column, the wavelength, the value and the tolerance named.
+        let set = SpectralSet::from_csv_str("wavelength_nm,a\n400,-0.02\n410,1\n", "f").unwrap();
+        let e = set
+            .clamp_negative_noise("SPD", Some("lamp.csv"), 0.01)
+            .unwrap_err()
+            .to_string();
+        for part in ["lamp.csv, column 'a'", "-0.02", "400 nm", "1 %"] {
+            assert!(e.contains(part), "{part}: {e}");
+        }
+        let set =
+            SpectralSet::from_csv_str("wavelength_nm,a\n400,-0.004\n410,1\n420,-0.001\n", "f")
+                .unwrap();
+        let (ok, notes) = set
+            .clamp_negative_noise("SPD", Some("lamp.csv"), 0.01)
+            .unwrap();
+        assert_eq!(ok.item(0), [0.0, 1.0, 0.0]);
+        assert_eq!(notes.len(), 1);
+        assert!(
+            notes[0].contains("2 negative") && notes[0].contains("-0.004 at 400 nm"),
+            "{notes:?}"
+        );
     }
 
     #[test]

@@ -53,7 +53,9 @@ pub struct EstimateArgs {
     /// estimates, long above.
     #[arg(long, value_enum, value_name = "wide|long")]
     layout: Option<LayoutArg>,
-    /// Wavelength grid of the output, START-END[:STEP] in nm (within the model's grid).
+    /// Wavelength grid of the output, START-END[:STEP] in nm (within the model's grid, two
+    /// wavelengths at least). It changes what is printed and written only: the colorimetry,
+    /// the metrics and the verdict are the model's whole estimate's.
     #[arg(long, default_value = "400-700:5", value_name = "START-END[:STEP]")]
     range: String,
     /// Also plot the estimates (SVG or PNG, by the name's extension), with CIE xy, CCT and

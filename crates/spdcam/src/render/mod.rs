@@ -168,10 +168,14 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
                 name: format!("{recipe} draw {index} (seed {})", args.seed),
                 spd: draw.spd,
                 resampling: None,
+                notes: Vec::new(),
             }
         }
         _ => bail!("give the light as --spd, or as --lighting RECIPE --draw INDEX"),
     };
+    for note in &spd.notes {
+        eprintln!("note: {note}");
+    }
     if let Some(report) = spd.resampling.as_ref().filter(|r| r.extrapolated()) {
         eprintln!(
             "warning: {}",

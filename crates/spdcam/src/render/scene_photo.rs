@@ -73,6 +73,9 @@ pub(super) fn render_scene(
         .as_deref()
         .map(|spec| light::resolve_spd(spec, data_dir, &grid))
         .transpose()?;
+    for note in right.iter().flat_map(|r| &r.notes) {
+        eprintln!("note: {note}");
+    }
     let light = SceneLight {
         spd,
         right_half: right.as_ref().map(|r| &r.spd),

@@ -210,7 +210,7 @@ pub fn run(args: ServeArgs, data_dir: &DataDir) -> Result<()> {
         Config {
             addrs: resolve(&args.host, args.port)?,
             max_upload_bytes: usize::try_from(
-                (args.max_upload_mb << 20).min(limits::PHOTO_BYTES.value()),
+                (args.max_upload_mb << 20).min(limits::PHOTO_BYTES.value()?),
             )?,
             workers,
             timeouts: Timeouts::default(),

@@ -9,6 +9,7 @@ pub use output::{reporter, sibling, write_log};
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use spdcam_core::builtin::DataDir;
+use spdcam_core::error::short_number;
 use spdcam_core::fsio;
 use spdcam_core::spectral::Grid;
 use spdcam_learn::network::Architecture;
@@ -17,6 +18,11 @@ use spdcam_learn::scale::RowScale;
 use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{add_photo_chart, train, Schedule, TrainOptions, TrainingSet};
 use std::path::PathBuf;
+
+/// The largest `--ridge`: the features are scaled to unit spread, so a penalty of 10⁶ per
+/// row already leaves weights a millionth of the unpenalised ones; far larger ones
+/// (1e308) overflow the solver's sums.
+const MAX_RIDGE: f64 = 1e6;
 
 /// `--row-scale`: what each feature row is divided by.
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -89,16 +95,29 @@ pub fn run(args: TrainArgs, data_dir: &DataDir) -> Result<()> {
     for path in args.log.iter().chain(&args.plot) {
         fsio::check_writable(path)?;
     }
-    let data = TrainingSet::load(&args.data)?;
-    let val = args.schedule.load_val()?;
     let architecture = match (args.model, args.ridge) {
-        (ModelKind::Linear, Some(ridge)) if ridge.is_finite() && ridge > 0.0 => {
+        (ModelKind::Linear, Some(ridge)) if ridge > 0.0 && ridge <= MAX_RIDGE => {
             Architecture::Linear { ridge }
         }
-        (ModelKind::Linear, Some(ridge)) => bail!("--ridge {ridge} must be a positive number"),
+        (ModelKind::Linear, Some(ridge)) if ridge > MAX_RIDGE => bail!(
+            "--ridge {} is too large for the solver: the penalty times the training rows \
+             must stay a finite number, and above {} the weights are zero anyway; give a \
+             positive value up to {} (or leave --ridge out to choose among 1e-8…1 on the \
+             validation rows)",
+            short_number(ridge),
+            short_number(MAX_RIDGE),
+            short_number(MAX_RIDGE)
+        ),
+        (ModelKind::Linear, Some(ridge)) => bail!(
+            "--ridge {} must be a positive number up to {}",
+            short_number(ridge),
+            short_number(MAX_RIDGE)
+        ),
         (_, Some(_)) => bail!("--ridge applies to --model linear only"),
         (kind, None) => kind.architecture(),
     };
+    let data = TrainingSet::load(&args.data)?;
+    let val = args.schedule.load_val()?;
     let base = match args.preset {
         Preset::Thesis => Schedule::thesis(),
         Preset::Default => Schedule::default_for(&architecture),
