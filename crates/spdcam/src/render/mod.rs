@@ -16,7 +16,7 @@ use spdcam_core::imageio;
 use spdcam_core::lighting::Lighting;
 use spdcam_core::photo::scene;
 use spdcam_core::spectral::{Grid, SpectralSet};
-use spdcam_core::{fsio, light};
+use spdcam_core::{fsio, light, limits};
 use std::path::{Path, PathBuf};
 
 /// Options of `spdcam render`.
@@ -43,8 +43,10 @@ pub struct RenderArgs {
     /// output.
     #[arg(long, value_name = "FILE.csv")]
     features: Option<PathBuf>,
-    /// Also write every intermediate stage as an image into this directory.
-    #[arg(long, value_name = "DIR")]
+    /// Also write every intermediate stage as an image into this directory. The stages are
+    /// held beside the image, so each pixel counts twice against SPDCAM_MAX_RENDER_PIXELS.
+    /// Not with --scene: a scene photo is developed in one pass, without stage images.
+    #[arg(long, value_name = "DIR", conflicts_with = "scene")]
     stages: Option<PathBuf>,
     /// Seed of the noise (and of the scene).
     #[arg(long, default_value_t = 0)]
@@ -135,13 +137,22 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
     let messages = Messages::new(
         fsio::is_stdout(&args.output) || args.features.as_deref().is_some_and(fsio::is_stdout),
     );
+    if let Some(path) = &args.spd_out {
+        fsio::check_parent_dir(path)?;
+    }
     if let Some(dir) = &args.stages {
+        let l = args.camera.chart(data_dir, &grid)?.layout;
+        limits::RENDER_PIXELS.check(
+            limits::product(&[l.width as u64, l.height as u64, 2]),
+            &format!(
+                "--stages with a {}×{} chart (the stage images are held beside the image, so \
+                 each pixel counts twice; render a smaller chart with --size or --patch-px)",
+                l.width, l.height
+            ),
+        )?;
         // Made here, before the render, so a bad place fails at once.
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot make the stages directory {}", dir.display()))?;
-    }
-    if let Some(path) = &args.spd_out {
-        fsio::check_parent_dir(path)?;
     }
     let scene = args
         .scene
@@ -183,7 +194,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
     if let Some(path) = &args.spd_out {
         let values = spd.spd.normalised_by_max().into_values();
         SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?.write_csv(path)?;
-        messages.say(format_args!("light SPD: {}", path.display()));
+        messages.say(format_args!("light SPD: {}", path.display()))?;
     }
     if let Some((width, height)) = scene {
         return render_scene(
@@ -203,7 +214,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         messages.say(format_args!(
             "stages (linear raw, 16-bit): {}",
             dir.display()
-        ));
+        ))?;
     }
     if let Some(path) = &args.features {
         let names = camera.chart().feature_names();
@@ -211,7 +222,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         let text = format!("{}\n{}\n", names.join(","), values.join(","));
         fsio::write_output(path, text.as_bytes())?;
         if !fsio::is_stdout(path) {
-            messages.say(format_args!("features: {}", path.display()));
+            messages.say(format_args!("features: {}", path.display()))?;
         }
     }
     fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
@@ -228,7 +239,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         l.height,
         depth,
         args.output.display()
-    ));
+    ))?;
     Ok(())
 }
 

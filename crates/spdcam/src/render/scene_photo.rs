@@ -98,6 +98,6 @@ pub(super) fn render_scene(
         camera.camera_name(),
         args.output.display(),
         corners.join(",")
-    ));
+    ))?;
     Ok(())
 }
