@@ -246,6 +246,10 @@ fn many_feature_rows_without_an_output_print_a_line_each() {
             "{line}"
         );
     }
+    assert!(
+        stdout.contains("one line per estimate as it is made (CIE xy, CCT, Duv, verdict)"),
+        "{stdout}"
+    );
     assert!(stdout.contains("23 estimates with"), "{stdout}");
     assert!(
         stdout.contains("-o FILE.csv writes them as CSV") && stdout.contains("JSON Lines"),

@@ -134,7 +134,9 @@ impl FeatureRun {
             RowLines::Summary => {
                 if row == DETAILED_MAX {
                     outln!(
-                        "more than {DETAILED_MAX} rows: one line per estimate as it is made                          (CIE xy, CCT, Duv, verdict); -o FILE.csv writes the SPDs, --json every                          number as JSON Lines"
+                        "more than {DETAILED_MAX} rows: one line per estimate as it is made \
+                         (CIE xy, CCT, Duv, verdict); -o FILE.csv writes the SPDs, --json \
+                         every number as JSON Lines"
                     )?;
                     for held in &self.first {
                         outln!("{}", summary_line(held))?;
