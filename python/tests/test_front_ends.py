@@ -12,7 +12,7 @@ import spdcam
 def test_a_photo_gives_the_command_lines_estimate(example, cli):
     done = cli("estimate", str(example), "--json")
     assert done.returncode == 0, done.stderr
-    want = json.loads(done.stdout)[0]
+    want = [json.loads(line) for line in done.stdout.splitlines()]  # JSON Lines[0]
     got = spdcam.estimate(example)
     np.testing.assert_array_equal(got.spd, want["spd"])
     assert got.verdict == want["verdict"] and got.reasons == want["reasons"]

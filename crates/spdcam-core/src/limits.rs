@@ -106,6 +106,24 @@ pub const DRAWS: Limit = Limit {
     default: 1_000_000,
 };
 
+/// Scene photos of one bucket and chart (`detection --photos`): each photo's outcome is held
+/// until its bucket is done, and a photo takes 0.1–1 s, so the default already runs for
+/// hours.
+pub const DETECTION_PHOTOS: Limit = Limit {
+    what: "scene photos per bucket and chart",
+    env: "SPDCAM_MAX_DETECTION_PHOTOS",
+    default: 100_000,
+};
+
+/// Bytes of a camera pool held whole (`generate --randomise camera`: each camera of
+/// `--cameras` and its `--camera-variants` perturbed copies, each with its own copy of the
+/// chart's pixel map), as [`crate::camera::Camera::estimated_bytes`] estimates them.
+pub const CAMERA_POOL_BYTES: Limit = Limit {
+    what: "bytes of a camera pool",
+    env: "SPDCAM_MAX_CAMERA_POOL_BYTES",
+    default: 1 << 30,
+};
+
 /// Width in pixels of a smoothing filter (`grey-edge:p:sigma`): the Gaussian spans
 /// ±3σ, so its cost per pixel grows with σ.
 pub const FILTER_SIGMA_PX: Limit = Limit {
@@ -115,7 +133,7 @@ pub const FILTER_SIGMA_PX: Limit = Limit {
 };
 
 /// Every limit, in the order of the README's table.
-pub const ALL: [Limit; 12] = [
+pub const ALL: [Limit; 14] = [
     PHOTO_BYTES,
     TEXT_FILE_BYTES,
     MODEL_BYTES,
@@ -128,6 +146,8 @@ pub const ALL: [Limit; 12] = [
     DRAWS,
     CHUNK_BYTES,
     FILTER_SIGMA_PX,
+    DETECTION_PHOTOS,
+    CAMERA_POOL_BYTES,
 ];
 
 impl Limit {

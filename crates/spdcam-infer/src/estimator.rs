@@ -30,6 +30,7 @@ use spdcam_core::photo::{
 };
 use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Grid, Spd};
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -652,22 +653,34 @@ impl RowStream<'_> {
     /// The full judged estimate of row `k` of `block`, named `estimate_N` after its place
     /// among all rows: the SPD the block holds, not estimated again.
     pub fn estimate(&self, block: &EstimatedBlock, k: usize) -> Result<Estimate> {
-        if k >= block.rows {
+        Ok(self.estimates(block, k..k + 1)?.remove(0))
+    }
+
+    /// The full judged estimates of rows `rows` of `block`, in order, as
+    /// [`RowStream::estimate`] makes each: judged in parallel, since judging (the self-check,
+    /// the perturbed spread, the lighting metrics) costs far more than the SPD.
+    pub fn estimates(&self, block: &EstimatedBlock, rows: Range<usize>) -> Result<Vec<Estimate>> {
+        if rows.start >= rows.end || rows.end > block.rows {
             return Err(InferError::invalid(format!(
-                "row {k} of a block of {} rows",
-                block.rows
+                "rows {}..{} of a block of {} rows",
+                rows.start, rows.end, block.rows
             )));
         }
         let width = self.stream.names().len();
         let d = self.estimator.named(self.index).model.grid().count;
-        self.estimator.judged(
-            self.index,
-            row_name(block.first_row + k),
-            block.model_spds[k * d..(k + 1) * d].to_vec(),
-            &block.features[k * width..(k + 1) * width],
-            &PhotoFlags::default(),
-            None,
-        )
+        let (estimator, index) = (self.estimator, self.index);
+        rows.into_par_iter()
+            .map(|k| {
+                estimator.judged(
+                    index,
+                    row_name(block.first_row + k),
+                    block.model_spds[k * d..(k + 1) * d].to_vec(),
+                    &block.features[k * width..(k + 1) * width],
+                    &PhotoFlags::default(),
+                    None,
+                )
+            })
+            .collect()
     }
 }
 

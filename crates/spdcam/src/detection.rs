@@ -1,6 +1,7 @@
 //! `spdcam detection`: how often the charts are found in the program's own scene photos,
 //! per difficulty (`spdcam_core::photo::detection_rate`), written as Markdown.
 
+use crate::outln;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
@@ -8,6 +9,7 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::fsio;
+use spdcam_core::limits;
 use spdcam_core::photo::detection_rate::{self, BucketRate};
 use spdcam_core::photo::scene;
 use spdcam_core::photo::ChartTemplate;
@@ -59,6 +61,7 @@ pub fn run(args: DetectionArgs, data_dir: &DataDir) -> Result<()> {
     if args.photos == 0 {
         bail!("--photos must be at least 1");
     }
+    limits::DETECTION_PHOTOS.check(args.photos as u64, "--photos")?;
     let (w, h) = args
         .size
         .split_once(['x', 'X', '×'])
@@ -165,7 +168,7 @@ pub fn run(args: DetectionArgs, data_dir: &DataDir) -> Result<()> {
     }
     let md = document(&args, (w, h), &rates, started.elapsed().as_secs_f64());
     fsio::write_atomic(&args.output, md.as_bytes())?;
-    println!("detection rates: {}", args.output.display());
+    outln!("detection rates: {}", args.output.display())?;
     Ok(())
 }
 

@@ -1,5 +1,6 @@
 //! `spdcam generate`: a dataset of (features, SPD) samples from the virtual camera.
 
+use crate::outln;
 use crate::render::CameraArgs;
 use anyhow::Result;
 use clap::Args;
@@ -206,14 +207,14 @@ pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
         bar.finish_and_clear();
     }
     let seconds = started.elapsed().as_secs_f64();
-    println!(
+    outln!(
         "{} samples in {} ({new} new in {seconds:.1} s, {:.0} samples/s)",
         manifest.samples,
         args.output.display(),
         new as f64 / seconds.max(1e-9)
-    );
+    )?;
     if let Some(ratio) = manifest.valid_ratio {
-        println!(
+        outln!(
             "valid ratio {ratio:.4} ({} lights drawn), families: {}",
             manifest.attempts,
             manifest
@@ -222,7 +223,7 @@ pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
                 .map(|(f, n)| format!("{f} {n}"))
                 .collect::<Vec<_>>()
                 .join(", ")
-        );
+        )?;
     }
     Ok(())
 }

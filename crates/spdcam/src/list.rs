@@ -1,5 +1,6 @@
 //! `spdcam list`: what is built in, and what the data directory offers.
 
+use crate::outln;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use spdcam_core::builtin::{self, DataDir};
@@ -31,60 +32,63 @@ pub fn run(args: ListArgs, data_dir: &DataDir) -> Result<()> {
     let all = args.topic.is_none();
     let want = |t: Topic| all || args.topic == Some(t);
     if want(Topic::Cameras) {
-        println!("cameras (built in):");
+        outln!("cameras (built in):")?;
         for c in builtin::CAMERAS {
-            println!("  {:<28} {}", c.name, c.description);
+            outln!("  {:<28} {}", c.name, c.description)?;
         }
         let more = data_dir.list_csv(&["cameras", "thesis"]);
         if !more.is_empty() {
-            println!("in the data directory (cameras and thesis tables; any r,g,b CSV works):");
+            outln!("in the data directory (cameras and thesis tables; any r,g,b CSV works):")?;
             for name in more {
-                println!("  {name}");
+                outln!("  {name}")?;
             }
         }
     }
     if want(Topic::Charts) {
-        println!("charts:");
+        outln!("charts:")?;
         for chart in KnownChart::ALL {
-            println!("  {:<28} {}", chart.name(), chart.description());
+            outln!("  {:<28} {}", chart.name(), chart.description())?;
         }
-        println!(
+        outln!(
             "  {:<28} a reflectance CSV with --layout ROWSxCOLS",
             "FILE.csv"
-        );
+        )?;
     }
     if want(Topic::Illuminants) {
-        println!("illuminants:");
+        outln!("illuminants:")?;
         for ill in StandardIlluminant::ALL {
-            println!("  {}", ill.name());
+            outln!("  {}", ill.name())?;
         }
-        println!("  forms: {SPD_FORMS}");
+        outln!("  forms: {SPD_FORMS}")?;
     }
     if want(Topic::Lighting) {
-        println!("lighting recipes (spdcam generate --lighting):");
+        outln!("lighting recipes (spdcam generate --lighting):")?;
         for (form, what) in lighting::catalogue() {
-            println!("  {form:<28} {what}");
+            outln!("  {form:<28} {what}")?;
         }
-        println!("lamp families (lamp:NAME), fitted to measured lamps:");
+        outln!("lamp families (lamp:NAME), fitted to measured lamps:")?;
         for family in lighting::LampFamily::ALL {
-            println!(
+            outln!(
                 "  {:<28} {}",
                 format!("lamp:{}", family.name()),
                 family.describe()
-            );
+            )?;
         }
     }
     if want(Topic::Presets) {
-        println!("noise presets:");
+        outln!("noise presets:")?;
         for (name, p) in NoiseParams::PRESETS {
-            println!(
+            outln!(
                 "  {name:<10} {} ADU/e-, read noise {} e-, black level {} ADU, {} bits",
-                p.gain_adu_per_e, p.read_noise_e, p.black_level_adu, p.bit_depth
-            );
+                p.gain_adu_per_e,
+                p.read_noise_e,
+                p.black_level_adu,
+                p.bit_depth
+            )?;
         }
-        println!("  off");
-        println!("demosaicing: menon2007 (default), malvar2004, bilinear");
-        println!("white balance: shades-of-grey:6 (default), grey-world, white-patch, grey-edge:p:sigma, none");
+        outln!("  off")?;
+        outln!("demosaicing: menon2007 (default), malvar2004, bilinear")?;
+        outln!("white balance: shades-of-grey:6 (default), grey-world, white-patch, grey-edge:p:sigma, none")?;
     }
     Ok(())
 }

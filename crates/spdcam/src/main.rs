@@ -32,6 +32,7 @@ mod photo_args;
 mod plot_file;
 mod render;
 mod serve;
+mod stdout;
 #[cfg(feature = "train")]
 mod train;
 mod trust;

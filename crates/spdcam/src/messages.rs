@@ -18,12 +18,14 @@ impl Messages {
         }
     }
 
-    /// Prints one message line.
-    pub fn say(&self, text: impl Display) {
+    /// Prints one message line; a failed write to standard output is an error (see
+    /// [`crate::stdout`]).
+    pub fn say(&self, text: impl Display) -> anyhow::Result<()> {
         if self.to_stderr {
             eprintln!("{text}");
+            Ok(())
         } else {
-            println!("{text}");
+            crate::outln!("{text}")
         }
     }
 }

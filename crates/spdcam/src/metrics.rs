@@ -1,6 +1,7 @@
 //! `spdcam metrics`: lighting-quality numbers of measured SPDs (every column of a spectral CSV)
 //! or named lights.
 
+use crate::outln;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
@@ -39,9 +40,9 @@ pub fn run(args: MetricsArgs, data_dir: &DataDir) -> Result<()> {
         rows.extend(lights(spec, data_dir)?);
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        outln!("{}", serde_json::to_string_pretty(&rows)?)?;
     } else {
-        print_table(&rows);
+        print_table(&rows)?;
     }
     Ok(())
 }
@@ -74,21 +75,31 @@ fn fixed(v: Option<f64>, decimals: usize) -> String {
 }
 
 /// The main numbers, one light per line, then the reasons and warnings.
-fn print_table(rows: &[Row]) {
+fn print_table(rows: &[Row]) -> Result<()> {
     let width = rows
         .iter()
         .map(|r| r.name.chars().count())
         .max()
         .unwrap_or(4)
         .max(4);
-    println!(
+    outln!(
         "{:<width$}  {:>7} {:>8} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>7} {:>9}",
-        "name", "CCT K", "Duv", "Ra", "R9", "Rf", "Rg", "M-EDER", "S/P", "PPF/lx", "BLH mW/lm"
-    );
+        "name",
+        "CCT K",
+        "Duv",
+        "Ra",
+        "R9",
+        "Rf",
+        "Rg",
+        "M-EDER",
+        "S/P",
+        "PPF/lx",
+        "BLH mW/lm"
+    )?;
     for r in rows {
         let m = &r.metrics;
         let pad = width - r.name.chars().count();
-        println!(
+        outln!(
             "{}{:pad$}  {:>7} {:>8} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>7} {:>9}",
             r.name,
             "",
@@ -102,22 +113,23 @@ fn print_table(rows: &[Row]) {
             fixed(m.sp_ratio, 2),
             fixed(m.ppf_per_lux.map(|v| 1000.0 * v), 2),
             fixed(m.blh_efficacy_w_per_lm.map(|v| 1000.0 * v), 3),
-        );
+        )?;
     }
-    println!(
+    outln!(
         "(PPF/lx in µmol·s⁻¹·klm⁻¹, i.e. µmol·m⁻²·s⁻¹ per 1000 lx; `--json` gives every number: \
          R1–R14, TM-30 hue bins, all five α-opic ratios, chromaticities)"
-    );
+    )?;
     for r in rows {
         let mut seen = Vec::new();
         for reason in r.metrics.reasons.values() {
             if !seen.contains(&reason) {
-                println!("{}: undefined values: {reason}", r.name);
+                outln!("{}: undefined values: {reason}", r.name)?;
                 seen.push(reason);
             }
         }
         for w in &r.metrics.warnings {
-            println!("{}: note: {w}", r.name);
+            outln!("{}: note: {w}", r.name)?;
         }
     }
+    Ok(())
 }

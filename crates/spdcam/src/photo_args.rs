@@ -27,7 +27,8 @@ pub struct PhotoArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub features_out: Option<PathBuf>,
     /// Print the result as JSON on stdout (with detection confidence, corners, per-patch
-    /// features and flags).
+    /// features and flags): a list for photos; with --features one object per row and line
+    /// (JSON Lines), written as each row is estimated.
     #[arg(long)]
     pub json: bool,
 }

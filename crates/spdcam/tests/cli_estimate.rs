@@ -247,10 +247,10 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
     );
     assert!(lo > 0.75 * hi, "{white:?}");
 
-    // Feature rows are matched to the model for their columns.
-    let json: serde_json::Value =
-        serde_json::from_str(&ok(&["estimate", "--features", &s(&features), "--json"])).unwrap();
-    assert_eq!(json[0]["model"], "the shipped colorchecker24 model");
+    // Feature rows are matched to the model for their columns (JSON Lines: a row a line).
+    let out = ok(&["estimate", "--features", &s(&features), "--json"]);
+    let json: serde_json::Value = serde_json::from_str(out.lines().next().unwrap()).unwrap();
+    assert_eq!(json["model"], "the shipped colorchecker24 model");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -1200,6 +1200,31 @@ fn every_limit_is_set_by_its_environment_variable() {
             ],
             "3 filter sigma in pixels exceed the limit of 2",
         ),
+        (
+            "SPDCAM_MAX_DETECTION_PHOTOS",
+            "10",
+            vec![
+                "detection".into(),
+                "--photos".into(),
+                "11".into(),
+                "-o".into(),
+                s(&dir.join("d.md")),
+            ],
+            "11 scene photos per bucket and chart exceed the limit of 10",
+        ),
+        (
+            "SPDCAM_MAX_CAMERA_POOL_BYTES",
+            "1000",
+            generate(&[
+                "--count",
+                "5",
+                "--randomise",
+                "camera",
+                "--cameras",
+                "nikon_d5100_npl",
+            ]),
+            "bytes of a camera pool exceed the limit of 1,000",
+        ),
     ];
     for limit in spdcam_core::limits::ALL {
         assert!(

@@ -169,9 +169,10 @@ fn the_photos_feature_row_gives_the_photos_spd_and_verdict() {
         &s(&features),
     ]))
     .unwrap();
-    let rows: serde_json::Value =
-        serde_json::from_str(&ok(&["estimate", "--features", &s(&features), "--json"])).unwrap();
-    let (photo, row) = (&photo[0], &rows[0]);
+    // JSON Lines: the features file's one row on one line.
+    let rows = ok(&["estimate", "--features", &s(&features), "--json"]);
+    let row: serde_json::Value = serde_json::from_str(rows.lines().next().unwrap()).unwrap();
+    let (photo, row) = (&photo[0], &row);
     assert_eq!(row["name"], "estimate_1");
     // The features file holds the features rounded to what the CSV writes; the SPD is the
     // photo's to within what that rounding moves (the SG model's ridge member carries a

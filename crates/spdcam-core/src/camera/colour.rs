@@ -8,6 +8,7 @@ use crate::raster::RgbImage;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::sync::OnceLock;
 
 /// Output settings of the colour stage.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -74,11 +75,22 @@ pub fn xyz_to_srgb_matrix() -> Matrix3<f64> {
 /// interpolation in it is within 1e-6 of the exact curve, far below a 16-bit step.
 const ENCODE_TABLE_STEPS: usize = 16384;
 
+/// The sRGB encoding table, made once and shared by every camera: a camera pool of
+/// thousands (`generate --randomise camera`) would otherwise hold 64 kB of it per camera.
+fn encode_table() -> &'static [f32] {
+    static TABLE: OnceLock<Vec<f32>> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        (0..=ENCODE_TABLE_STEPS)
+            .map(|k| colorimetry::srgb_encode(k as f64 / ENCODE_TABLE_STEPS as f64) as f32)
+            .collect()
+    })
+}
+
 /// Camera RGB → encoded, quantised sRGB, as one matrix, a table and a number of levels.
 #[derive(Debug, Clone)]
 pub struct ColourTransform {
     matrix: [[f32; 3]; 3],
-    table: Vec<f32>,
+    table: &'static [f32],
     levels: f32,
 }
 
@@ -95,12 +107,9 @@ impl ColourTransform {
             None => Matrix3::identity(),
         };
         let matrix = std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)] as f32));
-        let table = (0..=ENCODE_TABLE_STEPS)
-            .map(|k| colorimetry::srgb_encode(k as f64 / ENCODE_TABLE_STEPS as f64) as f32)
-            .collect();
         Ok(ColourTransform {
             matrix,
-            table,
+            table: encode_table(),
             levels: ((1u32 << bit_depth) - 1) as f32,
         })
     }

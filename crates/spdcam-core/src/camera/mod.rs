@@ -55,6 +55,12 @@ use white_balance::{RegionGeometry, WhiteBalance};
 /// brightest does, beyond which a photo holds nothing more.
 pub const MAX_EXPOSURE: f64 = 100.0;
 
+/// The smallest exposure: the brightest raw value (a chart's white patch) at 1 % of full
+/// scale, 2.6 levels of an 8-bit photo, about what the thesis's noise preset leaves of a
+/// signal (its read noise is 0.4 % of full scale). Below it the photo holds no signal: the
+/// patches are noise and quantisation steps, and the white balance divides by them.
+pub const MIN_EXPOSURE: f64 = 0.01;
+
 /// Every setting of the camera, one field per stage; `None` switches a stage off.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CameraConfig {
@@ -211,6 +217,9 @@ impl Camera {
                 crate::error::short_number(exposure)
             )));
         }
+        if exposure < MIN_EXPOSURE {
+            return Err(Error::invalid(too_low_exposure(exposure)));
+        }
         if let Some(ic) = &config.in_camera {
             ic.validate()?;
         }
@@ -291,6 +300,24 @@ impl Camera {
     /// The camera's name.
     pub fn camera_name(&self) -> &str {
         &self.camera_name
+    }
+
+    /// About how many bytes this camera holds (its chart's pixel map, geometry and
+    /// reflectances, its spectral response), to bound a pool of many cameras before it is
+    /// built ([`crate::limits::CAMERA_POOL_BYTES`]).
+    pub fn held_bytes(&self) -> u64 {
+        let bands = self.grid.count;
+        let regions = self.region_centres.len();
+        let patches = self.chart.reflectances.len();
+        let bytes = std::mem::size_of::<Camera>()
+            + self.region_map.len() * std::mem::size_of::<u16>()
+            + regions * std::mem::size_of::<[f32; 2]>()
+            + self.geometry.areas.len() * std::mem::size_of::<f64>()
+            + self.geometry.boundaries.len() * std::mem::size_of::<(usize, usize, f64)>()
+            + patches * (bands * std::mem::size_of::<f64>() + std::mem::size_of::<String>())
+            + self.chart.feature_patches.len() * std::mem::size_of::<usize>()
+            + regions * 3 * bands * std::mem::size_of::<f32>();
+        bytes as u64
     }
 
     /// The D65-fitted camera RGB → XYZ matrix, if colour correction is on.
@@ -835,6 +862,28 @@ impl Shot {
 }
 
 /// Scales raw values by the exposure's `scale` and clips them at `full_scale`.
+/// Why an exposure under [`MIN_EXPOSURE`] is refused, for a message that names the option
+/// it came from: "exposure 1e-10 puts the white patch …".
+pub fn too_low_exposure(exposure: f64) -> String {
+    let percent = 100.0 * exposure;
+    // Three significant digits: 1e-8 %, not 1.0000000000000001e-8 %.
+    let digits = 10f64.powi(2 - percent.abs().log10().floor() as i32);
+    let percent = if digits.is_finite() {
+        (percent * digits).round() / digits
+    } else {
+        percent
+    };
+    format!(
+        "exposure {} puts the chart's white patch (its brightest) at {}% of full scale, \
+         under the {}% a photo needs to hold a signal above the noise and the quantisation \
+         steps; use {MIN_EXPOSURE}–{MAX_EXPOSURE} (e.g. 0.8; above 1 the brightest patches \
+         clip)",
+        crate::error::short_number(exposure),
+        crate::error::short_number(percent),
+        crate::error::short_number(100.0 * MIN_EXPOSURE),
+    )
+}
+
 fn expose(raw: &mut [[f32; 3]], scale: f32, full_scale: f32) {
     raw.iter_mut()
         .for_each(|v| *v = v.map(|x| (x * scale).min(full_scale)));

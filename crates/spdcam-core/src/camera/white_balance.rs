@@ -235,7 +235,25 @@ pub fn apply_gains(image: &mut RgbImage, gains: [f32; 3]) {
 /// The Minkowski p-mean `(mean |v|^p)^(1/p)` of a channel (negative noise counts as zero).
 /// Powers are taken in f32 and summed per block of 4,096 values in f64, which keeps the
 /// sum exact to f32 precision and lets the compiler vectorise the inner loop.
+///
+/// A channel whose largest value is under 1/2 is first scaled by the power of two that
+/// brings it to [1/2, 1): `v^6` of a dim image (v = 1e-8, an exposure of 1e-8) is below
+/// f32's smallest number, and every channel's mean came out 0, so the white balance left
+/// the image unbalanced while the colour matrix expects it balanced (a white patch of
+/// 255, 255, 108). Scaling by a power of two is exact, so brighter images keep every bit.
 fn minkowski(values: &[f32], p: f64) -> f64 {
+    let largest = if values.len() > 200_000 {
+        values.par_iter().copied().reduce(|| 0.0, f32::max)
+    } else {
+        values.iter().copied().fold(0.0, f32::max)
+    };
+    if largest > 0.0 && largest < 0.5 {
+        // 2^k with largest·2^k in [1/2, 1), k at most 126 (f32's largest power of two).
+        let k = (-largest.log2().floor() - 1.0).clamp(1.0, 126.0) as i32;
+        let scale = 2f32.powi(k);
+        let scaled: Vec<f32> = values.iter().map(|&v| v * scale).collect();
+        return minkowski(&scaled, p) / scale as f64;
+    }
     let n = values.len().max(1) as f64;
     let block_sum = |block: &[f32]| -> f64 {
         // Whole powers spelled out so they compile to multiplications, not a libm call.
@@ -333,6 +351,30 @@ mod tests {
             [g / r, 1.0, g / b],
         );
         close(WhiteBalance::None.gains(&img), [1.0, 1.0, 1.0]);
+    }
+
+    #[test]
+    fn a_dim_image_gets_the_gains_of_a_bright_one() {
+        // Issue 39, item 15: at 1e-8 of full scale v^6 underflowed f32, every estimate was
+        // 0, and the gains fell back to 1 (an unbalanced image, a yellow white patch).
+        let scaled = |k: f32| {
+            let mut img = tiny();
+            img.planes
+                .iter_mut()
+                .for_each(|p| p.iter_mut().for_each(|v| *v *= k / 4.0));
+            img
+        };
+        for wb in [
+            WhiteBalance::ShadesOfGrey { p: 6.0 },
+            WhiteBalance::ShadesOfGrey { p: 2.5 },
+        ] {
+            let bright = wb.gains(&scaled(1.0));
+            assert_ne!(bright, [1.0; 3], "{wb:?}");
+            for k in [0.1, 1e-8, 1e-10, 1e-30] {
+                let dim = wb.gains(&scaled(k)).map(f64::from);
+                close(bright, dim);
+            }
+        }
     }
 
     #[test]

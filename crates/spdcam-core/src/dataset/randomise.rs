@@ -12,6 +12,7 @@ use crate::camera::{Camera, CameraConfig};
 use crate::chart::Chart;
 use crate::error::{Error, Result};
 use crate::lighting::ValidationSplit;
+use crate::limits;
 use crate::seed;
 use crate::spectral::{Grid, SpectralSet};
 use rand::rngs::SmallRng;
@@ -393,7 +394,28 @@ impl RandomiseRequest {
         let ranges = InCameraRanges::for_groups(&others)?;
         let mut sens = vec![base.clone()];
         let mut skipped = Vec::new();
+        let variants = if with_camera { self.camera_variants } else { 0 };
+        // Each camera of the pool holds its own chart map: the pool is bounded before the
+        // cameras are read (by one camera and its copies) and before it is built.
+        let copies = (variants as u64).saturating_add(1);
+        let per_camera = if with_camera {
+            Camera::new(base, chart.clone(), config, grid)?.held_bytes()
+        } else {
+            0
+        };
+        let pool_bytes = |cameras: usize| {
+            let bytes = limits::product(&[cameras as u64, copies, per_camera]);
+            limits::CAMERA_POOL_BYTES.check(
+                bytes,
+                &format!(
+                    "--camera-variants {variants}: {cameras} camera(s) and {variants} perturbed \
+                     copies of each, about {} kB each (lower --camera-variants)",
+                    per_camera.div_ceil(1000)
+                ),
+            )
+        };
         if with_camera {
+            pool_bytes(1)?;
             let spec = self.cameras.as_deref().ok_or_else(|| {
                 Error::invalid("--randomise camera needs --cameras DIR or a list")
             })?;
@@ -419,7 +441,7 @@ impl RandomiseRequest {
                 )));
             }
         }
-        let variants = if with_camera { self.camera_variants } else { 0 };
+        pool_bytes(sens.len())?;
         let pool = camera_pool(&sens, variants, seed, chart, config, grid)?;
         Ok((Some(Randomisation::new(pool, ranges)?), skipped))
     }

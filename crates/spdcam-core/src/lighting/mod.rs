@@ -461,7 +461,41 @@ fn parse_mix(
         }
         members.push((Lighting::parse(member, data_dir, grid)?, share));
     }
+    // Scaled by the largest first, so that the sum of proportions near f64::MAX (1e308 +
+    // 1e308) does not overflow to infinity and turn every share but the largest into 0.
+    let largest = members.iter().map(|(_, p)| *p).fold(0.0, f64::max);
+    members.iter_mut().for_each(|(_, p)| *p /= largest);
     let total: f64 = members.iter().map(|(_, p)| p).sum();
     members.iter_mut().for_each(|(_, p)| *p /= total);
     Ok(members)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn proportions_near_the_largest_number_are_shared_without_overflow() {
+        // Issue 39, item 14: 1e308 + 1e308 overflowed, and planck took every draw.
+        let grid = Grid::SIMULATION;
+        let mix = Lighting::parse(
+            "mix:daylight=1e308,planck=1e308",
+            &DataDir::new(None),
+            &grid,
+        )
+        .unwrap();
+        let shares: Vec<f64> = mix.mix_members().unwrap().iter().map(|m| m.1).collect();
+        assert_eq!(shares, [0.5, 0.5]);
+        let tiny = Lighting::parse(
+            "mix:daylight=1e-320,planck=3e-320",
+            &DataDir::new(None),
+            &grid,
+        )
+        .unwrap();
+        let shares: Vec<f64> = tiny.mix_members().unwrap().iter().map(|m| m.1).collect();
+        assert!(
+            (shares[0] - 0.25).abs() < 1e-3 && (shares[1] - 0.75).abs() < 1e-3,
+            "{shares:?}"
+        );
+    }
 }

@@ -1,9 +1,10 @@
 //! `estimate --features`: feature rows streamed through the model a block at a time.
 
-use super::print::{print_estimates, report_item, verdict_line, write_report};
+use super::print::{print_estimates, report_item, summary_line, verdict_line, write_report};
 use super::truth::read_truths;
 use super::{quiet, EstimateArgs, LayoutArg, DETAILED_MAX};
 use crate::plot_file::write_plot;
+use crate::{outln, stdout};
 use anyhow::{bail, Result};
 use spdcam_core::fsio;
 use spdcam_core::spectral::{Grid, SpectralSet};
@@ -17,6 +18,21 @@ use spdcam_infer::trust::Uncertainty;
 use spdcam_infer::{Estimate, Estimator, RowStream};
 use std::io::Write;
 use std::path::Path;
+
+/// Rows judged at a time when every row is judged (`--json`, one line per row): enough to
+/// keep the cores busy, few enough that lines come out as the rows are estimated.
+const JUDGED_AT_ONCE: usize = 64;
+
+/// What `estimate --features` writes of each row as it is estimated, besides the SPDs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RowLines {
+    /// Nothing: the first [`DETAILED_MAX`] rows are judged and printed at the end.
+    None,
+    /// `--json`: every row judged, one JSON object per line (JSON Lines).
+    Json,
+    /// No `-o`: beyond [`DETAILED_MAX`] rows, every row judged, one summary line each.
+    Summary,
+}
 
 /// What `estimate --features` keeps while it streams: the first estimates (to print and
 /// plot), the scores against the truths, and the count.
@@ -32,7 +48,7 @@ pub(super) struct FeatureRun {
     /// Every SPD while the output may still be laid out wide (row-major).
     wide: Option<Vec<f64>>,
     layout: Option<Layout>,
-    json_started: bool,
+    lines: RowLines,
 }
 
 impl FeatureRun {
@@ -49,12 +65,11 @@ impl FeatureRun {
     }
 
     /// Takes a block of estimated rows: scores, keeps the first judged estimates, prints
-    /// JSON (every row judged), writes the SPDs.
+    /// each row's JSON line or summary line, writes the SPDs.
     fn add(
         &mut self,
         stream: &RowStream,
         block: &EstimatedBlock,
-        json: bool,
         out: &mut Option<&mut dyn Write>,
     ) -> Result<()> {
         let width = self.grid.count;
@@ -71,25 +86,21 @@ impl FeatureRun {
             self.score_sums.0 += s.gfc;
             self.score_sums.1 += s.rmse;
         }
-        let mut text = String::new();
-        for (k, score) in scores.iter().enumerate() {
-            let kept = self.first.len() < DETAILED_MAX;
-            if !kept && !json {
-                break;
+        let judged = match self.lines {
+            RowLines::None => DETAILED_MAX
+                .saturating_sub(self.first.len())
+                .min(block.rows),
+            RowLines::Json | RowLines::Summary => block.rows,
+        };
+        for start in (0..judged).step_by(JUDGED_AT_ONCE) {
+            let end = (start + JUDGED_AT_ONCE).min(judged);
+            for (k, mut e) in (start..end).zip(stream.estimates(block, start..end)?) {
+                e.truth = scores[k];
+                self.print_row(block.first_row + k, &e)?;
+                if self.first.len() < DETAILED_MAX {
+                    self.first.push(e);
+                }
             }
-            let mut e = stream.estimate(block, k)?;
-            e.truth = *score;
-            if json {
-                text.push_str(if self.json_started { ",\n" } else { "[\n" });
-                self.json_started = true;
-                text.push_str(&serde_json::to_string_pretty(&e.to_json()?)?);
-            }
-            if kept {
-                self.first.push(e);
-            }
-        }
-        if json {
-            std::io::stdout().lock().write_all(text.as_bytes())?;
         }
         self.rows += block.rows;
         if let Some(out) = out {
@@ -107,6 +118,31 @@ impl FeatureRun {
                     out.write_all(long_header(&self.grid).as_bytes())?;
                 }
                 out.write_all(&long_rows(spds, width, block.first_row))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Prints what [`RowLines`] asks of row `row` (0-based), judged as `e`: its JSON line,
+    /// or, from the row after the first [`DETAILED_MAX`], its summary line (the first
+    /// rows' lines, held till then, printed first).
+    fn print_row(&self, row: usize, e: &Estimate) -> Result<()> {
+        match self.lines {
+            RowLines::None => {}
+            RowLines::Json => outln!("{}", serde_json::to_string(&e.to_json()?)?)?,
+            RowLines::Summary if row < DETAILED_MAX => {}
+            RowLines::Summary => {
+                if row == DETAILED_MAX {
+                    outln!(
+                        "more than {DETAILED_MAX} rows: one line per estimate as it is made \
+                         (CIE xy, CCT, Duv, verdict); -o FILE.csv writes the SPDs, --json \
+                         every number as JSON Lines"
+                    )?;
+                    for held in &self.first {
+                        outln!("{}", summary_line(held))?;
+                    }
+                }
+                outln!("{}", summary_line(e))?;
             }
         }
         Ok(())
@@ -131,8 +167,9 @@ impl FeatureRun {
 /// columns a block at a time by the estimator, the SPDs written as they come (long layout),
 /// so that time is linear in the rows and memory bounded whatever their number. The full
 /// judged estimates (colorimetry, lighting metrics, verdict, bands) are made only for what
-/// is printed: the estimates shown in full (up to 20), the plot's title, and every estimate
-/// of `--json`.
+/// is printed: the estimates shown in full (up to 20), the plot's title, every estimate of
+/// `--json` (one JSON object per line, JSON Lines, as it is made), and without `-o` beyond 20
+/// rows every estimate's summary line (as it is made).
 pub(super) fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimator) -> Result<()> {
     let source = path.display().to_string();
     let mut stream = estimator.stream(FeatureStream::open(path)?, &source)?;
@@ -153,11 +190,17 @@ pub(super) fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimat
             LayoutArg::Wide => Layout::Wide,
             LayoutArg::Long => Layout::Long,
         }),
-        json_started: false,
+        lines: if args.photo.json {
+            RowLines::Json
+        } else if args.output.is_none() {
+            RowLines::Summary
+        } else {
+            RowLines::None
+        },
     };
     let mut estimate_all = |out: &mut Option<&mut dyn Write>| -> Result<()> {
         while let Some(block) = stream.next_block()? {
-            run.add(&stream, &block, args.photo.json, out)?;
+            run.add(&stream, &block, out)?;
         }
         if run.rows == 0 {
             bail!("{source}: no rows of features below the header");
@@ -168,8 +211,8 @@ pub(super) fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimat
         None => estimate_all(&mut None)?,
         Some(out) if fsio::is_stdout(out) => {
             let mut lock = std::io::BufWriter::new(std::io::stdout().lock());
-            estimate_all(&mut Some(&mut lock as &mut dyn Write))?;
-            lock.flush()?;
+            estimate_all(&mut Some(&mut lock as &mut dyn Write)).map_err(stdout::io_error)?;
+            lock.flush().map_err(stdout::error)?;
         }
         Some(out) => {
             let mut failure = None;
@@ -184,9 +227,6 @@ pub(super) fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimat
             }
             written?;
         }
-    }
-    if run.json_started {
-        println!("\n]");
     }
     let detailed = run.rows <= DETAILED_MAX;
     if let Some(report) = &args.report {
@@ -238,8 +278,13 @@ pub(super) fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimat
             }
         }
         if run.rows > run.first.len() {
+            let every = if args.photo.json {
+                "every row's is in its JSON line"
+            } else {
+                "--json gives every one"
+            };
             eprintln!(
-                "(verdicts of the first {} of {} rows; --json gives every one)",
+                "(verdicts of the first {} of {} rows; {every})",
                 run.first.len(),
                 run.rows
             );
@@ -247,30 +292,36 @@ pub(super) fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimat
         return Ok(());
     }
     if detailed {
-        print_estimates(&run.first, args);
+        print_estimates(&run.first, args)?;
         return Ok(());
     }
-    println!("{} estimates with {}", run.rows, run.model);
+    outln!("{} estimates with {}", run.rows, run.model)?;
     if run.truths.is_some() {
-        println!(
+        outln!(
             "against the true SPDs: mean GFC {:.4}, mean RMSE {:.4} (both peak-normalised)",
             run.score_sums.0 / run.rows as f64,
             run.score_sums.1 / run.rows as f64
-        );
+        )?;
     }
-    if let Some(out) = &args.output {
-        let layout = if run.layout == Some(Layout::Wide) {
-            "wide"
-        } else {
-            "long"
-        };
-        println!("SPDs ({layout} layout) → {}", out.display());
+    match &args.output {
+        Some(out) => {
+            let layout = if run.layout == Some(Layout::Wide) {
+                "wide"
+            } else {
+                "long"
+            };
+            outln!("SPDs ({layout} layout) → {}", out.display())?;
+        }
+        None => outln!(
+            "the SPDs are not written: -o FILE.csv writes them as CSV, --json every number of \
+             each estimate as JSON Lines"
+        )?,
     }
     if let Some(plot) = &args.plot {
-        println!("plot → {}", plot.display());
+        outln!("plot → {}", plot.display())?;
     }
     if let Some(report) = &args.report {
-        println!("report → {}", report.display());
+        outln!("report → {}", report.display())?;
     }
     Ok(())
 }

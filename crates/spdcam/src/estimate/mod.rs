@@ -9,6 +9,7 @@ mod photos;
 mod print;
 mod truth;
 
+use crate::outln;
 use crate::photo_args::PhotoArgs;
 use crate::plot_file::{plot_is_png, write_plot};
 use anyhow::{bail, Result};
@@ -40,7 +41,9 @@ pub struct EstimateArgs {
     #[arg(long)]
     model: Option<PathBuf>,
     /// Estimate from a features CSV instead of photos: a header naming the columns (p01_r,
-    /// p01_g, …), one row per estimate; values on any scale (0–255 or 0–1).
+    /// p01_g, …), one row per estimate; values on any scale (0–255 or 0–1). Streamed: up to
+    /// 20 rows are printed in full, more one line each (xy, CCT, Duv, verdict) as they are
+    /// estimated; -o writes the SPDs, --json every number as JSON Lines (one row a line).
     #[arg(long, value_name = "FILE.csv", conflicts_with = "photos")]
     features: Option<PathBuf>,
     /// CSV of the SPDs to write, laid out as --layout says; `-` writes it to standard output
@@ -192,12 +195,12 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             .iter()
             .map(Estimate::to_json)
             .collect::<spdcam_infer::Result<Vec<_>>>()?;
-        println!("{}", serde_json::to_string_pretty(&json)?);
+        outln!("{}", serde_json::to_string_pretty(&json)?)?;
     }
     if quiet(&args) {
         verdicts_to_stderr(&estimates);
     } else {
-        print_estimates(&estimates, &args);
+        print_estimates(&estimates, &args)?;
     }
     if failed > 0 {
         bail!(

@@ -2,6 +2,7 @@
 //! verdicts, the bands' columns and the HTML report.
 
 use super::{EstimateArgs, DETAILED_MAX};
+use crate::outln;
 use anyhow::Result;
 use spdcam_core::fsio;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
@@ -15,10 +16,10 @@ use std::path::Path;
 
 /// The estimates as text: colorimetry and the SPD every 25 nm (for up to 20), the score
 /// against the truth, what each number means, and where the files went.
-pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
+pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Result<()> {
     let mut models: Vec<&str> = estimates.iter().map(|e| e.model.as_str()).collect();
     models.dedup();
-    println!("{} estimate(s) with {}", estimates.len(), models.join(", "));
+    outln!("{} estimate(s) with {}", estimates.len(), models.join(", "))?;
     let detailed = estimates.len() <= DETAILED_MAX;
     for e in estimates {
         let unusable = e
@@ -26,22 +27,22 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
             .as_ref()
             .is_some_and(|t| t.verdict == Verdict::Unusable);
         if unusable {
-            println!("{}: UNUSABLE, no estimate to rely on", e.name);
+            outln!("{}: UNUSABLE, no estimate to rely on", e.name)?;
         } else if detailed {
             let intervals = e
                 .trust
                 .as_ref()
                 .and_then(|t| t.uncertainty.as_ref())
                 .map(|u| &u.metrics);
-            println!(
+            outln!(
                 "{}: {}",
                 e.name,
                 colorimetry_line(&e.colorimetry, intervals)
-            );
-            println!("  relative SPD: {}", spd_line(&e.spd));
-            println!("  {}", metrics_line(e, intervals));
+            )?;
+            outln!("  relative SPD: {}", spd_line(&e.spd))?;
+            outln!("  {}", metrics_line(e, intervals))?;
             match (&e.absolute, e.photo.as_ref().and_then(|p| p.exposure)) {
-                (Some(Ok(a)), _) => println!(
+                (Some(Ok(a)), _) => outln!(
                     "  absolute (approximate, from {}): {:.0} lx, PPFD {}, melanopic EDI {}",
                     a.exposure.label(),
                     a.illuminance_lux,
@@ -49,15 +50,15 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
                         .map_or_else(|| "—".into(), |v| format!("{v:.1} µmol/m²/s")),
                     a.melanopic_edi_lux
                         .map_or_else(|| "—".into(), |v| format!("{v:.0} lx")),
-                ),
-                (Some(Err(reason)), Some(_)) => println!("  no absolute levels: {reason}"),
+                )?,
+                (Some(Err(reason)), Some(_)) => outln!("  no absolute levels: {reason}")?,
                 _ => {}
             }
         }
         if let Some(t) = &e.trust {
-            println!("  {}", trust_line(t));
+            outln!("  {}", trust_line(t))?;
             if let (Some(u), false) = (&t.uncertainty, unusable) {
-                println!(
+                outln!(
                     "  expected GFC {:.3}; 95 % band {:.2} wide on average (68 %: {:.2}; SPD peak 1){}",
                     u.expected_gfc,
                     u.band95.mean_width(),
@@ -70,23 +71,24 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
                     } else {
                         String::new()
                     }
-                );
+                )?;
             }
         }
         if let Some(s) = e.truth {
-            println!(
+            outln!(
                 "  against the true SPD: GFC {:.4}, RMSE {:.4} (both peak-normalised)",
-                s.gfc, s.rmse
-            );
+                s.gfc,
+                s.rmse
+            )?;
         }
     }
     if estimates.iter().any(|e| e.photo.is_some()) {
-        println!(
+        outln!(
             "confidence: how sure the chart's detection is (0–1; below 0.8 check the --debug image)"
-        );
+        )?;
     }
     if detailed {
-        println!(
+        outln!(
             "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and gamut; \
              M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: scotopic/photopic; \
              PPF: µmol/s of 400–700 nm photons per klm; ± the 95 % interval when calibrated; \
@@ -95,33 +97,34 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) {
              (`spdcam metrics` on a wider SPD, `--json` for every number)",
             estimates[0].spd.grid().start_nm,
             estimates[0].spd.grid().end_nm()
-        );
+        )?;
     }
     if estimates.iter().any(|e| e.trust.is_some()) {
-        println!(
+        outln!(
             "verdict: ok, doubtful (use with care) or unusable, from the detection, clipped and \
              dark patches, the self-check (the chart re-rendered under the estimate) and the \
              calibrated uncertainty; the bands hold the true SPD at 68 % and 95 % per wavelength"
-        );
+        )?;
     }
     if estimates.iter().any(|e| e.truth.is_some()) {
-        println!(
+        outln!(
             "GFC: goodness-of-fit of the spectral shape, 1 = identical (≥ 0.999 excellent, ≥ 0.99 good)"
-        );
+        )?;
     }
     if let Some(out) = &args.output {
-        println!(
+        outln!(
             "SPD{} → {}",
             if estimates.len() > 1 { "s" } else { "" },
             out.display()
-        );
+        )?;
     }
     if let Some(plot) = &args.plot {
-        println!("plot → {}", plot.display());
+        outln!("plot → {}", plot.display())?;
     }
     if let Some(report) = &args.report {
-        println!("report → {}", report.display());
+        outln!("report → {}", report.display())?;
     }
+    Ok(())
 }
 
 /// One estimate of the report: the estimate, for a photo the photo with the chart found
@@ -152,6 +155,20 @@ pub(super) fn verdicts_to_stderr(estimates: &[Estimate]) {
             eprintln!("{}", verdict_line(&e.name, t));
         }
     }
+}
+
+/// One estimate on one line, for runs of many rows: `estimate_21: xy (0.3127, 0.3290), CCT
+/// 6504 K, Duv +0.0003; verdict: ok`, and its score when it has a truth.
+pub(super) fn summary_line(e: &Estimate) -> String {
+    let mut line = match &e.trust {
+        Some(t) if t.verdict == Verdict::Unusable => verdict_line(&e.name, t),
+        Some(t) => format!("{}: {}; {}", e.name, e.colorimetry.label(), trust_line(t)),
+        None => format!("{}: {}", e.name, e.colorimetry.label()),
+    };
+    if let Some(s) = e.truth {
+        line.push_str(&format!("; GFC {:.4}, RMSE {:.4}", s.gfc, s.rmse));
+    }
+    line
 }
 
 /// `name: UNUSABLE, no estimate to rely on; verdict: unusable (reasons)`, or

@@ -10,7 +10,9 @@ use spdcam_core::camera::demosaic::DemosaicMethod;
 use spdcam_core::camera::noise::NoiseParams;
 use spdcam_core::camera::sensor::{Sensitivities, SensorMode};
 use spdcam_core::camera::white_balance::WhiteBalance;
-use spdcam_core::camera::{Camera, CameraConfig, WhiteBalanceStatistics, MAX_EXPOSURE};
+use spdcam_core::camera::{
+    too_low_exposure, Camera, CameraConfig, WhiteBalanceStatistics, MAX_EXPOSURE, MIN_EXPOSURE,
+};
 use spdcam_core::chart::{Chart, Layout};
 use spdcam_core::error::short_number;
 use spdcam_core::spectral::Grid;
@@ -78,6 +80,9 @@ impl CameraArgs {
                  (e.g. 0.8, or 1.5 to clip)",
                 short_number(self.exposure)
             );
+        }
+        if self.exposure < MIN_EXPOSURE {
+            bail!("--{}", too_low_exposure(self.exposure));
         }
         let noise = match self.noise.as_str() {
             "off" | "none" => None,

@@ -16,7 +16,7 @@ use spdcam_core::imageio;
 use spdcam_core::lighting::Lighting;
 use spdcam_core::photo::scene;
 use spdcam_core::spectral::{Grid, SpectralSet};
-use spdcam_core::{fsio, light};
+use spdcam_core::{fsio, light, limits};
 use std::path::{Path, PathBuf};
 
 /// Options of `spdcam render`.
@@ -43,8 +43,10 @@ pub struct RenderArgs {
     /// output.
     #[arg(long, value_name = "FILE.csv")]
     features: Option<PathBuf>,
-    /// Also write every intermediate stage as an image into this directory.
-    #[arg(long, value_name = "DIR")]
+    /// Also write every intermediate stage as an image into this directory. The stages are
+    /// held beside the image, so each pixel counts twice against SPDCAM_MAX_RENDER_PIXELS.
+    /// Not with --scene: a scene photo is developed in one pass, without stage images.
+    #[arg(long, value_name = "DIR", conflicts_with = "scene")]
     stages: Option<PathBuf>,
     /// Seed of the noise (and of the scene).
     #[arg(long, default_value_t = 0)]
@@ -137,6 +139,15 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
     }
     let messages = Messages::new(files().any(|p| fsio::is_stdout(p)));
     if let Some(dir) = &args.stages {
+        let l = args.camera.chart(data_dir, &grid)?.layout;
+        limits::RENDER_PIXELS.check(
+            limits::product(&[l.width as u64, l.height as u64, 2]),
+            &format!(
+                "--stages with a {}×{} chart (the stage images are held beside the image, so \
+                 each pixel counts twice; render a smaller chart with --size or --patch-px)",
+                l.width, l.height
+            ),
+        )?;
         // Made here, before the render, so a bad place fails at once.
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot make the stages directory {}", dir.display()))?;
@@ -187,7 +198,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         let set = SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?;
         fsio::write_output(path, set.to_csv_string().as_bytes())?;
         if !fsio::is_stdout(path) {
-            messages.say(format_args!("light SPD: {}", path.display()));
+            messages.say(format_args!("light SPD: {}", path.display()))?;
         }
     }
     if let Some((width, height)) = scene {
@@ -208,7 +219,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         messages.say(format_args!(
             "stages (linear raw, 16-bit): {}",
             dir.display()
-        ));
+        ))?;
     }
     if let Some(path) = &args.features {
         let names = camera.chart().feature_names();
@@ -216,7 +227,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         let text = format!("{}\n{}\n", names.join(","), values.join(","));
         fsio::write_output(path, text.as_bytes())?;
         if !fsio::is_stdout(path) {
-            messages.say(format_args!("features: {}", path.display()));
+            messages.say(format_args!("features: {}", path.display()))?;
         }
     }
     fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
@@ -233,7 +244,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         l.height,
         depth,
         args.output.display()
-    ));
+    ))?;
     Ok(())
 }
 

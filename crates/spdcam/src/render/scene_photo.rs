@@ -101,6 +101,6 @@ pub(super) fn render_scene(
         camera.camera_name(),
         args.output.display(),
         corners.join(",")
-    ));
+    ))?;
     Ok(())
 }
