@@ -516,15 +516,26 @@ impl Chart {
 
     /// Feature column names: `p01_r,p01_g,p01_b,p02_r,…` in feature order.
     pub fn feature_names(&self) -> Vec<String> {
-        let width = if self.feature_patches.len() >= 100 {
-            3
-        } else {
-            2
-        };
-        (1..=self.feature_patches.len())
-            .flat_map(|k| ["r", "g", "b"].map(|c| format!("p{k:0width$}_{c}")))
-            .collect()
+        feature_names_of(self.feature_patches.len())
     }
+}
+
+/// The feature column names a chart of `patches` feature patches gives: `p01_r,p01_g,
+/// p01_b,p02_r,…` (three digits from 100 patches on), three a patch.
+pub fn feature_names_of(patches: usize) -> Vec<String> {
+    let width = if patches >= 100 { 3 } else { 2 };
+    (1..=patches)
+        .flat_map(|k| ["r", "g", "b"].map(|c| format!("p{k:0width$}_{c}")))
+        .collect()
+}
+
+/// Whether `name` has the form of a feature column name ([`feature_names_of`]):
+/// `p`, digits, `_` and `r`, `g` or `b`.
+pub fn is_feature_name(name: &str) -> bool {
+    name.strip_prefix('p')
+        .and_then(|rest| rest.strip_suffix(['r', 'g', 'b']))
+        .and_then(|rest| rest.strip_suffix('_'))
+        .is_some_and(|digits| !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()))
 }
 
 #[cfg(test)]
