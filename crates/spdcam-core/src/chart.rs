@@ -543,6 +543,27 @@ mod tests {
     use super::*;
 
     #[test]
+    fn feature_names_have_the_form_they_are_recognised_by() {
+        for patches in [1, 24, 140] {
+            let names = feature_names_of(patches);
+            assert_eq!(names.len(), 3 * patches);
+            assert!(names.iter().all(|n| is_feature_name(n)), "{names:?}");
+        }
+        assert_eq!(feature_names_of(140)[0], "p001_r");
+        for other in [
+            "p_r",
+            "p01_x",
+            "p01r",
+            "q01_r",
+            "p1a_g",
+            "spd_380",
+            "__index_level_0__",
+        ] {
+            assert!(!is_feature_name(other), "{other}");
+        }
+    }
+
+    #[test]
     fn known_charts_round_trip_their_names_and_map_to_the_chart_photographed() {
         for chart in KnownChart::ALL {
             assert_eq!(KnownChart::from_name(chart.name()), Some(chart));
