@@ -516,20 +516,52 @@ impl Chart {
 
     /// Feature column names: `p01_r,p01_g,p01_b,p02_r,…` in feature order.
     pub fn feature_names(&self) -> Vec<String> {
-        let width = if self.feature_patches.len() >= 100 {
-            3
-        } else {
-            2
-        };
-        (1..=self.feature_patches.len())
-            .flat_map(|k| ["r", "g", "b"].map(|c| format!("p{k:0width$}_{c}")))
-            .collect()
+        feature_names_of(self.feature_patches.len())
     }
+}
+
+/// The feature column names a chart of `patches` feature patches gives: `p01_r,p01_g,
+/// p01_b,p02_r,…` (three digits from 100 patches on), three a patch.
+pub fn feature_names_of(patches: usize) -> Vec<String> {
+    let width = if patches >= 100 { 3 } else { 2 };
+    (1..=patches)
+        .flat_map(|k| ["r", "g", "b"].map(|c| format!("p{k:0width$}_{c}")))
+        .collect()
+}
+
+/// Whether `name` has the form of a feature column name ([`feature_names_of`]):
+/// `p`, digits, `_` and `r`, `g` or `b`.
+pub fn is_feature_name(name: &str) -> bool {
+    name.strip_prefix('p')
+        .and_then(|rest| rest.strip_suffix(['r', 'g', 'b']))
+        .and_then(|rest| rest.strip_suffix('_'))
+        .is_some_and(|digits| !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn feature_names_have_the_form_they_are_recognised_by() {
+        for patches in [1, 24, 140] {
+            let names = feature_names_of(patches);
+            assert_eq!(names.len(), 3 * patches);
+            assert!(names.iter().all(|n| is_feature_name(n)), "{names:?}");
+        }
+        assert_eq!(feature_names_of(140)[0], "p001_r");
+        for other in [
+            "p_r",
+            "p01_x",
+            "p01r",
+            "q01_r",
+            "p1a_g",
+            "spd_380",
+            "__index_level_0__",
+        ] {
+            assert!(!is_feature_name(other), "{other}");
+        }
+    }
 
     #[test]
     fn known_charts_round_trip_their_names_and_map_to_the_chart_photographed() {

@@ -132,8 +132,17 @@ pub const FILTER_SIGMA_PX: Limit = Limit {
     default: 100,
 };
 
+/// Samples whose content hashes are held at once to find samples held twice (`dataset
+/// merge`, `dataset info --verify`): about 34 bytes a sample in the hash table, so the
+/// default takes about 0.8 GiB and 10⁸ samples about 3.4 GiB.
+pub const DISTINCT_SAMPLES: Limit = Limit {
+    what: "samples checked for duplicates",
+    env: "SPDCAM_MAX_DISTINCT_SAMPLES",
+    default: 25_000_000,
+};
+
 /// Every limit, in the order of the README's table.
-pub const ALL: [Limit; 14] = [
+pub const ALL: [Limit; 15] = [
     PHOTO_BYTES,
     TEXT_FILE_BYTES,
     MODEL_BYTES,
@@ -144,6 +153,7 @@ pub const ALL: [Limit; 14] = [
     GRID_BANDS,
     SAMPLES,
     DRAWS,
+    DISTINCT_SAMPLES,
     CHUNK_BYTES,
     FILTER_SIGMA_PX,
     DETECTION_PHOTOS,

@@ -10,8 +10,8 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::{
-    self, Dataset, ExportOptions, FileFormat, GenerateOptions, Generator, ImportOptions, Origin,
-    Pipeline, Shard,
+    self, Dataset, Duplicates, ExportOptions, FileFormat, GenerateOptions, Generator,
+    ImportOptions, Origin, Pipeline, Shard,
 };
 use spdcam_core::lighting::Lighting;
 use spdcam_core::seed;
@@ -132,12 +132,14 @@ fn shards_merge_into_the_single_run() {
         shards.push(Dataset::open(&dir).unwrap());
     }
     let merged = scratch("shards-merged");
-    let manifest = dataset::merge(&shards, &merged, false, &|_| {}).unwrap();
+    let manifest = dataset::merge(&shards, &merged, false, Duplicates::Refuse, &|_| {})
+        .unwrap()
+        .manifest;
     assert!(matches!(manifest.origin, Origin::Generated(ref s) if s.shard.is_none()));
     assert_same_files(&whole, &merged);
 
     let missing = scratch("shards-missing");
-    let e = dataset::merge(&shards[..2], &missing, false, &|_| {})
+    let e = dataset::merge(&shards[..2], &missing, false, Duplicates::Refuse, &|_| {})
         .unwrap_err()
         .to_string();
     assert!(e.contains("missing"), "{e}");
@@ -479,7 +481,9 @@ fn split_is_seeded_complete_and_merges_back() {
         .map(|p| Dataset::open(&dir.join("a").join(p)).unwrap())
         .collect();
     let joined = dir.join("joined");
-    let m = dataset::merge(&opened, &joined, false, &|_| {}).unwrap();
+    let m = dataset::merge(&opened, &joined, false, Duplicates::Refuse, &|_| {})
+        .unwrap()
+        .manifest;
     assert!(matches!(m.origin, Origin::Merged { .. }));
     let mut samples = Dataset::open(&joined).unwrap().load().unwrap().samples;
     samples.sort_unstable();
@@ -640,7 +644,14 @@ fn generated_sets_are_compressed_float32_and_old_float64_files_still_read() {
 
     // The first datasets' files (uncompressed, SPDs and weights as DOUBLE) read as written.
     let old = scratch("float64");
-    dataset::merge(&[Dataset::open(&dir).unwrap()], &old, false, &|_| {}).unwrap();
+    dataset::merge(
+        &[Dataset::open(&dir).unwrap()],
+        &old,
+        false,
+        Duplicates::Refuse,
+        &|_| {},
+    )
+    .unwrap();
     let columns = generator.columns();
     let legacy = FileFormat::uncompressed_float64_values(columns);
     let mut first = 0;

@@ -7,7 +7,8 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::{
-    self, Dataset, ExportOptions, GenerateOptions, Generator, ImportOptions, Pipeline, LOCK_FILE,
+    self, Dataset, Duplicates, ExportOptions, GenerateOptions, Generator, ImportOptions, Pipeline,
+    LOCK_FILE,
 };
 use spdcam_core::lighting::Lighting;
 use spdcam_core::spectral::Grid;
@@ -343,7 +344,14 @@ fn writers_refuse_an_output_that_is_holds_or_lies_inside_an_input() {
         let errors = [
             dataset::split(&input, &out, [0.5, 0.25, 0.25], 1, true, &|_| {}).map(|_| ()),
             dataset::export_csv(&input, &out, &export, true).map(|_| ()),
-            dataset::merge(std::slice::from_ref(&input), &out, true, &|_| {}).map(|_| ()),
+            dataset::merge(
+                std::slice::from_ref(&input),
+                &out,
+                true,
+                Duplicates::Refuse,
+                &|_| {},
+            )
+            .map(|_| ()),
         ];
         for e in errors {
             let e = e.unwrap_err().to_string();
@@ -375,7 +383,7 @@ fn a_dataset_and_its_copy_are_not_merged() {
         std::fs::copy(a.join(name), b.join(name)).unwrap();
     }
     let inputs = [Dataset::open(&a).unwrap(), Dataset::open(&b).unwrap()];
-    let e = dataset::merge(&inputs, &dir.join("m"), false, &|_| {})
+    let e = dataset::merge(&inputs, &dir.join("m"), false, Duplicates::Refuse, &|_| {})
         .unwrap_err()
         .to_string();
     assert!(e.contains("hold the same samples"), "{e}");

@@ -259,6 +259,25 @@ fn check_set(set: &TrainingSet) -> Result<()> {
     Ok(())
 }
 
+/// Refuses training rows whose features, each row divided by its own scale as the model
+/// sees them, are the same in every row (every feature constant, or all rows identical):
+/// every input would scale to zero and a model could learn nothing from them.
+fn check_features_vary(scaler: &FeatureScaler, set: &TrainingSet, rows: usize) -> Result<()> {
+    if scaler.min.iter().zip(&scaler.max).any(|(lo, hi)| hi > lo) {
+        return Ok(());
+    }
+    Err(LearnError::invalid(format!(
+        "{}: every feature is the same in all {rows} training samples (each row divided by \
+         its {}): a model could not learn anything from them. The features must differ \
+         between samples; check how the dataset was generated or imported",
+        set.info.path,
+        match scaler.row_scale {
+            crate::scale::RowScale::Max => "maximum",
+            crate::scale::RowScale::Mean => "mean",
+        }
+    )))
+}
+
 /// A seeded split of `n` rows into (train, validation) indices.
 /// Row indices of training and validation, the set the validation rows index, and its SPDs.
 struct TrainValSplit<'a> {
@@ -411,6 +430,7 @@ pub fn train_in_parts(
         targets: TargetScaler::fit(&raw_targets, target.len())?,
         target,
     };
+    check_features_vary(&fitted.features, data, train_idx.len())?;
     let train_rows = prepare_rows(&fitted, data, &spds, &train_idx)?;
     let val_rows = prepare_rows(&fitted, val_set, &val_spds, &val_idx)?;
     let k = fitted.target.len();

@@ -1105,6 +1105,18 @@ fn every_limit_is_set_by_its_environment_variable() {
         args.extend(extra.iter().map(|a| a.to_string()));
         args
     };
+    let six = s(&dir.join("six"));
+    let made = spdcam(&[
+        "generate",
+        "--lighting",
+        "gaussian:4",
+        "--count",
+        "6",
+        "--fast",
+        "-o",
+        &six,
+    ]);
+    assert!(made.status.success(), "{made:?}");
     let cases: Vec<(&str, &str, Vec<String>, &str)> = vec![
         (
             "SPDCAM_MAX_PHOTO_BYTES",
@@ -1179,6 +1191,18 @@ fn every_limit_is_set_by_its_environment_variable() {
                 "--no-fit".into(),
             ],
             "11 draws exceed the limit of 10",
+        ),
+        (
+            "SPDCAM_MAX_DISTINCT_SAMPLES",
+            "5",
+            vec![
+                "dataset".into(),
+                "merge".into(),
+                six.clone(),
+                "-o".into(),
+                s(&dir.join("merged")),
+            ],
+            "6 samples checked for duplicates exceed the limit of 5",
         ),
         (
             "SPDCAM_MAX_CHUNK_BYTES",

@@ -324,6 +324,14 @@ pub fn import_csv(
             attempts: 1,
         })?;
     }
+    if writer.is_empty() {
+        return Err(Error::invalid(format!(
+            "{} and {} hold no samples (a header and no rows): nothing to import; give files \
+             with one row per sample",
+            features.display(),
+            spds.display()
+        )));
+    }
     let origin = Origin::Imported(ImportSource {
         features_file: features.display().to_string(),
         spds_file: spds.display().to_string(),
@@ -531,7 +539,19 @@ pub fn export_csv(
         )));
     }
     let columns = dataset.columns();
-    let grid = options.spd_grid.unwrap_or(columns.spd_grid);
+    let own = columns.spd_grid;
+    let grid = options.spd_grid.unwrap_or(own);
+    if grid.start_nm < own.start_nm - 1e-9 || grid.end_nm() > own.end_nm() + 1e-9 {
+        return Err(Error::invalid(format!(
+            "SPD grid {grid} reaches outside the dataset's SPDs, {}–{} nm ({}): they are not \
+             known there; give a grid within {}–{} nm",
+            own.start_nm,
+            own.end_nm(),
+            dataset.dir().display(),
+            own.start_nm,
+            own.end_nm()
+        )));
+    }
     let map = SpdMap::new(&columns.spd_grid.wavelengths(), &grid)?;
     let output = prepare_output(out, &[dataset.dir()], overwrite)?;
     let mut written = Vec::new();

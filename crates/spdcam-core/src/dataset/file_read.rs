@@ -50,6 +50,7 @@ pub(crate) fn decode(bytes: Bytes, columns: &Columns, source: &str) -> Result<Sa
             by_name.insert(c.name().to_string(), i);
         }
     }
+    check_feature_columns(&descr, columns).map_err(bad)?;
     let names = columns.column_names();
     let wanted = fields(columns);
     let mut index = Vec::with_capacity(names.len());
@@ -164,6 +165,32 @@ pub(crate) fn decode(bytes: Bytes, columns: &Columns, source: &str) -> Result<Sa
         )));
     }
     Ok(batch)
+}
+
+/// Refuses a file holding feature columns (named as charts name them,
+/// [`crate::chart::is_feature_name`]) that the manifest does not describe: a manifest naming
+/// some of a file's features would read, train on and export only those.
+fn check_feature_columns(
+    descr: &parquet::schema::types::SchemaDescriptor,
+    columns: &Columns,
+) -> std::result::Result<(), String> {
+    let in_file: Vec<String> = (0..descr.num_columns())
+        .map(|i| descr.column(i))
+        .filter(|c| c.path().parts().len() == 1)
+        .map(|c| c.name().to_string())
+        .filter(|n| crate::chart::is_feature_name(n) || columns.feature_names.contains(n))
+        .collect();
+    if in_file.iter().all(|n| columns.feature_names.contains(n)) {
+        return Ok(());
+    }
+    Err(format!(
+        "the file holds {} feature columns ({}) but the manifest names {} ({}): the manifest \
+         was edited or damaged; restore the one spdcam wrote",
+        in_file.len(),
+        super::manifest::name_range(&in_file),
+        columns.feature_count(),
+        super::manifest::name_range(&columns.feature_names)
+    ))
 }
 
 /// One column chunk to read: its rows, whether it may hold nulls, and names for errors.

@@ -133,6 +133,25 @@ impl Origin {
     }
 }
 
+/// The generate runs whose samples `origin` holds (some of them, for a split part).
+fn generate_runs(origin: &Origin) -> Vec<&GenerateSettings> {
+    match origin {
+        Origin::Generated(s) => vec![s.as_ref()],
+        Origin::Merged { sources } => sources.iter().flat_map(generate_runs).collect(),
+        Origin::Split { source, .. } => generate_runs(source),
+        Origin::Imported(_) => Vec::new(),
+    }
+}
+
+/// Column names in short: `p01_r … p24_b`, or the only one.
+pub(crate) fn name_range(names: &[String]) -> String {
+    match names {
+        [] => "none".to_string(),
+        [one] => one.clone(),
+        [first, .., last] => format!("{first} … {last}"),
+    }
+}
+
 /// Which camera pipeline renders the samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -320,7 +339,34 @@ impl Manifest {
             .columns
             .validate()
             .map_err(|e| Error::parse(&source, e.to_string()))?;
+        manifest
+            .check_feature_layout()
+            .map_err(|e| Error::parse(&source, e))?;
         Ok(manifest)
+    }
+
+    /// Checks the feature columns against the chart of every generate run the samples came
+    /// from (through splits and merges): the names that chart gives, three a feature patch.
+    /// (Imported samples name no chart; their sample files are checked for feature columns
+    /// the manifest leaves out as they are read.)
+    fn check_feature_layout(&self) -> std::result::Result<(), String> {
+        let found = &self.columns.feature_names;
+        for run in generate_runs(&self.origin) {
+            let expected = crate::chart::feature_names_of(run.chart.feature_patches.len());
+            if *found != expected {
+                return Err(format!(
+                    "the manifest names {} feature columns ({}), but chart '{}' the samples were \
+                     generated with gives {} ({}): the manifest was edited or damaged; restore \
+                     the one spdcam wrote, or generate the dataset again",
+                    found.len(),
+                    name_range(found),
+                    run.chart.name,
+                    expected.len(),
+                    name_range(&expected)
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Writes `DIR/manifest.json` atomically.

@@ -1,13 +1,36 @@
 //! Joining datasets: the shards of one `generate` run back into that run, or any datasets
-//! with the same columns one after the other.
+//! with the same columns one after the other, each sample once: samples already held (by
+//! content, [`super::identity::sample_hash`]) are refused or dropped.
 
 use super::batch::{Columns, Precision};
+use super::identity::SeenSamples;
 use super::manifest::{GenerateSettings, Manifest, Origin};
 use super::reader::Dataset;
 use super::writer::{prepare_output, DatasetWriter};
 use super::DEFAULT_CHUNK_SIZE;
 use crate::error::{Error, Result};
+use std::collections::BTreeMap;
 use std::path::Path;
+
+/// What [`merge`] does with a sample it already holds (same features and light as an earlier
+/// sample of the inputs, whatever path it came by: a split part, an export imported again,
+/// a copy).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Duplicates {
+    /// Refuse the merge, naming how many samples repeat and in which inputs.
+    Refuse,
+    /// Keep the first copy of each sample and leave the others out.
+    Drop,
+}
+
+/// What [`merge`] wrote.
+#[derive(Debug, Clone)]
+pub struct MergeReport {
+    /// The manifest of the merged dataset.
+    pub manifest: Manifest,
+    /// Samples left out as copies of earlier ones ([`Duplicates::Drop`]).
+    pub dropped: u64,
+}
 
 /// The settings shared by shards of one run, and the shards in sample order; `None` when
 /// the inputs are not all shards of one run.
@@ -100,10 +123,11 @@ fn same_draws(a: &GenerateSettings, b: &GenerateSettings) -> bool {
     draws(a) == draws(b)
 }
 
-/// Refuses two inputs that hold the same samples: overlapping samples of one generate run
-/// (a dataset given twice, a copy of it, runs with the same seed and settings), the same
-/// part of one split, or identical sample files. Merging them would hold each sample twice,
-/// and a split of the result would put copies in both train and test.
+/// Refuses two inputs that hold the same samples, from their manifests alone (before any
+/// sample is read): overlapping samples of one generate run (a dataset given twice, a copy
+/// of it, runs with the same seed and settings), the same part of one split, or identical
+/// sample files. Merging them would hold each sample twice, and a split of the result would
+/// put copies in both train and test.
 fn check_distinct(inputs: &[Dataset]) -> Result<()> {
     for (i, a) in inputs.iter().enumerate() {
         for b in &inputs[i + 1..] {
@@ -117,7 +141,8 @@ fn check_distinct(inputs: &[Dataset]) -> Result<()> {
                         return Err(Error::invalid(format!(
                             "{} hold the same samples: numbers {start}–{} of one generate run \
                              (lighting {}, seed {}); merging would hold each of them twice. \
-                             Give each dataset once, or generate with another --seed",
+                             Give each dataset once, generate with another --seed, or add \
+                             --drop-duplicates to keep one copy of each",
                             shown(),
                             end - 1,
                             ra.lighting.spec,
@@ -128,7 +153,8 @@ fn check_distinct(inputs: &[Dataset]) -> Result<()> {
             }
             if matches!(ma.origin, Origin::Split { .. }) && ma.origin == mb.origin {
                 return Err(Error::invalid(format!(
-                    "{} are the same part of one split: merging would hold each sample twice",
+                    "{} are the same part of one split: merging would hold each sample twice \
+                     (add --drop-duplicates to keep one copy of each)",
                     shown()
                 )));
             }
@@ -139,7 +165,7 @@ fn check_distinct(inputs: &[Dataset]) -> Result<()> {
             if let Some(file) = shared {
                 return Err(Error::invalid(format!(
                     "{} hold identical sample files ({} of the first): merging would hold \
-                     its samples twice",
+                     its samples twice (add --drop-duplicates to keep one copy of each)",
                     shown(),
                     file.name
                 )));
@@ -182,24 +208,55 @@ fn common_columns(inputs: &[Dataset]) -> Result<Columns> {
     })
 }
 
+/// The error for samples found again: `repeats[(first, later)]` samples of input `later`
+/// were already held by input `first`.
+fn repeated(inputs: &[&Dataset], repeats: &BTreeMap<(usize, usize), u64>) -> Error {
+    let total: u64 = repeats.values().sum();
+    let pairs: Vec<String> = repeats
+        .iter()
+        .map(|(&(first, later), n)| {
+            let later_dir = inputs[later].dir().display();
+            if first == later {
+                format!("{n} of {later_dir} repeat samples of {later_dir} itself")
+            } else {
+                format!(
+                    "{n} of {later_dir} are already in {}",
+                    inputs[first].dir().display()
+                )
+            }
+        })
+        .collect();
+    Error::invalid(format!(
+        "{total} samples would be held twice (same features and light): {}. A model would weigh \
+         them double, and a split of the result could put copies of one sample in both train \
+         and test. Give each sample's dataset once, or add --drop-duplicates to keep the first \
+         copy of each",
+        pairs.join("; ")
+    ))
+}
+
 /// Merges `inputs` into the dataset directory `out`. When they are the shards of one
 /// `generate` run (in any order), the result is that run as one directory — the same files
-/// a single run writes — and every shard must be present. Otherwise the datasets are
-/// joined one after the other (same columns needed), keeping their sample numbers.
-/// `progress` is told how many rows were copied.
+/// a single run writes — and every shard must be present (their sample ranges prove them
+/// distinct). Otherwise the datasets are joined one after the other (same columns needed),
+/// keeping their sample numbers, and each sample is recognised by its content
+/// ([`super::identity::sample_hash`]; at most [`crate::limits::DISTINCT_SAMPLES`] samples):
+/// one already held refuses the merge, or with [`Duplicates::Drop`] is left out. Nothing
+/// is left in `out` when the merge fails. `progress` is told how many rows were read.
 pub fn merge(
     inputs: &[Dataset],
     out: &Path,
     overwrite: bool,
+    duplicates: Duplicates,
     progress: &dyn Fn(u64),
-) -> Result<Manifest> {
+) -> Result<MergeReport> {
     if inputs.is_empty() {
         return Err(Error::invalid("merge needs at least one dataset"));
     }
     let dirs: Vec<&Path> = inputs.iter().map(Dataset::dir).collect();
     crate::fsio::check_output_apart(out, &dirs)?;
     let shards = shards_of_one_run(inputs);
-    if shards.is_none() {
+    if shards.is_none() && duplicates == Duplicates::Refuse {
         check_distinct(inputs)?;
     }
     let (ordered, columns, chunk_size, origin) = match shards {
@@ -222,18 +279,38 @@ pub fn merge(
             },
         ),
     };
+    let mut seen = match &origin {
+        Origin::Generated(_) => None,
+        _ => {
+            let total = inputs.iter().map(Dataset::len).sum();
+            let context = format!("merging {} datasets", inputs.len());
+            Some(SeenSamples::with_capacity(total, &context)?)
+        }
+    };
     let output = prepare_output(out, &dirs, overwrite)?;
     let mut writer = DatasetWriter::new(out, columns, chunk_size)?;
-    for dataset in ordered {
+    let mut repeats: BTreeMap<(usize, usize), u64> = BTreeMap::new();
+    for (k, dataset) in ordered.iter().enumerate() {
         for batch in dataset.batches() {
             let batch = batch?;
             for i in 0..batch.len() {
-                writer.push(batch.row(i))?;
+                let row = batch.row(i);
+                if let Some(first) = seen.as_mut().and_then(|s| s.insert(&row, k as u32)) {
+                    *repeats.entry((first as usize, k)).or_insert(0) += 1;
+                } else if repeats.is_empty() || duplicates == Duplicates::Drop {
+                    writer.push(row)?;
+                }
             }
             progress(batch.len() as u64);
         }
     }
+    if !repeats.is_empty() && duplicates == Duplicates::Refuse {
+        return Err(repeated(&ordered, &repeats));
+    }
     let manifest = writer.finish(origin)?;
     output.finish();
-    Ok(manifest)
+    Ok(MergeReport {
+        manifest,
+        dropped: repeats.values().sum(),
+    })
 }

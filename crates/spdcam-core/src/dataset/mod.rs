@@ -26,6 +26,7 @@ mod csv_io;
 mod file;
 mod file_read;
 mod generate;
+mod identity;
 mod lock;
 mod manifest;
 mod merge;
@@ -42,12 +43,13 @@ pub use csv_io::{
 };
 pub use file::{encode_parquet, encode_parquet_as, Compression, FileFormat, ZSTD_LEVEL};
 pub use generate::{GenerateEvent, GenerateOptions, GenerateRequest, Generator, Plan};
+pub use identity::{sample_hash, SeenSamples};
 pub use lock::{DirLock, LockOwner, LOCK_FILE};
 pub use manifest::{
     sha256_hex, CameraInfo, ChartInfo, FileEntry, GenerateSettings, ImportSource, LightingInfo,
     Manifest, Origin, Pipeline, Shard, FEATURE_SCALE, FORMAT, FORMAT_VERSION, MANIFEST_FILE,
 };
-pub use merge::merge;
+pub use merge::{merge, Duplicates, MergeReport};
 pub use reader::{Dataset, Verification};
 pub use split::{assign_parts, split};
 pub use writer::SAMPLES_DIR;

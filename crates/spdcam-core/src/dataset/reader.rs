@@ -2,6 +2,7 @@
 
 use super::batch::{Columns, Counts, SampleBatch};
 use super::file_read;
+use super::identity::SeenSamples;
 use super::lock::DirLock;
 use super::manifest::{FileEntry, Manifest};
 use crate::error::{Error, Result};
@@ -52,6 +53,12 @@ pub struct Verification {
     pub without_checksum: usize,
     /// What is wrong, one line each, naming the file.
     pub problems: Vec<String>,
+    /// Samples that repeat an earlier sample of the dataset (same features and light,
+    /// [`super::sample_hash`]); when any do, `problems` says so too.
+    pub duplicates: u64,
+    /// Why the samples were not checked for duplicates (more of them than
+    /// [`limits::DISTINCT_SAMPLES`]), when they were not.
+    pub duplicates_unchecked: Option<String>,
 }
 
 /// An opened dataset directory.
@@ -125,20 +132,48 @@ impl Dataset {
 
     /// Reads every sample file and checks it against the manifest: checksum, columns,
     /// finite values, row counts, and the manifest's totals of samples, attempts and
-    /// families. Unlike reading, it goes on after a bad file and lists every problem.
+    /// families; and that no sample repeats another (by content, up to
+    /// [`limits::DISTINCT_SAMPLES`] samples). Unlike reading, it goes on after a bad file
+    /// and lists every problem.
     pub fn verify(&self, progress: &dyn Fn(u64)) -> Verification {
         let mut report = Verification::default();
         let mut counts = Counts::default();
+        let context = format!("checking {} for duplicate samples", self.dir.display());
+        let mut seen = match SeenSamples::with_capacity(self.len(), &context) {
+            Ok(seen) => Some(seen),
+            Err(e) => {
+                report.duplicates_unchecked = Some(e.to_string());
+                None
+            }
+        };
         for (k, entry) in self.manifest.files.iter().enumerate() {
             match self.read_file(k) {
                 Ok(batch) => {
                     report.files_ok += 1;
                     report.without_checksum += usize::from(entry.sha256.is_none());
                     counts.add(&batch);
+                    if let Some(seen) = seen.as_mut() {
+                        for i in 0..batch.len() {
+                            if seen.insert(&batch.row(i), 0).is_some() {
+                                report.duplicates += 1;
+                            }
+                        }
+                    }
                     progress(batch.len() as u64);
                 }
                 Err(e) => report.problems.push(e.to_string()),
             }
+        }
+        if report.duplicates > 0 {
+            report.problems.push(format!(
+                "{}: {} samples repeat earlier samples of the dataset (same features and light): \
+                 a model would weigh them double, and a split could put copies of one sample in \
+                 both train and test; keep one copy of each with `spdcam dataset merge {} \
+                 --drop-duplicates -o NEW_DIR`",
+                self.dir.display(),
+                report.duplicates,
+                self.dir.display()
+            ));
         }
         if report.problems.is_empty() {
             let m = &self.manifest;

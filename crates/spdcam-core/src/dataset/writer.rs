@@ -216,6 +216,11 @@ impl<'a> DatasetWriter<'a> {
         })
     }
 
+    /// Whether no row was pushed yet.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.files.is_empty() && self.pending.is_empty()
+    }
+
     /// Appends one row.
     pub(crate) fn push(&mut self, row: SampleRow<'_>) -> Result<()> {
         self.pending.push(row)?;

@@ -2,6 +2,7 @@
 //! files checked against the manifest, and a plot of some of its SPDs.
 
 use crate::generate::progress_bar;
+use crate::plot_file::{plot_is_png, write_plot};
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use spdcam_core::dataset::{self, Dataset, Manifest, Origin};
@@ -13,11 +14,12 @@ use std::path::{Path, PathBuf};
 pub(super) struct InfoArgs {
     /// The dataset directory.
     dataset: PathBuf,
-    /// Also plot 20 SPDs spread over the dataset into this SVG file.
-    #[arg(long, value_name = "FILE.svg")]
+    /// Also plot 20 SPDs spread over the dataset into this file: SVG for .svg, PNG for .png.
+    #[arg(long, value_name = "FILE.svg|FILE.png")]
     plot: Option<PathBuf>,
     /// Read every sample file and check it against the manifest (SHA-256, columns, finite
-    /// values, row and family counts); exits non-zero when anything is wrong.
+    /// values, row and family counts) and for samples held twice; exits non-zero when
+    /// anything is wrong.
     #[arg(long)]
     verify: bool,
     /// After rewriting sample files on purpose (e.g. with pandas, same columns): re-read
@@ -114,6 +116,10 @@ fn print_info(dir: &Path, m: &Manifest) {
 
 /// Runs `spdcam dataset info`.
 pub(super) fn run(args: InfoArgs) -> Result<()> {
+    if let Some(path) = &args.plot {
+        plot_is_png(path)?;
+        fsio::check_parent_dir(path)?;
+    }
     if args.update_checksums {
         let m = Dataset::update_checksums(&args.dataset)?;
         println!(
@@ -142,9 +148,12 @@ pub(super) fn run(args: InfoArgs) -> Result<()> {
             0 => String::new(),
             n => format!(" ({n} without a checksum in the manifest: contents not proven)"),
         };
+        if let Some(why) = &report.duplicates_unchecked {
+            eprintln!("  note:     samples not checked for duplicates: {why}");
+        }
         if !report.problems.is_empty() {
             bail!(
-                "{} does not match its manifest: {} of {} sample files read correctly; problems: {}",
+                "{} failed verification: {} of {} sample files read correctly; problems: {}",
                 args.dataset.display(),
                 report.files_ok,
                 dataset.manifest().files.len(),
@@ -158,13 +167,12 @@ pub(super) fn run(args: InfoArgs) -> Result<()> {
         );
     }
     if let Some(path) = &args.plot {
-        fsio::check_parent_dir(path)?;
         let n = dataset.len();
         let shown = n.min(20);
         let positions: Vec<u64> = (0..shown).map(|k| k * n / shown.max(1)).collect();
         let rows = dataset.rows_at(&positions)?;
         let svg = plot_spds(&rows, &dataset.columns().spd_grid)?;
-        fsio::write_atomic(path, svg.as_bytes())?;
+        write_plot(path, &svg)?;
         println!("  plot:     {} ({shown} SPDs)", path.display());
     }
     Ok(())

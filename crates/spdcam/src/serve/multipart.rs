@@ -127,7 +127,26 @@ fn form_error(error: multer::Error) -> FormError {
 
 /// A field name as it may appear in a message: printable, at most 40 characters.
 fn printable(name: &str) -> String {
-    name.chars().filter(|c| !c.is_control()).take(40).collect()
+    name.chars().filter(|&c| shown(c)).take(40).collect()
+}
+
+/// Whether a character a client sent may be shown to a person: not a control character
+/// (C0, DEL, C1), a line or paragraph separator, nor a bidirectional formatting character
+/// (Unicode UAX #9: the embeddings and overrides U+202A–U+202E, the isolates U+2066–U+2069,
+/// the marks U+200E, U+200F and U+061C), which would reorder the text around it, e.g.
+/// make `photo\u{202E}gpj.exe` read as `photoexe.jpg`.
+pub(super) fn shown(c: char) -> bool {
+    !(c.is_control()
+        || matches!(
+            c,
+            '\u{202A}'..='\u{202E}'
+                | '\u{2066}'..='\u{2069}'
+                | '\u{200E}'
+                | '\u{200F}'
+                | '\u{061C}'
+                | '\u{2028}'
+                | '\u{2029}'
+        ))
 }
 
 #[cfg(test)]

@@ -39,10 +39,7 @@ pub(super) async fn locus(State(api): State<Arc<Api>>) -> Answer {
 /// `GET /api/jobs/ID`: where the job is, and its result once finished.
 pub(super) async fn job(State(api): State<Arc<Api>>, Path(id): Path<String>) -> Answer {
     let Some(progress) = id.parse::<u64>().ok().and_then(|id| api.jobs.progress(id)) else {
-        return Answer::error(
-            404,
-            format!("no job '{id}' (finished jobs are kept a while)"),
-        );
+        return unknown_job(&api, &id, "job");
     };
     let value = match progress {
         Progress::Queued { ahead } => serde_json::json!({ "state": "queued", "ahead": ahead }),
@@ -74,7 +71,20 @@ pub(super) async fn report(State(api): State<Arc<Api>>, Path(id): Path<String>) 
             "text/html; charset=utf-8",
             html.as_bytes().to_vec().into(),
         ),
-        None => Answer::error(404, format!("no report of job '{id}' is kept")),
+        None => unknown_job(&api, &id, "report of job"),
+    }
+}
+
+/// The 404 for a job (or its report) not kept: "no longer kept" when the id was given out
+/// and has since been forgotten, else no such job.
+fn unknown_job(api: &Api, id: &str, what: &str) -> Answer {
+    if id.parse::<u64>().is_ok_and(|n| api.jobs.issued(n)) {
+        Answer::error(
+            404,
+            format!("the {what} {id} is no longer kept (only the newest jobs are kept)"),
+        )
+    } else {
+        Answer::error(404, format!("no such {what}: '{id}'"))
     }
 }
 
@@ -82,8 +92,19 @@ pub(super) async fn not_allowed(method: Method, uri: Uri) -> Answer {
     Answer::error(405, format!("{method} is not allowed on {}", uri.path()))
 }
 
+/// Unknown addresses: a JSON error naming the path under `/api/`, a plain-text page
+/// elsewhere.
 pub(super) async fn not_found(uri: Uri) -> Answer {
-    Answer::error(404, format!("no such page or API: {}", uri.path()))
+    let path = uri.path();
+    if path == "/api" || path.starts_with("/api/") {
+        Answer::error(404, format!("no such API: {path}"))
+    } else {
+        Answer(
+            404,
+            "text/plain; charset=utf-8",
+            "404: no such page on this server\n".into(),
+        )
+    }
 }
 
 fn busy() -> Answer {

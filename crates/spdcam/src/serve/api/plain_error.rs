@@ -4,7 +4,7 @@
 /// The message for a person (no command-line words) and a code for the page, of a failed
 /// request's `status` and `error`: `no_chart` when the chart was not found (the page then
 /// asks for its corners), else `bad_photo`, `unknown_chart`, `bad_corners`, `too_large`,
-/// `busy`, `not_found` or `failed`.
+/// `busy`, `not_found` (a job no longer kept), `no_such_page` or `failed`.
 pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
     let (code, message) = if error.contains("no chart found") {
         (
@@ -38,9 +38,13 @@ pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
                 "busy",
                 "The server is busy with other photos; try again in a moment.".to_string(),
             ),
-            404 => (
+            404 if error.contains("no longer kept") => (
                 "not_found",
                 "This is no longer kept on the server; add the photo again.".to_string(),
+            ),
+            404 => (
+                "no_such_page",
+                "There is no such page or photo on this server; check the address.".to_string(),
             ),
             _ => (
                 "failed",
@@ -88,6 +92,8 @@ mod tests {
             (400, "--corners needs eight numbers x1,y1,x2,y2,x3,y3,x4,y4; got 3", "bad_corners"),
             (503, "too many photos are waiting; try again in a moment", "busy"),
             (500, "the model broke (try spdcam estimate --debug d.png); really", "failed"),
+            (404, "the job 3 is no longer kept (only the newest jobs are kept)", "not_found"),
+            (404, "no such API: /api/nope", "no_such_page"),
         ];
         for (status, error, want) in cases {
             let (code, message) = plain_error(status, error);

@@ -128,7 +128,8 @@ impl Api {
     }
 }
 
-/// A label from a client's file name: its last component only, printable, not too long.
+/// A label from a client's file name: its last component only, without control or
+/// bidirectional formatting characters ([`multipart::shown`]), not too long.
 fn label(filename: Option<&str>) -> String {
     let name = filename
         .unwrap_or("")
@@ -136,7 +137,7 @@ fn label(filename: Option<&str>) -> String {
         .next()
         .unwrap_or("")
         .chars()
-        .filter(|c| !c.is_control())
+        .filter(|&c| multipart::shown(c))
         .take(MAX_NAME_CHARS)
         .collect::<String>();
     let name = name.trim();
@@ -158,5 +159,18 @@ mod tests {
         assert_eq!(label(Some("..")), "photo");
         assert_eq!(label(None), "photo");
         assert_eq!(label(Some("a\u{7}b.jpg")), "ab.jpg");
+    }
+
+    #[test]
+    fn labels_drop_bidirectional_controls() {
+        // Issue 39, item 22: U+202E made `room\u{202E}gpj.exe` show as `roomexe.jpg`.
+        assert_eq!(label(Some("room\u{202E}gpj.exe")), "roomgpj.exe");
+        let every = "a\u{202A}\u{202B}\u{202C}\u{202D}\u{202E}\u{2066}\u{2067}\u{2068}\u{2069}\u{200E}\u{200F}\u{061C}\u{2028}\u{85}b.jpg";
+        assert_eq!(label(Some(every)), "ab.jpg");
+        assert_eq!(label(Some("\u{202E}\u{2066}")), "photo");
+        assert_eq!(
+            label(Some("café ünïcode 照片.jpg")),
+            "café ünïcode 照片.jpg"
+        );
     }
 }

@@ -126,6 +126,12 @@ impl Jobs {
         }
     }
 
+    /// Whether `id` was given to an upload (which may have been forgotten since): a job
+    /// no longer kept, as opposed to one that never was.
+    pub fn issued(&self, id: u64) -> bool {
+        (1..self.lock().next_id).contains(&id)
+    }
+
     /// The HTML report of finished job `id`, while it is kept.
     pub fn report(&self, id: u64) -> Option<Arc<str>> {
         self.lock().reports.get(&id).cloned()

@@ -112,11 +112,17 @@ function setStatus(entry, text) {
 
 // ---- adding photos --------------------------------------------------------------------
 
+/** A file name as shown: without control or bidirectional formatting characters, which would
+ * reorder the text around them (the server's rule for labels, multipart.rs `shown`). */
+function shownName(name) {
+  return (name || '').replace(/[\u0000-\u001f\u007f-\u009f\u061c\u200e\u200f\u2028\u2029\u202a-\u202e\u2066-\u2069]/g, '').trim();
+}
+
 function addFiles(files) {
   let first = null;
   for (const file of files) {
     const entry = {
-      id: state.nextId++, file, name: file.name || 'photo', url: URL.createObjectURL(file),
+      id: state.nextId++, file, name: shownName(file.name) || 'photo', url: URL.createObjectURL(file),
       color: COLORS[state.entries.length % COLORS.length], result: null, error: null, errorCode: null,
       status: '', busy: false, visible: true, corners: null, jobId: null, placing: null,
     };
@@ -146,12 +152,12 @@ function setupInputs() {
     const file = e.target.files[0];
     if (!file) return;
     try {
-      state.reference = { name: file.name, ...parseSpectralCsv(await file.text()) };
-      $('reference-info').textContent = `${file.name}: ${state.reference.wl.length} values, ${state.reference.wl[0]}–${state.reference.wl[state.reference.wl.length - 1]} nm`;
+      state.reference = { name: shownName(file.name), ...parseSpectralCsv(await file.text()) };
+      $('reference-info').textContent = `${state.reference.name}: ${state.reference.wl.length} values, ${state.reference.wl[0]}–${state.reference.wl[state.reference.wl.length - 1]} nm`;
       $('reference-info').className = '';
     } catch (err) {
       state.reference = null;
-      $('reference-info').textContent = `${file.name}: ${err.message}`;
+      $('reference-info').textContent = `${shownName(file.name)}: ${err.message}`;
       $('reference-info').className = 'error';
     }
     render();

@@ -80,6 +80,9 @@ fn bad_input_gets_a_clear_error_and_the_server_keeps_serving() {
     }
     let (status, got) = request(addr, "GET", "/no/such/page", None);
     assert_eq!(status, 404);
+    assert!(String::from_utf8_lossy(&got).contains("no such page"));
+    let (status, got) = request(addr, "GET", "/api/no/such/page", None);
+    assert_eq!(status, 404);
     assert!(json(&got)["error"].is_string());
     let (status, _) = request(addr, "GET", "/api/estimate", None);
     assert_eq!(status, 405);

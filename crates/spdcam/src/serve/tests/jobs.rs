@@ -1,6 +1,10 @@
 //! Jobs: queued, polled until done, their reports kept; corners with a named chart.
 
 use super::{expected, form, json, request, start, EXAMPLE};
+use crate::serve::jobs::{Jobs, Progress, Upload};
+use crate::serve::shipped_engine;
+use spdcam_core::builtin::DataDir;
+use std::sync::Arc;
 use std::time::Duration;
 
 #[test]
@@ -81,7 +85,7 @@ fn a_job_keeps_its_report_and_corners_take_a_named_chart_only() {
     assert!(report.contains("src=\"data:image/jpeg;base64,"));
     let (status, got) = request(addr, "GET", "/api/jobs/999999/report", None);
     assert_eq!(status, 404);
-    assert_eq!(json(&got)["code"], "not_found");
+    assert_eq!(json(&got)["code"], "no_such_page");
     // A chart is a name, never a path.
     let body = form(&[
         ("photo", Some("p.jpg"), EXAMPLE),
@@ -95,4 +99,36 @@ fn a_job_keeps_its_report_and_corners_take_a_named_chart_only() {
         "unknown chart '/etc/passwd'; valid: colorchecker24, colorchecker_sg96"
     );
     server.stop();
+}
+
+#[test]
+fn a_forgotten_job_is_told_from_one_that_never_was() {
+    // Issue 39, item 22: every 404 said "no longer kept", even for pages that never were.
+    let jobs = Arc::new(Jobs::new(
+        shipped_engine(&DataDir::new(None)).unwrap(),
+        4,
+        1,
+    ));
+    let worker = {
+        let jobs = Arc::clone(&jobs);
+        std::thread::spawn(move || jobs.work())
+    };
+    let upload = || Upload {
+        name: "notes.txt".into(),
+        bytes: b"not a photo".to_vec(),
+        corners: None,
+        memory: None,
+        chart: None,
+    };
+    let first = jobs.submit(upload()).unwrap();
+    let second = jobs.submit(upload()).unwrap();
+    while !matches!(jobs.progress(second), Some(Progress::Finished(_))) {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    jobs.stop();
+    worker.join().unwrap();
+    // Only the newest finished job is kept: the first is forgotten but was given out.
+    assert!(jobs.progress(first).is_none());
+    assert!(jobs.issued(first) && jobs.issued(second));
+    assert!(!jobs.issued(0) && !jobs.issued(second + 1));
 }

@@ -37,6 +37,30 @@ fn head_answers_like_get_without_a_body() {
 }
 
 #[test]
+fn unknown_addresses_are_no_such_page_not_an_expired_photo() {
+    // Issue 39, item 22: `GET /nope` answered "This is no longer kept on the server".
+    let server = start(16 << 20);
+    let (status, body) = request(server.addr(), "GET", "/nope", None);
+    assert_eq!(status, 404);
+    let text = String::from_utf8_lossy(&body);
+    assert!(text.contains("no such page"), "{text}");
+    assert!(!text.contains("no longer kept"), "{text}");
+    for path in ["/api/nope", "/api/jobs/999999", "/api/jobs/abc/report"] {
+        let (status, body) = request(server.addr(), "GET", path, None);
+        assert_eq!(status, 404, "{path}");
+        let got = json(&body);
+        assert_eq!(got["code"], "no_such_page", "{path}: {got}");
+        assert!(
+            !got["message"].as_str().unwrap().contains("no longer kept"),
+            "{got}"
+        );
+    }
+    let (_, body) = request(server.addr(), "GET", "/api/nope", None);
+    assert_eq!(json(&body)["error"], "no such API: /api/nope");
+    server.stop();
+}
+
+#[test]
 fn a_host_name_is_resolved() {
     let addrs = resolve("localhost", 0).unwrap();
     assert!(addrs.iter().all(|a| a.ip().is_loopback()), "{addrs:?}");
