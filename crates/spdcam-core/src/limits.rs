@@ -117,7 +117,7 @@ pub const DETECTION_PHOTOS: Limit = Limit {
 
 /// Bytes of a camera pool held whole (`generate --randomise camera`: each camera of
 /// `--cameras` and its `--camera-variants` perturbed copies, each with its own copy of the
-/// chart's pixel map), as [`crate::camera::Camera::estimated_bytes`] estimates them.
+/// chart's pixel map), as [`crate::camera::Camera::held_bytes`] estimates them.
 pub const CAMERA_POOL_BYTES: Limit = Limit {
     what: "bytes of a camera pool",
     env: "SPDCAM_MAX_CAMERA_POOL_BYTES",

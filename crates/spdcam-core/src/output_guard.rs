@@ -99,7 +99,7 @@ fn clash(out: &Resolved, kind: OutputKind, input: &Resolved) -> Option<&'static 
         return Some("lies inside");
     }
     if kind == OutputKind::Directory && input.canonical.starts_with(&out.canonical) {
-        return Some("holds");
+        return Some("contains");
     }
     None
 }
@@ -264,7 +264,7 @@ mod tests {
         let e = check_outputs(&inputs, &[directory_output("-o", &dir)])
             .unwrap_err()
             .to_string();
-        assert!(e.contains("holds"), "{e}");
+        assert!(e.contains("contains"), "{e}");
         check_outputs(&inputs, &[directory_output("-o", dir.join("other"))]).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -12,6 +12,7 @@
 //! (CIE A, D65, D50, six CIE 015 lamps and 15 coloured and LED-like lights); the second the
 //! 221 measured lamps of the data directory (`--features measured-data`).
 
+mod reference_csv;
 #[cfg(feature = "measured-data")]
 mod shared_data;
 
@@ -24,7 +25,7 @@ use spdcam_core::quality::uv::xyz_to_uv1960;
 use spdcam_core::quality::{dominant_wavelength_of, LightSpectrum, ILLUMINANT_E_XY};
 use spdcam_core::spectral::SpectralSet;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn reference_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/reference")
@@ -33,31 +34,6 @@ fn reference_dir() -> PathBuf {
 /// A reference row: each column's value, `None` where the reference leaves it empty
 /// (undefined for that light).
 type Row = BTreeMap<String, Option<f64>>;
-
-/// Rows of a reference CSV (lines starting with `#` are its description), by name.
-fn read_reference(path: &Path) -> BTreeMap<String, Row> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let body: String = text
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .map(|l| format!("{l}\n"))
-        .collect();
-    let mut reader = csv::Reader::from_reader(body.as_bytes());
-    let header = reader.headers().unwrap().clone();
-    reader
-        .records()
-        .map(|r| {
-            let r = r.unwrap();
-            let values = header
-                .iter()
-                .zip(r.iter())
-                .skip(1)
-                .map(|(k, v)| (k.to_string(), (!v.is_empty()).then(|| v.parse().unwrap())))
-                .collect();
-            (r[0].to_string(), values)
-        })
-        .collect()
-}
 
 /// Our value of each reference column, or the error message where we refuse it.
 fn ours(light: &LightSpectrum) -> BTreeMap<&'static str, Result<f64, String>> {
@@ -144,7 +120,7 @@ fn compare(set: &SpectralSet, reference: &BTreeMap<String, Row>) -> (usize, Vec<
 }
 
 fn assert_matches(set: &SpectralSet, reference_file: &str) -> usize {
-    let reference = read_reference(&reference_dir().join(reference_file));
+    let reference = reference_csv::read_optional(&reference_dir().join(reference_file));
     let (compared, failures) = compare(set, &reference);
     assert!(
         failures.is_empty(),

@@ -185,7 +185,10 @@ fn bad_input_is_a_clear_error_and_writes_no_features() {
     let text = dir.join("notes.jpg");
     std::fs::write(&text, b"these are notes, not a photo").unwrap();
     let e = analyse_photo(&text, &options()).unwrap_err().to_string();
-    assert!(e.contains("notes.jpg") && e.contains("not an image"), "{e}");
+    assert!(
+        e.contains("notes.jpg") && e.contains("not a JPEG, PNG or TIFF image"),
+        "{e}"
+    );
     // A truncated JPEG.
     let full = std::fs::read(photo_path("IMG_20140613_203438.jpg")).unwrap();
     let cut = dir.join("cut.jpg");

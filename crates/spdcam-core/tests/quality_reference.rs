@@ -7,41 +7,17 @@
 //! spectra (CIE A, D65, D50 and six CIE 015 lamps) form the first tier; the 221 measured lamps
 //! of the data directory the second (`--features measured-data`).
 
+mod reference_csv;
 #[cfg(feature = "measured-data")]
 mod shared_data;
 
 use spdcam_core::quality::{LightSpectrum, LightingMetrics};
 use spdcam_core::spectral::SpectralSet;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn reference_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/reference")
-}
-
-/// Rows of a reference CSV (lines starting with `#` are its description), by name.
-fn read_reference(path: &Path) -> BTreeMap<String, BTreeMap<String, f64>> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let body: String = text
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .map(|l| format!("{l}\n"))
-        .collect();
-    let mut reader = csv::Reader::from_reader(body.as_bytes());
-    let header = reader.headers().unwrap().clone();
-    reader
-        .records()
-        .map(|r| {
-            let r = r.unwrap();
-            let values = header
-                .iter()
-                .zip(r.iter())
-                .skip(1)
-                .map(|(k, v)| (k.to_string(), v.parse::<f64>().unwrap()))
-                .collect();
-            (r[0].to_string(), values)
-        })
-        .collect()
 }
 
 /// Our numbers under the reference file's column names.
@@ -187,7 +163,7 @@ fn compare(
 }
 
 fn assert_matches(set: &SpectralSet, reference_file: &str) {
-    let reference = read_reference(&reference_dir().join(reference_file));
+    let reference = reference_csv::read(&reference_dir().join(reference_file));
     let (worst, failures) = compare(set, &reference);
     for (group, (dev, case)) in &worst {
         println!("{group:12} worst deviation {dev:.3e} ({case})");

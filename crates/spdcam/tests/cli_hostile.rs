@@ -6,31 +6,10 @@
 
 mod common;
 
-use common::{fresh_clone_command, s, scratch, spdcam};
+use common::{fails_fast, fresh_clone_command, s, scratch, spdcam};
 use spdcam_core::builtin::DATA_DIR_ENV;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-
-/// Runs spdcam, expects it to fail within a few seconds with an error (not a signal or a
-/// panic), and returns its stderr.
-fn fails_fast(args: &[&str]) -> String {
-    let started = Instant::now();
-    let out = spdcam(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success(), "spdcam {args:?} succeeded");
-    // 1: the work was refused; 2: an option's value was (a usage error, clap's convention).
-    assert!(
-        matches!(out.status.code(), Some(1 | 2)),
-        "spdcam {args:?} died: {stderr}"
-    );
-    assert!(
-        started.elapsed() < Duration::from_secs(20),
-        "spdcam {args:?} took {:?}",
-        started.elapsed()
-    );
-    assert!(stderr.lines().any(|l| l.starts_with("error: ")), "{stderr}");
-    stderr
-}
 
 #[test]
 fn sizes_from_options_are_capped_with_a_clear_error() {
@@ -188,7 +167,7 @@ fn evaluate_refuses_to_overwrite_a_directory_of_user_files() {
         "--model",
         &s(&dir.join("m.spdm")),
         "--data",
-        &s(&dir),
+        &s(&dir.join("data")),
         "-o",
         &s(&dir),
     ]);
@@ -576,9 +555,9 @@ fn an_output_that_is_holds_or_lies_inside_an_input_is_refused_before_anything_is
         let e = fails_fast(&args);
         assert!(
             e.contains(&format!(
-                "the output {} {relation} the input {d}",
+                "the output -o {} {relation} the input",
                 args[args.len() - 2]
-            )) && e.contains("choose an output directory apart from the inputs"),
+            )) && e.contains(&format!("{d}: writing it would destroy what is read")),
             "{args:?}: {e}"
         );
         verifies(&data, 20);

@@ -415,7 +415,7 @@ fn an_average_of_a_network_and_a_ridge_estimates_between_them() {
     );
     // A member cannot be overwritten, and members must share their scaling.
     let err = fails(&["average", &s(&network), &s(&ridge), "-o", &s(&ridge)]);
-    assert!(err.contains("is a member"), "{err}");
+    assert!(err.contains("is the input MODELS"), "{err}");
     let max_scaled = dir.join("max.spdm");
     ok(&[
         "train",

@@ -4,29 +4,8 @@
 
 mod common;
 
-use common::{s, scratch, spdcam};
+use common::{fails, ok, s, scratch};
 use std::path::Path;
-
-/// Runs spdcam, which must succeed; its standard output.
-fn ok(args: &[&str]) -> String {
-    let out = spdcam(args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "spdcam {args:?} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
-
-/// Runs spdcam, which must fail with a message and no panic; its standard error.
-fn fails(args: &[&str]) -> String {
-    let out = spdcam(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!out.status.success(), "spdcam {args:?} should fail");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    stderr
-}
 
 /// A generated dataset of `count` samples (fast pipeline) in `dir`.
 fn generate(dir: &Path, count: &str) {

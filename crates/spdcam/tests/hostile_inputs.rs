@@ -6,11 +6,11 @@
 
 mod common;
 
-use common::{fresh_clone_command, s, scratch, spdcam};
+use common::{fails_fast, fresh_clone_command, refusal, s, scratch, spdcam};
 use spdcam_core::builtin::DATA_DIR_ENV;
 use std::path::{Path, PathBuf};
 use std::process::Output;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// The example photo of the repository and its truth.
 fn example(name: &str) -> PathBuf {
@@ -32,31 +32,6 @@ fn succeeds(args: &[&str]) -> (String, String) {
         "spdcam {args:?} failed:\n{stdout}\n{stderr}"
     );
     (stdout, stderr)
-}
-
-/// Checks that `out` is a refusal within `seconds` of `started` (exit 1 or 2, an `error:`
-/// line, no panic) and returns its standard error.
-fn refused(out: &Output, started: Instant, seconds: u64, what: &str) -> String {
-    let stderr = text(&out.stderr);
-    assert!(!out.status.success(), "{what} succeeded");
-    assert!(
-        matches!(out.status.code(), Some(1 | 2)),
-        "{what} died: {stderr}"
-    );
-    assert!(
-        started.elapsed() < Duration::from_secs(seconds),
-        "{what} took {:?}",
-        started.elapsed()
-    );
-    assert!(stderr.lines().any(|l| l.starts_with("error: ")), "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    stderr
-}
-
-/// Runs spdcam, expects a refusal within 20 s, and returns its stderr.
-fn fails_fast(args: &[&str]) -> String {
-    let started = Instant::now();
-    refused(&spdcam(args), started, 20, &format!("spdcam {args:?}"))
 }
 
 /// Runs `script` in bash with `$SPDCAM` the built spdcam, as a user's shell would (for
@@ -119,7 +94,7 @@ fn a_lamp_table_ending_in_zero_renders_as_a_chart_and_a_scene() {
 }
 
 #[test]
-fn small_negative_noise_is_set_to_zero_with_a_note_and_large_is_refused() {
+fn small_negative_noise_is_set_to_zero_with_a_note_and_large_is_refusal() {
     // Issue 39, item 5: the tolerance is 1 % of the peak (README, light::SPD_NEGATIVE_TOLERANCE).
     let dir = scratch("noise");
     let noisy = dir.join("noisy.csv");
@@ -180,7 +155,7 @@ fn a_photo_that_is_no_image_is_refused_from_its_first_bytes() {
     let out = fresh_clone_command(&["estimate", "/dev/zero"])
         .output()
         .unwrap();
-    let e = refused(&out, started, 10, "estimate /dev/zero");
+    let e = refusal(&out, started, 10, "estimate /dev/zero");
     assert!(
         e.contains("/dev/zero") && e.contains("JPEG, PNG or TIFF") && e.contains("00 00"),
         "{e}"
@@ -193,7 +168,7 @@ fn a_photo_that_is_no_image_is_refused_from_its_first_bytes() {
 }
 
 #[test]
-fn wavelengths_not_in_nanometres_are_refused() {
+fn wavelengths_not_in_nanometres_are_refusal() {
     // Issue 39, item 6: a spectral CSV in µm gave exit 0 and "no visible light".
     let dir = scratch("micrometres");
     let um = dir.join("um.csv");
@@ -224,7 +199,7 @@ fn limits_are_read_as_spdcam_prints_them_and_a_bad_value_is_named() {
             .env("SPDCAM_MAX_RENDER_PIXELS", value)
             .output()
             .unwrap();
-        let e = refused(&out, Instant::now(), 20, value);
+        let e = refusal(&out, Instant::now(), 20, value);
         assert!(
             e.contains("SPDCAM_MAX_RENDER_PIXELS") && e.contains("exceed the limit of 1,000"),
             "{value}: {e}"
@@ -234,7 +209,7 @@ fn limits_are_read_as_spdcam_prints_them_and_a_bad_value_is_named() {
         .env("SPDCAM_MAX_RENDER_PIXELS", "lots")
         .output()
         .unwrap();
-    let e = refused(&out, Instant::now(), 20, "lots");
+    let e = refusal(&out, Instant::now(), 20, "lots");
     assert!(
         e.contains("SPDCAM_MAX_RENDER_PIXELS") && e.contains("\"lots\""),
         "{e}"

@@ -5,48 +5,15 @@
 
 mod common;
 
-use common::{fresh_clone_command, s, scratch, spdcam};
+use common::{fails_fast, fresh_clone_command, ok, s, scratch};
 use std::fs::File;
 use std::path::Path;
 use std::process::{Output, Stdio};
-use std::time::{Duration, Instant};
-
-/// Runs spdcam, expects it to fail within a few seconds with exit code 1 or 2 (not a
-/// signal or a panic), and returns its stderr.
-fn refused(args: &[&str]) -> String {
-    let started = Instant::now();
-    let out = spdcam(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(
-        matches!(out.status.code(), Some(1 | 2)),
-        "spdcam {args:?}: {:?}\n{stderr}",
-        out.status
-    );
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(
-        started.elapsed() < Duration::from_secs(20),
-        "spdcam {args:?} took {:?}",
-        started.elapsed()
-    );
-    stderr
-}
-
-/// Runs spdcam, which must succeed; its standard output.
-fn succeeds(args: &[&str]) -> String {
-    let out = spdcam(args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "spdcam {args:?} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
 
 /// A features CSV of `rows` copies of the row of a ColorChecker 24 rendered under D65.
 fn features_csv(dir: &Path, rows: usize) -> String {
     let one = dir.join("one.csv");
-    succeeds(&[
+    ok(&[
         "render",
         "--spd",
         "D65",
@@ -75,7 +42,7 @@ fn counts_and_sizes_that_ask_for_gigabytes_are_refused_before_any_work() {
     // photos on 64 GB, and `render --size 5000x5000 --stages` peaked at 2.66 GB.
     let dir = scratch("counts");
     let data = s(&dir.join("d"));
-    let e = refused(&[
+    let e = fails_fast(&[
         "generate",
         "--lighting",
         "planck",
@@ -97,7 +64,7 @@ fn counts_and_sizes_that_ask_for_gigabytes_are_refused_before_any_work() {
             && e.contains("SPDCAM_MAX_CAMERA_POOL_BYTES="),
         "{e}"
     );
-    let e = refused(&[
+    let e = fails_fast(&[
         "detection",
         "--photos",
         "1000000000",
@@ -112,7 +79,7 @@ fn counts_and_sizes_that_ask_for_gigabytes_are_refused_before_any_work() {
         "{e}"
     );
     let stages = dir.join("stages");
-    let e = refused(&[
+    let e = fails_fast(&[
         "render",
         "--spd",
         "D65",
@@ -133,7 +100,7 @@ fn counts_and_sizes_that_ask_for_gigabytes_are_refused_before_any_work() {
         stages.display()
     );
     // A pool within the limit still generates.
-    succeeds(&[
+    ok(&[
         "generate",
         "--lighting",
         "planck",
@@ -219,7 +186,7 @@ fn features_as_json_are_json_lines_written_row_by_row() {
     // Item 9: `--features F --json` held every row's JSON in one list till the end.
     let dir = scratch("jsonl");
     let rows = features_csv(&dir, 30);
-    let stdout = succeeds(&["estimate", "--features", &rows, "--json"]);
+    let stdout = ok(&["estimate", "--features", &rows, "--json"]);
     let lines: Vec<&str> = stdout.lines().collect();
     assert_eq!(lines.len(), 30, "{stdout}");
     for (i, line) in lines.iter().enumerate() {
@@ -235,7 +202,7 @@ fn many_feature_rows_without_an_output_print_a_line_each() {
     // Item 17: 21 rows and no `-o` printed only "21 estimates with …".
     let dir = scratch("summary");
     let rows = features_csv(&dir, 23);
-    let stdout = succeeds(&["estimate", "--features", &rows]);
+    let stdout = ok(&["estimate", "--features", &rows]);
     for i in 1..=23 {
         let line = stdout
             .lines()
@@ -263,7 +230,7 @@ fn mixture_proportions_near_the_largest_number_share_the_draws() {
     // Item 14: `mix:daylight=1e308,planck=1e308` drew 1,000 planck and 0 daylight.
     let dir = scratch("mix");
     let data = dir.join("d");
-    succeeds(&[
+    ok(&[
         "generate",
         "--lighting",
         "mix:daylight=1e308,planck=1e308",
@@ -293,11 +260,11 @@ fn mixture_proportions_near_the_largest_number_share_the_draws() {
 }
 
 #[test]
-fn an_exposure_too_low_to_hold_a_signal_is_refused() {
+fn an_exposure_too_low_to_hold_a_signal_is_fails_fast() {
     // Item 15: `--exposure 1e-10 --noise off` gave a white patch of (255, 255, 108).
     let dir = scratch("exposure");
     let png = s(&dir.join("c.png"));
-    let e = refused(&[
+    let e = fails_fast(&[
         "render",
         "--spd",
         "D65",
@@ -313,7 +280,7 @@ fn an_exposure_too_low_to_hold_a_signal_is_refused() {
         "{e}"
     );
     assert!(!Path::new(&png).exists());
-    let e = refused(&[
+    let e = fails_fast(&[
         "generate",
         "--lighting",
         "planck",
@@ -329,7 +296,7 @@ fn an_exposure_too_low_to_hold_a_signal_is_refused() {
         "{e}"
     );
     // A dim photo that still holds a signal renders.
-    succeeds(&[
+    ok(&[
         "render",
         "--spd",
         "D65",
@@ -348,7 +315,7 @@ fn stages_of_a_scene_are_refused_clearly() {
     // Item 16: `render --scene … --stages DIR` wrote nothing.
     let dir = scratch("scene-stages");
     let stages = dir.join("stages");
-    let e = refused(&[
+    let e = fails_fast(&[
         "render",
         "--spd",
         "D65",

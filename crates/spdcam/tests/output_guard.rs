@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{fresh_clone_command, s, scratch, spdcam};
+use common::{fresh_clone_command, ok, s, scratch, spdcam};
 use std::path::{Path, PathBuf};
 
 /// The example photo, copied to `dir`, with its truth beside it.
@@ -16,6 +16,22 @@ fn photo_in(dir: &Path) -> (PathBuf, PathBuf) {
     std::fs::copy(examples.join("sg-telelumen.jpg"), &photo).unwrap();
     std::fs::copy(examples.join("sg-telelumen.truth.csv"), &truth).unwrap();
     (photo, truth)
+}
+
+/// A small dataset of 20 samples made by `generate` in `dir`.
+fn dataset_in(dir: &Path) -> PathBuf {
+    let ds = dir.join("ds");
+    ok(&[
+        "generate",
+        "--lighting",
+        "gaussian:4",
+        "--count",
+        "20",
+        "--fast",
+        "-o",
+        &s(&ds),
+    ]);
+    ds
 }
 
 /// Runs spdcam, which must refuse at once naming `names`, leaving every file of `dir`
@@ -174,22 +190,7 @@ fn spd_out_dash_is_standard_output_and_outputs_that_cannot_be_are_refused() {
 #[test]
 fn dataset_and_coverage_outputs_inside_their_inputs_are_refused() {
     let dir = scratch("dataset");
-    let ds = dir.join("ds");
-    let out = spdcam(&[
-        "generate",
-        "--lighting",
-        "gaussian:4",
-        "--count",
-        "20",
-        "--fast",
-        "-o",
-        &s(&ds),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let ds = dataset_in(&dir);
     let manifest = s(&ds.join("manifest.json"));
     refused_and_nothing_touched(
         &dir,
@@ -199,7 +200,7 @@ fn dataset_and_coverage_outputs_inside_their_inputs_are_refused() {
     refused_and_nothing_touched(
         &dir,
         &["dataset", "split", &s(&ds), "-o", &s(&dir)],
-        &["holds"],
+        &["contains"],
     );
     let spds = dir.join("S.csv");
     std::fs::write(&spds, "wavelength_nm,a\n380,1\n780,1\n").unwrap();
@@ -223,22 +224,7 @@ fn dataset_and_coverage_outputs_inside_their_inputs_are_refused() {
 #[test]
 fn training_outputs_onto_their_dataset_or_model_are_refused() {
     let dir = scratch("train");
-    let ds = dir.join("ds");
-    let out = spdcam(&[
-        "generate",
-        "--lighting",
-        "gaussian:4",
-        "--count",
-        "20",
-        "--fast",
-        "-o",
-        &s(&ds),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let ds = dataset_in(&dir);
     let d = s(&ds);
     let manifest = s(&ds.join("manifest.json"));
     let part = s(&ds.join("samples/part-00000.parquet"));

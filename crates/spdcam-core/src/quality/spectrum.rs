@@ -102,8 +102,13 @@ impl LightSpectrum {
             relative
         } else {
             let single = SpectralSet::new(w.to_vec(), vec![name.clone()], vec![relative])?;
-            let (resampled, _): (SpectralSet, ResampleReport) =
-                single.resample(&QUALITY_GRID, Interpolation::Auto, Extrapolation::Zero)?;
+            // Unclamped, as the metrics' standards and their reference implementations
+            // resample (colour-science keeps Sprague's undershoot beside a spike).
+            let (resampled, _): (SpectralSet, ResampleReport) = single.resample_unclamped(
+                &QUALITY_GRID,
+                Interpolation::Auto,
+                Extrapolation::Zero,
+            )?;
             resampled.item(0).to_vec()
         };
         let xyz = observer_2deg().spd_to_xyz(&values);

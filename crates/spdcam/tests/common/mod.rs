@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::time::{Duration, Instant};
 
 /// The built spdcam as a fresh clone runs it: in the crate's directory, with the data
 /// directory's variable removed from its environment (never read), so a first-tier test
@@ -35,11 +36,39 @@ pub fn ok(args: &[&str]) -> String {
     stdout
 }
 
-/// Runs spdcam, which must fail; its standard error.
+/// Runs spdcam, which must fail with a message and no panic; its standard error.
 pub fn fails(args: &[&str]) -> String {
     let out = spdcam(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(!out.status.success(), "spdcam {args:?} should fail");
-    String::from_utf8_lossy(&out.stderr).into_owned()
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
+/// Checks that `out` is a refusal that came within `seconds` of `started` — exit 1 (the
+/// work was refused) or 2 (an option's value was, clap's convention), an `error:` line,
+/// no panic — and returns its standard error; `what` names the run in messages.
+pub fn refusal(out: &Output, started: Instant, seconds: u64, what: &str) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "{what} succeeded");
+    assert!(
+        matches!(out.status.code(), Some(1 | 2)),
+        "{what} died: {stderr}"
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(seconds),
+        "{what} took {:?}",
+        started.elapsed()
+    );
+    assert!(stderr.lines().any(|l| l.starts_with("error: ")), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
+/// Runs spdcam, expects a refusal within 20 s, and returns its standard error.
+pub fn fails_fast(args: &[&str]) -> String {
+    let started = Instant::now();
+    refusal(&spdcam(args), started, 20, &format!("spdcam {args:?}"))
 }
 
 /// An empty scratch directory of this test binary named `name`.
