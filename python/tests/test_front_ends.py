@@ -12,7 +12,7 @@ import spdcam
 def test_a_photo_gives_the_command_lines_estimate(example, cli):
     done = cli("estimate", str(example), "--json")
     assert done.returncode == 0, done.stderr
-    want = [json.loads(line) for line in done.stdout.splitlines()]  # JSON Lines[0]
+    want = json.loads(done.stdout)[0]
     got = spdcam.estimate(example)
     np.testing.assert_array_equal(got.spd, want["spd"])
     assert got.verdict == want["verdict"] and got.reasons == want["reasons"]
@@ -38,7 +38,8 @@ def test_feature_rows_are_judged_as_the_command_line_judges_them(example, cli, t
             w.writerow([repr(float(v)) for v in r])
     done = cli("estimate", "--features", str(path), "--json")
     assert done.returncode == 0, done.stderr
-    want = json.loads(done.stdout)
+    # Feature rows stream as JSON Lines: one object per row.
+    want = [json.loads(line) for line in done.stdout.splitlines()]
     got = spdcam.estimate_features(rows, names)
     assert len(got) == len(want) == 3
     assert got.verdicts == [w["verdict"] for w in want]
