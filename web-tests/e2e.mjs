@@ -464,7 +464,7 @@ await test('every error message on the page is free of command-line words', asyn
       await post([['other', 'x']]),
       await fetch('api/jobs/999999').then((r) => r.json()),
       await fetch('api/jobs/999999/report').then((r) => r.json()),
-      await fetch('no/such/page').then((r) => r.json()),
+      await fetch('api/no/such/page').then((r) => r.json()),
     ];
   });
   for (const a of answers) {
