@@ -214,7 +214,6 @@ fn truths_beside_photos(matches: &ArgMatches) -> Vec<NamedPath> {
 mod tests {
     use super::*;
     use clap::CommandFactory;
-    use spdcam_core::output_guard::OutputKind;
 
     /// Every leaf command with its name.
     fn leaves(command: &Command, name: String, out: &mut Vec<(String, Command)>) {
@@ -272,39 +271,5 @@ mod tests {
                 "OUTPUTS names `{name}` {id}, which the command tree lacks"
             );
         }
-    }
-
-    #[test]
-    fn inputs_are_the_existing_paths_and_outputs_the_listed_arguments() {
-        let dir = std::env::temp_dir().join(format!("spdcam-command-paths-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let spd = dir.join("spd.csv");
-        std::fs::write(&spd, "wavelength_nm,a,b\n400,1,1\n700,1,1\n").unwrap();
-        let spec = format!("{}:b", spd.display());
-        let png = dir.join("x.png");
-        let line = [
-            "spdcam",
-            "render",
-            "--spd",
-            &spec,
-            "-o",
-            png.to_str().unwrap(),
-            "--spd-out",
-            spd.to_str().unwrap(),
-        ];
-        let command = crate::Cli::command();
-        let matches = command.clone().try_get_matches_from(line).unwrap();
-        let (inputs, outputs) = paths(&command, &matches).unwrap();
-        assert_eq!(inputs.len(), 1, "{inputs:?}");
-        assert_eq!(
-            (inputs[0].option.as_str(), &inputs[0].path),
-            ("--spd", &spd)
-        );
-        let options: Vec<&str> = outputs.iter().map(|o| o.named.option.as_str()).collect();
-        assert_eq!(options, ["-o", "--spd-out"]);
-        let e = check(&command, &matches).unwrap_err().to_string();
-        assert!(e.contains("--spd-out") && e.contains("--spd "), "{e}");
-        assert!(matches!(outputs[0].kind, OutputKind::File));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,6 +1,7 @@
 //! `estimate --features`: feature rows streamed through the model a block at a time.
 
-use super::print::{print_estimates, report_item, summary_line, verdict_line, write_report};
+use super::print::{print_estimates, report_item, verdict_line, write_report};
+use super::row_lines::RowLines;
 use super::truth::read_truths;
 use super::{quiet, EstimateArgs, LayoutArg, DETAILED_MAX};
 use crate::plot_file::write_plot;
@@ -22,17 +23,6 @@ use std::path::Path;
 /// Rows judged at a time when every row is judged (`--json`, one line per row): enough to
 /// keep the cores busy, few enough that lines come out as the rows are estimated.
 const JUDGED_AT_ONCE: usize = 64;
-
-/// What `estimate --features` writes of each row as it is estimated, besides the SPDs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum RowLines {
-    /// Nothing: the first [`DETAILED_MAX`] rows are judged and printed at the end.
-    None,
-    /// `--json`: every row judged, one JSON object per line (JSON Lines).
-    Json,
-    /// No `-o`: beyond [`DETAILED_MAX`] rows, every row judged, one summary line each.
-    Summary,
-}
 
 /// What `estimate --features` keeps while it streams: the first estimates (to print and
 /// plot), the scores against the truths, and the count.
@@ -96,7 +86,7 @@ impl FeatureRun {
             let end = (start + JUDGED_AT_ONCE).min(judged);
             for (k, mut e) in (start..end).zip(stream.estimates(block, start..end)?) {
                 e.truth = scores[k];
-                self.print_row(block.first_row + k, &e)?;
+                self.lines.print(&self.first, block.first_row + k, &e)?;
                 if self.first.len() < DETAILED_MAX {
                     self.first.push(e);
                 }
@@ -118,31 +108,6 @@ impl FeatureRun {
                     out.write_all(long_header(&self.grid).as_bytes())?;
                 }
                 out.write_all(&long_rows(spds, width, block.first_row))?;
-            }
-        }
-        Ok(())
-    }
-
-    /// Prints what [`RowLines`] asks of row `row` (0-based), judged as `e`: its JSON line,
-    /// or, from the row after the first [`DETAILED_MAX`], its summary line (the first
-    /// rows' lines, held till then, printed first).
-    fn print_row(&self, row: usize, e: &Estimate) -> Result<()> {
-        match self.lines {
-            RowLines::None => {}
-            RowLines::Json => outln!("{}", serde_json::to_string(&e.to_json()?)?)?,
-            RowLines::Summary if row < DETAILED_MAX => {}
-            RowLines::Summary => {
-                if row == DETAILED_MAX {
-                    outln!(
-                        "more than {DETAILED_MAX} rows: one line per estimate as it is made \
-                         (CIE xy, CCT, Duv, verdict); -o FILE.csv writes the SPDs, --json \
-                         every number as JSON Lines"
-                    )?;
-                    for held in &self.first {
-                        outln!("{}", summary_line(held))?;
-                    }
-                }
-                outln!("{}", summary_line(e))?;
             }
         }
         Ok(())

@@ -7,6 +7,7 @@
 mod features;
 mod photos;
 mod print;
+mod row_lines;
 mod truth;
 
 use crate::outln;
