@@ -62,6 +62,7 @@
 #![deny(missing_docs)]
 
 pub mod absolute;
+pub mod colour_head;
 pub mod error;
 pub mod estimate;
 pub mod estimator;

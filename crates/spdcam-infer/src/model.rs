@@ -315,6 +315,11 @@ impl Model {
                 p.len(),
                 100.0 * p.explained_variance()
             ),
+            Target::PcaColour(p) => format!(
+                "{} PCA components ({:.2} % of the variance) and the light's u′v′",
+                p.pca.len(),
+                100.0 * p.pca.explained_variance()
+            ),
             Target::Weights(c) => format!("{} channel weights", c.names.len()),
         };
         format!(

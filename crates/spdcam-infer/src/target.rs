@@ -1,7 +1,10 @@
 //! What a model predicts and how an SPD comes back from it: PCA coefficients of the SPD
-//! (the default) or the channel weights of a luminaire (`--target weights`, the thesis's
-//! G/H experiments), whose channel spectra are fitted from the training data.
+//! (the default), the same with the light's u′v′ chromaticity beside them (`--target
+//! pca-colour`, [`crate::colour_head`]), or the channel weights of a luminaire (`--target
+//! weights`, the thesis's G/H experiments), whose channel spectra are fitted from the
+//! training data.
 
+use crate::colour_head::ColourHead;
 use crate::error::{InferError, Result};
 use crate::pca::{Components, Pca};
 use faer::{linalg::solvers::Solve, Mat, Side};
@@ -13,8 +16,26 @@ use spdcam_core::metrics;
 pub enum TargetKind {
     /// PCA coefficients of the max-normalised SPD.
     Pca(Components),
+    /// PCA coefficients and the light's u′v′, the colour outputs weighing `colour_weight`
+    /// PCA coefficients each in the loss.
+    PcaColour {
+        /// The PCA components kept.
+        components: Components,
+        /// The weight of each colour output against one PCA coefficient.
+        colour_weight: f64,
+    },
     /// The luminaire's channel weights.
     Weights,
+}
+
+/// PCA coefficients and the light's chromaticity: the network's outputs are the
+/// coefficients, then u′ and v′.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PcaColour {
+    /// The PCA of the training SPDs.
+    pub pca: Pca,
+    /// The colour outputs.
+    pub colour: ColourHead,
 }
 
 /// The channel spectra of a luminaire, fitted so that an SPD is
@@ -35,6 +56,9 @@ pub struct Channels {
 pub enum Target {
     /// PCA coefficients.
     Pca(Pca),
+    /// PCA coefficients, then the light's u′v′.
+    #[serde(rename = "pca-colour")]
+    PcaColour(PcaColour),
     /// Channel weights.
     Weights(Channels),
 }
@@ -44,6 +68,7 @@ impl Target {
     pub fn len(&self) -> usize {
         match self {
             Target::Pca(p) => p.len(),
+            Target::PcaColour(p) => p.pca.len() + 2,
             Target::Weights(c) => c.names.len(),
         }
     }
@@ -57,6 +82,7 @@ impl Target {
     pub fn spd_len(&self) -> usize {
         match self {
             Target::Pca(p) => p.dim(),
+            Target::PcaColour(p) => p.pca.dim(),
             Target::Weights(c) => c.spectra.first().map_or(0, Vec::len),
         }
     }
@@ -65,6 +91,13 @@ impl Target {
     pub fn decode_into(&self, targets: &[f64], spd: &mut [f64]) {
         match self {
             Target::Pca(p) => spd.copy_from_slice(&p.reconstruct(targets)),
+            Target::PcaColour(p) => {
+                let k = p.pca.len();
+                let mut coefficients = targets[..k].to_vec();
+                p.colour
+                    .conform(&p.pca, &mut coefficients, [targets[k], targets[k + 1]]);
+                spd.copy_from_slice(&p.pca.reconstruct(&coefficients));
+            }
             Target::Weights(c) => {
                 spd.iter_mut().for_each(|v| *v = 0.0);
                 for (w, ch) in targets.iter().zip(&c.spectra) {
@@ -78,10 +111,37 @@ impl Target {
         metrics::clip_normalise(spd);
     }
 
+    /// The targets of one max-normalised SPD on the model's grid, or `None` for a target
+    /// made from channel weights (their targets are the dataset's weights).
+    pub fn encode(&self, spd: &[f64]) -> Option<Vec<f64>> {
+        match self {
+            Target::Pca(p) => Some(p.project(spd)),
+            Target::PcaColour(p) => {
+                let mut t = p.pca.project(spd);
+                t.extend(p.colour.uv(spd).unwrap_or([0.0; 2]));
+                Some(t)
+            }
+            Target::Weights(_) => None,
+        }
+    }
+
+    /// The PCA of the SPDs, for a target that has one.
+    pub fn pca(&self) -> Option<&Pca> {
+        match self {
+            Target::Pca(p) => Some(p),
+            Target::PcaColour(p) => Some(&p.pca),
+            Target::Weights(_) => None,
+        }
+    }
+
     /// Checks the stored numbers (for a target read from a file).
     pub fn validate(&self) -> Result<()> {
         match self {
             Target::Pca(p) => p.validate(),
+            Target::PcaColour(p) => {
+                p.pca.validate()?;
+                p.colour.validate(p.pca.dim())
+            }
             Target::Weights(c) => {
                 let d = self.spd_len();
                 if c.names.is_empty()

@@ -10,7 +10,7 @@ use crate::pca::Pca;
 use crate::record::{DataInfo, TrainingRecord};
 use crate::ridge::Gram;
 use crate::scale::{FeatureScaler, TargetScaler};
-use crate::target::{Channels, Target, TargetKind};
+use crate::target::{Channels, PcaColour, Target, TargetKind};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::seq::SliceRandom;
@@ -22,6 +22,7 @@ use spdcam_core::dataset::{Columns, Dataset, SampleBatch};
 use spdcam_core::metrics;
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::Grid;
+use spdcam_infer::colour_head::ColourHead;
 pub use spdcam_infer::record::{Backend, Schedule, TrainOptions};
 use std::ops::Range;
 use std::path::Path;
@@ -182,12 +183,26 @@ fn take_rows(data: &[f64], w: usize, idx: &[usize]) -> Vec<f64> {
 /// The targets (unscaled) of rows of SPDs (and weights).
 fn targets_of(target: &Target, spds: &[f64], weights: &[f64]) -> Vec<f64> {
     match target {
-        Target::Pca(p) => spds
-            .chunks_exact(p.dim())
-            .flat_map(|s| p.project(s))
-            .collect(),
         Target::Weights(_) => weights.to_vec(),
+        _ => spds
+            .chunks_exact(target.spd_len())
+            .flat_map(|s| target.encode(s).unwrap_or_default())
+            .collect(),
     }
+}
+
+/// The target scaling fitted on `raw` targets; the colour outputs of a [`Target::PcaColour`]
+/// scaled to a range of √weight instead of 1, so that each weighs `weight` PCA coefficients
+/// in the mean squared error the networks are trained on.
+fn fit_target_scaler(target: &Target, raw: &[f64]) -> Result<TargetScaler> {
+    let mut scaler = TargetScaler::fit(raw, target.len())?;
+    if let Target::PcaColour(p) = target {
+        let root = p.colour.weight.sqrt();
+        for j in p.pca.len()..target.len() {
+            scaler.max[j] = scaler.min[j] + (scaler.max[j] - scaler.min[j]) / root;
+        }
+    }
+    Ok(scaler)
 }
 
 /// Model-independent pieces fitted on the training rows.
@@ -402,6 +417,13 @@ pub fn train_in_parts(
     let train_spds = take_rows(&spds, d, &train_idx);
     let target = match options.target {
         TargetKind::Pca(components) => Target::Pca(Pca::fit(&train_spds, d, components)?),
+        TargetKind::PcaColour {
+            components,
+            colour_weight,
+        } => Target::PcaColour(PcaColour {
+            pca: Pca::fit(&train_spds, d, components)?,
+            colour: ColourHead::on_grid(&options.grid, colour_weight)?,
+        }),
         TargetKind::Weights => {
             let k = data.samples.weight_count;
             if k == 0 {
@@ -427,7 +449,7 @@ pub fn train_in_parts(
     let raw_targets = targets_of(&target, &train_spds, &weights);
     let fitted = Fitted {
         features: FeatureScaler::fit(&train_features, f, Some(options.row_scale))?,
-        targets: TargetScaler::fit(&raw_targets, target.len())?,
+        targets: fit_target_scaler(&target, &raw_targets)?,
         target,
     };
     check_features_vary(&fitted.features, data, train_idx.len())?;
@@ -828,7 +850,17 @@ pub fn finetune(
             let pca = Pca::fit(&train_spds, d, crate::pca::Components::Count(pca.len()))?;
             let target = Target::Pca(pca);
             let raw = targets_of(&target, &train_spds, &[]);
-            let scaler = TargetScaler::fit(&raw, target.len())?;
+            let scaler = fit_target_scaler(&target, &raw)?;
+            (target, scaler)
+        }
+        (Target::PcaColour(p), true) => {
+            let pca = Pca::fit(&train_spds, d, crate::pca::Components::Count(p.pca.len()))?;
+            let target = Target::PcaColour(PcaColour {
+                pca,
+                colour: p.colour.clone(),
+            });
+            let raw = targets_of(&target, &train_spds, &[]);
+            let scaler = fit_target_scaler(&target, &raw)?;
             (target, scaler)
         }
         (Target::Weights(_), true) => {

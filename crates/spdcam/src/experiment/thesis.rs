@@ -95,6 +95,10 @@ pub(super) fn run(args: ThesisArgs, data_dir: &spdcam_core::builtin::DataDir) ->
             let target = match args.target {
                 TargetArg::Weights => TargetKind::Weights,
                 TargetArg::Pca => TargetKind::Pca(Components::default()),
+                TargetArg::PcaColour => TargetKind::PcaColour {
+                    components: Components::default(),
+                    colour_weight: 1.0,
+                },
             };
             let options = train_options(architecture, schedule, target, grid, args.seed);
             let name = kind

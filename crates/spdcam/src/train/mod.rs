@@ -53,6 +53,10 @@ pub struct TrainArgs {
     /// What the model predicts.
     #[arg(long, value_enum, default_value = "pca")]
     target: TargetArg,
+    /// With `--target pca-colour`: how much each of the two colour outputs (u′, v′) weighs
+    /// in the training loss against one PCA coefficient.
+    #[arg(long, default_value = "1", value_name = "WEIGHT")]
+    colour_weight: f64,
     /// PCA components: an explained-variance share (0.99) or a count (12).
     #[arg(long, default_value = "0.99")]
     components: String,
@@ -125,6 +129,10 @@ pub fn run(args: TrainArgs, data_dir: &DataDir) -> Result<()> {
     let options = TrainOptions {
         target: match args.target {
             TargetArg::Pca => TargetKind::Pca(parse_components(&args.components)?),
+            TargetArg::PcaColour => TargetKind::PcaColour {
+                components: parse_components(&args.components)?,
+                colour_weight: args.colour_weight,
+            },
             TargetArg::Weights => TargetKind::Weights,
         },
         row_scale: match args.row_scale {

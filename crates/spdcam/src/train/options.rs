@@ -34,6 +34,9 @@ impl ModelKind {
 pub enum TargetArg {
     /// PCA coefficients of the SPD.
     Pca,
+    /// PCA coefficients and the light's u′v′ chromaticity, the spectrum made to have that
+    /// colour (`--colour-weight`).
+    PcaColour,
     /// The luminaire's channel weights (datasets with weight columns).
     Weights,
 }
