@@ -40,6 +40,17 @@ pub struct ColourHead {
     /// How much each colour output weighed in the training loss against one PCA coefficient
     /// (the colour targets' scaled range is √weight instead of 1).
     pub weight: f64,
+    /// The share of the way from the spectrum's own chromaticity to the predicted one that
+    /// the spectrum is moved (1: all the way; 0: the colour outputs are not used). Chosen on
+    /// validation photos, real ones among them: a colour learnt from virtual photos alone
+    /// may transfer to real cameras worse than the spectrum it corrects.
+    #[serde(default = "all_the_way")]
+    pub pull: f64,
+}
+
+/// The default [`ColourHead::pull`].
+fn all_the_way() -> f64 {
+    1.0
 }
 
 impl ColourHead {
@@ -55,7 +66,19 @@ impl ColourHead {
         Ok(ColourHead {
             observer: [0, 1, 2].map(|c| observer.cmf(c).to_vec()),
             weight,
+            pull: 1.0,
         })
+    }
+
+    /// The same head moving the spectrum `pull` of the way to the predicted colour.
+    pub fn with_pull(mut self, pull: f64) -> Result<ColourHead> {
+        if !(0.0..=1.0).contains(&pull) {
+            return Err(InferError::invalid(format!(
+                "the colour pull must lie between 0 and 1, got {pull}"
+            )));
+        }
+        self.pull = pull;
+        Ok(self)
     }
 
     /// The spectrum's length.
@@ -76,13 +99,18 @@ impl ColourHead {
     }
 
     /// Changes `coefficients` (of `pca`) as little as the training spectra's spread allows so
-    /// that the spectrum they stand for, its negatives set to 0, has the chromaticity
-    /// `target` (see the module's documentation). Leaves them as they are where no step can
-    /// be made (a black spectrum, a non-finite target).
-    pub fn conform(&self, pca: &Pca, coefficients: &mut [f64], target: [f64; 2]) {
-        if !target.iter().all(|t| t.is_finite()) {
+    /// that the spectrum they stand for, its negatives set to 0, moves [`ColourHead::pull`]
+    /// of the way from its own chromaticity to `predicted` (see the module's
+    /// documentation). Leaves them as they are where no step can be made (a black spectrum,
+    /// a non-finite prediction).
+    pub fn conform(&self, pca: &Pca, coefficients: &mut [f64], predicted: [f64; 2]) {
+        if !predicted.iter().all(|t| t.is_finite()) || self.pull == 0.0 {
             return;
         }
+        let mut own = pca.reconstruct(coefficients);
+        own.iter_mut().for_each(|v| *v = v.max(0.0));
+        let Some(own) = self.uv(&own) else { return };
+        let target = [0, 1].map(|i| own[i] + self.pull * (predicted[i] - own[i]));
         let k = coefficients.len().min(pca.len());
         let variance: Vec<f64> = pca.explained_ratio[..k]
             .iter()
@@ -132,6 +160,7 @@ impl ColourHead {
         }
         if self.observer.iter().flatten().any(|v| !v.is_finite())
             || !(self.weight.is_finite() && self.weight > 0.0)
+            || !(0.0..=1.0).contains(&self.pull)
         {
             return Err(InferError::invalid(
                 "the colour head holds non-finite or non-positive numbers",
@@ -225,8 +254,41 @@ mod tests {
     }
 
     #[test]
-    fn a_bad_weight_is_refused() {
+    fn a_pull_of_a_half_goes_half_way() {
+        let data = planckians();
+        let pca = Pca::fit(&data, 61, Components::Count(4)).unwrap();
+        let head = ColourHead::on_grid(&grid(), 1.0)
+            .unwrap()
+            .with_pull(0.5)
+            .unwrap();
+        let start = &data[61 * 4..61 * 5];
+        let (own, goal) = (
+            head.uv(start).unwrap(),
+            head.uv(&data[61 * 8..61 * 9]).unwrap(),
+        );
+        let mut c = pca.project(start);
+        head.conform(&pca, &mut c, goal);
+        let mut spd = pca.reconstruct(&c);
+        spd.iter_mut().for_each(|v| *v = v.max(0.0));
+        let uv = head.uv(&spd).unwrap();
+        for i in 0..2 {
+            let half = 0.5 * (own[i] + goal[i]);
+            assert!((uv[i] - half).abs() < 2e-4, "{uv:?}: half way is {half}");
+        }
+        // A pull of 0 leaves the coefficients as they are.
+        let none = head.with_pull(0.0).unwrap();
+        let mut c0 = pca.project(start);
+        let before = c0.clone();
+        none.conform(&pca, &mut c0, goal);
+        assert_eq!(c0, before);
+    }
+
+    #[test]
+    fn bad_settings_are_refused() {
         assert!(ColourHead::on_grid(&grid(), 0.0).is_err());
         assert!(ColourHead::on_grid(&grid(), f64::NAN).is_err());
+        let head = ColourHead::on_grid(&grid(), 1.0).unwrap();
+        assert!(head.clone().with_pull(1.5).is_err());
+        assert!(head.with_pull(-0.1).is_err());
     }
 }

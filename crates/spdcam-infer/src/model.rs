@@ -241,6 +241,21 @@ impl Model {
         Ok(())
     }
 
+    /// Sets how far the spectrum is moved to the predicted colour
+    /// ([`crate::colour_head::ColourHead::pull`]); an error for a model without colour
+    /// outputs.
+    pub fn set_colour_pull(&mut self, pull: f64) -> Result<()> {
+        match &mut self.header.target {
+            Target::PcaColour(p) => {
+                p.colour = p.colour.clone().with_pull(pull)?;
+                Ok(())
+            }
+            _ => Err(InferError::invalid(
+                "the model has no colour outputs (train it with --target pca-colour)",
+            )),
+        }
+    }
+
     /// The header (everything but the weights).
     pub fn header(&self) -> &ModelHeader {
         &self.header
