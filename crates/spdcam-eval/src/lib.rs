@@ -16,6 +16,9 @@
 //! - [`lamp_validation`]: held-out lamps photographed by held-out cameras and by an
 //!   independent simple camera, scored per lamp type beside the average SPD
 //!   ([`lamp_validation::LampValidation`]).
+//! - [`colour`]: every model judged on the light's colour as a colour meter reads it
+//!   (Δu′v′, CCT) on scene and patch-level photos by held-out cameras
+//!   ([`colour::ColourReport`]).
 //! - [`coverage`]: how well lighting recipes reach measured SPDs, per lamp type
 //!   ([`coverage::Coverage`]).
 //! - [`error`]: the crate's error type.
@@ -32,6 +35,7 @@
 
 #![deny(missing_docs)]
 
+pub mod colour;
 pub mod coverage;
 pub mod error;
 pub mod held_out;

@@ -56,6 +56,7 @@ const OUTPUTS: &[(&str, &str, Output)] = &[
     ("finetune", "output", Output::File),
     ("experiment thesis", "output", Output::Directory),
     ("experiment real-cameras", "output", Output::File),
+    ("experiment colour", "output", Output::File),
     ("calibrate", "output", Output::File),
     ("sim2real", "output", Output::File),
     ("coverage", "output", Output::File),

@@ -26,7 +26,7 @@ pub const SCENES: usize = 20;
 
 /// The chart as photos show it for `model_chart` (the SG's 96 patches are read from the
 /// whole 140-patch chart).
-fn photo_chart(model_chart: &str) -> &str {
+pub(crate) fn photo_chart(model_chart: &str) -> &str {
     match KnownChart::from_name(model_chart).and_then(KnownChart::physical) {
         Some(physical) => physical.name(),
         None => model_chart,

@@ -1,0 +1,284 @@
+//! The colour protocol (`spdcam experiment colour`): every model judged on the light's
+//! colour as a colour meter reads it (Δu′v′, CCT), beside its shape (GFC).
+//!
+//! Lights: the split's validation lamps (choose on these), its test lamps (report only) and
+//! eight white references ([`lights::references`]). Photos, all by the split's held-out
+//! cameras (cameras outside the training pool):
+//!
+//! - (a) scene photos ([`photos::Shoot::scenes`]): the chart in a cluttered scene, the full
+//!   camera chain and a JPEG, then found, sampled and estimated by the [`Estimator`] a
+//!   user's photo goes through;
+//! - (b) patch-level photos ([`photos::Shoot::patches`]) with the randomised in-camera
+//!   stage, as `spdcam lamps validate` (a) takes them, estimated as feature rows.
+//!
+//! Beside the models: the constant (the mean SPD of the split's fit lamps) and the truth seen
+//! over 400–700 nm only (the nearest an estimate on those wavelengths can come). Scores per
+//! lamp type or reference and per set ([`summary::Summary`]); [`ColourReport::markdown`]
+//! writes them.
+
+pub mod lights;
+pub mod photos;
+mod report;
+pub mod score;
+pub mod summary;
+
+pub use score::{ColourScore, LightColour, CCT_MAX_DUV};
+pub use summary::{median, CctSummary, Summary};
+
+use crate::error::{EvalError, Result};
+use crate::held_out::{HeldOutPhotos, SkippedCamera, GRID};
+use crate::lamp_validation::average_spd;
+use lights::{Light, LightSet};
+use photos::{PhotoScore, Scored, Shoot};
+use spdcam_core::builtin::DataDir;
+use spdcam_core::chart::Chart;
+use spdcam_core::lighting::validation_split::LampPart;
+use spdcam_core::lighting::LampType;
+use spdcam_core::seed;
+use spdcam_core::spectral::{Grid, Spd};
+use spdcam_infer::{Estimator, ModelSet};
+use std::path::PathBuf;
+
+/// The options of the colour protocol.
+#[derive(Debug, Clone)]
+pub struct ColourOptions {
+    /// The models, split, lamp library, cameras and seed; `shots`: scene photos of each lamp.
+    pub held_out: HeldOutPhotos,
+    /// Scene photos of each white reference.
+    pub reference_photos: u64,
+    /// Patch-level photos of each light.
+    pub patch_photos: u64,
+}
+
+/// What a row of a table groups.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Group {
+    /// The lamps of one type.
+    Type(LampType),
+    /// One white reference.
+    Light(String),
+    /// Every light of the set.
+    All,
+}
+
+impl Group {
+    /// Whether `light` belongs to the group.
+    fn holds(&self, light: &Light) -> bool {
+        match self {
+            Group::Type(t) => light.kind == Some(*t),
+            Group::Light(name) => light.name == *name,
+            Group::All => true,
+        }
+    }
+}
+
+/// The scores of one group of lights.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row<T> {
+    /// The set the lights belong to.
+    pub set: LightSet,
+    /// Which of its lights.
+    pub group: Group,
+    /// How many lights.
+    pub lights: usize,
+    /// The scores.
+    pub scores: T,
+}
+
+/// A model's scores on one group: (a) scene photos and (b) patch-level photos.
+pub type ModelRow = Row<[Summary; 2]>;
+/// The baselines' scores on one group: the constant and the truth over 400–700 nm.
+pub type BaselineRow = Row<[Summary; 2]>;
+
+/// One model measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelColour {
+    /// The model's file.
+    pub model: PathBuf,
+    /// The chart it names.
+    pub chart: String,
+    /// Whether the program holds a trust calibration for it (CCT intervals).
+    pub calibrated: bool,
+    /// Per group of lights.
+    pub rows: Vec<ModelRow>,
+}
+
+/// The colour protocol's results.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColourReport {
+    /// Each model, in the order given.
+    pub models: Vec<ModelColour>,
+    /// The constant and the truncated truth, per group, on [`Grid::ESTIMATION`].
+    pub baselines: Vec<BaselineRow>,
+    /// Scene photos of each lamp, of each reference, and patch-level photos of each light.
+    pub photos: [u64; 3],
+    /// How many held-out cameras took them.
+    pub cameras: usize,
+    /// The seed.
+    pub seed: u64,
+    /// The held-out cameras left out (unreadable curves), for the caller to report.
+    pub skipped: Vec<SkippedCamera>,
+}
+
+/// Every group of `lights` with a light: per lamp set its lamp types (in [`LampType::ALL`]'s
+/// order), per reference the light, then the whole set.
+fn groups(lights: &[Light]) -> Vec<(LightSet, Group)> {
+    let mut out = Vec::new();
+    for set in LightSet::ALL {
+        let members: Vec<&Light> = lights.iter().filter(|l| l.set == set).collect();
+        if members.is_empty() {
+            continue;
+        }
+        if set == LightSet::References {
+            out.extend(members.iter().map(|l| (set, Group::Light(l.name.clone()))));
+        } else {
+            out.extend(
+                LampType::ALL
+                    .into_iter()
+                    .filter(|t| members.iter().any(|l| l.kind == Some(*t)))
+                    .map(|t| (set, Group::Type(t))),
+            );
+        }
+        out.push((set, Group::All));
+    }
+    out
+}
+
+/// The rows of `groups` over `lights`, each summarising every score list of `scores`.
+fn rows<const N: usize>(
+    groups: &[(LightSet, Group)],
+    lights: &[Light],
+    scores: [&[PhotoScore]; N],
+) -> Result<Vec<Row<[Summary; N]>>> {
+    groups
+        .iter()
+        .map(|(set, group)| {
+            let select = |j: usize| lights[j].set == *set && group.holds(&lights[j]);
+            let summaries = scores.map(|s| Summary::of(s, select));
+            let summaries = summaries
+                .into_iter()
+                .collect::<Option<Vec<Summary>>>()
+                .and_then(|v| <[Summary; N]>::try_from(v).ok())
+                .ok_or_else(|| EvalError::invalid("a group of lights without a photo"))?;
+            Ok(Row {
+                set: *set,
+                group: group.clone(),
+                lights: (0..lights.len()).filter(|&j| select(j)).count(),
+                scores: summaries,
+            })
+        })
+        .collect()
+}
+
+impl ColourReport {
+    /// Measures every model of `options` (see the module's documentation); `progress` hears
+    /// what is being done.
+    pub fn measure(
+        options: &ColourOptions,
+        data_dir: &DataDir,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<ColourReport> {
+        let held_out = &options.held_out;
+        for (value, option) in [
+            (held_out.shots, "--photos"),
+            (options.reference_photos, "--reference-photos"),
+            (options.patch_photos, "--patch-photos"),
+        ] {
+            if value == 0 {
+                return Err(EvalError::invalid(format!("{option} must be at least 1")));
+            }
+        }
+        let setup = held_out.setup(data_dir)?;
+        let mut lights = Vec::new();
+        for set in LightSet::ALL {
+            lights.extend(lights::lights(&setup.library, &setup.split, set)?);
+        }
+        let groups = groups(&lights);
+        let count = |l: &Light, lamps: u64, references: u64| {
+            if l.set == LightSet::References {
+                references
+            } else {
+                lamps
+            }
+        };
+        let scene_lights: Vec<(Light, u64)> = lights
+            .iter()
+            .map(|l| (l.clone(), count(l, held_out.shots, options.reference_photos)))
+            .collect();
+        let patch_lights: Vec<(Light, u64)> = lights
+            .iter()
+            .map(|l| (l.clone(), options.patch_photos))
+            .collect();
+        let scenes = Shoot {
+            cameras: &setup.cameras,
+            lights: &scene_lights,
+            seed: seed::derive(held_out.seed, 1),
+        };
+        let patches = Shoot {
+            cameras: &setup.cameras,
+            lights: &patch_lights,
+            seed: seed::derive(held_out.seed, 2),
+        };
+
+        let mut models = Vec::new();
+        for (path, model, chart_name) in held_out.models()? {
+            let chart = Chart::resolve(&chart_name, None, data_dir, &GRID)?;
+            model.check_features(&chart.feature_names(), &chart_name)?;
+            let calibrated = spdcam_infer::trust::calibration_for(&model)?.is_some();
+            let name = crate::held_out::file_name(&path);
+            let estimator = Estimator::new(
+                ModelSet::single(model.clone(), name.clone()),
+                data_dir.clone(),
+                model.grid(),
+            )?;
+            progress(&format!("{name}: scene photos"));
+            let a = scenes.scenes(&estimator, &chart_name, data_dir)?;
+            progress(&format!("{name}: patch-level photos"));
+            let b = patches.patches(&estimator, &chart)?;
+            models.push(ModelColour {
+                model: path,
+                chart: chart_name,
+                calibrated,
+                rows: rows(&groups, &lights, [&a, &b])?,
+            });
+        }
+        let fit = setup
+            .library
+            .positions(setup.split.lamps(LampPart::Fit), "the split's fit lamps")?;
+        let baselines = baselines(&setup.library.spds, &fit, &lights)?;
+        Ok(ColourReport {
+            models,
+            baselines: rows(&groups, &lights, [&baselines[0], &baselines[1]])?,
+            photos: [
+                held_out.shots,
+                options.reference_photos,
+                options.patch_photos,
+            ],
+            cameras: setup.cameras.len(),
+            seed: held_out.seed,
+            skipped: setup.skipped,
+        })
+    }
+}
+
+/// Per light, on [`Grid::ESTIMATION`]: the constant (the mean of the fit lamps `fit` of
+/// `spds`) and the truth cut to those wavelengths, each scored as one estimate.
+fn baselines(spds: &[Spd], fit: &[usize], lights: &[Light]) -> Result<[Vec<PhotoScore>; 2]> {
+    let grid = Grid::ESTIMATION;
+    let on_grid = spds
+        .iter()
+        .map(|s| Ok(s.resampled(&grid)?.into_values()))
+        .collect::<Result<Vec<_>>>()?;
+    let constant = Spd::new(grid, average_spd(&on_grid, fit))?;
+    let mut out = [Vec::new(), Vec::new()];
+    for (j, light) in lights.iter().enumerate() {
+        let truncated = light.spd.resampled(&grid)?;
+        for (k, spd) in [&constant, &truncated].into_iter().enumerate() {
+            out[k].push(PhotoScore {
+                light: j,
+                estimate: Some(Scored::spd(spd, light)?),
+            });
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,182 @@
+//! The colour protocol's photos, each estimated and scored: (a) scene photos (the code of
+//! `spdcam render --scene`) found, sampled and estimated like a user's photo, and (b) the
+//! patch-level photos of the randomised in-camera stage, estimated as feature rows.
+
+use super::lights::Light;
+use super::score::ColourScore;
+use crate::error::{EvalError, Result};
+use crate::held_out::{randomised_cameras, GRID};
+use crate::trust::scenes::photo_chart;
+use rayon::prelude::*;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::sensor::Sensitivities;
+use spdcam_core::camera::CameraConfig;
+use spdcam_core::chart::Chart;
+use spdcam_core::dataset::randomise::camera_pool;
+use spdcam_core::metrics;
+use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
+use spdcam_core::photo::ChartTemplate;
+use spdcam_core::seed;
+use spdcam_core::spectral::Spd;
+use spdcam_infer::estimate::PhotoOptions;
+use spdcam_infer::trust::Verdict;
+use spdcam_infer::{Estimate, Estimator, FeatureRows};
+
+/// Width and height of the scene photos: the trust report's scenes.
+pub const SCENE_SIZE: (usize, usize) = (1200, 900);
+
+/// One photo scored: refused, or the estimate's shape and colour against the truth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhotoScore {
+    /// Which of the protocol's lights it shows.
+    pub light: usize,
+    /// The scoring of the estimate; `None`: refused (no chart found).
+    pub estimate: Option<Scored>,
+}
+
+/// One estimate scored against the truth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scored {
+    /// GFC of the peak-normalised estimate against the truth on the model's wavelengths.
+    pub gfc: f64,
+    /// The light's colour against the truth's.
+    pub colour: ColourScore,
+    /// Judged `ok`.
+    pub ok: bool,
+    /// The estimate's CCT (K) and the half-width (K) of its calibrated 95 % interval, where
+    /// the model has a calibration and the estimate a CCT.
+    pub cct_interval: Option<(f64, f64)>,
+}
+
+impl Scored {
+    /// Scores `estimate` of `light`: its SPD, its verdict and its CCT interval.
+    pub fn of(estimate: &Estimate, light: &Light) -> Result<Scored> {
+        let trust = estimate.trust.as_ref();
+        let half95 = trust
+            .and_then(|t| t.uncertainty.as_ref())
+            .and_then(|u| u.metrics.get("cct_k"))
+            .map(|m| m.half95);
+        Ok(Scored {
+            ok: trust.is_some_and(|t| t.verdict == Verdict::Ok),
+            cct_interval: estimate.metrics.cct_k.zip(half95),
+            ..Scored::spd(&estimate.spd, light)?
+        })
+    }
+
+    /// Scores an SPD estimated for `light` without a verdict or intervals (a baseline).
+    pub fn spd(spd: &Spd, light: &Light) -> Result<Scored> {
+        let truth = light.spd.resampled(spd.grid())?.normalised_by_max();
+        Ok(Scored {
+            gfc: metrics::gfc_spd(&truth, &spd.normalised_by_max())?,
+            colour: ColourScore::of(&light.spd, spd)?,
+            ok: false,
+            cct_interval: None,
+        })
+    }
+}
+
+/// What a set of photos is taken with: the held-out cameras, the seed of the draws, and how
+/// many photos of each light.
+pub struct Shoot<'a> {
+    /// The held-out cameras.
+    pub cameras: &'a [Sensitivities],
+    /// The lights, each with how many photos to take of it.
+    pub lights: &'a [(Light, u64)],
+    /// Seed of this set's draws.
+    pub seed: u64,
+}
+
+impl Shoot<'_> {
+    /// The light of every photo, in order: each light as many times as it is photographed.
+    fn jobs(&self) -> Vec<usize> {
+        self.lights
+            .iter()
+            .enumerate()
+            .flat_map(|(j, (_, n))| std::iter::repeat_n(j, *n as usize))
+            .collect()
+    }
+
+    /// (a): each light photographed in a cluttered scene by a held-out camera (each camera
+    /// in turn) with the default camera stage, then found, sampled and estimated by
+    /// `estimator` like a user's photo of `model_chart`; in parallel, the same for a seed.
+    pub fn scenes(
+        &self,
+        estimator: &Estimator,
+        model_chart: &str,
+        data_dir: &DataDir,
+    ) -> Result<Vec<PhotoScore>> {
+        let name = photo_chart(model_chart);
+        let chart = Chart::resolve(name, None, data_dir, &GRID)?;
+        let template = ChartTemplate::from_chart(&chart)?;
+        let chart = chart.with_layout(scene::scene_layout(&template))?;
+        let config = CameraConfig::default();
+        let pool = camera_pool(self.cameras, 0, self.seed, &chart, config, &GRID)?;
+        let options = PhotoOptions {
+            chart: Some(name.to_string()),
+            ..PhotoOptions::default()
+        };
+        let scene_options = SceneOptions {
+            width: SCENE_SIZE.0,
+            height: SCENE_SIZE.1,
+            ..SceneOptions::default()
+        };
+        self.jobs()
+            .into_par_iter()
+            .enumerate()
+            .map(|(g, j)| {
+                let light = &self.lights[j].0;
+                let camera = &pool[g % pool.len()];
+                let shot_seed = seed::derive(self.seed, g as u64);
+                let shot = scene::photograph(
+                    camera,
+                    SceneLight::single(&light.spd),
+                    shot_seed,
+                    &scene_options,
+                )?;
+                let estimate = match estimator.estimate_photo_bytes(&shot.jpeg, "scene.jpg", &options)
+                {
+                    Ok(e) => Some(Scored::of(&e, light)?),
+                    Err(_) => None,
+                };
+                Ok(PhotoScore { light: j, estimate })
+            })
+            .collect()
+    }
+
+    /// (b): each light through a held-out camera with the randomised in-camera stage
+    /// (exposure, white balance, tone, JPEG, gradient; `lamps validate`'s (a)), patch level
+    /// on `chart`, estimated by `estimator` as feature rows.
+    pub fn patches(&self, estimator: &Estimator, chart: &Chart) -> Result<Vec<PhotoScore>> {
+        let randomisation = randomised_cameras(self.cameras, self.seed, chart)?;
+        let names = chart.feature_names();
+        let jobs = self.jobs();
+        let mut values = Vec::with_capacity(jobs.len() * names.len());
+        let (mut raw, mut out) = (Vec::new(), Vec::new());
+        for (g, &j) in jobs.iter().enumerate() {
+            let (camera, ic) = randomisation.draw(self.seed, g as u64);
+            let light = camera.light(&self.lights[j].0.spd)?;
+            out.clear();
+            camera.features_fast_with(ic.as_ref(), &light, &mut raw, &mut out);
+            values.extend(out.iter().map(|&v| f64::from(v)));
+        }
+        let rows = FeatureRows::from_values(names, values, "the patch-level photos")?;
+        let estimates = estimator.estimate_rows(&rows, "the patch-level photos")?;
+        if estimates.len() != jobs.len() {
+            return Err(EvalError::invalid(format!(
+                "{} estimates for {} patch-level photos",
+                estimates.len(),
+                jobs.len()
+            )));
+        }
+        estimates
+            .par_iter()
+            .zip(jobs)
+            .map(|(e, j)| {
+                Ok(PhotoScore {
+                    light: j,
+                    estimate: Some(Scored::of(e, &self.lights[j].0)?),
+                })
+            })
+            .collect()
+    }
+}
