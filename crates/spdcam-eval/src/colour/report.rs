@@ -41,9 +41,10 @@ fn cells(s: &Summary, judged: bool) -> String {
     );
     match &s.cct {
         Some(c) => {
-            let (width, holds) = c
-                .interval
-                .map_or_else(|| (dash(), dash()), |(w, h)| (format!("±{:.1} %", 100.0 * w), percent(h)));
+            let (width, holds) = c.interval.map_or_else(
+                || (dash(), dash()),
+                |(w, h)| (format!("±{:.1} %", 100.0 * w), percent(h)),
+            );
             out += &format!(
                 " {} | {} | {} | {:.1} % | {width} | {holds} |",
                 c.photos,
@@ -75,7 +76,9 @@ impl ColourReport {
     /// The results as the Markdown `spdcam experiment colour` writes.
     pub fn markdown(&self) -> String {
         let mut md = String::from("## Summary: every light of each set\n\n");
-        md += &format!("| model and kind of photo | set | lights | {COLUMNS}\n|---|---|---:|{ALIGN}\n");
+        md += &format!(
+            "| model and kind of photo | set | lights | {COLUMNS}\n|---|---|---:|{ALIGN}\n"
+        );
         let all = |rows: &[Row<[Summary; 2]>], set: LightSet| -> Option<(usize, [Summary; 2])> {
             rows.iter()
                 .find(|r| r.set == set && r.group == Group::All)
@@ -98,14 +101,20 @@ impl ColourReport {
         for (k, name) in BASELINES.iter().enumerate() {
             for set in LightSet::ALL {
                 if let Some((n, s)) = all(&self.baselines, set) {
-                    md += &format!("| {name} | {} | {n} | {}\n", set.label(), cells(&s[k], false));
+                    md += &format!(
+                        "| {name} | {} | {n} | {}\n",
+                        set.label(),
+                        cells(&s[k], false)
+                    );
                 }
             }
         }
         md.push('\n');
         for m in &self.models {
             md += &format!("## `{}` ({})\n\n", file_name(&m.model), m.chart);
-            md += &format!("| set | group | lights | kind of photo | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n");
+            md += &format!(
+                "| set | group | lights | kind of photo | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n"
+            );
             for r in &m.rows {
                 for (k, path) in PATHS.iter().enumerate() {
                     md += &format!(
@@ -123,7 +132,8 @@ impl ColourReport {
             md.push('\n');
         }
         md += "## Baselines\n\n";
-        md += &format!("| set | group | lights | estimate | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n");
+        md +=
+            &format!("| set | group | lights | estimate | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n");
         for r in &self.baselines {
             for (k, name) in BASELINES.iter().enumerate() {
                 md += &format!(

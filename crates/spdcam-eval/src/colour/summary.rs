@@ -179,6 +179,13 @@ mod tests {
         assert_eq!(holds, 0.5);
         // No photo of light 2; light 1 without intervals.
         assert!(Summary::of(&scores, |l| l == 2).is_none());
-        assert_eq!(Summary::of(&scores, |l| l == 1).unwrap().cct.unwrap().interval, None);
+        assert_eq!(
+            Summary::of(&scores, |l| l == 1)
+                .unwrap()
+                .cct
+                .unwrap()
+                .interval,
+            None
+        );
     }
 }
