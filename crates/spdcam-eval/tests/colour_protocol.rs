@@ -33,8 +33,13 @@ fn check(s: &Summary, what: &str) {
     }
     assert!(s.refused < 1.0, "{what}: every photo refused");
     assert!(s.gfc > 0.5 && s.gfc <= 1.0 + 1e-12, "{what}: {s:?}");
-    assert!(s.delta_uv_prime >= 0.0 && s.delta_uv_prime < 0.1, "{what}: {s:?}");
-    let c = s.cct.unwrap_or_else(|| panic!("{what}: white lights without a CCT score"));
+    assert!(
+        s.delta_uv_prime >= 0.0 && s.delta_uv_prime < 0.1,
+        "{what}: {s:?}"
+    );
+    let c = s
+        .cct
+        .unwrap_or_else(|| panic!("{what}: white lights without a CCT score"));
     assert!(c.median_error.abs() < 0.5, "{what}: {c:?}");
     assert!((0.0..=1.0).contains(&c.too_high), "{what}: {c:?}");
     assert!(c.median_abs_error >= 0.0, "{what}: {c:?}");
@@ -104,7 +109,11 @@ fn one_camera_a_few_photos() {
         .map(|s| s.resampled(&Grid::ESTIMATION).unwrap().into_values())
         .collect();
     let constant = Spd::new(Grid::ESTIMATION, average_spd(&spds, &fit)).unwrap();
-    let d65 = references().unwrap().into_iter().find(|l| l.name == "CIE D65").unwrap();
+    let d65 = references()
+        .unwrap()
+        .into_iter()
+        .find(|l| l.name == "CIE D65")
+        .unwrap();
     let direct = ColourScore::of(&d65.spd, &constant).unwrap();
     let row = report
         .baselines
@@ -112,7 +121,10 @@ fn one_camera_a_few_photos() {
         .find(|r| r.group == Group::Light("CIE D65".into()))
         .unwrap();
     assert_eq!(row.scores[0].delta_uv_prime, direct.delta_uv_prime);
-    assert_eq!(row.scores[0].cct.unwrap().median_error, direct.cct_error().unwrap());
+    assert_eq!(
+        row.scores[0].cct.unwrap().median_error,
+        direct.cct_error().unwrap()
+    );
 
     // The same seed gives the same report.
     let again = ColourReport::measure(&options, &data, &mut |_| {}).unwrap();

@@ -104,7 +104,9 @@ mod tests {
     fn the_references_are_white_at_their_temperatures() {
         let refs = references().unwrap();
         assert_eq!(refs.len(), 8);
-        let expected = [2856.0, 5003.0, 6504.0, 2700.0, 3000.0, 4000.0, 5000.0, 6500.0];
+        let expected = [
+            2856.0, 5003.0, 6504.0, 2700.0, 3000.0, 4000.0, 5000.0, 6500.0,
+        ];
         for (light, want) in refs.iter().zip(expected) {
             let (cct, duv) = LightColour::of(&light.spd).unwrap().cct_duv.unwrap();
             // Within 0.3 % (the 5 nm grid); every one near the locus.

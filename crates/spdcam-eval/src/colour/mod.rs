@@ -203,7 +203,12 @@ impl ColourReport {
         };
         let scene_lights: Vec<(Light, u64)> = lights
             .iter()
-            .map(|l| (l.clone(), count(l, held_out.shots, options.reference_photos)))
+            .map(|l| {
+                (
+                    l.clone(),
+                    count(l, held_out.shots, options.reference_photos),
+                )
+            })
             .collect();
         let patch_lights: Vec<(Light, u64)> = lights
             .iter()

@@ -133,11 +133,11 @@ impl Shoot<'_> {
                     shot_seed,
                     &scene_options,
                 )?;
-                let estimate = match estimator.estimate_photo_bytes(&shot.jpeg, "scene.jpg", &options)
-                {
-                    Ok(e) => Some(Scored::of(&e, light)?),
-                    Err(_) => None,
-                };
+                let estimate =
+                    match estimator.estimate_photo_bytes(&shot.jpeg, "scene.jpg", &options) {
+                        Ok(e) => Some(Scored::of(&e, light)?),
+                        Err(_) => None,
+                    };
                 Ok(PhotoScore { light: j, estimate })
             })
             .collect()

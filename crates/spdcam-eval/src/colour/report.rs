@@ -41,9 +41,10 @@ fn cells(s: &Summary, judged: bool) -> String {
     );
     match &s.cct {
         Some(c) => {
-            let (width, holds) = c
-                .interval
-                .map_or_else(|| (dash(), dash()), |(w, h)| (format!("±{:.1} %", 100.0 * w), percent(h)));
+            let (width, holds) = c.interval.map_or_else(
+                || (dash(), dash()),
+                |(w, h)| (format!("±{:.1} %", 100.0 * w), percent(h)),
+            );
             out += &format!(
                 " {} | {} | {} | {:.1} % | {width} | {holds} |",
                 c.photos,
@@ -75,7 +76,9 @@ impl ColourReport {
     /// The results as the Markdown `spdcam experiment colour` writes.
     pub fn markdown(&self) -> String {
         let mut md = String::from("## Summary: every light of each set\n\n");
-        md += &format!("| model and kind of photo | set | lights | {COLUMNS}\n|---|---|---:|{ALIGN}\n");
+        md += &format!(
+            "| model and kind of photo | set | lights | {COLUMNS}\n|---|---|---:|{ALIGN}\n"
+        );
         let all = |rows: &[Row<[Summary; 2]>], set: LightSet| -> Option<(usize, [Summary; 2])> {
             rows.iter()
                 .find(|r| r.set == set && r.group == Group::All)
@@ -98,14 +101,20 @@ impl ColourReport {
         for (k, name) in BASELINES.iter().enumerate() {
             for set in LightSet::ALL {
                 if let Some((n, s)) = all(&self.baselines, set) {
-                    md += &format!("| {name} | {} | {n} | {}\n", set.label(), cells(&s[k], false));
+                    md += &format!(
+                        "| {name} | {} | {n} | {}\n",
+                        set.label(),
+                        cells(&s[k], false)
+                    );
                 }
             }
         }
         md.push('\n');
         for m in &self.models {
             md += &format!("## `{}` ({})\n\n", file_name(&m.model), m.chart);
-            md += &format!("| set | group | lights | kind of photo | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n");
+            md += &format!(
+                "| set | group | lights | kind of photo | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n"
+            );
             for r in &m.rows {
                 for (k, path) in PATHS.iter().enumerate() {
                     md += &format!(
@@ -123,7 +132,8 @@ impl ColourReport {
             md.push('\n');
         }
         md += "## Baselines\n\n";
-        md += &format!("| set | group | lights | estimate | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n");
+        md +=
+            &format!("| set | group | lights | estimate | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n");
         for r in &self.baselines {
             for (k, name) in BASELINES.iter().enumerate() {
                 md += &format!(
@@ -180,5 +190,62 @@ impl ColourReport {
             self.seed,
             wavelengths(&Grid::ESTIMATION),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::colour::{CctSummary, ModelColour};
+    use std::path::PathBuf;
+
+    fn summary(interval: Option<(f64, f64)>) -> Summary {
+        Summary {
+            photos: 4,
+            refused: 0.25,
+            ok: 0.5,
+            gfc: 0.95,
+            delta_uv_prime: 0.0042,
+            cct: Some(CctSummary {
+                photos: 3,
+                median_error: -0.055,
+                too_high: 1.0 / 3.0,
+                median_abs_error: 0.06,
+                interval,
+            }),
+        }
+    }
+
+    #[test]
+    fn rows_show_shares_signed_errors_and_dashes_where_nothing_was_measured() {
+        let row = |scores| Row {
+            set: LightSet::Validation,
+            group: Group::All,
+            lights: 2,
+            scores,
+        };
+        let report = ColourReport {
+            models: vec![ModelColour {
+                model: PathBuf::from("models/cc24.spdm"),
+                chart: "colorchecker24".into(),
+                calibrated: false,
+                rows: vec![row([summary(Some((0.04, 0.9))), summary(None)])],
+            }],
+            baselines: vec![row([summary(None), summary(None)])],
+            photos: [2, 4, 8],
+            cameras: 13,
+            seed: 1,
+            skipped: Vec::new(),
+        };
+        let md = report.markdown();
+        assert!(md.contains("| `cc24.spdm` (a) scene | validation lamps | 2 | 4 | 25 % | 50 % | 0.9500 | 0.0042 | 3 | -5.5 % | 33 % | 6.0 % | ±4.0 % | 90 % |\n"), "{md}");
+        assert!(md.contains("| `cc24.spdm` (b) patch level | validation lamps | 2 | 4 | 25 % | 50 % | 0.9500 | 0.0042 | 3 | -5.5 % | 33 % | 6.0 % | – | – |\n"), "{md}");
+        assert!(
+            md.contains("| constant | validation lamps | 2 | 4 | – | – | 0.9500 |"),
+            "{md}"
+        );
+        assert!(md.contains("carry no CCT interval"));
+        assert!(md.contains("the split's 13 held-out cameras"));
+        assert!(md.contains("Baselines, over 400–700 nm"));
     }
 }

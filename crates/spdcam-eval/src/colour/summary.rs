@@ -17,8 +17,9 @@ pub struct CctSummary {
     pub too_high: f64,
     /// Median absolute relative CCT error.
     pub median_abs_error: f64,
-    /// Median half-width of the 95 % interval relative to the estimated CCT, and the share
-    /// of photos whose interval holds the true CCT; `None` without calibrated intervals.
+    /// Median half-width of the 95 % interval relative to the estimated CCT (over the photos
+    /// with one), and the share of the photos scored on CCT whose interval holds the true
+    /// CCT (a photo without an interval does not); `None` where no photo has an interval.
     pub interval: Option<(f64, f64)>,
 }
 
@@ -101,10 +102,11 @@ fn cct_summary(estimated: &[&Scored]) -> Option<CctSummary> {
         return None;
     }
     let errors: Vec<f64> = scored.iter().map(|(_, e)| *e).collect();
-    // Intervals only where every photo scored carries one (a calibrated model).
-    let intervals: Option<Vec<(f64, bool)>> = scored
+    // Half-widths over the photos with an interval; a photo without one (its perturbed
+    // copies define no CCT) does not hold the truth.
+    let intervals: Vec<(f64, bool)> = scored
         .iter()
-        .map(|(s, _)| {
+        .filter_map(|(s, _)| {
             let (cct, half) = s.cct_interval?;
             let truth = s.colour.true_cct?;
             Some((half / cct, (cct - truth).abs() <= half))
@@ -115,10 +117,11 @@ fn cct_summary(estimated: &[&Scored]) -> Option<CctSummary> {
         median_error: median(errors.clone()),
         too_high: share(&errors, |e| *e > 0.0),
         median_abs_error: median(errors.iter().map(|e| e.abs()).collect()),
-        interval: intervals.map(|v| {
+        interval: (!intervals.is_empty()).then(|| {
+            let held = intervals.iter().filter(|(_, holds)| *holds).count();
             (
-                median(v.iter().map(|(w, _)| *w).collect()),
-                share(&v, |(_, holds)| *holds),
+                median(intervals.iter().map(|(w, _)| *w).collect()),
+                held as f64 / scored.len() as f64,
             )
         }),
     })
@@ -179,6 +182,13 @@ mod tests {
         assert_eq!(holds, 0.5);
         // No photo of light 2; light 1 without intervals.
         assert!(Summary::of(&scores, |l| l == 2).is_none());
-        assert_eq!(Summary::of(&scores, |l| l == 1).unwrap().cct.unwrap().interval, None);
+        assert_eq!(
+            Summary::of(&scores, |l| l == 1)
+                .unwrap()
+                .cct
+                .unwrap()
+                .interval,
+            None
+        );
     }
 }
