@@ -18,10 +18,12 @@
 
 use crate::absolute::absolute_level;
 use crate::error::{InferError, Result};
-use crate::estimate::{chart_templates, Colorimetry, Estimate, FeatureRows, PhotoOptions};
+use crate::estimate::{Colorimetry, Estimate};
+use crate::feature_rows::FeatureRows;
+use crate::photo_options::{chart_templates, PhotoOptions};
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
-use crate::trust::{self, Calibration, ChartCheck, PhotoFlags, Trust};
+use crate::trust::{self, ChartCheck, PhotoFlags, Trust, TrustCalibration};
 use rayon::prelude::*;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
@@ -37,7 +39,7 @@ use std::sync::Arc;
 /// What judging one model's estimates needs, made once per model.
 struct ModelTrust {
     /// The shipped calibration measured on the model, parsed once.
-    calibration: Option<Calibration>,
+    calibration: Option<TrustCalibration>,
     /// The chart re-rendered under an estimate (the self-check), built once.
     check: Option<ChartCheck>,
 }
@@ -366,7 +368,7 @@ impl Estimator {
     /// use spdcam_core::camera::sensor::Sensitivities;
     /// use spdcam_core::camera::{Camera, CameraConfig};
     /// use spdcam_core::chart::Chart;
-    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::cie_illuminant::StandardIlluminant;
     /// use spdcam_core::spectral::Grid;
     /// use spdcam_infer::{Estimator, FeatureRows};
     ///

@@ -2,8 +2,8 @@
 //! made; the photos that give none reported and counted.
 
 use super::{quiet, EstimateArgs};
+use crate::args::photo::describe;
 use crate::outln;
-use crate::photo_args::{self};
 use anyhow::Result;
 use spdcam_core::photo::{self, PhotoAnalysis};
 use spdcam_infer::report::REPORT_IMAGE_WIDTH;
@@ -99,7 +99,7 @@ pub(super) fn estimate_from_photos(
     let mut overlays = Vec::with_capacity(analyses.len());
     for (path, label, analysis, overlay) in analyses {
         if !quiet(args) {
-            outln!("{}", photo_args::describe(&analysis))?;
+            outln!("{}", describe(&analysis))?;
         }
         match estimator.estimate_analysis(analysis, label) {
             Ok(e) => {

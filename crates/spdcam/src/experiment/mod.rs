@@ -1,6 +1,7 @@
 //! `spdcam experiment`: the thesis's model-selection experiment on its virtual datasets,
 //! and the real-camera study.
 
+mod real_cameras;
 mod thesis;
 
 use anyhow::Result;
@@ -20,13 +21,13 @@ enum ExperimentCommand {
     Thesis(ThesisArgs),
     /// Every way of estimating on the real photo sets' validation and test photos, beside a
     /// constant guess and ridge on real photos (`docs/real-cameras-table.md`).
-    RealCameras(crate::experiment_real_cameras::RealCamerasArgs),
+    RealCameras(real_cameras::RealCamerasArgs),
 }
 
 /// Runs `spdcam experiment`.
 pub fn run(args: ExperimentArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
     match args.command {
         ExperimentCommand::Thesis(a) => thesis::run(a, data_dir),
-        ExperimentCommand::RealCameras(a) => crate::experiment_real_cameras::run(a, data_dir),
+        ExperimentCommand::RealCameras(a) => real_cameras::run(a, data_dir),
     }
 }
