@@ -84,7 +84,7 @@ pub mod trust;
 
 pub use error::{InferError, Result};
 pub use estimate::Estimate;
-pub use estimator::{estimate_photo_bytes, AnalysedPhoto, Estimator, RowStream};
+pub use estimator::{AnalysedPhoto, Estimator, PhotoEstimate, PhotoProgress, RowStream};
 pub use feature_rows::FeatureRows;
 pub use model::Model;
 pub use photo_options::PhotoOptions;

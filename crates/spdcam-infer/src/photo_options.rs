@@ -20,7 +20,7 @@ pub struct PhotoOptions {
     /// Where to write a debug image of each photo (see `spdcam_core::photo::debug_path`).
     pub debug: Option<PathBuf>,
     /// Also draw the chart found on each photo, reduced to at most this many pixels wide
-    /// (a JPEG for a report; [`crate::estimator::AnalysedPhoto::overlay`]), while the
+    /// (a JPEG for a report; [`crate::AnalysedPhoto::overlay`]), while the
     /// photo is decoded anyway.
     pub overlay_width: Option<u32>,
 }
