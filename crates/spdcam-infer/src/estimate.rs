@@ -99,7 +99,7 @@ impl Score {
     /// The score of `estimate` against `truth`; an error when they are on different grids.
     ///
     /// ```
-    /// use spdcam_core::spectral::Spd;
+    /// use spdcam_core::spectral::{Grid, Spd};
     /// use spdcam_infer::estimate::Score;
     ///
     /// let grid = Grid::parse("400-600:100")?;

@@ -939,6 +939,40 @@ mod tests {
     }
 
     #[test]
+    fn one_call_gives_the_analysis_the_estimate_and_the_debug_image_written() {
+        let debug = std::env::temp_dir().join(format!("spdcam-debug-{}.png", std::process::id()));
+        let options = PhotoOptions {
+            debug: Some(debug.clone()),
+            ..PhotoOptions::default()
+        };
+        let missing = PathBuf::from("no-such-photo.jpg");
+        let mut steps = Vec::new();
+        let photos = shipped()
+            .estimate_photos(&[example_photo(), missing], &options, |step| {
+                steps.push(match step {
+                    PhotoProgress::Analysed(all) => format!("analysed {}", all.len()),
+                    PhotoProgress::Estimating(a) => format!("estimating {}", a.chart),
+                });
+                Ok::<(), InferError>(())
+            })
+            .unwrap();
+        assert_eq!(steps, ["analysed 2", "estimating colorchecker_sg140"]);
+        let written = photos[0].debug.clone().unwrap();
+        assert!(written.is_file(), "{}", written.display());
+        std::fs::remove_file(&written).unwrap();
+        assert!(photos[0].analysed.is_ok());
+        assert!(matches!(photos[0].estimate, Some(Ok(_))));
+        // The photo that cannot be read writes no debug image and has no estimate.
+        assert!(photos[1].debug.is_none() && photos[1].estimate.is_none());
+        assert!(photos[1]
+            .analysed
+            .as_ref()
+            .unwrap_err()
+            .to_string()
+            .contains("no-such-photo"));
+    }
+
+    #[test]
     fn the_report_picture_is_drawn_from_the_one_decoding() {
         let options = PhotoOptions {
             overlay_width: Some(320),
