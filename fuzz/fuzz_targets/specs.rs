@@ -9,10 +9,10 @@ use spdcam_core::camera::demosaic::DemosaicMethod;
 use spdcam_core::camera::noise::NoiseParams;
 use spdcam_core::camera::white_balance::WhiteBalance;
 use spdcam_core::dataset::Shard;
-use spdcam_core::lighting::Lighting;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::raster::CfaPattern;
 use spdcam_core::spectral::Grid;
-use spdcam_core::{builtin, light};
+use spdcam_core::{builtin, named_light};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
@@ -31,7 +31,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     }
     let data_dir = DataDir::new(None);
-    let _ = light::resolve_spd(text, &data_dir, &grid);
+    let _ = named_light::resolve_spd(text, &data_dir, &grid);
     if let Ok(lighting) = Lighting::parse(text, &data_dir, &grid) {
         for i in 0..3 {
             let _ = lighting.draw(1, i);

@@ -18,13 +18,13 @@ use spdcam_core::output_guard::{check_outputs, file_output, named};
 use spdcam_core::photo::{load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
-use spdcam_core::{fsio, light};
+use spdcam_core::{fsio, named_light};
+use spdcam_infer::network::{Architecture, CnnSpec, MlpSpec};
+use spdcam_infer::pca::Components;
+use spdcam_infer::scale::RowScale;
+use spdcam_infer::target::TargetKind;
 use spdcam_infer::{Estimate, Estimator, FeatureRows, Model, ModelSet, PhotoOptions};
-use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
-use spdcam_learn::pca::Components;
 use spdcam_learn::recipe;
-use spdcam_learn::scale::RowScale;
-use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{
     add_photo_chart, Backend, FinetuneOptions, Progress, Schedule, TrainOptions, TrainingSet,
 };
@@ -293,18 +293,7 @@ fn default_names(models: &ModelSet, columns: usize, source: &str) -> PyResult<Ve
         .find(|m| m.model.feature_names().len() == columns)
         .map(|m| m.model.feature_names().to_vec())
         .ok_or_else(|| {
-            let known = models
-                .models()
-                .iter()
-                .map(|m| {
-                    format!(
-                        "{} ({} features)",
-                        m.model.header().chart.as_deref().unwrap_or("unknown chart"),
-                        m.model.feature_names().len()
-                    )
-                })
-                .collect::<Vec<_>>()
-                .join(", ");
+            let known = models.known();
             SpdcamError::new_err(format!(
                 "{source}: no model reads {columns} feature columns; the models are for {known}"
             ))
@@ -374,7 +363,7 @@ fn render<'py>(
                         set.resample(&grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
                     set.spd(0)?
                 }
-                _ => light::resolve_spd(spd, &data_dir, &grid)?.spd,
+                _ => named_light::resolve_spd(spd, &data_dir, &grid)?.spd,
             };
             let chart = grid_chart(chart, patch_px, &data_dir, &grid)?;
             let sensitivities = Sensitivities::resolve(camera, &data_dir, &grid)?;

@@ -20,7 +20,7 @@ use spdcam_core::chart::Chart;
 use spdcam_core::dataset::{
     self, FileFormat, GenerateOptions, Generator, Pipeline, SampleBatch, DEFAULT_CHUNK_SIZE,
 };
-use spdcam_core::lighting::Lighting;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::spectral::Grid;
 use std::hint::black_box;
 use std::time::{Duration, Instant};

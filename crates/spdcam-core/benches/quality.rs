@@ -7,7 +7,7 @@
 //! present (`SPDCAM_PYTHON` picks the interpreter), `tools/baseline_quality.py` computes the
 //! same metrics on the first SPDs in the same run and the speed-up over it is printed.
 
-use spdcam_core::illuminant::{daylight, planck};
+use spdcam_core::cie_illuminant::{daylight, planck};
 use spdcam_core::quality::{LightSpectrum, LightingMetrics};
 use spdcam_core::spectral::{Grid, SpectralSet};
 use std::hint::black_box;

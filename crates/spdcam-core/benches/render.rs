@@ -18,7 +18,7 @@ use spdcam_core::camera::noise::{self, NoiseParams};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, Layout};
-use spdcam_core::illuminant::StandardIlluminant;
+use spdcam_core::cie_illuminant::StandardIlluminant;
 use spdcam_core::raster::RgbImage;
 use spdcam_core::seed;
 use spdcam_core::spectral::{Grid, SpectralSet};

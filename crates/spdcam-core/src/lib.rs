@@ -7,8 +7,10 @@
 //!
 //! - [`spectral`]: wavelength grids, named spectral sets and resampling; [`builtin`]: the
 //!   tables shipped inside the binary and names resolved against a data directory.
-//! - [`illuminant`], [`light`], [`lighting`]: standard illuminants, single lights named on
-//!   the command line, and random but reproducible families of lights (recipes).
+//! - [`cie_illuminant`], [`named_light`], [`light_families`]: the CIE standard illuminants,
+//!   one light named on the command line or read from a file, and random but reproducible
+//!   families of lights (recipes) drawn for datasets; [`chart_lighting`]: the light across
+//!   the chart in a photo (gradient, veiling glare) measured and taken out of its features.
 //! - [`chart`]: colour charts (patch reflectances and layout).
 //! - [`camera`]: the virtual camera of the thesis (sensor, noise, demosaicing, white
 //!   balance, aberration, colour) and the chart features a model reads; [`raster`] holds its
@@ -20,7 +22,7 @@
 //!   turns pixels into features, for simulated images and photos alike.
 //! - [`photo`]: real photos — find the chart, rectify it, sample the patches into the same
 //!   feature row; [`feature_check`] rejects rows that cannot say anything about the light.
-//! - [`metrics`] (RMSE, GFC, SAM, SID between spectra), [`colorimetry`] (XYZ, CCT/Duv,
+//! - [`spectral_error`] (RMSE, GFC, SAM, SID between spectra), [`colorimetry`] (XYZ, CCT/Duv,
 //!   sRGB, CIELAB) and [`quality`] (CRI, TM-30, α-opic and other metrics of a light).
 //! - [`error`], [`fsio`] (atomic file writes), [`output_guard`] (no output onto an input)
 //!   and [`limits`] (resource limits) serve all of them.
@@ -32,7 +34,7 @@
 //! use spdcam_core::camera::sensor::Sensitivities;
 //! use spdcam_core::camera::{Camera, CameraConfig};
 //! use spdcam_core::chart::Chart;
-//! use spdcam_core::illuminant::StandardIlluminant;
+//! use spdcam_core::cie_illuminant::StandardIlluminant;
 //! use spdcam_core::spectral::Grid;
 //!
 //! let grid = Grid::SIMULATION;
@@ -60,7 +62,7 @@
 //! use spdcam_core::camera::{Camera, CameraConfig};
 //! use spdcam_core::chart::Chart;
 //! use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
-//! use spdcam_core::lighting::Lighting;
+//! use spdcam_core::light_families::Lighting;
 //! use spdcam_core::spectral::Grid;
 //!
 //! let grid = Grid::SIMULATION;
@@ -91,18 +93,18 @@
 pub mod builtin;
 pub mod camera;
 pub mod chart;
+pub mod chart_lighting;
+pub mod cie_illuminant;
 pub mod colorimetry;
 pub mod dataset;
 pub mod error;
 pub mod feature_check;
 pub mod fsio;
-pub mod illuminant;
 pub mod imageio;
-pub mod light;
-pub mod lighting;
+pub mod light_families;
 pub mod limits;
-pub mod metrics;
 mod minimise;
+pub mod named_light;
 pub mod output_guard;
 pub mod photo;
 pub mod quality;
@@ -111,6 +113,6 @@ pub mod sampler;
 pub mod seed;
 pub mod simple_camera;
 pub mod spectral;
-pub mod uneven_light;
+pub mod spectral_error;
 
 pub use error::{Error, Result};

@@ -13,10 +13,10 @@
 
 use crate::camera::sensor::Sensitivities;
 use crate::chart::Chart;
+use crate::cie_illuminant::StandardIlluminant;
 use crate::colorimetry::Observer;
 use crate::colorimetry::{srgb_encode, xyz_to_linear_srgb};
 use crate::error::{Error, Result};
-use crate::illuminant::StandardIlluminant;
 use crate::spectral::Grid;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use rand::rngs::SmallRng;

@@ -8,8 +8,8 @@ use spdcam_core::camera::demosaic::{demosaic, DemosaicMethod};
 use spdcam_core::camera::sensor::{Sensitivities, SensorMode};
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
+use spdcam_core::cie_illuminant::StandardIlluminant;
 use spdcam_core::colorimetry::{self, Observer};
-use spdcam_core::illuminant::StandardIlluminant;
 use spdcam_core::raster::{CfaPattern, Mosaic, RgbImage};
 use spdcam_core::spectral::Grid;
 
@@ -117,7 +117,8 @@ fn fast_features_match_the_noise_free_image_pipeline() {
         let chart = Chart::colorchecker24(&GRID).unwrap();
         let camera = Camera::new(&nikon(), chart, config, &GRID).unwrap();
         for spd in ["A", "cct:9000", "D50"] {
-            let spd = spdcam_core::light::resolve_spd(spd, &DataDir::default(), &GRID).unwrap();
+            let spd =
+                spdcam_core::named_light::resolve_spd(spd, &DataDir::default(), &GRID).unwrap();
             let full = camera.render(&spd.spd, 0, false).unwrap().features;
             let light = camera.light(&spd.spd).unwrap();
             let mut fast = Vec::new();

@@ -3,13 +3,13 @@
 //! section's `description` says exactly how its numbers were made).
 
 use serde_json::Value;
+use spdcam_core::cie_illuminant::{
+    daylight, daylight_from_xy, daylight_xy, planck, StandardIlluminant,
+};
 use spdcam_core::colorimetry::{
     cct_duv_to_uv, delta_e_2000, lab_to_xyz, linear_srgb_to_xyz, srgb_decode, srgb_encode,
     srgb_encode_f32, uv_to_cct_duv, xy_to_uv1960, xy_to_xyz, xyz_to_lab, xyz_to_linear_srgb,
     Observer,
-};
-use spdcam_core::illuminant::{
-    daylight, daylight_from_xy, daylight_xy, planck, StandardIlluminant,
 };
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 
@@ -287,8 +287,8 @@ fn cct_and_duv_ohno() {
 fn planck_radiance() {
     let reference = load("colorimetry.json");
     let section = &reference["planck"];
-    assert_eq!(num(&section["c1"]), spdcam_core::illuminant::PLANCK_C1);
-    assert_eq!(num(&section["c2"]), spdcam_core::illuminant::PLANCK_C2);
+    assert_eq!(num(&section["c1"]), spdcam_core::cie_illuminant::PLANCK_C1);
+    assert_eq!(num(&section["c2"]), spdcam_core::cie_illuminant::PLANCK_C2);
     let grid = Grid::new(400.0, 700.0, 20.0).unwrap();
     let idx: Vec<usize> = vec(&section["wavelengths_nm"])
         .iter()

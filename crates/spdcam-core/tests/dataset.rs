@@ -13,7 +13,7 @@ use spdcam_core::dataset::{
     self, Dataset, Duplicates, ExportOptions, FileFormat, GenerateOptions, Generator,
     ImportOptions, Origin, Pipeline, Shard,
 };
-use spdcam_core::lighting::Lighting;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::seed;
 use spdcam_core::spectral::{Grid, Spd};
 use std::collections::BTreeMap;

@@ -10,7 +10,7 @@ use spdcam_core::builtin::{self, DataDir};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
-use spdcam_core::illuminant;
+use spdcam_core::cie_illuminant;
 use spdcam_core::photo::detection_rate::{self, BucketRate, Difficulty};
 use spdcam_core::photo::scene::{self, SceneLight};
 use spdcam_core::photo::{analyse, decode_photo, AnalyseOptions, ChartTemplate};
@@ -105,7 +105,7 @@ fn tilted_scene(camera: &Camera, seed: u64) -> (spdcam_core::photo::Photo, [[f64
     let bucket = &detection_rate::buckets()[7];
     let (mut options, cct) = bucket.scene(seed, SIZE.0, SIZE.1);
     options.width_share = (0.2, 0.2);
-    let spd = illuminant::planck(cct, &GRID).unwrap();
+    let spd = cie_illuminant::planck(cct, &GRID).unwrap();
     let shot = scene::photograph(camera, SceneLight::single(&spd), seed, &options).unwrap();
     let photo = decode_photo(&shot.jpeg, "tilted.jpg").unwrap();
     (photo, shot.corners)

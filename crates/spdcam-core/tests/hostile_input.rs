@@ -10,7 +10,7 @@ use spdcam_core::dataset::{
     self, Dataset, Duplicates, ExportOptions, GenerateOptions, Generator, ImportOptions, Pipeline,
     LOCK_FILE,
 };
-use spdcam_core::lighting::Lighting;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::spectral::Grid;
 use std::path::{Path, PathBuf};
 

@@ -10,13 +10,13 @@ use spdcam_core::camera::tone::jpeg_quantise;
 use spdcam_core::camera::white_balance;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
+use spdcam_core::cie_illuminant::StandardIlluminant;
 use spdcam_core::colorimetry;
 use spdcam_core::dataset::randomise::{
     camera_pool, InCameraRanges, Randomisation, IN_CAMERA_AND_GRADIENT_GROUPS, IN_CAMERA_GROUPS,
 };
 use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
-use spdcam_core::illuminant::StandardIlluminant;
-use spdcam_core::lighting::Lighting;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::spectral::{Grid, Spd};
 
 const GRID: Grid = Grid::SIMULATION;

@@ -8,8 +8,8 @@ use spdcam_core::camera::colour::fit_correction_matrix;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
-use spdcam_core::illuminant::StandardIlluminant;
-use spdcam_core::lighting::Lighting;
+use spdcam_core::cie_illuminant::StandardIlluminant;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::spectral::{Grid, Spd};
 
 /// A spectrum on the 5 nm simulation grid: positive, smooth or spiky.

@@ -5,7 +5,7 @@
 mod shared_data;
 
 use spdcam_core::builtin::DataDir;
-use spdcam_core::lighting::{catalogue, Lighting};
+use spdcam_core::light_families::{catalogue, Lighting};
 use spdcam_core::spectral::Grid;
 
 const GRID: Grid = Grid::SIMULATION;

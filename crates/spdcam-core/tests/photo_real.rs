@@ -5,8 +5,8 @@
 mod shared_data;
 
 use spdcam_core::chart::Chart;
+use spdcam_core::cie_illuminant::StandardIlluminant;
 use spdcam_core::colorimetry::Observer;
-use spdcam_core::illuminant::StandardIlluminant;
 use spdcam_core::photo::{
     analyse, analyse_photo, decode_photo, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis,
 };

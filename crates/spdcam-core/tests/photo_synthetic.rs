@@ -253,7 +253,7 @@ fn exif_orientation_is_honoured() {
 fn photos_by_the_full_camera_are_found_and_sampled_close_to_the_truth() {
     use spdcam_core::camera::{Camera, CameraConfig};
     use spdcam_core::chart::Chart;
-    use spdcam_core::illuminant::StandardIlluminant;
+    use spdcam_core::cie_illuminant::StandardIlluminant;
     use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
     use spdcam_core::spectral::Grid;
     let grid = Grid::SIMULATION;

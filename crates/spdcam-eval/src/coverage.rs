@@ -7,10 +7,10 @@
 
 use crate::error::Result;
 use spdcam_core::builtin::DataDir;
-use spdcam_core::lighting::coverage::best_gfc;
-use spdcam_core::lighting::lamp_families::fit_lamp;
-use spdcam_core::lighting::validation_split::LampPart;
-use spdcam_core::lighting::{LampFamily, LampLibrary, LampType, Lighting, ValidationSplit};
+use spdcam_core::light_families::coverage::best_gfc;
+use spdcam_core::light_families::lamp_families::fit_lamp;
+use spdcam_core::light_families::validation_split::LampPart;
+use spdcam_core::light_families::{LampFamily, LampLibrary, LampType, Lighting, ValidationSplit};
 use spdcam_core::spectral::Grid;
 use std::path::PathBuf;
 
@@ -47,7 +47,7 @@ pub struct RecipeCoverage {
 /// Built by hand, the table of two incandescent lamps and one recipe:
 ///
 /// ```
-/// use spdcam_core::lighting::LampType;
+/// use spdcam_core::light_families::LampType;
 /// use spdcam_eval::coverage::{Coverage, RecipeCoverage};
 ///
 /// let coverage = Coverage {

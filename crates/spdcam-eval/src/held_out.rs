@@ -10,8 +10,7 @@ use spdcam_core::chart::Chart;
 use spdcam_core::dataset::randomise::{
     camera_pool, InCameraRanges, Randomisation, IN_CAMERA_AND_GRADIENT_GROUPS,
 };
-use spdcam_core::lighting::{LampLibrary, ValidationSplit};
-use spdcam_core::metrics;
+use spdcam_core::light_families::{LampLibrary, ValidationSplit};
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_infer::Model;
 use std::path::{Path, PathBuf};
@@ -200,7 +199,7 @@ pub fn on_grid(library: &LampLibrary, grid: &Grid) -> Result<Vec<Vec<f64>>> {
     Ok(set
         .items()
         .iter()
-        .map(|s| metrics::normalise_by_max(s))
+        .map(|s| spdcam_core::spectral::normalise_by_max(s))
         .collect())
 }
 
@@ -272,7 +271,7 @@ impl HeldOutPhotos {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use spdcam_core::lighting::validation_split::{CameraSplit, LampSplit};
+    use spdcam_core::light_families::validation_split::{CameraSplit, LampSplit};
 
     #[test]
     fn unreadable_held_out_cameras_are_returned_not_printed() {

@@ -31,10 +31,10 @@ use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::colorimetry::Observer;
 use spdcam_core::dataset::randomise::RandomiseRequest;
 use spdcam_core::dataset::{GenerateOptions, Generator, MeasuredPhotos, Pipeline};
-use spdcam_core::lighting::Lighting;
-use spdcam_core::metrics;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::quality::uv::xyz_to_uv1976;
 use spdcam_core::spectral::Grid;
+use spdcam_core::spectral_error;
 use spdcam_infer::ridge::Ridge;
 use spdcam_infer::Model;
 use std::path::{Path, PathBuf};
@@ -114,7 +114,7 @@ pub fn targets(photos: &MeasuredPhotos) -> Vec<Vec<f64>> {
     photos
         .spds
         .iter()
-        .map(|s| metrics::normalise_by_max(s.values()))
+        .map(|s| spdcam_core::spectral::normalise_by_max(s.values()))
         .collect()
 }
 
@@ -141,7 +141,7 @@ pub fn score(truths: &[Vec<f64>], estimates: &[Vec<f64>]) -> Result<Score> {
     let mut gfc = 0.0;
     let mut duv = Vec::with_capacity(truths.len());
     for (t, e) in truths.iter().zip(estimates) {
-        gfc += metrics::gfc(t, e).unwrap_or(0.0);
+        gfc += spectral_error::gfc(t, e).unwrap_or(0.0);
         let (a, b) = (uv(t), uv(e));
         let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
         duv.push(if d.is_finite() { d } else { 1.0 });
@@ -201,7 +201,9 @@ pub fn model_estimates(model: &Model, photos: &MeasuredPhotos) -> Result<Vec<Vec
     let spds = model.estimate_rows(&flat)?;
     Ok(spds
         .chunks(grid.count)
-        .map(|s| metrics::normalise_by_max(&at.iter().map(|&i| s[i]).collect::<Vec<_>>()))
+        .map(|s| {
+            spdcam_core::spectral::normalise_by_max(&at.iter().map(|&i| s[i]).collect::<Vec<_>>())
+        })
         .collect())
 }
 
@@ -274,7 +276,9 @@ pub fn virtual_photos(
         targets: (0..batch.len())
             .map(|i| {
                 let spd = batch.spd_of(i);
-                metrics::normalise_by_max(&at.iter().map(|&k| spd[k]).collect::<Vec<_>>())
+                spdcam_core::spectral::normalise_by_max(
+                    &at.iter().map(|&k| spd[k]).collect::<Vec<_>>(),
+                )
             })
             .collect(),
     })

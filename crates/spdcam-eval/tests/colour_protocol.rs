@@ -4,7 +4,7 @@
 #![cfg(feature = "measured-data")]
 
 use spdcam_core::builtin::DataDir;
-use spdcam_core::lighting::ValidationSplit;
+use spdcam_core::light_families::ValidationSplit;
 use spdcam_core::spectral::{Grid, Spd};
 use spdcam_eval::colour::lights::{references, LightSet};
 use spdcam_eval::colour::{ColourOptions, ColourReport, ColourScore, Group, Summary};

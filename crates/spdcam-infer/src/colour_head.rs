@@ -191,7 +191,7 @@ fn uv_slope([x, y, z]: [f64; 3], [bx, by, bz]: [f64; 3]) -> [f64; 2] {
 mod tests {
     use super::*;
     use crate::pca::Components;
-    use spdcam_core::illuminant::planck;
+    use spdcam_core::cie_illuminant::planck;
 
     fn grid() -> Grid {
         Grid::new(400.0, 700.0, 5.0).unwrap()

@@ -18,10 +18,12 @@
 
 use crate::absolute::absolute_level;
 use crate::error::{InferError, Result};
-use crate::estimate::{chart_templates, Colorimetry, Estimate, FeatureRows, PhotoOptions};
+use crate::estimate::{Colorimetry, Estimate};
+use crate::feature_rows::FeatureRows;
+use crate::photo_options::{chart_templates, PhotoOptions};
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
-use crate::trust::{self, Calibration, ChartCheck, PhotoFlags, Trust};
+use crate::trust::{self, ChartCheck, PhotoFlags, Trust, TrustCalibration};
 use rayon::prelude::*;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
@@ -37,7 +39,7 @@ use std::sync::Arc;
 /// What judging one model's estimates needs, made once per model.
 struct ModelTrust {
     /// The shipped calibration measured on the model, parsed once.
-    calibration: Option<Calibration>,
+    calibration: Option<TrustCalibration>,
     /// The chart re-rendered under an estimate (the self-check), built once.
     check: Option<ChartCheck>,
 }
@@ -208,15 +210,52 @@ impl Estimator {
 
     /// The estimate for the photo file at `path`, labelled with its file name.
     pub fn estimate_photo(&self, path: &Path, options: &PhotoOptions) -> Result<Estimate> {
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| path.display().to_string());
-        let analysed = self
-            .analyse_photos(&[path.to_path_buf()], options)?
+        self.estimate_photos(&[path.to_path_buf()], options, |_| Ok::<(), InferError>(()))?
             .pop()
-            .ok_or_else(|| InferError::invalid("no photo analysed"))??;
-        self.estimate_analysis(analysed.analysis, name)
+            .ok_or_else(|| InferError::invalid("no photo analysed"))?
+            .into_estimate()
+    }
+
+    /// Photo files the whole way, in one call: each analysed (in parallel; one bad photo
+    /// does not cost the others), then estimated by the model for its chart, labelled with
+    /// its file name (its path where names repeat). One [`PhotoEstimate`] per photo, in
+    /// order: the analysis, the debug image written for it and the estimate. `progress`
+    /// hears of each step ([`PhotoProgress`]) so that a front end prints between them; an
+    /// error it returns stops the work.
+    pub fn estimate_photos<E: From<InferError>>(
+        &self,
+        paths: &[PathBuf],
+        options: &PhotoOptions,
+        mut progress: impl FnMut(PhotoProgress<'_>) -> std::result::Result<(), E>,
+    ) -> std::result::Result<Vec<PhotoEstimate>, E> {
+        if options.corners.is_some() && paths.len() > 1 {
+            return Err(InferError::invalid(format!(
+                "corners apply to one photo; {} were given",
+                paths.len()
+            ))
+            .into());
+        }
+        let templates = self.templates(options.chart.as_deref())?;
+        let debug = options.debug.as_ref().map(|d| debug_paths(d, paths));
+        let mut photos: Vec<PhotoEstimate> = paths
+            .par_iter()
+            .enumerate()
+            .map(|(i, path)| {
+                let debug = debug.as_ref().map(|d| d[i].clone());
+                match photo::load_photo(path) {
+                    Ok(decoded) => self.analyse_with(&decoded, options, templates.clone(), debug),
+                    Err(e) => PhotoEstimate::unusable(e.into()),
+                }
+            })
+            .collect();
+        progress(PhotoProgress::Analysed(&photos))?;
+        for (photo, label) in photos.iter_mut().zip(photo_labels(paths)) {
+            if let Ok(analysed) = &photo.analysed {
+                progress(PhotoProgress::Estimating(&analysed.analysis))?;
+                photo.estimate = Some(self.estimate_analysis(analysed.analysis.clone(), label));
+            }
+        }
+        Ok(photos)
     }
 
     /// The estimate for a photo held in memory (an upload, never written to disk), decoded
@@ -241,8 +280,25 @@ impl Estimator {
         name: &str,
         options: &PhotoOptions,
     ) -> Result<Estimate> {
-        let decoded = photo::decode_photo(bytes, name)?;
-        self.estimate_decoded(&decoded, options)
+        self.photo_bytes(bytes, name, options).into_estimate()
+    }
+
+    /// A photo held in memory the whole way, in one call: its analysis (with the picture of
+    /// the chart found when `options.overlay_width` asks for it), the debug image written
+    /// and its estimate, labelled `name`.
+    pub fn photo_bytes(&self, bytes: &[u8], name: &str, options: &PhotoOptions) -> PhotoEstimate {
+        let decoded = match photo::decode_photo(bytes, name) {
+            Ok(decoded) => decoded,
+            Err(e) => return PhotoEstimate::unusable(e.into()),
+        };
+        let mut photo = match self.templates(options.chart.as_deref()) {
+            Ok(templates) => self.analyse_with(&decoded, options, templates, options.debug.clone()),
+            Err(e) => PhotoEstimate::unusable(e),
+        };
+        if let Ok(analysed) = &photo.analysed {
+            photo.estimate = Some(self.estimate_analysis(analysed.analysis.clone(), name.into()));
+        }
+        photo
     }
 
     /// The estimate for a photo already decoded (from bytes, or a pixel array in Python),
@@ -252,79 +308,41 @@ impl Estimator {
         self.estimate_analysis(analysed.analysis, photo.source.clone())
     }
 
-    /// Analyses photo files in parallel with `options`: one result per photo, in order, so
-    /// one bad photo does not cost the others. Each photo is decoded once; the picture of
-    /// the chart found ([`AnalysedPhoto::overlay`]) is drawn while it is at hand when
-    /// `options.overlay_width` asks for it.
-    pub fn analyse_photos(
-        &self,
-        paths: &[PathBuf],
-        options: &PhotoOptions,
-    ) -> Result<Vec<Result<AnalysedPhoto>>> {
-        if options.corners.is_some() && paths.len() > 1 {
-            return Err(InferError::invalid(format!(
-                "corners apply to one photo; {} were given",
-                paths.len()
-            )));
-        }
-        let templates = self.templates(options.chart.as_deref())?;
-        let debug = options.debug.as_ref().map(|d| debug_paths(d, paths));
-        Ok(paths
-            .par_iter()
-            .enumerate()
-            .map(|(i, path)| {
-                let decoded = photo::load_photo(path)?;
-                let debug = debug.as_ref().map(|d| d[i].clone());
-                self.analyse_with(&decoded, options, templates.clone(), debug)
-            })
-            .collect())
-    }
-
     /// Analyses a decoded photo with `options` (the chart found among the charts
     /// [`Estimator::templates`] gives, or placed by `options.corners`, and sampled).
     pub fn analyse_decoded(&self, photo: &Photo, options: &PhotoOptions) -> Result<AnalysedPhoto> {
         let templates = self.templates(options.chart.as_deref())?;
         self.analyse_with(photo, options, templates, options.debug.clone())
+            .analysed
     }
 
     /// One decoded photo analysed with `options` among `templates`, its debug image (if
-    /// any) written to `debug`.
+    /// any) written to `debug`; no estimate yet.
     fn analyse_with(
         &self,
         photo: &Photo,
         options: &PhotoOptions,
         templates: Vec<ChartTemplate>,
         debug: Option<PathBuf>,
-    ) -> Result<AnalysedPhoto> {
+    ) -> PhotoEstimate {
         let analyse = AnalyseOptions {
             templates,
             corners: options.corners.clone(),
             debug,
         };
-        let analysis = photo::analyse(photo, &analyse)?;
-        let overlay = match options.overlay_width {
-            Some(width) => {
-                let template = analyse
-                    .templates
-                    .iter()
-                    .find(|t| t.name == analysis.chart)
-                    .ok_or_else(|| {
-                        InferError::invalid(format!(
-                            "{}: no template of chart {}",
-                            analysis.source, analysis.chart
-                        ))
-                    })?;
-                Some(analysis_overlay_jpeg(
-                    photo,
-                    template,
-                    &analysis.detection(),
-                    &analysis.patches,
-                    width,
-                )?)
-            }
-            None => None,
-        };
-        Ok(AnalysedPhoto { analysis, overlay })
+        let (analysis, debug) = photo::analyse_telling_debug(photo, &analyse);
+        let analysed = analysis.map_err(InferError::from).and_then(|analysis| {
+            let overlay = match options.overlay_width {
+                Some(width) => Some(overlay_of(photo, &analyse.templates, &analysis, width)?),
+                None => None,
+            };
+            Ok(AnalysedPhoto { analysis, overlay })
+        });
+        PhotoEstimate {
+            debug,
+            analysed,
+            estimate: None,
+        }
     }
 
     /// The estimate for an analysed photo, by the model for the chart it shows, labelled
@@ -366,7 +384,7 @@ impl Estimator {
     /// use spdcam_core::camera::sensor::Sensitivities;
     /// use spdcam_core::camera::{Camera, CameraConfig};
     /// use spdcam_core::chart::Chart;
-    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::cie_illuminant::StandardIlluminant;
     /// use spdcam_core::spectral::Grid;
     /// use spdcam_infer::{Estimator, FeatureRows};
     ///
@@ -583,7 +601,98 @@ impl Estimator {
     }
 }
 
-/// A photo analysed by [`Estimator::analyse_photos`].
+/// The picture of the chart found on `photo` (as `--debug` draws it), `width` pixels wide,
+/// as JPEG.
+fn overlay_of(
+    photo: &Photo,
+    templates: &[ChartTemplate],
+    analysis: &PhotoAnalysis,
+    width: u32,
+) -> Result<Vec<u8>> {
+    let template = templates
+        .iter()
+        .find(|t| t.name == analysis.chart)
+        .ok_or_else(|| {
+            InferError::invalid(format!(
+                "{}: no template of chart {}",
+                analysis.source, analysis.chart
+            ))
+        })?;
+    Ok(analysis_overlay_jpeg(
+        photo,
+        template,
+        &analysis.detection(),
+        &analysis.patches,
+        width,
+    )?)
+}
+
+/// Column labels for photos: their file names, or their paths where names repeat.
+fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
+    let names: Vec<String> = photos
+        .iter()
+        .map(|p| {
+            p.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| p.display().to_string())
+        })
+        .collect();
+    names
+        .iter()
+        .zip(photos)
+        .map(|(n, p)| {
+            if names.iter().filter(|m| *m == n).count() > 1 {
+                p.display().to_string()
+            } else {
+                n.clone()
+            }
+        })
+        .collect()
+}
+
+/// One photo's way through the [`Estimator`] ([`Estimator::estimate_photos`],
+/// [`Estimator::photo_bytes`]): its analysis, the debug image written for it and its
+/// estimate.
+#[derive(Debug)]
+pub struct PhotoEstimate {
+    /// The debug image written for the photo (`PhotoOptions::debug`), also when no chart
+    /// was found in it; `None` when none was written.
+    pub debug: Option<PathBuf>,
+    /// What the photo gave, or why it could not be used (unreadable, no chart found).
+    pub analysed: Result<AnalysedPhoto>,
+    /// The estimate, or why the model gave none; `None` while not made (the photo could
+    /// not be used, or [`PhotoProgress::Analysed`] reports before any estimate).
+    pub estimate: Option<Result<Estimate>>,
+}
+
+impl PhotoEstimate {
+    fn unusable(error: InferError) -> PhotoEstimate {
+        PhotoEstimate {
+            debug: None,
+            analysed: Err(error),
+            estimate: None,
+        }
+    }
+
+    /// The estimate, or why there is none (the photo's error first).
+    pub fn into_estimate(self) -> Result<Estimate> {
+        self.analysed?;
+        self.estimate
+            .unwrap_or_else(|| Err(InferError::invalid("no estimate was made")))
+    }
+}
+
+/// The steps [`Estimator::estimate_photos`] reports, so that a front end prints between
+/// them.
+#[derive(Debug)]
+pub enum PhotoProgress<'a> {
+    /// Every photo analysed (in order), before any estimate is made.
+    Analysed(&'a [PhotoEstimate]),
+    /// The estimate of this analysed photo is about to be made.
+    Estimating(&'a PhotoAnalysis),
+}
+
+/// A photo analysed by the [`Estimator`].
 #[derive(Debug, Clone)]
 pub struct AnalysedPhoto {
     /// What the photo gave.
@@ -682,21 +791,6 @@ impl RowStream<'_> {
             })
             .collect()
     }
-}
-
-/// The estimate for one photo held in memory, labelled `name`: an [`Estimator`] built for
-/// this photo alone. Build the estimator once (and call [`Estimator::estimate_photo_bytes`])
-/// when estimating many.
-pub fn estimate_photo_bytes(
-    bytes: &[u8],
-    name: &str,
-    models: &ModelSet,
-    options: &PhotoOptions,
-    data_dir: &DataDir,
-    grid: &Grid,
-) -> Result<Estimate> {
-    Estimator::new(models.clone(), data_dir.clone(), *grid)?
-        .estimate_photo_bytes(bytes, name, options)
 }
 
 #[cfg(test)]
@@ -845,25 +939,63 @@ mod tests {
     }
 
     #[test]
+    fn one_call_gives_the_analysis_the_estimate_and_the_debug_image_written() {
+        let debug = std::env::temp_dir().join(format!("spdcam-debug-{}.png", std::process::id()));
+        let options = PhotoOptions {
+            debug: Some(debug.clone()),
+            ..PhotoOptions::default()
+        };
+        let missing = PathBuf::from("no-such-photo.jpg");
+        let mut steps = Vec::new();
+        let photos = shipped()
+            .estimate_photos(&[example_photo(), missing], &options, |step| {
+                steps.push(match step {
+                    PhotoProgress::Analysed(all) => format!("analysed {}", all.len()),
+                    PhotoProgress::Estimating(a) => format!("estimating {}", a.chart),
+                });
+                Ok::<(), InferError>(())
+            })
+            .unwrap();
+        assert_eq!(steps, ["analysed 2", "estimating colorchecker_sg140"]);
+        let written = photos[0].debug.clone().unwrap();
+        assert!(written.is_file(), "{}", written.display());
+        std::fs::remove_file(&written).unwrap();
+        assert!(photos[0].analysed.is_ok());
+        assert!(matches!(photos[0].estimate, Some(Ok(_))));
+        // The photo that cannot be read writes no debug image and has no estimate.
+        assert!(photos[1].debug.is_none() && photos[1].estimate.is_none());
+        assert!(photos[1]
+            .analysed
+            .as_ref()
+            .unwrap_err()
+            .to_string()
+            .contains("no-such-photo"));
+    }
+
+    #[test]
     fn the_report_picture_is_drawn_from_the_one_decoding() {
         let options = PhotoOptions {
             overlay_width: Some(320),
             ..PhotoOptions::default()
         };
         let analysed = shipped()
-            .analyse_photos(&[example_photo()], &options)
+            .estimate_photos(&[example_photo()], &options, |_| Ok::<(), InferError>(()))
             .unwrap()
             .pop()
             .unwrap()
+            .analysed
             .unwrap();
         let jpeg = analysed.overlay.unwrap();
         let picture = decode_photo(&jpeg, "overlay.jpg").unwrap();
         assert_eq!(picture.width, 320);
         let plain = shipped()
-            .analyse_photos(&[example_photo()], &PhotoOptions::default())
+            .estimate_photos(&[example_photo()], &PhotoOptions::default(), |_| {
+                Ok::<(), InferError>(())
+            })
             .unwrap()
             .pop()
             .unwrap()
+            .analysed
             .unwrap();
         assert!(plain.overlay.is_none());
         assert_eq!(plain.analysis, analysed.analysis);

@@ -19,9 +19,10 @@
 //! - [`estimator`]: the [`Estimator`], built once from the models, the data directory and
 //!   the output grid, the one path every front end (command line, web app, Python) takes
 //!   from a photo (file, bytes, decoded) or feature rows (in memory, streamed) to a judged
-//!   [`Estimate`]; [`estimate`]: what an estimate is (SPD, colorimetry, lighting metrics,
-//!   verdict, bands) and what it is made from; [`stream`]: feature rows read a block at a
-//!   time, and the CSV layouts of many SPDs.
+//!   [`Estimate`]; its inputs: [`feature_rows`] (feature rows in memory) and
+//!   [`photo_options`] (how photos are analysed, the charts looked for); [`estimate`]: what
+//!   an estimate is (SPD, colorimetry, lighting metrics, verdict, bands); [`stream`]: feature
+//!   rows read a block at a time, and the CSV layouts of many SPDs.
 //! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
 //!   verdict); [`presentation`]: what an estimate means in words and rounded numbers;
 //!   [`plot`] and [`report`]: SVG plots and the HTML report.
@@ -66,9 +67,11 @@ pub mod colour_head;
 pub mod error;
 pub mod estimate;
 pub mod estimator;
+pub mod feature_rows;
 pub mod model;
 pub mod network;
 pub mod pca;
+pub mod photo_options;
 pub mod plot;
 pub mod presentation;
 pub mod record;
@@ -81,7 +84,9 @@ pub mod target;
 pub mod trust;
 
 pub use error::{InferError, Result};
-pub use estimate::{Estimate, FeatureRows, PhotoOptions};
-pub use estimator::{estimate_photo_bytes, AnalysedPhoto, Estimator, RowStream};
+pub use estimate::Estimate;
+pub use estimator::{AnalysedPhoto, Estimator, PhotoEstimate, PhotoProgress, RowStream};
+pub use feature_rows::FeatureRows;
 pub use model::Model;
+pub use photo_options::PhotoOptions;
 pub use shipped::ModelSet;

@@ -14,7 +14,7 @@
 
 use crate::error::{InferError, Result};
 use faer::{linalg::solvers::Solve, Mat, Side};
-use spdcam_core::metrics;
+use spdcam_core::spectral_error;
 
 /// Relative penalties (times the mean diagonal of `XᵀX`) that [`Ridge::fit_cv`] chooses
 /// among.
@@ -179,7 +179,7 @@ impl Ridge {
     }
 
     /// Fits with the penalty among [`PENALTIES`] whose `folds`-fold cross-validated mean GFC
-    /// (goodness-of-fit coefficient, [`metrics::gfc`]) of [`Ridge::predict_non_negative`] on
+    /// (goodness-of-fit coefficient, [`spectral_error::gfc`]) of [`Ridge::predict_non_negative`] on
     /// the rows is best, then refits on every row. Fold `f` holds rows `i % folds == f`; ties
     /// go to the smaller penalty. For non-negative targets such as spectra.
     pub fn fit_cv<'a>(
@@ -205,7 +205,8 @@ impl Ridge {
                 *total += test
                     .iter()
                     .map(|&i| {
-                        metrics::gfc(&y[i], &model.predict_non_negative(&x[i])).unwrap_or(0.0)
+                        spectral_error::gfc(&y[i], &model.predict_non_negative(&x[i]))
+                            .unwrap_or(0.0)
                     })
                     .sum::<f64>();
             }

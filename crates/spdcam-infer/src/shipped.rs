@@ -117,8 +117,17 @@ impl ModelSet {
         if let [only] = same_count.as_slice() {
             only.model.check_features(names, source)?;
         }
-        let known = self
-            .models
+        Err(InferError::invalid(format!(
+            "{source}: no model reads these {} feature columns; the models are for {}",
+            names.len(),
+            self.known()
+        )))
+    }
+
+    /// The models' charts and how many features each reads (`colorchecker24 (72 features),
+    /// …`), the one list every "no model reads these columns" message names.
+    pub fn known(&self) -> String {
+        self.models
             .iter()
             .map(|m| {
                 format!(
@@ -128,11 +137,7 @@ impl ModelSet {
                 )
             })
             .collect::<Vec<_>>()
-            .join(", ");
-        Err(InferError::invalid(format!(
-            "{source}: no model reads these {} feature columns; the models are for {known}",
-            names.len()
-        )))
+            .join(", ")
     }
 }
 

@@ -9,7 +9,6 @@ use crate::error::{InferError, Result};
 use crate::pca::{Components, Pca};
 use faer::{linalg::solvers::Solve, Mat, Side};
 use serde::{Deserialize, Serialize};
-use spdcam_core::metrics;
 
 /// Which targets to train on.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -108,7 +107,7 @@ impl Target {
             }
         }
         // An estimate is a relative SPD: peak 1, nothing below 0.
-        metrics::clip_normalise(spd);
+        spdcam_core::spectral::clip_normalise(spd);
     }
 
     /// The targets of one max-normalised SPD on the model's grid, or `None` for a target

@@ -3,7 +3,7 @@
 
 use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::Grid;
-use spdcam_infer::{estimate_photo_bytes, Estimator, ModelSet, PhotoOptions};
+use spdcam_infer::{Estimator, ModelSet, PhotoOptions};
 use std::path::PathBuf;
 
 fn example() -> PathBuf {
@@ -22,8 +22,10 @@ fn bytes_and_file_give_the_same_estimate() {
         .estimate_photo(&path, &options)
         .unwrap();
     let bytes = std::fs::read(&path).unwrap();
-    let from_bytes =
-        estimate_photo_bytes(&bytes, "sg-telelumen.jpg", &models, &options, &data, &grid).unwrap();
+    let from_bytes = Estimator::new(models, data, grid)
+        .unwrap()
+        .estimate_photo_bytes(&bytes, "sg-telelumen.jpg", &options)
+        .unwrap();
     assert_eq!(from_bytes.name, "sg-telelumen.jpg");
     assert_eq!(from_bytes.spd, from_file.spd);
     assert_eq!(from_bytes.colorimetry, from_file.colorimetry);
@@ -39,15 +41,10 @@ fn corners_in_memory_move_the_sampling() {
     let grid = Grid::parse("400-700:5").unwrap();
     let data = DataDir::new(None);
     let bytes = std::fs::read(example()).unwrap();
-    let detected = estimate_photo_bytes(
-        &bytes,
-        "p.jpg",
-        &models,
-        &PhotoOptions::default(),
-        &data,
-        &grid,
-    )
-    .unwrap();
+    let estimator = Estimator::new(models, data, grid).unwrap();
+    let detected = estimator
+        .estimate_photo_bytes(&bytes, "p.jpg", &PhotoOptions::default())
+        .unwrap();
     let mut corners = detected.photo.as_ref().unwrap().corners.to_vec();
     corners[0][0] += 40.0;
     corners[0][1] += 30.0;
@@ -55,7 +52,9 @@ fn corners_in_memory_move_the_sampling() {
         corners: Some(corners),
         ..PhotoOptions::default()
     };
-    let moved = estimate_photo_bytes(&bytes, "p.jpg", &models, &options, &data, &grid).unwrap();
+    let moved = estimator
+        .estimate_photo_bytes(&bytes, "p.jpg", &options)
+        .unwrap();
     assert_eq!(moved.photo.as_ref().unwrap().method, "corners");
     assert_ne!(moved.spd, detected.spd);
 }
@@ -64,16 +63,11 @@ fn corners_in_memory_move_the_sampling() {
 fn bytes_that_are_no_image_are_named_in_the_error() {
     let models = ModelSet::shipped().unwrap();
     let grid = Grid::parse("400-700:5").unwrap();
-    let err = estimate_photo_bytes(
-        b"hello, not a photo",
-        "notes.txt",
-        &models,
-        &PhotoOptions::default(),
-        &DataDir::new(None),
-        &grid,
-    )
-    .unwrap_err()
-    .to_string();
+    let err = Estimator::new(models, DataDir::new(None), grid)
+        .unwrap()
+        .estimate_photo_bytes(b"hello, not a photo", "notes.txt", &PhotoOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("notes.txt"), "{err}");
     assert!(err.contains("not an image"), "{err}");
 }

@@ -19,11 +19,11 @@ use burn::nn::{Dropout, DropoutConfig, Linear, LinearConfig};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::activation::{relu, sigmoid};
 use burn::tensor::{Device, Tensor, TensorData};
-use spdcam_learn::network::{Architecture, CnnSpec};
-use spdcam_learn::pca::Components;
-use spdcam_learn::scale::RowScale;
+use spdcam_infer::network::{Architecture, CnnSpec};
+use spdcam_infer::pca::Components;
+use spdcam_infer::scale::RowScale;
+use spdcam_infer::target::TargetKind;
 use spdcam_learn::synthetic::gaussian_set;
-use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{train_in_parts, Backend, Schedule, TrainOptions, BATCH_PARTS};
 use std::time::Instant;
 

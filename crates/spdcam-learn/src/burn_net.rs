@@ -1,5 +1,5 @@
 //! The networks as burn modules, for training. Their parameters have the layouts of
-//! [`crate::network`], so weights move between the two with plain copies.
+//! [`spdcam_infer::network`], so weights move between the two with plain copies.
 //!
 //! The convolutions are written as dense layers over windows (im2col), which flex runs as one
 //! large matrix product per layer; the max pooling is an element-wise maximum of the
@@ -7,13 +7,13 @@
 //! with a fast seeded generator (burn's own Bernoulli sampling was ~10 % of a step).
 
 use crate::error::{LearnError, Result};
-use crate::network::{Architecture, CnnSpec, Network, Parameter};
 use burn::module::{Module, Param, ParamId};
 use burn::nn::Linear;
 use burn::optim::GradientsParams;
 use burn::tensor::activation::{relu, sigmoid};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::Rng;
+use spdcam_infer::network::{Architecture, CnnSpec, Network, Parameter};
 
 /// The trainable layers: dense (or convolution-as-dense) layers in forward order.
 #[derive(Module, Debug)]

@@ -2,12 +2,12 @@
 //! summaries, the per-band mean absolute error, and SVG plots of the results.
 
 use crate::error::{LearnError, Result};
-use crate::model::Model;
 use crate::train::{spds_on_grid, EpochRecord, TrainingSet};
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
-use spdcam_core::metrics::{compare, summarise, SpectralMetrics, Summary};
 use spdcam_core::spectral::Grid;
+use spdcam_core::spectral_error::{compare, summarise, SpectralMetrics, Summary};
+use spdcam_infer::model::Model;
 use spdcam_infer::plot::{plot_error, spds_svg, svg};
 
 /// Summaries of the four metrics over a set.

@@ -1,7 +1,7 @@
 //! spdcam-learn: training the models that estimate the light's SPD from chart features — PCA
 //! of the SPDs, the thesis's networks (1D CNN, MLP) trained with burn, a closed-form ridge
 //! baseline, fine-tuning and evaluation. The model file, the forward pass and the scalings
-//! live in `spdcam-infer` (re-exported here), which estimating needs without burn.
+//! live in `spdcam-infer` (import them from there), which estimating needs without burn.
 //!
 //! The modules in pipeline order:
 //!
@@ -21,11 +21,11 @@
 //!
 //! ```
 //! use spdcam_core::spectral::Grid;
-//! use spdcam_learn::network::Architecture;
-//! use spdcam_learn::pca::Components;
-//! use spdcam_learn::scale::RowScale;
+//! use spdcam_infer::network::Architecture;
+//! use spdcam_infer::pca::Components;
+//! use spdcam_infer::scale::RowScale;
 //! use spdcam_learn::synthetic::gaussian_set;
-//! use spdcam_learn::target::TargetKind;
+//! use spdcam_infer::target::TargetKind;
 //! use spdcam_learn::train::{train, Backend, Schedule, TrainOptions};
 //!
 //! let data = gaussian_set(400, 24, 1, 2);
@@ -58,4 +58,3 @@ pub mod synthetic;
 pub mod train;
 
 pub use error::{LearnError, Result};
-pub use spdcam_infer::{model, network, pca, record, ridge, scale, target, Model};

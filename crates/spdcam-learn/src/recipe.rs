@@ -11,14 +11,14 @@
 
 use crate::error::{LearnError, Result};
 use crate::evaluate::evaluate;
-use crate::model::Model;
-use crate::network::Architecture;
-use crate::pca::Components;
-use crate::record::{Backend, Schedule};
-use crate::scale::RowScale;
-use crate::target::TargetKind;
 use crate::train::{finetune, train, FinetuneOptions, TrainOptions, TrainingSet};
 use spdcam_core::dataset::SampleBatch;
+use spdcam_infer::model::Model;
+use spdcam_infer::network::Architecture;
+use spdcam_infer::pca::Components;
+use spdcam_infer::record::{Backend, Schedule};
+use spdcam_infer::scale::RowScale;
+use spdcam_infer::target::TargetKind;
 
 /// Fewest samples a recipe can be chosen on: two folds of at least two photos.
 pub const MIN_SAMPLES: usize = 4;

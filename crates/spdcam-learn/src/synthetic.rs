@@ -4,11 +4,11 @@
 //! summed over wavelength, then a 1/2.2 gamma — so that learning has a real, non-linear
 //! inverse problem to solve.
 
-use crate::record::DataInfo;
 use crate::train::TrainingSet;
 use rand::{Rng, SeedableRng};
 use spdcam_core::dataset::{Columns, Precision, SampleBatch};
 use spdcam_core::spectral::Grid;
+use spdcam_infer::record::DataInfo;
 use std::collections::BTreeMap;
 
 /// The thesis's 4-channel Gaussian lights: (centre, width) in nm.

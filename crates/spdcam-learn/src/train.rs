@@ -4,13 +4,6 @@
 
 use crate::burn_net::{dropout_masks, prepare, BurnNet};
 use crate::error::{LearnError, Result};
-use crate::model::Model;
-use crate::network::{Architecture, Network, Parameter};
-use crate::pca::Pca;
-use crate::record::{DataInfo, TrainingRecord};
-use crate::ridge::Gram;
-use crate::scale::{FeatureScaler, TargetScaler};
-use crate::target::{Channels, PcaColour, Target, TargetKind};
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
 use rand::seq::SliceRandom;
@@ -19,11 +12,18 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::dataset::{Columns, Dataset, SampleBatch};
-use spdcam_core::metrics;
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::Grid;
+use spdcam_core::spectral_error;
 use spdcam_infer::colour_head::ColourHead;
+use spdcam_infer::model::Model;
+use spdcam_infer::network::{Architecture, Network, Parameter};
+use spdcam_infer::pca::Pca;
 pub use spdcam_infer::record::{Backend, Schedule, TrainOptions};
+use spdcam_infer::record::{DataInfo, TrainingRecord};
+use spdcam_infer::ridge::Gram;
+use spdcam_infer::scale::{FeatureScaler, TargetScaler};
+use spdcam_infer::target::{Channels, PcaColour, Target, TargetKind};
 use std::ops::Range;
 use std::path::Path;
 use std::time::Instant;
@@ -165,7 +165,7 @@ pub fn spds_on_grid(batch: &SampleBatch, columns: &Columns, grid: &Grid) -> Resu
         for (v, &j) in spd.iter_mut().zip(&indices) {
             *v = row[j];
         }
-        metrics::clip_normalise(&mut spd);
+        spdcam_core::spectral::clip_normalise(&mut spd);
         out.extend_from_slice(&spd);
     }
     Ok(out)
@@ -232,7 +232,7 @@ fn score(fitted: &Fitted, outputs: &[f32], y: &[f32], spds: &[f64]) -> Result<(f
             .targets
             .unscale_into(&outputs[r * k..(r + 1) * k], &mut t);
         fitted.target.decode_into(&t, &mut spd);
-        gfc += spdcam_core::metrics::gfc(&spds[r * d..(r + 1) * d], &spd)?;
+        gfc += spectral_error::gfc(&spds[r * d..(r + 1) * d], &spd)?;
     }
     Ok((mse, gfc / rows.max(1) as f64))
 }
@@ -287,56 +287,64 @@ fn check_features_vary(scaler: &FeatureScaler, set: &TrainingSet, rows: usize) -
          between samples; check how the dataset was generated or imported",
         set.info.path,
         match scaler.row_scale {
-            crate::scale::RowScale::Max => "maximum",
-            crate::scale::RowScale::Mean => "mean",
+            spdcam_infer::scale::RowScale::Max => "maximum",
+            spdcam_infer::scale::RowScale::Mean => "mean",
         }
     )))
 }
 
-/// A seeded split of `n` rows into (train, validation) indices.
-/// Row indices of training and validation, the set the validation rows index, and its SPDs.
+/// What training and fine-tuning both start from: the SPDs of `data` on the grid, the row
+/// indices of training and validation, the set the validation rows index and its SPDs, and
+/// the training rows' SPDs.
 struct TrainValSplit<'a> {
+    spds: Vec<f64>,
     train_idx: Vec<usize>,
     val_idx: Vec<usize>,
     val_set: &'a TrainingSet,
     val_spds: Vec<f64>,
+    train_spds: Vec<f64>,
 }
 
-/// Training and validation rows: all of `data` against `validation` (checked by
-/// `check_columns`), or without one a seeded `(share, seed)` split of `data`. Returns the
-/// split; the validation SPDs are on `grid` (`spds`: those of `data`).
+/// The set-up [`train`] and [`finetune`] share: the SPDs of `data` on `grid`, and training
+/// and validation rows: all of `data` against `validation` (checked by `check_columns`), or
+/// without one a seeded `(share, seed)` split of `data`.
 fn split_train_val<'a>(
     data: &'a TrainingSet,
     validation: Option<&'a TrainingSet>,
-    spds: &[f64],
     grid: &Grid,
     (share, seed): (f64, u64),
     check_columns: impl Fn(&TrainingSet) -> Result<()>,
 ) -> Result<TrainValSplit<'a>> {
-    match validation {
+    let spds = spds_on_grid(&data.samples, &data.columns, grid)?;
+    let (train_idx, val_idx, val_set, val_spds) = match validation {
         Some(v) => {
             check_set(v)?;
             check_columns(v)?;
             let vs = spds_on_grid(&v.samples, &v.columns, grid)?;
-            Ok(TrainValSplit {
-                train_idx: (0..data.samples.len()).collect(),
-                val_idx: (0..v.samples.len()).collect(),
-                val_set: v,
-                val_spds: vs,
-            })
+            (
+                (0..data.samples.len()).collect(),
+                (0..v.samples.len()).collect(),
+                v,
+                vs,
+            )
         }
         None => {
             let (train_idx, val_idx) = split_indices(data.samples.len(), share, seed)?;
-            Ok(TrainValSplit {
-                train_idx,
-                val_idx,
-                val_set: data,
-                val_spds: spds.to_vec(),
-            })
+            (train_idx, val_idx, data, spds.clone())
         }
-    }
+    };
+    let train_spds = take_rows(&spds, grid.count, &train_idx);
+    Ok(TrainValSplit {
+        spds,
+        train_idx,
+        val_idx,
+        val_set,
+        val_spds,
+        train_spds,
+    })
 }
 
+/// A seeded split of `n` rows into (train, validation) indices.
 fn split_indices(n: usize, val_split: f64, seed: u64) -> Result<(Vec<usize>, Vec<usize>)> {
     if !(val_split > 0.0 && val_split < 1.0) {
         return Err(LearnError::invalid(format!(
@@ -389,16 +397,16 @@ pub fn train_in_parts(
     options.schedule.validate()?;
     check_set(data)?;
     let d = options.grid.count;
-    let spds = spds_on_grid(&data.samples, &data.columns, &options.grid)?;
     let TrainValSplit {
+        spds,
         train_idx,
         val_idx,
         val_set,
         val_spds,
+        train_spds,
     } = split_train_val(
         data,
         validation,
-        &spds,
         &options.grid,
         (options.val_split, options.seed),
         |v| {
@@ -414,7 +422,6 @@ pub fn train_in_parts(
     )?;
     let f = data.samples.feature_count;
     let train_features = take_rows(&data.samples.features, f, &train_idx);
-    let train_spds = take_rows(&spds, d, &train_idx);
     let target = match options.target {
         TargetKind::Pca(components) => Target::Pca(Pca::fit(&train_spds, d, components)?),
         TargetKind::PcaColour {
@@ -503,7 +510,7 @@ pub fn train_in_parts(
     Ok(Trained { model, log })
 }
 
-/// Closed-form ridge regression ([`crate::ridge`]) from normalised features (plus a bias) to
+/// Closed-form ridge regression ([`spdcam_infer::ridge`]) from normalised features (plus a bias) to
 /// scaled targets, the feature weights penalised by λ·n (n rows) and the bias by 10⁻¹²·n;
 /// with `ridge` 0, λ is chosen on the validation rows among 10⁻⁸…10⁰.
 fn fit_ridge(
@@ -830,31 +837,38 @@ pub fn finetune(
     }
     let grid = model.grid();
     let d = grid.count;
-    let spds = spds_on_grid(&data.samples, &data.columns, &grid)?;
     let TrainValSplit {
+        spds,
         train_idx,
         val_idx,
         val_set,
         val_spds,
+        train_spds,
     } = split_train_val(
         data,
         validation,
-        &spds,
         &grid,
         (options.val_split, options.seed),
         |v| Ok(model.check_features(&v.columns.feature_names, &v.info.path)?),
     )?;
-    let train_spds = take_rows(&spds, d, &train_idx);
     let (target, targets) = match (model.target(), options.refit_pca) {
         (Target::Pca(pca), true) => {
-            let pca = Pca::fit(&train_spds, d, crate::pca::Components::Count(pca.len()))?;
+            let pca = Pca::fit(
+                &train_spds,
+                d,
+                spdcam_infer::pca::Components::Count(pca.len()),
+            )?;
             let target = Target::Pca(pca);
             let raw = targets_of(&target, &train_spds, &[]);
             let scaler = fit_target_scaler(&target, &raw)?;
             (target, scaler)
         }
         (Target::PcaColour(p), true) => {
-            let pca = Pca::fit(&train_spds, d, crate::pca::Components::Count(p.pca.len()))?;
+            let pca = Pca::fit(
+                &train_spds,
+                d,
+                spdcam_infer::pca::Components::Count(p.pca.len()),
+            )?;
             let target = Target::PcaColour(PcaColour {
                 pca,
                 colour: p.colour.clone(),
@@ -944,10 +958,10 @@ pub fn finetune(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::network::{Architecture, CnnSpec};
-    use crate::pca::Components;
-    use crate::scale::RowScale;
     use crate::synthetic::gaussian_set;
+    use spdcam_infer::network::{Architecture, CnnSpec};
+    use spdcam_infer::pca::Components;
+    use spdcam_infer::scale::RowScale;
 
     #[test]
     fn part_ranges_tile_the_batch() {

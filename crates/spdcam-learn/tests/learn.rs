@@ -3,12 +3,12 @@
 //! break.
 
 use spdcam_core::spectral::Grid;
-use spdcam_learn::model::Model;
-use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
-use spdcam_learn::pca::Components;
-use spdcam_learn::scale::RowScale;
+use spdcam_infer::model::Model;
+use spdcam_infer::network::{Architecture, CnnSpec, MlpSpec};
+use spdcam_infer::pca::Components;
+use spdcam_infer::scale::RowScale;
+use spdcam_infer::target::TargetKind;
 use spdcam_learn::synthetic::gaussian_set;
-use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::{
     finetune, train, Backend, FinetuneOptions, Schedule, TrainOptions, Trained, TrainingSet,
 };
@@ -43,9 +43,12 @@ fn mean_gfc(model: &Model, set: &TrainingSet) -> f64 {
     let n = set.samples.len();
     (0..n)
         .map(|i| {
-            spdcam_core::metrics::compare(&spds[i * d..(i + 1) * d], &est[i * d..(i + 1) * d])
-                .expect("metrics")
-                .gfc
+            spdcam_core::spectral_error::compare(
+                &spds[i * d..(i + 1) * d],
+                &est[i * d..(i + 1) * d],
+            )
+            .expect("metrics")
+            .gfc
         })
         .sum::<f64>()
         / n as f64

@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
-use spdcam_core::lighting::validation_split::LampPart;
+use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_eval::coverage::{Coverage, CoverageOptions};
 use std::path::PathBuf;
 

@@ -10,10 +10,10 @@ use spdcam_core::fsio::write_atomic;
 use spdcam_core::imageio::write_png;
 use spdcam_core::raster::RgbImage;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
+use spdcam_infer::model::Model;
 use spdcam_learn::evaluate::{
     band_mae_svg, best_median_worst_svg, boxplots_svg, evaluate, Evaluation,
 };
-use spdcam_learn::model::Model;
 use spdcam_learn::train::TrainingSet;
 use std::path::{Path, PathBuf};
 

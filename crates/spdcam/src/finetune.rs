@@ -7,7 +7,7 @@ use crate::train::{reporter, sibling, write_log, ScheduleArgs};
 use anyhow::Result;
 use clap::Args;
 use spdcam_core::fsio;
-use spdcam_learn::model::Model;
+use spdcam_infer::model::Model;
 use spdcam_learn::recipe;
 use spdcam_learn::train::{finetune, FinetuneOptions, TrainingSet};
 use std::path::PathBuf;

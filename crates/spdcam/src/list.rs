@@ -6,9 +6,9 @@ use clap::{Args, ValueEnum};
 use spdcam_core::builtin::{self, DataDir};
 use spdcam_core::camera::noise::NoiseParams;
 use spdcam_core::chart::KnownChart;
-use spdcam_core::illuminant::StandardIlluminant;
-use spdcam_core::light::SPD_FORMS;
-use spdcam_core::lighting;
+use spdcam_core::cie_illuminant::StandardIlluminant;
+use spdcam_core::light_families;
+use spdcam_core::named_light::SPD_FORMS;
 
 /// What to list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -63,11 +63,11 @@ pub fn run(args: ListArgs, data_dir: &DataDir) -> Result<()> {
     }
     if want(Topic::Lighting) {
         outln!("lighting recipes (spdcam generate --lighting):")?;
-        for (form, what) in lighting::catalogue() {
+        for (form, what) in light_families::catalogue() {
             outln!("  {form:<28} {what}")?;
         }
         outln!("lamp families (lamp:NAME), fitted to measured lamps:")?;
-        for family in lighting::LampFamily::ALL {
+        for family in light_families::LampFamily::ALL {
             outln!(
                 "  {:<28} {}",
                 format!("lamp:{}", family.name()),

@@ -4,6 +4,7 @@
 // not a link.
 #![allow(rustdoc::broken_intra_doc_links)]
 
+mod args;
 #[cfg(feature = "train")]
 mod average;
 mod calibrate;
@@ -17,26 +18,21 @@ mod evaluate;
 #[cfg(feature = "train")]
 mod experiment;
 #[cfg(feature = "train")]
-mod experiment_real_cameras;
-#[cfg(feature = "train")]
-mod experiment_sim2real;
-#[cfg(feature = "train")]
 mod finetune;
 mod generate;
-mod held_out_args;
 mod lamps;
 mod list;
 mod messages;
 mod metrics;
-mod photo_args;
 mod plot_file;
 mod render;
 mod serve;
+#[cfg(feature = "train")]
+mod sim2real;
 mod stdout;
 #[cfg(feature = "train")]
 mod train;
 mod trust;
-mod validate_lamps;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::path::PathBuf;
@@ -89,7 +85,7 @@ enum Command {
     Calibrate(Box<calibrate::CalibrateArgs>),
     #[cfg(feature = "train")]
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
-    Sim2real(experiment_sim2real::Sim2realArgs),
+    Sim2real(sim2real::Sim2realArgs),
     /// Serve a local web page where photos are dropped and their light is shown.
     Serve(serve::ServeArgs),
     /// How well lighting recipes cover measured SPDs, per lamp type.
@@ -154,7 +150,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => experiment::run(args, &data_dir),
         Command::Calibrate(args) => calibrate::run(*args, &data_dir),
         #[cfg(feature = "train")]
-        Command::Sim2real(args) => experiment_sim2real::run(args, &data_dir),
+        Command::Sim2real(args) => sim2real::run(args, &data_dir),
         Command::Serve(args) => serve::run(args, &data_dir),
         Command::Coverage(args) => coverage::run(*args, &data_dir),
         Command::Lamps(args) => lamps::run(args, &data_dir),

@@ -7,7 +7,7 @@ use clap::Args;
 use serde::Serialize;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
-use spdcam_core::light::resolve_spd;
+use spdcam_core::named_light::resolve_spd;
 use spdcam_core::quality::{LightSpectrum, LightingMetrics, QUALITY_GRID};
 use spdcam_core::spectral::SpectralSet;
 use std::path::Path;

@@ -95,7 +95,7 @@ fn a_lamp_table_ending_in_zero_renders_as_a_chart_and_a_scene() {
 
 #[test]
 fn small_negative_noise_is_set_to_zero_with_a_note_and_large_is_refusal() {
-    // Issue 39, item 5: the tolerance is 1 % of the peak (README, light::SPD_NEGATIVE_TOLERANCE).
+    // Issue 39, item 5: the tolerance is 1 % of the peak (README, named_light::SPD_NEGATIVE_TOLERANCE).
     let dir = scratch("noise");
     let noisy = dir.join("noisy.csv");
     std::fs::write(&noisy, lamp_csv([-0.004, -0.002])).unwrap();

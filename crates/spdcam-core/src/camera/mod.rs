@@ -31,9 +31,9 @@ pub mod tone;
 pub mod white_balance;
 
 use crate::chart::Chart;
+use crate::cie_illuminant::StandardIlluminant;
 use crate::colorimetry::Observer;
 use crate::error::{short_number, Error, Result};
-use crate::illuminant::StandardIlluminant;
 use crate::raster::{Mosaic, RgbImage};
 use crate::sampler::{self, SampleBuffers};
 use crate::seed;
@@ -745,7 +745,7 @@ impl Camera {
     /// use spdcam_core::camera::sensor::Sensitivities;
     /// use spdcam_core::camera::{Camera, CameraConfig};
     /// use spdcam_core::chart::Chart;
-    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::cie_illuminant::StandardIlluminant;
     /// use spdcam_core::spectral::Grid;
     ///
     /// let grid = Grid::SIMULATION;

@@ -2,7 +2,7 @@
 //!
 //! Y. Ohno (2014), "Practical use and calculation of CCT and Duv", LEUKOS 10(1), 47–55,
 //! doi:10.1080/15502724.2014.839020. The Planckian locus is tabulated in CIE 1960 (u, v) from
-//! Planck's law ([`crate::illuminant::PLANCK_C1`], [`crate::illuminant::PLANCK_C2`]) and the
+//! Planck's law ([`crate::cie_illuminant::PLANCK_C1`], [`crate::cie_illuminant::PLANCK_C2`]) and the
 //! CIE 1931 2° CMFs (plain sum over their native 360–830 nm at 1 nm); the table point nearest
 //! the test chromaticity and its two neighbours give the CCT by Ohno's triangular solution
 //! when |Duv| < 0.002 and by his parabolic solution otherwise. This is the method of
@@ -21,8 +21,8 @@
 //! table point as a full scan, at every point of a dense test set.
 
 use super::observer::cie1931_native;
+use crate::cie_illuminant::planck_radiance;
 use crate::error::{Error, Result};
-use crate::illuminant::planck_radiance;
 use std::sync::OnceLock;
 
 /// Lowest CCT [`uv_to_cct_duv`] returns, in kelvin.

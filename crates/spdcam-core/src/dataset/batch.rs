@@ -244,3 +244,31 @@ impl Counts {
         }
     }
 }
+
+/// What a column of a sample file holds, in file order: the one layout the writer
+/// (`file`) and the reader (`file_read`) share.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Field {
+    /// The sample's index.
+    Sample,
+    /// The light family's name.
+    Family,
+    /// Feature column j.
+    Feature(usize),
+    /// SPD band j.
+    Spd(usize),
+    /// Drive weight j.
+    Weight(usize),
+    /// How many draws the sample took.
+    Attempts,
+}
+
+/// The columns of a sample file with `columns`, in file order.
+pub(super) fn fields(columns: &Columns) -> Vec<Field> {
+    let mut f = vec![Field::Sample, Field::Family];
+    f.extend((0..columns.feature_count()).map(Field::Feature));
+    f.extend((0..columns.spd_len()).map(Field::Spd));
+    f.extend((0..columns.weight_count()).map(Field::Weight));
+    f.push(Field::Attempts);
+    f
+}

@@ -1,7 +1,7 @@
 //! Writing one sample file: a Parquet file with one row group, flat and wide, so that
 //! pandas, polars, DuckDB and Spark read it as it is (`file_read` reads it back).
 
-use super::batch::{Columns, Precision, SampleBatch};
+use super::batch::{fields, Columns, Field, Precision, SampleBatch};
 use crate::error::{Error, Result};
 use parquet::basic::{
     Compression as ParquetCompression, ConvertedType, Encoding, LogicalType, Repetition,
@@ -12,26 +12,6 @@ use parquet::file::properties::{EnabledStatistics, WriterProperties};
 use parquet::file::writer::{SerializedColumnWriter, SerializedFileWriter};
 use parquet::schema::types::{ColumnPath, Type};
 use std::sync::Arc;
-
-/// What each column holds, in file order.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Field {
-    Sample,
-    Family,
-    Feature(usize),
-    Spd(usize),
-    Weight(usize),
-    Attempts,
-}
-
-fn fields(columns: &Columns) -> Vec<Field> {
-    let mut f = vec![Field::Sample, Field::Family];
-    f.extend((0..columns.feature_count()).map(Field::Feature));
-    f.extend((0..columns.spd_len()).map(Field::Spd));
-    f.extend((0..columns.weight_count()).map(Field::Weight));
-    f.push(Field::Attempts);
-    f
-}
 
 /// How a sample file is encoded: its compression and the precision of its float columns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,7 +7,7 @@
 //! DOUBLE; any number of row groups; the compressions the workspace enables. The decoded
 //! size is checked against [`limits::CHUNK_BYTES`] before anything is allocated.
 
-use super::batch::{Columns, SampleBatch};
+use super::batch::{fields, Columns, Field, SampleBatch};
 use crate::error::{Error, Result};
 use crate::limits;
 use bytes::Bytes;
@@ -15,26 +15,6 @@ use parquet::column::reader::{ColumnReader, ColumnReaderImpl};
 use parquet::data_type::DataType;
 use parquet::file::reader::{FileReader, SerializedFileReader};
 use std::collections::HashMap;
-
-/// What a column of the manifest holds.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Field {
-    Sample,
-    Family,
-    Feature(usize),
-    Spd(usize),
-    Weight(usize),
-    Attempts,
-}
-
-fn fields(columns: &Columns) -> Vec<Field> {
-    let mut f = vec![Field::Sample, Field::Family];
-    f.extend((0..columns.feature_count()).map(Field::Feature));
-    f.extend((0..columns.spd_len()).map(Field::Spd));
-    f.extend((0..columns.weight_count()).map(Field::Weight));
-    f.push(Field::Attempts);
-    f
-}
 
 /// Decodes the sample file `bytes` (named `source` in errors) whose columns the manifest
 /// describes as `columns`.

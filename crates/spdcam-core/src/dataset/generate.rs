@@ -21,7 +21,7 @@ use crate::camera::sensor::Sensitivities;
 use crate::camera::{Camera, CameraConfig, RenderBuffers};
 use crate::chart::Chart;
 use crate::error::{Error, Result};
-use crate::lighting::Lighting;
+use crate::light_families::Lighting;
 use crate::spectral::Grid;
 use crate::{fsio, imageio, limits, seed};
 use rayon::prelude::*;

@@ -11,7 +11,7 @@ use crate::camera::sensor::{Sensitivities, SkippedFiles};
 use crate::camera::{Camera, CameraConfig};
 use crate::chart::Chart;
 use crate::error::{Error, Result};
-use crate::lighting::ValidationSplit;
+use crate::light_families::ValidationSplit;
 use crate::limits;
 use crate::seed;
 use crate::spectral::{Grid, SpectralSet};

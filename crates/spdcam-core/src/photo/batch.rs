@@ -9,7 +9,6 @@ use super::sample::{sample, PatchSample};
 use super::{ChartTemplate, Detection};
 use crate::error::{Error, Result};
 use crate::fsio;
-use rayon::prelude::*;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -85,16 +84,32 @@ pub fn analyse_photo(path: &Path, options: &AnalyseOptions) -> Result<PhotoAnaly
 /// [`analyse_photo`] for a decoded photo. When it fails, the error tells what the decoder
 /// noticed too (a truncated or corrupt file explains a chart not found).
 pub fn analyse(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnalysis> {
-    analyse_decoded(photo, options).map_err(|e| {
+    analyse_telling_debug(photo, options).0
+}
+
+/// [`analyse`], also giving the debug image it wrote (`options.debug`, when it was written:
+/// with the chart found, or with none found), so that a front end announces what is on disk
+/// without looking there.
+pub fn analyse_telling_debug(
+    photo: &Photo,
+    options: &AnalyseOptions,
+) -> (Result<PhotoAnalysis>, Option<PathBuf>) {
+    let mut written = None;
+    let result = analyse_decoded(photo, options, &mut written).map_err(|e| {
         if photo.warnings.is_empty() {
             e
         } else {
             Error::invalid(format!("{e}; note: {}", photo.warnings.join("; ")))
         }
-    })
+    });
+    (result, written)
 }
 
-fn analyse_decoded(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnalysis> {
+fn analyse_decoded(
+    photo: &Photo,
+    options: &AnalyseOptions,
+    written: &mut Option<PathBuf>,
+) -> Result<PhotoAnalysis> {
     let templates = &options.templates;
     if templates.is_empty() {
         return Err(Error::invalid("no chart to look for"));
@@ -115,6 +130,7 @@ fn analyse_decoded(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnaly
     let Some(detection) = detection else {
         if let Some(path) = &options.debug {
             write_overlay(path, &debug_overlay_full(photo, None, trace.as_ref()))?;
+            *written = Some(path.clone());
         }
         return Err(no_chart(photo, templates));
     };
@@ -127,6 +143,7 @@ fn analyse_decoded(photo: &Photo, options: &AnalyseOptions) -> Result<PhotoAnaly
     if let Some(path) = &options.debug {
         let image = debug_overlay_full(photo, Some((template, &detection, &patches)), None);
         write_overlay(path, &image)?;
+        *written = Some(path.clone());
     }
     Ok(assemble(photo, template, detection, method, patches))
 }
@@ -202,21 +219,6 @@ fn list(items: &[usize]) -> String {
         .map(|k| k.to_string())
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-/// Analyses several photos in parallel; one result per photo, in order. With several
-/// photos the debug image of each goes to its own file, see [`debug_paths`].
-pub fn analyse_photos(paths: &[PathBuf], options: &AnalyseOptions) -> Vec<Result<PhotoAnalysis>> {
-    let debug = options.debug.as_ref().map(|d| debug_paths(d, paths));
-    paths
-        .par_iter()
-        .enumerate()
-        .map(|(i, path)| {
-            let mut own = options.clone();
-            own.debug = debug.as_ref().map(|d| d[i].clone());
-            analyse_photo(path, &own)
-        })
-        .collect()
 }
 
 /// The debug image of each of `photos`, all different: [`debug_path`], and where two photos

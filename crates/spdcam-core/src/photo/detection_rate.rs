@@ -12,8 +12,8 @@ use super::load::decode_photo;
 use super::scene::{self, SceneLight, SceneOptions, ScenePhoto, Shadow, Tilt, TiltAxis};
 use super::ChartTemplate;
 use crate::camera::Camera;
+use crate::cie_illuminant;
 use crate::error::Result;
-use crate::illuminant;
 use crate::seed;
 use crate::spectral::Grid;
 use rand::rngs::SmallRng;
@@ -161,7 +161,7 @@ impl Bucket {
         (width, height): (usize, usize),
     ) -> Result<ScenePhoto> {
         let (options, cct) = self.scene(seed, width, height);
-        let spd = illuminant::planck(cct, &Grid::SIMULATION)?;
+        let spd = cie_illuminant::planck(cct, &Grid::SIMULATION)?;
         scene::photograph(camera, SceneLight::single(&spd), seed, &options)
     }
 }

@@ -28,7 +28,7 @@ pub mod scene;
 mod segment;
 
 pub use batch::{
-    analyse, analyse_photo, analyse_photos, debug_path, debug_paths, features_csv,
+    analyse, analyse_photo, analyse_telling_debug, debug_path, debug_paths, features_csv,
     write_features_csv, AnalyseOptions, PhotoAnalysis,
 };
 pub use detect::{

@@ -19,8 +19,8 @@
 
 use super::spectrum::{LightSpectrum, QUALITY_GRID};
 use crate::builtin;
+use crate::cie_illuminant::StandardIlluminant;
 use crate::error::Result;
-use crate::illuminant::StandardIlluminant;
 use crate::spectral::{Extrapolation, Interpolation};
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;

@@ -170,7 +170,7 @@ mod tests {
     fn a_reference_illuminant_renders_perfectly() {
         // A Planckian radiator at 3000 K is its own reference: every R_i = 100 (CIE 13.3 §5).
         let grid = QUALITY_GRID;
-        let spd = crate::illuminant::planck(3000.0, &grid).unwrap();
+        let spd = crate::cie_illuminant::planck(3000.0, &grid).unwrap();
         let light = LightSpectrum::on_grid(&grid, &spd).unwrap();
         let (cct, _) = uv_to_cct_duv(xyz_to_uv1960(light.xyz())).unwrap();
         let cri = colour_rendering_cie1995(&light, cct).unwrap();

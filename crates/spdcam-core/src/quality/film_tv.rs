@@ -6,9 +6,9 @@ use super::cri::{colour_rendering_cie1995, sample_weights_of, special_indices, T
 use super::spectrum::{BandWeights, LightSpectrum, QUALITY_GRID};
 use super::uv::xyz_to_uv1960;
 use crate::builtin;
+use crate::cie_illuminant::{daylight, planck};
 use crate::colorimetry::{uv_to_cct_duv, CCT_MAX_K, CCT_MIN_K};
 use crate::error::{Error, Result};
-use crate::illuminant::{daylight, planck};
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
 
@@ -117,7 +117,7 @@ fn ssi_bands(values: &[f64]) -> Option<[f64; SSI_BANDS]> {
 /// 1000–25,000 K or beyond [`CCT_MAX_ABS_DUV`]; daylight below 4000 K).
 ///
 /// ```
-/// use spdcam_core::illuminant::StandardIlluminant;
+/// use spdcam_core::cie_illuminant::StandardIlluminant;
 /// use spdcam_core::quality::film_tv::{spectral_similarity_index, SsiReference};
 /// use spdcam_core::quality::LightSpectrum;
 /// use spdcam_core::spectral::Grid;

@@ -186,7 +186,7 @@ impl LightingMetrics {
     /// The metrics of `spd` on its wavelengths (see [`LightingMetrics::from_samples`]).
     ///
     /// ```
-    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::cie_illuminant::StandardIlluminant;
     /// use spdcam_core::quality::LightingMetrics;
     /// use spdcam_core::spectral::Grid;
     ///
@@ -337,7 +337,7 @@ impl LightingMetrics {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::illuminant::StandardIlluminant;
+    use crate::cie_illuminant::StandardIlluminant;
     use crate::spectral::Grid;
 
     #[test]

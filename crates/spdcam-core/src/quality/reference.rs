@@ -1,8 +1,8 @@
 //! The reference illuminants colour rendering and colour fidelity compare a light with.
 
+use crate::cie_illuminant::{daylight_xy, planck, DaylightBasis};
 use crate::colorimetry::Observer;
 use crate::error::Result;
-use crate::illuminant::{daylight_xy, planck, DaylightBasis};
 use crate::spectral::{Grid, Spd};
 
 /// Planckian and CIE daylight references on one grid, with what they need prepared once.
@@ -69,7 +69,7 @@ impl ReferenceIlluminants {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::illuminant::daylight;
+    use crate::cie_illuminant::daylight;
 
     #[test]
     fn switches_and_blends_at_the_standard_temperatures() {

@@ -213,7 +213,7 @@ mod tests {
 
     #[test]
     fn a_reference_illuminant_has_full_fidelity_and_gamut() {
-        let spd = crate::illuminant::planck(3000.0, &QUALITY_GRID).unwrap();
+        let spd = crate::cie_illuminant::planck(3000.0, &QUALITY_GRID).unwrap();
         let light = LightSpectrum::on_grid(&QUALITY_GRID, &spd).unwrap();
         let f = colour_fidelity_cie2017(&light, 3000.0).unwrap();
         assert!((f.rf - fidelity(0.0)).abs() < 1e-9, "{}", f.rf);

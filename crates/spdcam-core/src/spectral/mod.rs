@@ -9,4 +9,4 @@ mod spd;
 pub use grid::Grid;
 pub use resample::{clamp_undershoot, Extrapolation, Interpolation, ResampleReport};
 pub use set::SpectralSet;
-pub use spd::{normalise_peak, Spd};
+pub use spd::{clip_normalise, normalise_by_max, normalise_peak, Spd};

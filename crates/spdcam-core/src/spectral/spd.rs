@@ -69,7 +69,7 @@ impl Spd {
     pub fn normalised_by_max(&self) -> Spd {
         Spd {
             grid: self.grid,
-            values: crate::metrics::normalise_by_max(&self.values),
+            values: normalise_by_max(&self.values),
         }
     }
 
@@ -77,7 +77,7 @@ impl Spd {
     /// has six or more samples, else linear; zero outside its range).
     ///
     /// ```
-    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::cie_illuminant::StandardIlluminant;
     /// use spdcam_core::spectral::Grid;
     ///
     /// let a = StandardIlluminant::A.spd(&Grid::SIMULATION)?; // 380–780 nm, 5 nm
@@ -127,6 +127,24 @@ pub fn normalise_peak(values: &mut [f64]) -> Result<()> {
     }
     values.iter_mut().for_each(|v| *v /= peak);
     Ok(())
+}
+
+/// The spectrum divided by its maximum ([`normalise_peak`]), with negative values clipped
+/// to 0. A spectrum that cannot be normalised (a non-finite value, no positive one) comes
+/// back as zeros.
+pub fn normalise_by_max(spd: &[f64]) -> Vec<f64> {
+    let mut out = spd.to_vec();
+    clip_normalise(&mut out);
+    out
+}
+
+/// [`normalise_by_max`] in place.
+pub fn clip_normalise(spd: &mut [f64]) {
+    if normalise_peak(spd).is_err() {
+        spd.fill(0.0);
+        return;
+    }
+    spd.iter_mut().for_each(|v| *v = v.max(0.0));
 }
 
 /// Reading an `Spd` as its values (indexing, iterating, slice functions), the way a `String`

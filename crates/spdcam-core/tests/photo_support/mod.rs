@@ -12,7 +12,7 @@ use spdcam_core::camera::white_balance::WhiteBalance;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::{self, srgb_decode};
-use spdcam_core::light;
+use spdcam_core::named_light;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::{decode_photo, ChartTemplate, Photo};
 use spdcam_core::spectral::{Grid, Spd};
@@ -109,7 +109,7 @@ fn random_light(rng: &mut SmallRng) -> (String, Spd) {
     if rng.random_bool(0.5) {
         let cct = rng.random_range(2500.0..10000.0f64).round();
         let spec = format!("cct:{cct}");
-        let spd = light::resolve_spd(&spec, &DataDir::new(None), &GRID)
+        let spd = named_light::resolve_spd(&spec, &DataDir::new(None), &GRID)
             .unwrap()
             .spd;
         (spec, spd)

@@ -3,9 +3,9 @@
 
 use crate::error::Result;
 use crate::held_out::GRID;
-use spdcam_core::illuminant::{daylight, planck, StandardIlluminant};
-use spdcam_core::lighting::validation_split::LampPart;
-use spdcam_core::lighting::{LampLibrary, LampType, ValidationSplit};
+use spdcam_core::cie_illuminant::{daylight, planck, StandardIlluminant};
+use spdcam_core::light_families::validation_split::LampPart;
+use spdcam_core::light_families::{LampLibrary, LampType, ValidationSplit};
 use spdcam_core::spectral::Spd;
 
 /// Which set a light belongs to.

@@ -13,12 +13,12 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::CameraConfig;
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::randomise::camera_pool;
-use spdcam_core::metrics;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::seed;
 use spdcam_core::spectral::Spd;
-use spdcam_infer::estimate::PhotoOptions;
+use spdcam_core::spectral_error;
+use spdcam_infer::photo_options::PhotoOptions;
 use spdcam_infer::trust::Verdict;
 use spdcam_infer::{Estimate, Estimator, FeatureRows};
 
@@ -67,7 +67,7 @@ impl Scored {
     pub fn spd(spd: &Spd, light: &Light) -> Result<Scored> {
         let truth = light.spd.resampled(spd.grid())?.normalised_by_max();
         Ok(Scored {
-            gfc: metrics::gfc_spd(&truth, &spd.normalised_by_max())?,
+            gfc: spectral_error::gfc_spd(&truth, &spd.normalised_by_max())?,
             colour: ColourScore::of(&light.spd, spd)?,
             ok: false,
             cct_interval: None,

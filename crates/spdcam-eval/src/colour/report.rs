@@ -4,7 +4,7 @@
 use super::lights::LightSet;
 use super::{ColourReport, Group, Row, Summary, CCT_MAX_DUV};
 use crate::held_out::file_name;
-use spdcam_core::lighting::LampType;
+use spdcam_core::light_families::LampType;
 use spdcam_core::spectral::Grid;
 
 /// The columns every table shares after its own.

@@ -55,7 +55,7 @@ impl ColourScore {
     /// spectrum without visible light.
     ///
     /// ```
-    /// use spdcam_core::illuminant::planck;
+    /// use spdcam_core::cie_illuminant::planck;
     /// use spdcam_core::spectral::Grid;
     /// use spdcam_eval::colour::ColourScore;
     ///
@@ -98,8 +98,8 @@ impl ColourScore {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use spdcam_core::cie_illuminant::{daylight, planck, StandardIlluminant};
     use spdcam_core::colorimetry::cct_to_uv_planck;
-    use spdcam_core::illuminant::{daylight, planck, StandardIlluminant};
     use spdcam_core::spectral::Grid;
 
     #[test]

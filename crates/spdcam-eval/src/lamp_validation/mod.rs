@@ -18,10 +18,10 @@ use photos::{pipeline_photos, score, simple_photos};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::dataset::REAL_PHOTO_SETS;
-use spdcam_core::lighting::validation_split::LampPart;
-use spdcam_core::lighting::LampType;
+use spdcam_core::light_families::validation_split::LampPart;
+use spdcam_core::light_families::LampType;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
-use spdcam_core::{metrics, seed};
+use spdcam_core::{seed, spectral_error};
 use spdcam_infer::Model;
 use std::path::{Path, PathBuf};
 
@@ -126,7 +126,7 @@ impl LampValidation {
                 let b = simple_photos(&setup.cameras, &chart, library, ids, shots, stream)?;
                 let baseline: Vec<f64> = ids
                     .iter()
-                    .map(|&i| metrics::gfc(&truth[i], &average).unwrap_or(0.0))
+                    .map(|&i| spectral_error::gfc(&truth[i], &average).unwrap_or(0.0))
                     .collect();
                 cells.push([
                     baseline,
@@ -276,8 +276,8 @@ fn real_scores(thesis_data: Option<&Path>, model: &Model, data_dir: &DataDir) ->
         let d = grid.count;
         out[k] = (0..set.spds.len())
             .map(|i| {
-                metrics::gfc(
-                    &metrics::normalise_by_max(truth.item(i)),
+                spectral_error::gfc(
+                    &spdcam_core::spectral::normalise_by_max(truth.item(i)),
                     &estimates[i * d..(i + 1) * d],
                 )
                 .unwrap_or(0.0)

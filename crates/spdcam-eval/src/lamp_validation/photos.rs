@@ -9,9 +9,9 @@ use rand::{Rng, SeedableRng};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::Camera;
 use spdcam_core::chart::Chart;
-use spdcam_core::lighting::LampLibrary;
+use spdcam_core::light_families::LampLibrary;
 use spdcam_core::simple_camera::{Shot, SimpleCamera};
-use spdcam_core::{metrics, seed};
+use spdcam_core::{seed, spectral_error};
 use spdcam_infer::Model;
 
 /// Random stream of the simple camera's draws.
@@ -39,7 +39,7 @@ pub fn average_spd(spds: &[Vec<f64>], ids: &[usize]) -> Vec<f64> {
     let sum: Vec<f64> = (0..d)
         .map(|k| ids.iter().map(|&i| spds[i][k]).sum::<f64>())
         .collect();
-    metrics::normalise_by_max(&sum)
+    spdcam_core::spectral::normalise_by_max(&sum)
 }
 
 /// (a): each lamp `shots` times through a held-out camera with the randomised in-camera stage.
@@ -117,7 +117,8 @@ pub(crate) fn score(
             (0..shots as usize)
                 .map(|k| {
                     let row = j * shots as usize + k;
-                    metrics::gfc(&truth[i], &estimates[row * d..(row + 1) * d]).unwrap_or(0.0)
+                    spectral_error::gfc(&truth[i], &estimates[row * d..(row + 1) * d])
+                        .unwrap_or(0.0)
                 })
                 .sum::<f64>()
                 / shots as f64

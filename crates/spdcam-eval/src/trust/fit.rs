@@ -12,12 +12,12 @@ use crate::trust::judged::{
 use crate::trust::real::{balanced, real_split};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
-use spdcam_core::lighting::validation_split::LampPart;
+use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::quality::SCALAR_KEYS;
 use spdcam_infer::pca::{Components, Pca};
 use spdcam_infer::ridge::{Gram, Ridge};
 use spdcam_infer::trust::{
-    self, Calibration, ChartCheck, GfcModel, MetricCalibration, SelfCheck, JITTER_COPIES,
+    self, ChartCheck, GfcModel, MetricCalibration, SelfCheck, TrustCalibration, JITTER_COPIES,
     JITTER_SIGMA,
 };
 use spdcam_infer::Model;
@@ -69,7 +69,7 @@ pub fn fit_calibration(
     chart: &str,
     photos: &CalibrationPhotos,
     method: String,
-) -> Result<Calibration> {
+) -> Result<TrustCalibration> {
     let (judged, features) = (&photos.judged, &photos.features);
     let d = model.grid().count;
     let err = |j: &Judged, k: usize| (j.spd[k] - j.truth.as_ref().map_or(0.0, |t| t[k])).abs();
@@ -149,7 +149,7 @@ pub fn fit_calibration(
         .iter()
         .map(|row| trust::clipped_patches(row) as f64)
         .collect();
-    Ok(Calibration {
+    Ok(TrustCalibration {
         model: model.fingerprint(),
         chart: chart.to_string(),
         method,
@@ -304,7 +304,7 @@ pub struct Calibrated {
     /// The chart it reads (the calibration's file is `<chart>.trust.json`).
     pub chart: String,
     /// The calibration.
-    pub calibration: Calibration,
+    pub calibration: TrustCalibration,
 }
 
 /// The calibrations [`calibrate`] fitted, and the held-out cameras it left out.

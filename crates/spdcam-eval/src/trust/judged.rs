@@ -3,8 +3,8 @@
 //! take of them.
 
 use crate::error::Result;
-use spdcam_core::metrics;
 use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
+use spdcam_core::spectral_error;
 use spdcam_infer::trust::{self, ChartCheck, Perturbed, SelfCheck};
 use spdcam_infer::Model;
 use std::collections::BTreeMap;
@@ -41,7 +41,7 @@ pub fn judge_rows(
         .iter()
         .enumerate()
         .map(|(r, row)| {
-            let spd = metrics::normalise_by_max(&spds[r * d..(r + 1) * d]);
+            let spd = spdcam_core::spectral::normalise_by_max(&spds[r * d..(r + 1) * d]);
             let scale = trust::feature_scale(row);
             let self_check = match check {
                 Some(c) => c
@@ -107,7 +107,7 @@ pub fn gfc(judged: &Judged) -> f64 {
     judged
         .truth
         .as_deref()
-        .and_then(|t| metrics::gfc(t, &judged.spd).ok())
+        .and_then(|t| spectral_error::gfc(t, &judged.spd).ok())
         .unwrap_or(0.0)
 }
 
@@ -123,7 +123,7 @@ pub fn residual(judged: &Judged) -> Option<f64> {
 
 /// A photo's band error in units of its calibrated scale: per wavelength
 /// |error(λ)| / ((f(λ) + s(λ))·w), the quantity the calibration's conformal quantiles are
-/// taken of ([`trust::Calibration`]); `floor` is the calibration's f(λ) and `widening` the
+/// taken of ([`trust::TrustCalibration`]); `floor` is the calibration's f(λ) and `widening` the
 /// photo's w.
 pub fn band_z(floor: &[f64], widening: f64, judged: &Judged) -> Vec<f64> {
     let truth = judged.truth.as_deref().unwrap_or_default();

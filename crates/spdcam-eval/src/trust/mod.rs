@@ -1,5 +1,5 @@
 //! The trust protocols: fitting a model's uncertainty calibration (the file
-//! `spdcam_infer::trust::Calibration` reads) and measuring how far its estimates can be
+//! `spdcam_infer::trust::TrustCalibration` reads) and measuring how far its estimates can be
 //! trusted on held-out virtual photos, the real photo sets, photos made bad on purpose and
 //! scene photos.
 //!

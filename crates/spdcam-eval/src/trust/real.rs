@@ -8,7 +8,6 @@ use crate::trust::shots::Rows;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::KnownChart;
 use spdcam_core::dataset::MeasuredPhotos;
-use spdcam_core::metrics;
 use spdcam_infer::Model;
 use std::path::Path;
 
@@ -64,7 +63,7 @@ pub fn real_split(
         truths: photos
             .spds
             .iter()
-            .map(|s| metrics::normalise_by_max(s.values()))
+            .map(|s| spdcam_core::spectral::normalise_by_max(s.values()))
             .collect(),
         features: photos.features,
     };

@@ -13,11 +13,11 @@ use crate::trust::real::{balanced, real_split, RealSplit};
 use crate::trust::scenes::{scene_verdicts, SCENES};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
-use spdcam_core::lighting::validation_split::LampPart;
-use spdcam_core::metrics;
+use spdcam_core::chart_lighting::{Corrections, UnevenLight};
+use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::quality::SCALAR_KEYS;
-use spdcam_core::uneven_light::{Corrections, UnevenLight};
-use spdcam_infer::trust::{self, assess, Calibration, ChartCheck, PhotoFlags, Verdict};
+use spdcam_core::spectral_error;
+use spdcam_infer::trust::{self, assess, ChartCheck, PhotoFlags, TrustCalibration, Verdict};
 use spdcam_infer::Model;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -33,7 +33,7 @@ linear RGB. `mean`/`worst`: the patch residuals relative to the chart's mean RGB
 `split`: the residual when each half of the chart (left/right, top/bottom) is predicted by \
 the other half's map; `colour_gradient`: how differently the three channels brighten across \
 the chart on its neutral patches (a linear gain and a flare per channel fitted there, \
-`spdcam_core::uneven_light`; one light falling off brightens all alike, two lights do not); \
+`spdcam_core::chart_lighting`; one light falling off brightens all alike, two lights do not); \
 `glare`: the share of the residual that an additive light changing linearly across the chart \
 (two more columns of the map per channel) removes, a nested-model comparison: glare, a \
 reflection or flare from a light beside the chart adds light to one side of it; \
@@ -127,7 +127,7 @@ struct MetricCoverage {
 
 /// Per level of [`reliability::LEVELS`], the scales of `cal`'s bands measured on its
 /// calibration photos ([`quantile_scales`]).
-fn level_scales(cal: &Calibration, calibration_photos: &[Judged]) -> Vec<Vec<f64>> {
+fn level_scales(cal: &TrustCalibration, calibration_photos: &[Judged]) -> Vec<Vec<f64>> {
     let z: Vec<Vec<f64>> = calibration_photos
         .iter()
         .map(|j| band_z(&cal.floor, cal.widening(residual(j)), j))
@@ -151,7 +151,7 @@ struct Measured {
 fn measure_row(
     label: &str,
     model: &Model,
-    cal: &Calibration,
+    cal: &TrustCalibration,
     check: Option<&ChartCheck>,
     level_scales: &[Vec<f64>],
     features: &[Vec<f64>],
@@ -253,7 +253,7 @@ fn corrections_row(
         let mean = truths
             .iter()
             .enumerate()
-            .map(|(r, t)| metrics::gfc(t, &spds[r * d..(r + 1) * d]).unwrap_or(0.0))
+            .map(|(r, t)| spectral_error::gfc(t, &spds[r * d..(r + 1) * d]).unwrap_or(0.0))
             .sum::<f64>()
             / truths.len() as f64;
         cells += &format!(" {mean:.4} |");
@@ -418,7 +418,7 @@ impl TrustReport {
         let mut corrections_md = String::from(
             "## The photo's own corrections\n\n\
              Flare and the light's gradient across the chart measured on the chart's neutral \
-             patches of each photo (`spdcam_core::uneven_light`: per channel, a linear gain across \
+             patches of each photo (`spdcam_core::chart_lighting`: per channel, a linear gain across \
              the chart and an additive flare, least squares) and taken out of its features before \
              the model; mean GFC with the features as they are, with the flare or the gradient \
              corrected, and both. Fitted: photos with enough unclipped neutral patches (the others \
@@ -433,7 +433,7 @@ impl TrustReport {
         let mut diagram = Vec::new();
         for ((path, model, chart_name), cal_path) in models.iter().zip(calibrations) {
             let text = spdcam_core::fsio::read_text(cal_path)?;
-            let cal = Calibration::from_json(&text, &cal_path.display().to_string())?;
+            let cal = TrustCalibration::from_json(&text, &cal_path.display().to_string())?;
             if cal.model != model.fingerprint() {
                 return Err(EvalError::invalid(format!(
                     "{} is not a calibration of {}",
@@ -663,7 +663,7 @@ mod tests {
             "/../../models/colorchecker24.trust.json"
         ))
         .unwrap();
-        let cal = Calibration::from_json(&cal_json, "cc24").unwrap();
+        let cal = TrustCalibration::from_json(&cal_json, "cc24").unwrap();
         let d = cal.floor.len();
         let photos: Vec<Judged> = (0..200)
             .map(|i| {

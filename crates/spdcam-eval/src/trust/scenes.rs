@@ -12,13 +12,13 @@ use spdcam_core::camera::optics::Glow;
 use spdcam_core::camera::CameraConfig;
 use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::dataset::randomise::camera_pool;
-use spdcam_core::lighting::validation_split::LampPart;
+use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::seed;
 use spdcam_core::spectral::SpectralSet;
-use spdcam_infer::estimate::PhotoOptions;
-use spdcam_infer::trust::{Calibration, Verdict};
+use spdcam_infer::trust::{TrustCalibration, Verdict};
+use spdcam_infer::PhotoOptions;
 use spdcam_infer::{Estimator, Model, ModelSet};
 
 /// Scene photos per kind in [`scene_verdicts`].
@@ -42,7 +42,7 @@ pub(crate) fn photo_chart(model_chart: &str) -> &str {
 /// flags.
 pub fn scene_verdicts(
     model: &Model,
-    cal: &Calibration,
+    cal: &TrustCalibration,
     model_chart: &str,
     setup: &Setup,
     data_dir: &DataDir,

@@ -9,7 +9,7 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
-use spdcam_core::lighting::validation_split::LampPart;
+use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::seed;
 use spdcam_infer::Model;
 

@@ -38,7 +38,7 @@ pub struct Uncertainty {
     pub difficulty: f64,
     /// How many times the bands and intervals are widened because the estimated light
     /// explains this photo worse than it explains a typical calibration photo
-    /// ([`Calibration::widening`]); 1 when it explains it as well or better.
+    /// ([`TrustCalibration::widening`]); 1 when it explains it as well or better.
     pub widening: f64,
     /// Half-widths of the 68 % and 95 % intervals of the single-number metrics, by key
     /// ([`SCALAR_KEYS`](spdcam_core::quality::SCALAR_KEYS)): "Ra 82 ± 4" is `cri_ra` ± `half95`. Only metrics the calibration
@@ -56,7 +56,7 @@ pub struct MetricInterval {
 }
 
 /// One metric's calibration: the same scaled-residual conformal rule as the bands (see
-/// [`Calibration`]) with the metric's spread over the perturbed copies as the scale.
+/// [`TrustCalibration`]) with the metric's spread over the perturbed copies as the scale.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MetricCalibration {
     /// The metric's key ([`SCALAR_KEYS`](spdcam_core::quality::SCALAR_KEYS)).
@@ -91,13 +91,13 @@ impl Band {
 /// predictive inference for regression", JASA 113: 1094–1111, section 5.2, locally weighted
 /// residuals): with the spread s(λ) of the perturbed estimates, a floor f(λ) (the median
 /// absolute error at λ) and the widening w ≥ 1 of a photo the estimate explains worse than
-/// a typical calibration photo ([`Calibration::widening`]), the q-quantile of
+/// a typical calibration photo ([`TrustCalibration::widening`]), the q-quantile of
 /// |error(λ)| / ((f(λ) + s(λ))·w) over the calibration photos times (f(λ) + s(λ))·w is the
 /// band's half-width. The expected GFC comes from [`GfcModel`] (not widened: on the real
 /// Telelumen dev photos scaling 1 − GFC by w or w² made it two to four times too
 /// pessimistic, while the estimate's shape alone came within 0.02 of their median GFC).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Calibration {
+pub struct TrustCalibration {
     /// The calibrated model's [`Model::fingerprint`].
     pub model: String,
     /// The model's chart.
@@ -116,7 +116,7 @@ pub struct Calibration {
     pub gfc_model: GfcModel,
     /// The median self-check residual ([`SelfCheck::mean`]) on the calibration photos, when
     /// the chart's reflectances were at hand: the residual of a typical photo, against which
-    /// [`Calibration::widening`] measures a photo's.
+    /// [`TrustCalibration::widening`] measures a photo's.
     pub residual_reference: Option<f64>,
     /// The 99th percentile of the difficulty on the calibration photos: harder photos are
     /// unlike the lights the model knows, or many lights give nearly the same photo.
@@ -224,7 +224,7 @@ impl GfcModel {
 }
 
 /// The widening of a photo whose self-check residual is `residual` against the typical
-/// residual `reference` (see [`Calibration::widening`]): their ratio, at least 1; 1 when
+/// residual `reference` (see [`TrustCalibration::widening`]): their ratio, at least 1; 1 when
 /// either is unknown.
 pub fn widening(residual: Option<f64>, reference: Option<f64>) -> f64 {
     match (residual, reference) {
@@ -233,7 +233,7 @@ pub fn widening(residual: Option<f64>, reference: Option<f64>) -> f64 {
     }
 }
 
-impl Calibration {
+impl TrustCalibration {
     /// Whether the self-check `check` exceeds any of this calibration's doubtful levels:
     /// the residual, the half-to-half residual, the colour gradient, the glare or the
     /// two-lights ratio.
@@ -249,8 +249,8 @@ impl Calibration {
 
     /// Reads a calibration from JSON (`shown` names it in errors), its arrays checked to
     /// agree in length and its wavelengths to be evenly spaced.
-    pub fn from_json(text: &str, shown: &str) -> Result<Calibration> {
-        let c: Calibration =
+    pub fn from_json(text: &str, shown: &str) -> Result<TrustCalibration> {
+        let c: TrustCalibration =
             serde_json::from_str(text).map_err(|e| InferError::invalid(format!("{shown}: {e}")))?;
         let d = c.wavelength_nm.len();
         if d == 0
@@ -363,10 +363,10 @@ const SHIPPED_CALIBRATIONS: &[(&str, &str)] = &[
 ];
 
 /// The shipped calibration measured on `model`, if any.
-pub fn calibration_for(model: &Model) -> Result<Option<Calibration>> {
+pub fn calibration_for(model: &Model) -> Result<Option<TrustCalibration>> {
     let fingerprint = model.fingerprint();
     for (name, text) in SHIPPED_CALIBRATIONS {
-        let c = Calibration::from_json(text, name)?;
+        let c = TrustCalibration::from_json(text, name)?;
         if c.model == fingerprint {
             return Ok(Some(c));
         }
@@ -426,7 +426,7 @@ mod tests {
     #[test]
     fn bands_widen_with_the_residual_and_the_expected_gfc_does_not_move() {
         let d = 2;
-        let cal = Calibration {
+        let cal = TrustCalibration {
             model: "0".into(),
             chart: "c".into(),
             method: "m".into(),
@@ -487,7 +487,7 @@ mod tests {
                 "low":[-9.0,1.0],"high":[0.0,1.0],"gap_range":[-9.0,0.0]},
             "residual_reference":null,"difficulty_doubtful":0.1,"self_check_doubtful":null,"split_doubtful":null,
             "clipped_doubtful":0}"#;
-        let err = Calibration::from_json(text, "c.json")
+        let err = TrustCalibration::from_json(text, "c.json")
             .unwrap_err()
             .to_string();
         assert!(err.contains("c.json"), "{err}");

@@ -21,7 +21,7 @@ pub mod spread;
 pub mod verdict;
 
 pub use calibration::{
-    calibration_for, widening, Band, Calibration, GfcModel, MetricCalibration, MetricInterval,
+    calibration_for, widening, Band, GfcModel, MetricCalibration, MetricInterval, TrustCalibration,
     Uncertainty,
 };
 pub use self_check::{ChartCheck, SelfCheck};

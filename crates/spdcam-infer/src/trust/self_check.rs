@@ -10,9 +10,9 @@ use serde::Serialize;
 use spdcam_core::builtin::{self, DataDir};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::chart::Chart;
+use spdcam_core::chart_lighting::UnevenLight;
 use spdcam_core::colorimetry::srgb_decode;
 use spdcam_core::spectral::Grid;
-use spdcam_core::uneven_light::UnevenLight;
 
 /// How many patches the self-check names as the worst.
 const WORST_NAMED: usize = 3;
@@ -497,8 +497,8 @@ fn least_squares(
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+    use spdcam_core::cie_illuminant::StandardIlluminant;
     use spdcam_core::colorimetry::srgb_encode;
-    use spdcam_core::illuminant::StandardIlluminant;
 
     pub(in crate::trust) fn cc24_check(grid: &Grid) -> ChartCheck {
         let chart = Chart::colorchecker24(grid).unwrap();

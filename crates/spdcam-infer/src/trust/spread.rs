@@ -7,7 +7,6 @@ use crate::model::Model;
 use rand::rngs::SmallRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use spdcam_core::metrics;
 use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
 use std::collections::BTreeMap;
 
@@ -58,7 +57,7 @@ impl Perturbed {
         let copies = model
             .estimate_rows(&rows)?
             .chunks_exact(d)
-            .map(metrics::normalise_by_max)
+            .map(spdcam_core::spectral::normalise_by_max)
             .collect();
         Ok(Perturbed { copies })
     }

@@ -2,7 +2,7 @@
 //! self-check and the calibrated uncertainty weighed into ok, doubtful or unusable, with the
 //! reasons.
 
-use super::calibration::{Calibration, Uncertainty};
+use super::calibration::{TrustCalibration, Uncertainty};
 use super::self_check::{ChartCheck, SelfCheck};
 use super::spread::{feature_scale, Perturbed};
 use crate::error::Result;
@@ -99,7 +99,7 @@ pub struct PhotoFlags {
 /// (docs/trust.md).
 pub fn assess(
     model: &Model,
-    calibration: Option<&Calibration>,
+    calibration: Option<&TrustCalibration>,
     check: Option<&ChartCheck>,
     row: &[f64],
     spd: &[f64],
@@ -324,13 +324,13 @@ pub fn photo_flags(analysis: &PhotoAnalysis, feature_patches: Option<&[usize]>) 
 mod tests {
     use super::super::self_check::tests::{cc24_check, features_of};
     use super::*;
-    use crate::estimate::FeatureRows;
     use crate::estimator::Estimator;
+    use crate::feature_rows::FeatureRows;
     use crate::shipped::ModelSet;
     use spdcam_core::builtin::DataDir;
     use spdcam_core::chart::Chart;
+    use spdcam_core::cie_illuminant::StandardIlluminant;
     use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
-    use spdcam_core::illuminant::StandardIlluminant;
 
     /// The shipped models and the ColorChecker 24's self-check on their model's grid.
     fn cc24_setup() -> (ModelSet, ChartCheck) {

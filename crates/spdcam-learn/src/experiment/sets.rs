@@ -4,7 +4,7 @@
 use crate::error::{LearnError, Result};
 use crate::train::TrainingSet;
 use spdcam_core::dataset::{Columns, Precision, SampleBatch};
-use spdcam_core::lighting::Channels;
+use spdcam_core::light_families::Channels;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, SpectralSet};
 use spdcam_infer::record::DataInfo;
 use spdcam_infer::FeatureRows;

@@ -4,11 +4,11 @@
 use super::sets::{channels, load_part, SetName};
 use crate::error::Result;
 use crate::evaluate::{evaluate, Evaluation};
-use crate::network::Architecture;
-use crate::scale::RowScale;
-use crate::target::TargetKind;
 use crate::train::{train, Backend, Progress, Schedule, TrainOptions, TrainingSet};
 use spdcam_core::spectral::Grid;
+use spdcam_infer::network::Architecture;
+use spdcam_infer::scale::RowScale;
+use spdcam_infer::target::TargetKind;
 use std::path::Path;
 
 /// Share of the `_train` part held out to select the epoch.
@@ -166,7 +166,7 @@ mod tests {
         let options = train_options(
             Architecture::Linear { ridge: 0.0 },
             Schedule::thesis(),
-            TargetKind::Pca(crate::pca::Components::default()),
+            TargetKind::Pca(spdcam_infer::pca::Components::default()),
             Grid::ESTIMATION,
             1,
         );

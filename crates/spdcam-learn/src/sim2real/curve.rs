@@ -14,8 +14,8 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use spdcam_core::dataset::MeasuredPhotos;
 use spdcam_core::dataset::{Columns, Precision, SampleBatch};
-use spdcam_core::metrics;
 use spdcam_core::spectral::Grid;
+use spdcam_core::spectral_error;
 use spdcam_infer::model::Model;
 use spdcam_infer::record::{Backend, DataInfo};
 use spdcam_infer::ridge::Ridge;
@@ -97,7 +97,7 @@ fn truth_on(set: &MeasuredPhotos, i: usize, set_grid: &Grid, model_grid: &Grid) 
         .iter()
         .map(|nm| set.spds[i][((nm - set_grid.start_nm) / set_grid.step_nm).round() as usize])
         .collect();
-    metrics::normalise_by_max(&values)
+    spdcam_core::spectral::normalise_by_max(&values)
 }
 
 /// Mean GFC of `model` on the photos `test`.
@@ -108,7 +108,7 @@ fn model_gfc(model: &Model, set: &MeasuredPhotos, test: &[usize], set_grid: &Gri
     let mut total = 0.0;
     for (k, &i) in test.iter().enumerate() {
         let est = &spds[k * grid.count..(k + 1) * grid.count];
-        total += metrics::gfc(&truth_on(set, i, set_grid, &grid), est)?;
+        total += spectral_error::gfc(&truth_on(set, i, set_grid, &grid), est)?;
     }
     Ok(total / test.len() as f64)
 }

@@ -21,7 +21,7 @@ use spdcam_core::dataset::randomise::{
     camera_pool, InCameraRanges, Randomisation, IN_CAMERA_AND_GRADIENT_GROUPS, IN_CAMERA_GROUPS,
 };
 use spdcam_core::dataset::{MeasuredPhotos, REAL_PHOTO_SETS};
-use spdcam_core::lighting::Lighting;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::spectral::Grid;
 use spdcam_infer::ridge::Ridge;
 use std::path::Path;

@@ -6,8 +6,8 @@ use crate::error::Result;
 use spdcam_core::camera::Camera;
 use spdcam_core::dataset::randomise::Randomisation;
 use spdcam_core::dataset::{GenerateOptions, Generator, MeasuredPhotos, Pipeline};
-use spdcam_core::lighting::Lighting;
-use spdcam_core::metrics;
+use spdcam_core::light_families::Lighting;
+use spdcam_core::spectral_error;
 use spdcam_infer::ridge::Ridge;
 
 /// Input vector: features divided by their mean (removes exposure), and a bias.
@@ -33,7 +33,7 @@ pub fn target(spd: &[f64]) -> Vec<f64> {
             spd[((nm - GRID.start_nm) / GRID.step_nm).round() as usize]
         })
         .collect();
-    metrics::normalise_by_max(&v)
+    spdcam_core::spectral::normalise_by_max(&v)
 }
 
 /// Mean GFC of `model` on the photos `indices` of `set`.
@@ -42,7 +42,7 @@ pub fn score(model: &Ridge, set: &MeasuredPhotos, indices: &[usize]) -> Result<f
     for &i in indices {
         let truth = target(&set.spds[i]);
         let est = model.predict_non_negative(&inputs(&set.features[i]));
-        total += metrics::gfc(&truth, &est).unwrap_or(0.0);
+        total += spectral_error::gfc(&truth, &est).unwrap_or(0.0);
     }
     Ok(total / indices.len() as f64)
 }

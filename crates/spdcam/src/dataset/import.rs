@@ -5,7 +5,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::dataset::{self, ImportOptions, Origin, DEFAULT_CHUNK_SIZE, FEATURE_SCALE};
-use spdcam_core::lighting::Lighting;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::spectral::Grid;
 use std::path::PathBuf;
 

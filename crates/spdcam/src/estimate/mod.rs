@@ -10,8 +10,8 @@ mod print;
 mod row_lines;
 mod truth;
 
+use crate::args::photo::PhotoArgs;
 use crate::outln;
-use crate::photo_args::PhotoArgs;
 use crate::plot_file::{plot_is_png, write_plot};
 use anyhow::{bail, Result};
 use clap::Args;

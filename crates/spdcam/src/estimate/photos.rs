@@ -1,37 +1,15 @@
-//! Estimates from photos: each photo analysed, its debug image announced, its estimate
-//! made; the photos that give none reported and counted.
+//! Estimates from photos, in one call to the Estimator per run: each photo analysed, its
+//! debug image announced (the path the library says it wrote), its estimate made; the
+//! photos that give none reported and counted.
 
 use super::{quiet, EstimateArgs};
+use crate::args::photo::describe;
 use crate::outln;
-use crate::photo_args::{self};
 use anyhow::Result;
 use spdcam_core::photo::{self, PhotoAnalysis};
 use spdcam_infer::report::REPORT_IMAGE_WIDTH;
-use spdcam_infer::{Estimate, Estimator};
+use spdcam_infer::{Estimate, Estimator, PhotoEstimate, PhotoProgress};
 use std::path::PathBuf;
-
-/// Column labels for photos: their file names, or their paths where names repeat.
-pub(super) fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
-    let names: Vec<String> = photos
-        .iter()
-        .map(|p| {
-            p.file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_else(|| p.display().to_string())
-        })
-        .collect();
-    names
-        .iter()
-        .zip(photos)
-        .map(|(n, p)| {
-            if names.iter().filter(|m| *m == n).count() > 1 {
-                p.display().to_string()
-            } else {
-                n.clone()
-            }
-        })
-        .collect()
-}
 
 /// What [`estimate_from_photos`] gives: the estimates, their photos, with `--report` each
 /// photo with the chart found drawn on it, and how many photos gave none.
@@ -50,23 +28,47 @@ pub(super) fn estimate_from_photos(
 ) -> Result<PhotoEstimates> {
     let mut options = args.photo.options()?;
     options.overlay_width = args.report.is_some().then_some(REPORT_IMAGE_WIDTH);
-    // Debug images written from now on are announced (file times run on a coarser clock).
-    let started = std::time::SystemTime::now() - std::time::Duration::from_secs(1);
-    let results = estimator.analyse_photos(&args.photos, &options)?;
-    let labels = photo_labels(&args.photos);
-    let debug = options
-        .debug
-        .as_ref()
-        .map(|d| photo::debug_paths(d, &args.photos));
-    let mut analyses: Vec<(PathBuf, String, PhotoAnalysis, Option<Vec<u8>>)> = Vec::new();
-    let mut failed = 0;
-    for (i, ((path, label), result)) in args.photos.iter().zip(labels).zip(results).enumerate() {
-        if let Some(written) = debug.as_ref().map(|d| &d[i]).filter(|d| {
-            std::fs::metadata(d)
-                .and_then(|m| m.modified())
-                .is_ok_and(|t| t >= started)
-        }) {
-            let factor = result.as_ref().map_or(1, |a| {
+    let done = estimator.estimate_photos(&args.photos, &options, |step| -> Result<()> {
+        match step {
+            PhotoProgress::Analysed(photos) => analysed(args, photos),
+            PhotoProgress::Estimating(analysis) if !quiet(args) => {
+                outln!("{}", describe(analysis))?;
+                Ok(())
+            }
+            PhotoProgress::Estimating(_) => Ok(()),
+        }
+    })?;
+    let mut out = PhotoEstimates {
+        estimates: Vec::with_capacity(done.len()),
+        photos: Vec::with_capacity(done.len()),
+        overlays: Vec::with_capacity(done.len()),
+        failed: 0,
+    };
+    for (path, photo) in args.photos.iter().zip(done) {
+        match (photo.analysed, photo.estimate) {
+            (Ok(analysed), Some(Ok(estimate))) => {
+                out.estimates.push(estimate);
+                out.photos.push(path.clone());
+                out.overlays.push(analysed.overlay);
+            }
+            (Ok(_), Some(Err(e))) => {
+                eprintln!("error: no estimate for {}: {e}", path.display());
+                out.failed += 1;
+            }
+            // Reported when the photos were analysed.
+            _ => out.failed += 1,
+        }
+    }
+    Ok(out)
+}
+
+/// Every photo analysed: each debug image written announced, each photo's warnings or why
+/// it cannot be used printed, and with `--features-out` the features of those that can.
+fn analysed(args: &EstimateArgs, photos: &[PhotoEstimate]) -> Result<()> {
+    let mut analyses: Vec<PhotoAnalysis> = Vec::new();
+    for (path, photo) in args.photos.iter().zip(photos) {
+        if let Some(written) = &photo.debug {
+            let factor = photo.analysed.as_ref().map_or(1, |a| {
                 photo::debug_factor(a.analysis.width, a.analysis.height)
             });
             match factor {
@@ -74,49 +76,21 @@ pub(super) fn estimate_from_photos(
                 k => eprintln!("debug → {} (1:{k} of the photo)", written.display()),
             }
         }
-        match result {
+        match &photo.analysed {
             Ok(a) => {
                 for w in &a.analysis.warnings {
                     eprintln!("warning: {}: {w}", a.analysis.source);
                 }
-                analyses.push((path.clone(), label, a.analysis, a.overlay));
+                analyses.push(a.analysis.clone());
             }
-            Err(e) => {
-                eprintln!("error: cannot use photo {}: {e}", path.display());
-                failed += 1;
-            }
+            Err(e) => eprintln!("error: cannot use photo {}: {e}", path.display()),
         }
     }
     if let Some(out) = &args.photo.features_out {
-        let all: Vec<PhotoAnalysis> = analyses.iter().map(|(_, _, a, _)| a.clone()).collect();
-        if !all.is_empty() {
-            photo::write_features_csv(out, &all)?;
+        if !analyses.is_empty() {
+            photo::write_features_csv(out, &analyses)?;
             eprintln!("features → {}", out.display());
         }
     }
-    let mut estimates = Vec::with_capacity(analyses.len());
-    let mut paths = Vec::with_capacity(analyses.len());
-    let mut overlays = Vec::with_capacity(analyses.len());
-    for (path, label, analysis, overlay) in analyses {
-        if !quiet(args) {
-            outln!("{}", photo_args::describe(&analysis))?;
-        }
-        match estimator.estimate_analysis(analysis, label) {
-            Ok(e) => {
-                estimates.push(e);
-                paths.push(path);
-                overlays.push(overlay);
-            }
-            Err(e) => {
-                eprintln!("error: no estimate for {}: {e}", path.display());
-                failed += 1;
-            }
-        }
-    }
-    Ok(PhotoEstimates {
-        estimates,
-        photos: paths,
-        overlays,
-        failed,
-    })
+    Ok(())
 }

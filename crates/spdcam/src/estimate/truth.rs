@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Context, Result};
 use spdcam_core::error::short_number;
-use spdcam_core::light::SPD_NEGATIVE_TOLERANCE;
+use spdcam_core::named_light::SPD_NEGATIVE_TOLERANCE;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use std::path::Path;
 

@@ -4,7 +4,7 @@
 //! beside the constant. The protocol is `spdcam_eval::colour`'s; this parses its options
 //! and writes its results.
 
-use crate::held_out_args::LibraryArgs;
+use crate::args::held_out::LibraryArgs;
 use anyhow::Result;
 use clap::Args;
 use spdcam_core::builtin::DataDir;

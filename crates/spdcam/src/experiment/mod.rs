@@ -2,6 +2,7 @@
 //! the real-camera study, and the light's colour as a colour meter reads it.
 
 mod colour;
+mod real_cameras;
 mod thesis;
 
 use anyhow::Result;
@@ -21,7 +22,7 @@ enum ExperimentCommand {
     Thesis(ThesisArgs),
     /// Every way of estimating on the real photo sets' validation and test photos, beside a
     /// constant guess and ridge on real photos (`docs/real-cameras-table.md`).
-    RealCameras(crate::experiment_real_cameras::RealCamerasArgs),
+    RealCameras(real_cameras::RealCamerasArgs),
     /// Every model judged on the light's colour (Δu′v′, CCT and its interval) on scene and
     /// patch-level photos of the split's lamps and white references by held-out cameras,
     /// beside the constant (`docs/colour.md`).
@@ -32,7 +33,7 @@ enum ExperimentCommand {
 pub fn run(args: ExperimentArgs, data_dir: &spdcam_core::builtin::DataDir) -> Result<()> {
     match args.command {
         ExperimentCommand::Thesis(a) => thesis::run(a, data_dir),
-        ExperimentCommand::RealCameras(a) => crate::experiment_real_cameras::run(a, data_dir),
+        ExperimentCommand::RealCameras(a) => real_cameras::run(a, data_dir),
         ExperimentCommand::Colour(a) => colour::run(a, data_dir),
     }
 }

@@ -15,10 +15,10 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use spdcam_core::fsio::write_atomic;
 use spdcam_core::spectral::Grid;
+use spdcam_infer::pca::Components;
+use spdcam_infer::target::TargetKind;
 use spdcam_learn::experiment::sets;
 use spdcam_learn::experiment::thesis::{train_options, SetParts, ThesisRow};
-use spdcam_learn::pca::Components;
-use spdcam_learn::target::TargetKind;
 use spdcam_learn::train::Schedule;
 use std::path::PathBuf;
 

@@ -13,10 +13,10 @@ use parse::parse_pair;
 use scene_photo::render_scene;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::imageio;
-use spdcam_core::lighting::Lighting;
+use spdcam_core::light_families::Lighting;
 use spdcam_core::photo::scene;
 use spdcam_core::spectral::{Grid, SpectralSet};
-use spdcam_core::{fsio, light, limits};
+use spdcam_core::{fsio, limits, named_light};
 use std::path::{Path, PathBuf};
 
 /// Options of `spdcam render`.
@@ -172,10 +172,10 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         (None, _) => bail!("the chart is written as PNG: name the output FILE.png"),
     }
     let spd = match (&args.spd, &args.lighting, args.draw) {
-        (Some(spec), _, _) => light::resolve_spd(spec, data_dir, &grid)?,
+        (Some(spec), _, _) => named_light::resolve_spd(spec, data_dir, &grid)?,
         (None, Some(recipe), Some(index)) => {
             let draw = Lighting::parse(recipe, data_dir, &grid)?.draw(args.seed, index)?;
-            light::ResolvedSpd {
+            named_light::ResolvedSpd {
                 name: format!("{recipe} draw {index} (seed {})", args.seed),
                 spd: draw.spd,
                 resampling: None,

@@ -9,7 +9,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions, Shadow, Tilt, TiltAxis};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::{Grid, Spd};
-use spdcam_core::{fsio, light};
+use spdcam_core::{fsio, named_light};
 
 impl RenderArgs {
     /// The scene options of a `width × height` scene these arguments describe.
@@ -71,7 +71,7 @@ pub(super) fn render_scene(
     let right = args
         .right_light
         .as_deref()
-        .map(|spec| light::resolve_spd(spec, data_dir, &grid))
+        .map(|spec| named_light::resolve_spd(spec, data_dir, &grid))
         .transpose()?;
     for note in right.iter().flat_map(|r| &r.notes) {
         eprintln!("note: {note}");

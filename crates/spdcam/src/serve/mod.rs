@@ -199,7 +199,7 @@ fn resolve(host: &str, port: u16) -> Result<Vec<SocketAddr>> {
 /// (the default of `spdcam estimate`, so the answers equal its `--json`).
 pub fn shipped_engine(data_dir: &DataDir) -> Result<Engine> {
     Ok(Engine {
-        estimator: Estimator::shipped(data_dir.clone(), Grid::parse("400-700:5")?)?,
+        estimator: Estimator::shipped(data_dir.clone(), Grid::ESTIMATION)?,
     })
 }
 

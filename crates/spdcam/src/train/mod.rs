@@ -12,10 +12,10 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::error::short_number;
 use spdcam_core::fsio;
 use spdcam_core::spectral::Grid;
-use spdcam_learn::network::Architecture;
-use spdcam_learn::pca::Components;
-use spdcam_learn::scale::RowScale;
-use spdcam_learn::target::TargetKind;
+use spdcam_infer::network::Architecture;
+use spdcam_infer::pca::Components;
+use spdcam_infer::scale::RowScale;
+use spdcam_infer::target::TargetKind;
 use spdcam_learn::train::{add_photo_chart, train, Schedule, TrainOptions, TrainingSet};
 use std::path::PathBuf;
 

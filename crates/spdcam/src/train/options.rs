@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
-use spdcam_learn::network::{Architecture, CnnSpec, MlpSpec};
+use spdcam_infer::network::{Architecture, CnnSpec, MlpSpec};
 use spdcam_learn::train::{Backend, Schedule, TrainingSet};
 use std::path::PathBuf;
 

@@ -48,9 +48,10 @@ pub(super) async fn job(State(api): State<Arc<Api>>, Path(id): Path<String>) -> 
             "seconds": since.elapsed().as_secs_f64(),
         }),
         Progress::Finished(Outcome::Done(json)) => {
-            let result: serde_json::Value =
-                serde_json::from_str(&json).unwrap_or(serde_json::Value::Null);
-            serde_json::json!({ "state": "done", "result": result })
+            // The estimate's JSON text, made once by the engine, goes in as it is (keys in
+            // the order serde_json's map writes them: "result", "state").
+            let text = format!(r#"{{"result":{json},"state":"done"}}"#);
+            return Answer(200, "application/json", text.into());
         }
         Progress::Finished(Outcome::Failed(status, error)) => {
             let (code, message) = plain_error(status, &error);

@@ -90,7 +90,7 @@ impl Api {
         };
         let corners = match form.corners.as_deref().map(str::trim) {
             Some(text) if !text.is_empty() => Some(
-                crate::photo_args::parse_corners(text)
+                crate::args::photo::parse_corners(text)
                     .map_err(|e| Answer::error(400, e.to_string()))?,
             ),
             _ => None,

@@ -2,10 +2,9 @@
 //! report.
 
 use super::{Outcome, Upload};
-use spdcam_core::photo;
 use spdcam_infer::presentation::Presentation;
 use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
-use spdcam_infer::{Estimator, InferError, PhotoOptions};
+use spdcam_infer::{Estimator, PhotoOptions};
 use std::sync::Arc;
 
 /// What estimates: the estimator of the models, built once for every upload.
@@ -39,22 +38,19 @@ impl Engine {
             overlay_width: Some(REPORT_IMAGE_WIDTH),
             ..PhotoOptions::default()
         };
-        let analysed = match photo::decode_photo(&upload.bytes, &upload.name)
-            .map_err(InferError::from)
-            .and_then(|decoded| self.estimator.analyse_decoded(&decoded, &options))
-        {
-            Ok(a) => a,
-            Err(e) => return failed(400, e.to_string()),
-        };
+        let estimated = self
+            .estimator
+            .photo_bytes(&upload.bytes, &upload.name, &options);
         drop(upload.bytes);
         drop(upload.memory);
-        let overlay = analysed.overlay;
-        let estimate = match self
-            .estimator
-            .estimate_analysis(analysed.analysis, upload.name)
-        {
-            Ok(e) => e,
-            Err(e) => return failed(422, e.to_string()),
+        let overlay = match estimated.analysed {
+            Ok(a) => a.overlay,
+            Err(e) => return failed(400, e.to_string()),
+        };
+        let estimate = match estimated.estimate {
+            Some(Ok(e)) => e,
+            Some(Err(e)) => return failed(422, e.to_string()),
+            None => return failed(500, "no estimate was made".into()),
         };
         let mut json = match estimate.to_json() {
             Ok(json) => json,

@@ -9,7 +9,7 @@ use super::{shipped_engine, Config, Server, Timeouts};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::spectral::Grid;
 use spdcam_infer::presentation::Presentation;
-use spdcam_infer::{estimate_photo_bytes, ModelSet, PhotoOptions};
+use spdcam_infer::{Estimator, ModelSet, PhotoOptions};
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
@@ -104,14 +104,13 @@ fn json(body: &[u8]) -> serde_json::Value {
 /// What `spdcam estimate --json` gives for the example under `name`, with its
 /// `presentation`.
 fn expected(name: &str) -> serde_json::Value {
-    let estimate = estimate_photo_bytes(
-        EXAMPLE,
-        name,
-        &ModelSet::shipped().unwrap(),
-        &PhotoOptions::default(),
-        &DataDir::new(None),
-        &Grid::parse("400-700:5").unwrap(),
+    let estimate = Estimator::new(
+        ModelSet::shipped().unwrap(),
+        DataDir::new(None),
+        Grid::ESTIMATION,
     )
+    .unwrap()
+    .estimate_photo_bytes(EXAMPLE, name, &PhotoOptions::default())
     .unwrap();
     let mut json = estimate.to_json().unwrap();
     json["presentation"] = serde_json::to_value(Presentation::of(&estimate)).unwrap();

@@ -3,7 +3,7 @@
 //! in photon energy), an atomic or ionic emission line as the spectroradiometer records it,
 //! and a filament (Planck's law with a smooth transmission filter).
 
-use crate::illuminant::planck_radiance;
+use crate::cie_illuminant::planck_radiance;
 
 /// hc in eV·nm: photon energy E = [`HC_EV_NM`] / λ.
 pub const HC_EV_NM: f64 = 1_239.841_984;

@@ -4,7 +4,7 @@
 use anyhow::Result;
 use clap::Args;
 use spdcam_core::builtin::DataDir;
-use spdcam_core::lighting::LampLibrary;
+use spdcam_core::light_families::LampLibrary;
 use spdcam_core::spectral::Grid;
 use spdcam_eval::held_out::{HeldOutPhotos, LampFiles};
 use std::path::PathBuf;

@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
-use spdcam_learn::model::Model;
+use spdcam_infer::model::Model;
 use spdcam_learn::sim2real::curve::{CurveOptions, FinetuneCurves};
 use spdcam_learn::sim2real::{real_sets, Ablation, AblationOptions, VirtualCameras, GRID};
 use std::path::{Path, PathBuf};
@@ -94,7 +94,7 @@ fn curves(
     args: &Sim2realArgs,
     path: &Path,
     sets: &[spdcam_learn::sim2real::RealSet],
-    prior: &spdcam_learn::ridge::Ridge,
+    prior: &spdcam_infer::ridge::Ridge,
 ) -> Result<FinetuneCurves> {
     let model = Model::load(path)?;
     let options = CurveOptions {

@@ -22,9 +22,9 @@ pub use parametric::{fluorescent, normalised_daylight, normalised_planck, CctRan
 pub use validation_split::ValidationSplit;
 
 use crate::builtin::DataDir;
+use crate::cie_illuminant::{DAYLIGHT_CCT_MAX_K, DAYLIGHT_CCT_MIN_K};
 use crate::colorimetry::Observer;
 use crate::error::{Error, Result};
-use crate::illuminant::{DAYLIGHT_CCT_MAX_K, DAYLIGHT_CCT_MIN_K};
 use crate::seed;
 use crate::spectral::{normalise_peak, Grid, Spd};
 use rand::rngs::SmallRng;
@@ -99,7 +99,7 @@ impl Lighting {
     ///
     /// ```
     /// use spdcam_core::builtin::DataDir;
-    /// use spdcam_core::lighting::Lighting;
+    /// use spdcam_core::light_families::Lighting;
     /// use spdcam_core::spectral::Grid;
     ///
     /// let grid = Grid::SIMULATION;
@@ -287,7 +287,7 @@ impl Lighting {
     ///
     /// ```
     /// use spdcam_core::builtin::DataDir;
-    /// use spdcam_core::lighting::Lighting;
+    /// use spdcam_core::light_families::Lighting;
     /// use spdcam_core::spectral::Grid;
     ///
     /// let leds = Lighting::parse("gaussian:7", &DataDir::new(None), &Grid::SIMULATION)?;

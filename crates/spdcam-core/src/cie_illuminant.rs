@@ -223,7 +223,7 @@ impl StandardIlluminant {
     /// interpolation (CIE 167:2005; exact at the 5 nm table points), zero outside 300–780 nm.
     ///
     /// ```
-    /// use spdcam_core::illuminant::StandardIlluminant;
+    /// use spdcam_core::cie_illuminant::StandardIlluminant;
     /// use spdcam_core::spectral::Grid;
     ///
     /// let grid = Grid::ESTIMATION;

@@ -10,7 +10,7 @@ use spdcam_eval::real_cameras::{
     appearance, baseline_rows, model_row, recipes, split_sets, virtual_photos, virtual_rows,
     CameraSource, Row, DEV_SPLIT_SEED,
 };
-use spdcam_learn::model::Model;
+use spdcam_infer::model::Model;
 use std::path::PathBuf;
 
 /// Options of `spdcam experiment real-cameras`.

@@ -1,15 +1,17 @@
 //! `spdcam lamps`: the real-lamp work. `split` fixes the validation split of the lamp
 //! library and the camera pool; `fit` fits the lamp families to the split's fit lamps and
 //! writes the parameters the `lamp:` recipes draw around; `validate` runs the validation
-//! protocol (`crate::validate_lamps`).
+//! protocol (`validate`).
 
-use crate::held_out_args::LibraryArgs;
+mod validate;
+
+use crate::args::held_out::LibraryArgs;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use spdcam_core::builtin::DataDir;
-use spdcam_core::lighting::lamp_families::{fit_families, LampFits};
-use spdcam_core::lighting::validation_split::LampPart;
-use spdcam_core::lighting::ValidationSplit;
+use spdcam_core::light_families::lamp_families::{fit_families, LampFits};
+use spdcam_core::light_families::validation_split::LampPart;
+use spdcam_core::light_families::ValidationSplit;
 use spdcam_core::spectral::Grid;
 use spdcam_eval::held_out::{camera_names, in_data_dir};
 use std::path::PathBuf;
@@ -30,7 +32,7 @@ enum LampsCommand {
     Fit(FitArgs),
     /// The validation protocol: held-out lamps through held-out cameras (the randomised
     /// in-camera stage and an independent simple camera), and the real photo sets.
-    Validate(Box<crate::validate_lamps::ValidateArgs>),
+    Validate(Box<validate::ValidateArgs>),
 }
 
 #[derive(Debug, Args)]
@@ -65,7 +67,7 @@ pub fn run(args: LampsArgs, data_dir: &DataDir) -> Result<()> {
     match args.command {
         LampsCommand::Split(a) => split(a, data_dir),
         LampsCommand::Fit(a) => fit(a, data_dir),
-        LampsCommand::Validate(a) => crate::validate_lamps::run(*a, data_dir),
+        LampsCommand::Validate(a) => validate::run(*a, data_dir),
     }
 }
 

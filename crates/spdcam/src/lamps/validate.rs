@@ -6,7 +6,7 @@
 //! (report only). (c) The real photo sets of the thesis (SG 96 models only). The protocol is
 //! `spdcam_eval::lamp_validation`'s; this parses its options and writes its results.
 
-use crate::held_out_args::HeldOutArgs;
+use crate::args::held_out::HeldOutArgs;
 use anyhow::Result;
 use clap::Args;
 use spdcam_core::builtin::DataDir;

@@ -18,8 +18,8 @@ use super::bands::Shape;
 use super::fit::{levenberg_marquardt, nnls};
 use super::lamp_library::{LampLibrary, LampType};
 use crate::error::{Error, Result};
-use crate::metrics;
 use crate::spectral::{normalise_peak, Grid};
+use crate::spectral_error;
 use nalgebra::{DMatrix, DVector};
 use rand::rngs::SmallRng;
 use rand::Rng;
@@ -533,7 +533,7 @@ pub fn visible_gfc(a: &[f64], b: &[f64], grid: &Grid) -> f64 {
             .map(|k| s[k])
             .collect()
     };
-    metrics::gfc(&pick(a), &pick(b)).unwrap_or(0.0)
+    spectral_error::gfc(&pick(a), &pick(b)).unwrap_or(0.0)
 }
 
 /// Draws lamps of one family around its fitted lamps.

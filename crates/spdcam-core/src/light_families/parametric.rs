@@ -2,9 +2,9 @@
 //! a random colour temperature, phosphor-converted white LEDs and fluorescent-like line
 //! spectra. Every SPD is normalised by its maximum.
 
+use crate::cie_illuminant;
 use crate::colorimetry::{cct_duv_to_uv, Observer};
 use crate::error::{Error, Result};
-use crate::illuminant;
 use crate::spectral::{normalise_peak, Grid};
 use rand::rngs::SmallRng;
 use rand::Rng;
@@ -62,17 +62,17 @@ impl CctRange {
 }
 
 /// CIE daylight (D series) at `cct`, normalised by its maximum (the absolute-scaled one,
-/// 100 at 560 nm, is [`illuminant::daylight`]).
+/// 100 at 560 nm, is [`cie_illuminant::daylight`]).
 pub fn normalised_daylight(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
-    let mut spd = illuminant::daylight(cct, grid)?.into_values();
+    let mut spd = cie_illuminant::daylight(cct, grid)?.into_values();
     normalise_peak(&mut spd)?;
     Ok(spd)
 }
 
 /// Planck's law at `cct`, normalised by its maximum (the absolute radiance is
-/// [`illuminant::planck`]).
+/// [`cie_illuminant::planck`]).
 pub fn normalised_planck(cct: f64, grid: &Grid) -> Result<Vec<f64>> {
-    let mut spd = illuminant::planck(cct, grid)?.into_values();
+    let mut spd = cie_illuminant::planck(cct, grid)?.into_values();
     normalise_peak(&mut spd)?;
     Ok(spd)
 }
@@ -211,8 +211,8 @@ pub fn fluorescent(grid: &Grid, rng: &mut SmallRng) -> Result<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cie_illuminant::StandardIlluminant;
     use crate::colorimetry::{uv_to_cct_duv, xy_to_uv1960};
-    use crate::illuminant::StandardIlluminant;
     use rand::SeedableRng;
 
     #[test]

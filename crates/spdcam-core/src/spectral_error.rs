@@ -20,7 +20,7 @@
 //! slices of the same length, for inner loops over rows of model output that share one grid.
 
 use crate::error::{Error, Result};
-use crate::spectral::{normalise_peak, Spd};
+use crate::spectral::{normalise_by_max, Spd};
 use serde::{Deserialize, Serialize};
 
 /// Added to every band of a max-normalised spectrum before SID turns it into a distribution.
@@ -52,24 +52,6 @@ pub struct Summary {
     pub min: f64,
     /// The largest value.
     pub max: f64,
-}
-
-/// The spectrum divided by its maximum ([`normalise_peak`]), with negative values clipped
-/// to 0. A spectrum that cannot be normalised (a non-finite value, no positive one) comes
-/// back as zeros.
-pub fn normalise_by_max(spd: &[f64]) -> Vec<f64> {
-    let mut out = spd.to_vec();
-    clip_normalise(&mut out);
-    out
-}
-
-/// [`normalise_by_max`] in place.
-pub fn clip_normalise(spd: &mut [f64]) {
-    if normalise_peak(spd).is_err() {
-        spd.fill(0.0);
-        return;
-    }
-    spd.iter_mut().for_each(|v| *v = v.max(0.0));
 }
 
 fn check_pair(truth: &[f64], estimate: &[f64]) -> Result<()> {
@@ -123,7 +105,7 @@ pub fn rmse(truth: &[f64], estimate: &[f64]) -> Result<f64> {
 /// [`gfc_spd`] is the typed form that checks the grids.
 ///
 /// ```
-/// use spdcam_core::metrics::gfc;
+/// use spdcam_core::spectral_error::gfc;
 ///
 /// assert_eq!(gfc(&[1.0, 2.0, 3.0], &[2.0, 4.0, 6.0])?, 1.0); // the same shape
 /// assert!(gfc(&[1.0, 0.0], &[0.0, 1.0])?.abs() < 1e-12); // nothing in common
@@ -169,8 +151,8 @@ pub fn sid(truth: &[f64], estimate: &[f64]) -> Result<f64> {
 /// that checks the grids.
 ///
 /// ```
-/// use spdcam_core::illuminant::StandardIlluminant;
-/// use spdcam_core::metrics::compare;
+/// use spdcam_core::cie_illuminant::StandardIlluminant;
+/// use spdcam_core::spectral_error::compare;
 /// use spdcam_core::spectral::Grid;
 ///
 /// let grid = Grid::ESTIMATION;
@@ -196,7 +178,7 @@ pub fn compare(truth: &[f64], estimate: &[f64]) -> Result<SpectralMetrics> {
 /// [`rmse`] of two spectra on the same grid; an error, not a panic, when their grids differ.
 ///
 /// ```
-/// use spdcam_core::metrics::rmse_spd;
+/// use spdcam_core::spectral_error::rmse_spd;
 /// use spdcam_core::spectral::{Grid, Spd};
 ///
 /// let grid = Grid::parse("400-700:100")?;
@@ -215,8 +197,8 @@ pub fn rmse_spd(truth: &Spd, estimate: &Spd) -> Result<f64> {
 /// [`gfc`] of two spectra on the same grid; an error, not a panic, when their grids differ.
 ///
 /// ```
-/// use spdcam_core::illuminant::StandardIlluminant;
-/// use spdcam_core::metrics::gfc_spd;
+/// use spdcam_core::cie_illuminant::StandardIlluminant;
+/// use spdcam_core::spectral_error::gfc_spd;
 /// use spdcam_core::spectral::Grid;
 ///
 /// let a = StandardIlluminant::A.spd(&Grid::ESTIMATION)?;
@@ -241,7 +223,7 @@ pub fn compare_spd(truth: &Spd, estimate: &Spd) -> Result<SpectralMetrics> {
 /// or when a value is not finite.
 ///
 /// ```
-/// use spdcam_core::metrics::summarise;
+/// use spdcam_core::spectral_error::summarise;
 ///
 /// let s = summarise(&[0.99, 0.97, 0.95, 0.93])?;
 /// assert!((s.mean - 0.96).abs() < 1e-12 && (s.median - 0.96).abs() < 1e-12);

@@ -10,7 +10,7 @@
 
 use super::lamp_library::{product_key, LampLibrary, LampType};
 use crate::error::{Error, Result};
-use crate::{metrics, seed};
+use crate::{seed, spectral_error};
 use rand::rngs::SmallRng;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -245,7 +245,8 @@ fn lamp_groups(library: &LampLibrary) -> Vec<Vec<usize>> {
     for i in 0..n {
         for j in 0..i {
             let same = keys[i] == keys[j]
-                || metrics::gfc(&visible[i], &visible[j]).unwrap_or(0.0) >= NEAR_IDENTICAL_GFC;
+                || spectral_error::gfc(&visible[i], &visible[j]).unwrap_or(0.0)
+                    >= NEAR_IDENTICAL_GFC;
             if same {
                 let (a, b) = (root(&mut parent, i), root(&mut parent, j));
                 parent[a.max(b)] = a.min(b);

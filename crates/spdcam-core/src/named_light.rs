@@ -2,8 +2,8 @@
 //! spectral CSV, resolved to an SPD on the simulation grid.
 
 use crate::builtin::{self, DataDir};
+use crate::cie_illuminant::{self, StandardIlluminant};
 use crate::error::{short_number, Error, Result};
-use crate::illuminant::{self, StandardIlluminant};
 use crate::spectral::{Extrapolation, Grid, Interpolation, ResampleReport, Spd};
 
 /// The forms an SPD may be named in, for help and error messages.
@@ -58,10 +58,10 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
                 ))
             })?;
             let spd = match kind_lc.as_str() {
-                "daylight" => illuminant::daylight(t, grid)?,
-                "planck" => illuminant::planck(t, grid)?,
-                _ if t < 5000.0 => illuminant::planck(t, grid)?,
-                _ => illuminant::daylight(t, grid)?,
+                "daylight" => cie_illuminant::daylight(t, grid)?,
+                "planck" => cie_illuminant::planck(t, grid)?,
+                _ if t < 5000.0 => cie_illuminant::planck(t, grid)?,
+                _ => cie_illuminant::daylight(t, grid)?,
             };
             return Ok(ResolvedSpd {
                 name: spec.to_string(),

@@ -1,0 +1,5 @@
+//! Argument groups several commands share: the photo options (`estimate`) and the held-out
+//! lamp library and cameras (`lamps validate`, `trust`).
+
+pub mod held_out;
+pub mod photo;

@@ -1,0 +1,59 @@
+//! `spdcam trust calibrate`: the uncertainty calibration of models on held-out virtual
+//! photos of the split's validation lamps (`spdcam_eval::trust::fit`), written as
+//! `<chart>.trust.json`.
+
+use crate::args::held_out::HeldOutArgs;
+use anyhow::{Context, Result};
+use clap::Args;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::fsio::write_atomic;
+use spdcam_eval::trust::fit::calibrate as fit;
+use std::path::PathBuf;
+
+/// Options of `spdcam trust calibrate`.
+#[derive(Debug, Args)]
+pub(super) struct CalibrateArgs {
+    #[command(flatten)]
+    photos: HeldOutArgs,
+    /// For an SG model, also calibrate on the real photo sets' validation photos (the split
+    /// of `spdcam experiment real-cameras`; each set at most a third as many photos as the
+    /// virtual ones, evenly spaced): they join the bands, the expected GFC, the metric
+    /// intervals and the clipping and difficulty levels; the self-check's levels stay those
+    /// of the virtual photos.
+    #[arg(long)]
+    real: bool,
+    /// The thesis's data (holding measured/…); default: the data directory's thesis/.
+    #[arg(long)]
+    thesis_data: Option<PathBuf>,
+    /// Directory to write `<chart>.trust.json` into.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+/// Runs `spdcam trust calibrate`.
+pub(super) fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("creating {}", args.output.display()))?;
+    let fitted = fit(
+        &args.photos.protocol(),
+        args.real,
+        args.thesis_data.as_deref(),
+        data_dir,
+    )?;
+    for skipped in &fitted.skipped {
+        eprintln!("warning: {skipped}");
+    }
+    for c in fitted.models {
+        let out = args.output.join(format!("{}.trust.json", c.chart));
+        let json = serde_json::to_string_pretty(&c.calibration)?;
+        write_atomic(&out, format!("{json}\n").as_bytes())?;
+        eprintln!(
+            "{}: calibration → {} (expected GFC from ln(difficulty) and {} principal components; {} real photos)",
+            c.model.display(),
+            out.display(),
+            c.calibration.gfc_model.components.len(),
+            c.calibration.real_photos
+        );
+    }
+    Ok(())
+}
