@@ -40,6 +40,7 @@ __all__ = [
     "generate",
     "train",
     "finetune",
+    "CAN_TRAIN",
     "__version__",
 ]
 
@@ -669,6 +670,23 @@ def _dataset_dir(data: Union[Dataset, PathLike]) -> str:
     return data.path if isinstance(data, Dataset) else os.fspath(data)
 
 
+#: Whether this build trains: ``train`` and ``finetune`` need the training stack (burn),
+#: which a plain ``pip install ./python`` leaves out so that it installs in minutes.
+CAN_TRAIN: bool = hasattr(_native, "train")
+
+#: How to install the build that trains, as the error of :func:`train` says it.
+TRAIN_INSTALL = 'pip install ./python --config-settings=build-args="--features train"'
+
+
+def _require_training(what: str) -> None:
+    """Raises the ImportError naming the install that trains, in a build without training."""
+    if not CAN_TRAIN:
+        raise ImportError(
+            f"spdcam.{what}() needs the training build of spdcam (burn), which this install "
+            f"leaves out; reinstall from the repository root with: {TRAIN_INSTALL}"
+        )
+
+
 def train(
     data: Union[Dataset, PathLike],
     output: PathLike,
@@ -686,8 +704,10 @@ def train(
 
     ``progress`` is a callback ``(epochs done, epochs)``; by default a tqdm bar when tqdm
     is installed, ``False`` for none. The work runs without the GIL. Raises
-    :class:`SpdcamError` with the command line's message on bad input.
+    :class:`SpdcamError` with the command line's message on bad input, and ImportError in a
+    build without training (:data:`CAN_TRAIN`).
     """
+    _require_training("train")
     out = os.fspath(output)
     native = _run(
         progress,
@@ -724,8 +744,10 @@ def finetune(
     ``progress`` is a callback ``(done, total)`` counting the cross-validation's fits, or
     epochs with a recipe given; by default a tqdm bar when tqdm is installed, ``False`` for
     none. The work runs without the GIL. Raises :class:`SpdcamError` with the command
-    line's message on bad input.
+    line's message on bad input, and ImportError in a build without training
+    (:data:`CAN_TRAIN`).
     """
+    _require_training("finetune")
     out = os.fspath(output)
     native = _run(
         progress,

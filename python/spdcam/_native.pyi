@@ -76,7 +76,8 @@ def train(
     seed: int = 1,
     progress: Progress = None,
 ) -> Models:
-    """Trains a model on a dataset as ``spdcam train``; the model written to ``output``."""
+    """Trains a model on a dataset as ``spdcam train``; the model written to ``output``.
+    Only in the training build (cargo feature ``train``)."""
 
 def finetune(
     model: str,
@@ -89,4 +90,5 @@ def finetune(
     seed: int = 1,
     progress: Progress = None,
 ) -> Models:
-    """Fine-tunes a model file on a dataset as ``spdcam finetune``; the model written."""
+    """Fine-tunes a model file on a dataset as ``spdcam finetune``; the model written.
+    Only in the training build (cargo feature ``train``)."""

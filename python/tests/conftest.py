@@ -1,4 +1,5 @@
-"""Shared fixtures: the repository's example photo and the `spdcam` command line."""
+"""Shared fixtures: the repository's example photo, the `spdcam` command line, a small
+dataset; and the check that a Python error is the command line's."""
 
 import os
 import shlex
@@ -7,9 +8,13 @@ from pathlib import Path
 
 import pytest
 
+import spdcam
+
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "sg-telelumen.jpg"
 TRUTH = ROOT / "examples" / "sg-telelumen.truth.csv"
+#: The lighting recipe of the small datasets the tests generate.
+LIGHTING = "gaussian:4"
 
 
 @pytest.fixture(scope="session")
@@ -36,3 +41,17 @@ def cli():
         )
 
     return run
+
+
+@pytest.fixture(scope="session")
+def data(tmp_path_factory):
+    """300 noise-free samples (the fast pipeline), for training and the dataset tests."""
+    out = tmp_path_factory.mktemp("learn") / "set"
+    return spdcam.generate(out, LIGHTING, 300, seed=5, fast=True, progress=False)
+
+
+def errors_match(cli, caught, *args):
+    """The command line fails on the same input with the same message."""
+    done = cli(*args)
+    assert done.returncode != 0
+    assert str(caught.value) in done.stderr, done.stderr

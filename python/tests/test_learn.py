@@ -1,24 +1,12 @@
-"""Datasets, training and fine-tuning from Python: the same library runs as `spdcam
-generate`, `spdcam train` and `spdcam finetune`, kept small (seconds)."""
+"""Training and fine-tuning from Python: the same library runs as `spdcam train` and
+`spdcam finetune`, kept small (seconds). These need the training build (`python/README.md`);
+`python/ci.sh` runs them against it, the other tests against the build without training."""
 
 import numpy as np
-import pyarrow.parquet as pq
 import pytest
 
 import spdcam
-
-LIGHTING = "gaussian:4"
-
-
-def feature_columns(table):
-    return [c for c in table.column_names if c.startswith("p") and c[-2:] in ("_r", "_g", "_b")]
-
-
-@pytest.fixture(scope="module")
-def data(tmp_path_factory):
-    """300 noise-free samples (the fast pipeline), for training."""
-    out = tmp_path_factory.mktemp("learn") / "set"
-    return spdcam.generate(out, LIGHTING, 300, seed=5, fast=True, progress=False)
+from conftest import LIGHTING, errors_match
 
 
 @pytest.fixture(scope="module")
@@ -28,43 +16,6 @@ def mlp(data, tmp_path_factory):
     path = tmp_path_factory.mktemp("models") / "mlp.spdm"
     model = spdcam.train(data, path, "mlp", epochs=2, progress=lambda d, t: calls.append((d, t)))
     return path, model, calls
-
-
-def test_generate_writes_the_columns_and_rows(data):
-    table = data.to_arrow()
-    assert table.num_rows == len(data) == 300
-    assert table.column("sample").to_pylist() == list(range(300))
-    features = feature_columns(table)
-    assert features[:3] == ["p01_r", "p01_g", "p01_b"] and len(features) == 72
-    spds = [c for c in table.column_names if c.startswith("spd_")]
-    assert spds[0] == "spd_380" and spds[-1] == "spd_780" and len(spds) == 81
-    frame = data.to_pandas()
-    assert frame.shape == (table.num_rows, table.num_columns)
-    assert np.all(np.isfinite(frame[features].to_numpy()))
-
-
-def test_generate_equals_the_command_line(cli, tmp_path):
-    calls = []
-    ours = spdcam.generate(
-        tmp_path / "py", LIGHTING, 40, seed=3, progress=lambda d, t: calls.append((d, t))
-    )
-    done = cli("generate", "--lighting", LIGHTING, "--count", "40", "--seed", "3",
-               "-o", str(tmp_path / "cli"))
-    assert done.returncode == 0, done.stderr
-    theirs = pq.read_table(tmp_path / "cli" / "samples")
-    assert ours.to_arrow().equals(theirs)
-    assert ours.manifest["files"] == spdcam.Dataset(str(tmp_path / "cli")).manifest["files"]
-    assert calls and calls[-1] == (40, 40)
-    assert all(a[0] < b[0] for a, b in zip(calls, calls[1:]))
-
-
-def test_generate_resumes_and_replaces(tmp_path):
-    first = spdcam.generate(tmp_path / "set", LIGHTING, 20, fast=True, progress=False)
-    again = spdcam.generate(tmp_path / "set", LIGHTING, 20, fast=True, progress=False)
-    assert again.to_arrow().equals(first.to_arrow())
-    other = spdcam.generate(tmp_path / "set", LIGHTING, 10, seed=9, fast=True, force=True,
-                            progress=False)
-    assert len(other) == 10
 
 
 def test_a_linear_model_estimates_the_dataset_rows(data, tmp_path):
@@ -116,27 +67,6 @@ def test_an_exception_of_the_callback_reaches_the_caller(data, tmp_path):
 
     with pytest.raises(RuntimeError, match="stop"):
         spdcam.train(data, tmp_path / "m.spdm", "mlp", epochs=1, progress=boom)
-
-
-def errors_match(cli, caught, *args):
-    """The command line fails on the same input with the same message."""
-    done = cli(*args)
-    assert done.returncode != 0
-    assert str(caught.value) in done.stderr, done.stderr
-
-
-def test_a_bad_lighting_spec_gives_the_cli_message(cli, tmp_path):
-    with pytest.raises(spdcam.SpdcamError, match="nonsense") as caught:
-        spdcam.generate(tmp_path / "x", "nonsense:3", 10, progress=False)
-    errors_match(cli, caught, "generate", "--lighting", "nonsense:3", "--count", "10",
-                 "-o", str(tmp_path / "y"))
-
-
-def test_a_count_below_one_is_refused(cli, tmp_path):
-    with pytest.raises(spdcam.SpdcamError, match="at least 1") as caught:
-        spdcam.generate(tmp_path / "x", LIGHTING, 0, progress=False)
-    errors_match(cli, caught, "generate", "--lighting", LIGHTING, "--count", "0",
-                 "-o", str(tmp_path / "y"))
 
 
 def test_a_missing_dataset_gives_the_cli_message(cli, tmp_path):
