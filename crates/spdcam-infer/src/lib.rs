@@ -24,7 +24,9 @@
 //!   time, and the CSV layouts of many SPDs.
 //! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
 //!   verdict); [`presentation`]: what an estimate means in words and rounded numbers;
-//!   [`plot`] and [`report`]: SVG plots and the HTML report.
+//!   [`rounding`]: the one rule every front end writes numbers by; [`meter`]: what a
+//!   colour meter's screen shows; [`plot`] and [`report`]: SVG plots (with the CIE 1976
+//!   u′v′ diagram of [`chromaticity`]) and the HTML report.
 //! - [`ridge`]: closed-form ridge regression, the `linear` model's fit and the simple
 //!   learner every protocol compares against (here, so that it runs without burn).
 //! - [`error`]: the crate's error type.
@@ -62,9 +64,11 @@
 #![deny(missing_docs)]
 
 pub mod absolute;
+pub mod chromaticity;
 pub mod error;
 pub mod estimate;
 pub mod estimator;
+pub mod meter;
 pub mod model;
 pub mod network;
 pub mod pca;
@@ -73,10 +77,13 @@ pub mod presentation;
 pub mod record;
 pub mod report;
 pub mod ridge;
+pub mod rounding;
 pub mod scale;
 pub mod shipped;
 pub mod stream;
 pub mod target;
+#[cfg(test)]
+mod test_support;
 pub mod trust;
 
 pub use error::{InferError, Result};
