@@ -76,6 +76,7 @@ pub mod plot;
 pub mod presentation;
 pub mod record;
 pub mod report;
+mod report_meter;
 pub mod ridge;
 pub mod rounding;
 pub mod scale;
