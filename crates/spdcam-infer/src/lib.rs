@@ -72,6 +72,7 @@ pub mod meter;
 pub mod model;
 pub mod network;
 pub mod pca;
+pub mod people_words;
 pub mod plot;
 pub mod presentation;
 pub mod record;

@@ -207,3 +207,38 @@ fn filter_words(mired: f64) -> &'static str {
         "cooling: blue, CTB"
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::{estimate_of, estimate_of_d65};
+    use spdcam_core::spectral::{Grid, Spd};
+
+    #[test]
+    fn white_light_leads_with_cct_and_duv_coloured_light_with_its_wavelength() {
+        let d65 = Meter::of(&estimate_of_d65());
+        assert_eq!(d65.kind, "white");
+        assert_eq!(d65.headline[0].key, "cct_k");
+        // D65 cut to 400–700 nm: about 6500 K, shown ± 150 K.
+        assert!(d65.headline[0].value.ends_with(" ± 150 K"), "{:?}", d65.headline);
+        assert_eq!(d65.headline[1].key, "duv");
+        assert_eq!(d65.r1_r15.as_ref().map(Vec::len), Some(15));
+        // The mired shift to 5600 K of a 6500 K light: 10⁶/5600 − 10⁶/6500 ≈ +25 (warming).
+        let to5600 = d65.film_tv.iter().find(|r| r.key == "mired_5600").unwrap();
+        assert!(to5600.value.starts_with("+2") && to5600.value.contains("warming"), "{to5600:?}");
+        // A narrow band at 610 nm: coloured, dominant wavelength near 610 nm, purity near 1.
+        let grid = Grid::ESTIMATION;
+        let red: Vec<f64> = grid
+            .wavelengths()
+            .iter()
+            .map(|w| (-((w - 610.0) / 8.0).powi(2)).exp())
+            .collect();
+        let red = Meter::of(&estimate_of(Spd::new(grid, red).unwrap(), &[]));
+        assert_eq!(red.kind, "coloured");
+        assert_eq!(red.headline[0].label, "Dominant wavelength");
+        let nm: f64 = red.headline[0].value.trim_end_matches(" nm").parse().unwrap();
+        assert!((nm - 610.0).abs() < 3.0, "{nm}");
+        assert_eq!(red.headline[2].value, "610 nm");
+        assert!(red.film_tv.is_empty() && red.r1_r15.is_none());
+    }
+}

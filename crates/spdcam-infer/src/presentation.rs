@@ -48,6 +48,12 @@ pub struct Presentation {
     pub gfc: String,
     /// What a colour meter's screen shows: the headline readings and the film/TV numbers.
     pub meter: Meter,
+    /// The CIE 1976 u′v′ diagram of the estimate, SVG ([`crate::chromaticity`]): the
+    /// drawing the report shows, served to the web page.
+    pub uv_diagram: String,
+    /// The photo's and the metrics' warnings in a person's words
+    /// ([`crate::people_words::for_people`]).
+    pub warnings: Vec<String>,
     /// The metrics in groups (colour, colour rendering, circadian and eye, plants), each
     /// group's meaningful metrics first.
     pub groups: Vec<MetricGroup>,
@@ -250,6 +256,14 @@ impl Presentation {
             verdict,
             gfc: gfc_words(uncertainty.map(|u| u.expected_gfc)),
             meter: Meter::of(estimate),
+            uv_diagram: crate::chromaticity::uv_diagram_svg(estimate, None),
+            warnings: estimate
+                .photo
+                .iter()
+                .flat_map(|a| &a.warnings)
+                .chain(&estimate.metrics.warnings)
+                .map(|w| crate::people_words::for_people(w))
+                .collect(),
             groups,
         }
     }
@@ -349,7 +363,7 @@ pub fn cri_meaningful(estimate: &Estimate) -> Result<(), String> {
 fn not_determinable_words(key: &str, half95: Option<f64>) -> String {
     match half95 {
         Some(h) => format!(
-            "{NOT_DETERMINABLE}: its 95 % interval (± {}{}) is too wide",
+            "{NOT_DETERMINABLE} (95 % interval ± {}{})",
             round_sig(crate::rounding::scale(key) * h, 2),
             match crate::rounding::unit(key) {
                 "" => String::new(),

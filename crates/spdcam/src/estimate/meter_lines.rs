@@ -29,7 +29,7 @@ pub(super) fn headline_line(e: &Estimate, meter: &Meter) -> String {
 
 /// The main lighting-quality numbers on one line, `—` where undefined or not meaningful for
 /// this light (CRI and TM-30 far from white), each with its 95 % interval when the estimate
-/// has one: `Ra 82 ± 4, R9 20 ± 15, …, PPF 29.6 ± 7.5 µmol s⁻¹ m⁻² per 1000 lx`.
+/// has one: `Ra 82 ± 4, R9 20 ± 15, …, PPF 30 ± 8 µmol s⁻¹ m⁻² per 1000 lx`.
 pub(super) fn metrics_line(e: &Estimate) -> String {
     let intervals = e
         .trust
@@ -47,13 +47,14 @@ pub(super) fn metrics_line(e: &Estimate) -> String {
         }
     };
     format!(
-        "Ra {}, R9 {}, Rf {}, Rg {}, M-EDER {}, S/P {}, PPF {}",
+        "Ra {}, R9 {}, Rf {}, Rg {}, M-EDER {}, S/P {}, blue-light hazard {}, PPF {}",
         f("cri_ra"),
         f("cri_r9"),
         f("tm30_rf"),
         f("tm30_rg"),
         f("mel_der"),
         f("sp_ratio"),
+        f("blh_efficacy_w_per_lm"),
         f("ppf_per_lux"),
     )
 }
