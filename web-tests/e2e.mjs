@@ -543,7 +543,8 @@ await test('the page reads from 360 to 1,920 px: nothing spills out of its box, 
         const box = section.getBoundingClientRect();
         for (const el of section.querySelectorAll('*')) {
           const r = el.getBoundingClientRect();
-          if (r.width === 0 || getComputedStyle(el).position === 'absolute') continue;
+          // Inside a drawing only the drawing's own box counts (its clipped parts report their full size).
+          if (r.width === 0 || getComputedStyle(el).position === 'absolute' || (el.closest('svg') && el.closest('svg') !== el)) continue;
           if (r.right > box.right + 1 || r.left < box.left - 1) out.push(`${el.tagName.toLowerCase()}#${el.id}.${el.className && el.className.baseVal === undefined ? el.className : ''} (${Math.round(r.left)}–${Math.round(r.right)} in ${Math.round(box.left)}–${Math.round(box.right)})`);
         }
       }

@@ -38,8 +38,10 @@ pub struct Meter {
     pub headline: Vec<Reading>,
     /// The illuminance on the chart in words, when the photo's EXIF gives it.
     pub illuminance: Option<String>,
-    /// R1–R15 (R1 first), when CIE 13.3 is meaningful for the light.
-    pub r1_r15: Option<Vec<f64>>,
+    /// R1–R15 (R1 first), when CIE 13.3 is meaningful for the light; R9 `None` when its
+    /// calibrated 95 % interval is too wide ([`crate::rounding::determinable`]), the others
+    /// have no calibrated interval.
+    pub r1_r15: Option<Vec<Option<f64>>>,
     /// SSI and the filter corrections to 3200 K and 5600 K, for white light.
     pub film_tv: Vec<Reading>,
 }
@@ -175,16 +177,15 @@ fn film_tv(
         let Ok(c) = cct_correction(cct, duv, target) else {
             continue;
         };
-        let mired = if cct_undetermined {
+        let value = if cct_undetermined {
             NOT_DETERMINABLE.to_string()
         } else {
-            shown_with_unit(key, c.mired_shift, mired_half)
+            match shown(key, c.mired_shift, mired_half) {
+                Ok(v) => format!("{v} mired ({})", filter_words(c.mired_shift)),
+                Err(words) => words.to_string(),
+            }
         };
-        out.push(Reading {
-            key,
-            label,
-            value: format!("{mired} ({})", filter_words(c.mired_shift)),
-        });
+        out.push(Reading { key, label, value });
     }
     out.push(Reading {
         key: "green_magenta_duv",
@@ -223,6 +224,7 @@ mod tests {
         assert!(d65.headline[0].value.ends_with(" ± 150 K"), "{:?}", d65.headline);
         assert_eq!(d65.headline[1].key, "duv");
         assert_eq!(d65.r1_r15.as_ref().map(Vec::len), Some(15));
+        assert!(d65.r1_r15.as_ref().unwrap().iter().all(Option::is_some));
         // The mired shift to 5600 K of a 6500 K light: 10⁶/5600 − 10⁶/6500 ≈ +25 (warming).
         let to5600 = d65.film_tv.iter().find(|r| r.key == "mired_5600").unwrap();
         assert!(to5600.value.starts_with("+2") && to5600.value.contains("warming"), "{to5600:?}");

@@ -52,7 +52,7 @@ pub struct Presentation {
     /// drawing the report shows, served to the web page.
     pub uv_diagram: String,
     /// The photo's and the metrics' warnings in a person's words
-    /// ([`crate::people_words::for_people`]).
+    /// ([`crate::people_words::for_people`]), less those a greyed metric says already.
     pub warnings: Vec<String>,
     /// The metrics in groups (colour, colour rendering, circadian and eye, plants), each
     /// group's meaningful metrics first.
@@ -261,7 +261,14 @@ impl Presentation {
                 .photo
                 .iter()
                 .flat_map(|a| &a.warnings)
-                .chain(&estimate.metrics.warnings)
+                // A metric's warning that it is not meaningful is said by its greyed row.
+                .chain(
+                    estimate
+                        .metrics
+                        .warnings
+                        .iter()
+                        .filter(|w| !w.contains("not meaningful")),
+                )
                 .map(|w| crate::people_words::for_people(w))
                 .collect(),
             groups,

@@ -36,10 +36,11 @@ pub(crate) fn headline_html(out: &mut String, m: &Meter) {
     out.push_str("</div>\n");
 }
 
-/// R1–R15 as bars (0–100; negative values below the axis), with their values.
-pub(crate) fn r_bars_svg(r: &[f64]) -> String {
+/// R1–R15 as bars (0–100; negative values below the axis), with their values; one not
+/// determinable has no bar and `—`.
+pub(crate) fn r_bars_svg(r: &[Option<f64>]) -> String {
     let (w, h, top, axis) = (300.0, 96.0, 12.0, 78.0);
-    let low = r.iter().copied().fold(0.0_f64, f64::min).max(-100.0);
+    let low = r.iter().flatten().copied().fold(0.0_f64, f64::min).max(-100.0);
     // 0 at `axis`, 100 at `top`; negative values go below down to `low`.
     let scale = (axis - top) / (100.0 - low.min(0.0) * 0.3);
     let step = w / r.len() as f64;
@@ -50,6 +51,18 @@ pub(crate) fn r_bars_svg(r: &[f64]) -> String {
     );
     for (i, v) in r.iter().enumerate() {
         let x = i as f64 * step + 2.0;
+        let Some(v) = v else {
+            let _ = write!(
+                s,
+                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"8\" text-anchor=\"middle\">—</text>\
+                 <text x=\"{:.1}\" y=\"{h}\" font-size=\"8\" text-anchor=\"middle\" fill=\"#555\">R{}</text>",
+                x + (step - 4.0) / 2.0,
+                axis - 2.0,
+                x + (step - 4.0) / 2.0,
+                i + 1
+            );
+            continue;
+        };
         let len = v.clamp(low, 100.0) * scale;
         let (y, height) = if len >= 0.0 {
             (axis - len, len)
@@ -86,8 +99,13 @@ pub(crate) fn film_tv_html(out: &mut String, m: &Meter) {
         let _ = write!(
             out,
             "<figure>{}<figcaption>R1–R15: how true each test colour looks (CIE 13.3; R15 \
-             Japanese skin, JIS Z 8726); R9 is the saturated red.</figcaption></figure>",
-            r_bars_svg(r)
+             Japanese skin, JIS Z 8726); R9 is the saturated red{}.</figcaption></figure>",
+            r_bars_svg(r),
+            if r.get(8).is_some_and(Option::is_none) {
+                " (—: not determinable from this photo)"
+            } else {
+                ""
+            }
         );
     }
     out.push_str("</div>\n<div><table class=\"film-tv small\">");

@@ -65,7 +65,7 @@ pub fn determinable(key: &str, value: f64, half: f64) -> bool {
 pub fn shown(key: &str, value: f64, half95: Option<f64>) -> Result<String, &'static str> {
     let k = scale(key);
     let value = k * value;
-    let signed = key == "duv" || key.starts_with("mired") || key == "green_magenta_duv";
+    let signed = key == "duv" || key.starts_with("mired");
     let sign = if signed && value >= 0.0 { "+" } else { "" };
     match half95.map(|h| k * h).filter(|h| *h > 0.0 && h.is_finite()) {
         Some(half) if !determinable(key, value, half) => Err(NOT_DETERMINABLE),
@@ -74,7 +74,7 @@ pub fn shown(key: &str, value: f64, half95: Option<f64>) -> Result<String, &'sta
             Ok(format!("{sign}{v} ± {h}"))
         }
         None => Ok(match key {
-            "duv" | "green_magenta_duv" => format!("{value:+.4}"),
+            "duv" => format!("{value:+.4}"),
             k if k.starts_with("mired") => format!("{value:+.0}"),
             "cct_k" | "cri_ra" | "tm30_rf" | "tm30_rg" | "ssi" => format!("{value:.0}"),
             k if k.starts_with("cri_r") => format!("{value:.0}"),

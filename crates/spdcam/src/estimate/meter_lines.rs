@@ -64,8 +64,16 @@ pub(super) fn metrics_line(e: &Estimate) -> String {
 pub(super) fn film_tv_line(meter: &Meter) -> Option<String> {
     let mut parts = Vec::new();
     if let Some(r) = &meter.r1_r15 {
-        let bars: Vec<String> = r.iter().map(|v| format!("{v:.0}")).collect();
-        parts.push(format!("R1–R15 {}", bars.join(" ")));
+        let bars: Vec<String> = r
+            .iter()
+            .map(|v| v.map_or_else(|| "—".into(), |v| format!("{v:.0}")))
+            .collect();
+        let r9 = if r.get(8).is_some_and(Option::is_none) {
+            format!(" (R9 {NOT_DETERMINABLE})")
+        } else {
+            String::new()
+        };
+        parts.push(format!("R1–R15 {}{r9}", bars.join(" ")));
     }
     parts.extend(
         meter

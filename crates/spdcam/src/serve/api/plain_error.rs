@@ -119,7 +119,10 @@ mod tests {
             }
         }
         let http = for_http(cases[0].1);
-        assert!(http.contains("form field `corners`") && !http.contains("--"), "{http}");
+        assert!(
+            http.contains("form field `corners`") && !http.contains("--"),
+            "{http}"
+        );
         for (status, error, _) in cases {
             for text in [plain_error(status, error).1, for_http(error)] {
                 assert!(!text.contains("  ") && !text.contains("--"), "{text}");

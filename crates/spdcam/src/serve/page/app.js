@@ -645,7 +645,7 @@ function filmTv(box, meter) {
   if (!meter || (!meter.r1_r15 && !meter.film_tv.length)) return;
   html('h3', {}, box, 'Film and TV');
   const table = html('table', { id: 'film-tv', class: 'film-tv' }, box);
-  if (meter.r1_r15) row(table, 'R1–R15', meter.r1_r15.map((v) => v.toFixed(0)).join(' '), 'r1-r15');
+  if (meter.r1_r15) row(table, 'R1–R15', meter.r1_r15.map((v) => (v === null ? '—' : v.toFixed(0))).join(' ') + (meter.r1_r15[8] === null ? ' (R9 not determinable from this photo)' : ''), 'r1-r15');
   meter.film_tv.forEach((r) => row(table, r.label, r.value, `film-${r.key}`));
 }
 
