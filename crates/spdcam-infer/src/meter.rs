@@ -119,9 +119,13 @@ impl Meter {
         let cct_duv = cct.zip(duv).filter(|_| white);
         let r1_r15 = match (&light, cct_duv) {
             (Some(light), Some((cct, _))) if cri_meaningful(e).is_ok() => {
-                special_rendering_indices_r1_r15(light, cct)
-                    .ok()
-                    .map(Vec::from)
+                special_rendering_indices_r1_r15(light, cct).ok().map(|r| {
+                    let r9_shown = shown("cri_r9", r[8], half95(e, "cri_r9")).is_ok();
+                    r.iter()
+                        .enumerate()
+                        .map(|(i, v)| (i != 8 || r9_shown).then_some(*v))
+                        .collect()
+                })
             }
             _ => None,
         };
@@ -221,13 +225,20 @@ mod tests {
         assert_eq!(d65.kind, "white");
         assert_eq!(d65.headline[0].key, "cct_k");
         // D65 cut to 400–700 nm: about 6500 K, shown ± 150 K.
-        assert!(d65.headline[0].value.ends_with(" ± 150 K"), "{:?}", d65.headline);
+        assert!(
+            d65.headline[0].value.ends_with(" ± 150 K"),
+            "{:?}",
+            d65.headline
+        );
         assert_eq!(d65.headline[1].key, "duv");
         assert_eq!(d65.r1_r15.as_ref().map(Vec::len), Some(15));
         assert!(d65.r1_r15.as_ref().unwrap().iter().all(Option::is_some));
         // The mired shift to 5600 K of a 6500 K light: 10⁶/5600 − 10⁶/6500 ≈ +25 (warming).
         let to5600 = d65.film_tv.iter().find(|r| r.key == "mired_5600").unwrap();
-        assert!(to5600.value.starts_with("+2") && to5600.value.contains("warming"), "{to5600:?}");
+        assert!(
+            to5600.value.starts_with("+2") && to5600.value.contains("warming"),
+            "{to5600:?}"
+        );
         // A narrow band at 610 nm: coloured, dominant wavelength near 610 nm, purity near 1.
         let grid = Grid::ESTIMATION;
         let red: Vec<f64> = grid
@@ -238,7 +249,11 @@ mod tests {
         let red = Meter::of(&estimate_of(Spd::new(grid, red).unwrap(), &[]));
         assert_eq!(red.kind, "coloured");
         assert_eq!(red.headline[0].label, "Dominant wavelength");
-        let nm: f64 = red.headline[0].value.trim_end_matches(" nm").parse().unwrap();
+        let nm: f64 = red.headline[0]
+            .value
+            .trim_end_matches(" nm")
+            .parse()
+            .unwrap();
         assert!((nm - 610.0).abs() < 3.0, "{nm}");
         assert_eq!(red.headline[2].value, "610 nm");
         assert!(red.film_tv.is_empty() && red.r1_r15.is_none());

@@ -25,9 +25,15 @@ pub fn for_people(text: &str) -> String {
     }
     let out = out
         .replace("feature patches", "of the chart's patches")
-        .replace("check the debug image", "check the chart's outline on the photo");
+        .replace(
+            "check the debug image",
+            "check the chart's outline on the photo",
+        );
     match out.find("--corners") {
-        Some(i) => format!("{}its four corners on the photo", &out[..i].trim_end_matches("with ")),
+        Some(i) => format!(
+            "{}its four corners on the photo",
+            &out[..i].trim_end_matches("with ")
+        ),
         None => out,
     }
 }

@@ -1,9 +1,10 @@
 //! The HTML report of estimates (`spdcam estimate --report`, and the web page's "Report"
-//! download): for each estimate one page with the plain-words summary and verdict, the photo
-//! with the chart found, the SPD with its labelled 68/95 % bands (and the true SPD when
-//! known), the metrics grouped and rounded as [`Presentation`] gives them (those not
-//! meaningful for the light greyed with the reason), the TM-30 colour vector graphic and
-//! the detection. Everything is inline (CSS, SVG, the photo as a data URI): the page loads
+//! download): for each estimate one page with the plain-words summary, the colour meter's
+//! headline ([`crate::meter`]) and the verdict, the photo with the chart found, the SPD with
+//! its labelled 68/95 % bands (and the true SPD when known), the CIE 1976 u′v′ diagram
+//! ([`crate::chromaticity`]), the metrics grouped and rounded as [`Presentation`] gives them
+//! (those not meaningful for the light greyed with the reason), the TM-30 colour vector
+//! graphic, R1–R15 as bars with SSI and the filter corrections, and the detection. Everything is inline (CSS, SVG, the photo as a data URI): the page loads
 //! nothing. Each estimate prints on one A4 or Letter page.
 
 use crate::chromaticity::uv_diagram_svg;

@@ -40,7 +40,12 @@ pub(crate) fn headline_html(out: &mut String, m: &Meter) {
 /// determinable has no bar and `—`.
 pub(crate) fn r_bars_svg(r: &[Option<f64>]) -> String {
     let (w, h, top, axis) = (300.0, 96.0, 12.0, 78.0);
-    let low = r.iter().flatten().copied().fold(0.0_f64, f64::min).max(-100.0);
+    let low = r
+        .iter()
+        .flatten()
+        .copied()
+        .fold(0.0_f64, f64::min)
+        .max(-100.0);
     // 0 at `axis`, 100 at `top`; negative values go below down to `low`.
     let scale = (axis - top) / (100.0 - low.min(0.0) * 0.3);
     let step = w / r.len() as f64;
