@@ -133,7 +133,7 @@ pub fn uv_diagram_svg(e: &Estimate, truth_xy: Option<[f64; 2]>) -> String {
     let mut s = String::new();
     let _ = write!(
         s,
-        "<svg class=\"uv-diagram\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 {} {}\" \
+        "<svg class=\"uv-diagram\" viewBox=\"0 0 {} {}\" \
          role=\"img\" aria-label=\"CIE 1976 u′v′ chromaticity diagram with the estimate\" \
          font-family=\"sans-serif\">",
         SIZE.0, SIZE.1

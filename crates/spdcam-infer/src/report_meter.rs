@@ -50,7 +50,7 @@ pub(crate) fn r_bars_svg(r: &[Option<f64>]) -> String {
     let scale = (axis - top) / (100.0 - low.min(0.0) * 0.3);
     let step = w / r.len() as f64;
     let mut s = format!(
-        "<svg class=\"r-bars\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 {w} {h}\" \
+        "<svg class=\"r-bars\" viewBox=\"0 0 {w} {h}\" \
          role=\"img\" aria-label=\"Special colour rendering indices R1 to R15\" \
          font-family=\"sans-serif\"><line x1=\"0\" x2=\"{w}\" y1=\"{axis}\" y2=\"{axis}\" stroke=\"#888\"/>"
     );

@@ -577,15 +577,16 @@ function renderSpd() {
 }
 
 /** The CIE 1976 u′v′ diagram of the selected estimate: the server's SVG (the drawing its
- *  report shows), parsed as SVG so that no markup of it runs as the page's HTML. */
+ *  report shows). */
 function renderUv() {
   const box = $('uv-plot');
   box.replaceChildren();
   const e = selected();
   const svgText = e && e.result && e.result.presentation && e.result.presentation.uv_diagram;
   if (!svgText) { html('p', { class: 'placeholder' }, box, 'The light\'s colour appears here.'); return; }
-  const doc = new DOMParser().parseFromString(svgText, 'image/svg+xml');
-  if (doc.documentElement.nodeName === 'svg') box.append(document.importNode(doc.documentElement, true));
+  // Parsed as inline SVG in an inert document: nothing in it runs.
+  const svg = new DOMParser().parseFromString(svgText, 'text/html').body.firstElementChild;
+  if (svg && svg.nodeName.toLowerCase() === 'svg') box.append(document.importNode(svg, true));
 }
 
 function row(table, label, value, id) {
