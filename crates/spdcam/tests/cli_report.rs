@@ -169,7 +169,11 @@ fn the_report_of_the_example_photo_shows_its_numbers_as_json_gives_them() {
     // that, without repeating the raw value.
     for w in e["metrics"]["warnings"].as_array().unwrap() {
         let w = w.as_str().unwrap().replace('\'', "&#39;");
-        assert_eq!(html.contains(&w), !w.contains("not meaningful"), "warning {w}");
+        assert_eq!(
+            html.contains(&w),
+            !w.contains("not meaningful"),
+            "warning {w}"
+        );
     }
     assert_eq!(html.matches("<section class=\"estimate\"").count(), 1);
 }
