@@ -100,7 +100,7 @@ async function checkNotMeaningful(tab, scope, result) {
   const all = await tab.locator(scope).innerText();
   for (const w of walked) {
     check(w.value === '—', `${w.key} shows '${w.value}' though not meaningful`);
-    check(/not meaningful|no colour temperature|not defined|undefined|cannot|no /.test(w.reason), `${w.key}: reason '${w.reason}'`);
+    check(/not meaningful|not determinable|no colour temperature|not defined|undefined|cannot|no /.test(w.reason), `${w.key}: reason '${w.reason}'`);
     const raw = w.key === 'cri_r9' ? result.metrics.cri_r && result.metrics.cri_r[8] : result.metrics[w.key];
     if (typeof raw !== 'number') continue;
     const forms = new Set([raw.toFixed(1), raw.toFixed(2), raw.toPrecision(4)]);
@@ -219,9 +219,9 @@ await test('an uploaded photo shows the SPD and xy of `spdcam estimate --json` a
   const legend = await page.evaluate(() => [...document.querySelectorAll('#spd-plot g.legend')].map((g) => [g.textContent, g.getBBox().y + g.getBBox().height]));
   check(legend.some(([t]) => t === '68 % band') && legend.some(([t]) => t === '95 % band'), `legend ${JSON.stringify(legend)}`);
   check(legend.every(([, b]) => b <= top), `the legend reaches into the frame: ${JSON.stringify(legend)}`);
-  // The point on the xy diagram.
-  const dot = await page.locator('#xy-plot circle.xy-point').first().getAttribute('cx');
-  close((Number(dot) - 44) / (388 - 44) * 0.8, c.xy[0], 1e-4, 'x on the diagram');
+  // The point on the u′v′ diagram: u′ = 4x / (−2x + 12y + 3).
+  const u = await page.locator('#uv-plot circle.estimate-point').first().getAttribute('data-u');
+  close(Number(u), 4 * c.xy[0] / (-2 * c.xy[0] + 12 * c.xy[1] + 3), 1e-4, 'u′ on the diagram');
   // The CSV download carries the exact numbers and the band columns of the CLI's -o CSV.
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#download-csv')]);
   const csv = readFileSync(await download.path(), 'utf8').trim().split('\n');
@@ -291,7 +291,7 @@ await test('a file that is no image shows a plain error in the page', async () =
 await test('several photos share one plot', async () => {
   await page.setInputFiles('#files', [photoPath, photoPath]);
   await page.waitForFunction(() => document.querySelectorAll('#spd-plot polyline.spd').length >= 3, null, { timeout: 30000 });
-  check(await page.locator('#xy-plot circle.xy-point').count() >= 3, 'fewer than three xy points');
+  check(await page.locator('#uv-plot circle.estimate-point').count() >= 1, 'no point on the u′v′ diagram');
 });
 
 await test('the summary says in plain words what the light is and how good the estimate is', async () => {
@@ -348,14 +348,14 @@ await test('the report prints on one page on A4 and Letter, from the CLI and fro
   await cli.goto(pathToFileURL(reportPath).href);
   const pages = await printedPages(cli, 'report-cli');
   check(pages.A4 === 1 && pages.Letter === 1, `the CLI report prints on ${JSON.stringify(pages)} pages`);
-  // Nothing runs out of its column: the hue-bin and R1–R14 tables fit, all 14 R values shown.
+  // Nothing runs out of its column: the hue-bin and film/TV tables fit, R1–R15 drawn as 15
+  // bars, or none for a light too far from white.
   await cli.emulateMedia({ media: 'print' });
   const overflow = await cli.evaluate(() => [...document.querySelectorAll('table')].filter((t) => t.scrollWidth > t.parentElement.clientWidth + 1).map((t) => t.className));
   await cli.emulateMedia({ media: 'screen' });
   check(overflow.length === 0, `tables wider than their column: ${overflow}`);
-  const rShown = await cli.locator('#estimate-1 [data-key^="cri_r."]').count();
-  const rGreyed = await cli.locator('#estimate-1 p[data-key="cri_r"]').count();
-  check(rShown === 14 || rGreyed === 1, `R1–R14: ${rShown} shown`);
+  const bars = await cli.locator('#estimate-1 svg.r-bars rect').count();
+  check(bars === 15 || bars === 0, `R1–R15: ${bars} bars`);
   await cli.close();
   // The page's report of one of two photos: that photo's name and curve only.
   const tab = await context.newPage();
@@ -523,6 +523,40 @@ if (reportPath) {
     await tab.close();
   });
 }
+
+await test('the page reads from 360 to 1,920 px: nothing spills out of its box, no command-line words', async () => {
+  const input = page.locator('#files');
+  check(await input.getAttribute('accept') === 'image/*' && await input.getAttribute('capture') !== null, 'the file input offers no camera');
+  for (const width of [360, 768, 1400, 1920]) {
+    // 360 px as a phone: a touch screen at twice the pixel density.
+    const phone = width === 360;
+    const ctx = await chromium.launch({ executablePath: '/usr/bin/chromium', args: ['--headless', '--no-sandbox', '--disable-gpu'] });
+    const view = await ctx.newContext({ viewport: { width, height: phone ? 740 : 1000 }, isMobile: phone, hasTouch: phone, deviceScaleFactor: phone ? 2 : 1 });
+    const tab = await view.newPage();
+    await tab.goto(url);
+    await tab.click('#example');
+    await tab.waitForSelector('#metrics');
+    const spills = await tab.evaluate(() => {
+      const out = [];
+      if (document.documentElement.scrollWidth > window.innerWidth + 1) out.push(`the page is ${document.documentElement.scrollWidth} px wide`);
+      for (const section of document.querySelectorAll('main > section')) {
+        const box = section.getBoundingClientRect();
+        for (const el of section.querySelectorAll('*')) {
+          const r = el.getBoundingClientRect();
+          // Inside a drawing only the drawing's own box counts (its clipped parts report their full size).
+          if (r.width === 0 || getComputedStyle(el).position === 'absolute' || (el.closest('svg') && el.closest('svg') !== el)) continue;
+          if (r.right > box.right + 1 || r.left < box.left - 1) out.push(`${el.tagName.toLowerCase()}#${el.id}.${el.className && el.className.baseVal === undefined ? el.className : ''} (${Math.round(r.left)}–${Math.round(r.right)} in ${Math.round(box.left)}–${Math.round(box.right)})`);
+        }
+      }
+      return out;
+    });
+    check(spills.length === 0, `${width} px: ${spills.slice(0, 5).join('; ')}`);
+    const words = await tab.locator('body').innerText();
+    check(!COMMAND_LINE.test(words) && !/debug image|\(features? \d/.test(words), `${width} px: command-line words on the page`);
+    await tab.screenshot({ path: join(artefacts, `width-${width}.png`), fullPage: true });
+    await ctx.close();
+  }
+});
 
 await context.close();
 rmSync(profile, { recursive: true, force: true });

@@ -237,6 +237,21 @@ class Estimate:
         """The SPD as a ``colour.SpectralDistribution`` (needs colour-science)."""
         return _to_colour(self.wavelengths, self.spd, self.name)
 
+    def __repr__(self) -> str:
+        """The estimate as the command line, the report and the web page show it: the meter's
+        headline and the metrics, every number written by the library's one rule."""
+        p = self.json.get("presentation")
+        if not p:
+            return f"Estimate({self.name!r}, xy=({self.xy[0]:.4f}, {self.xy[1]:.4f}))"
+        shown = [f"{r['label']} {r['value']}" for r in p["meter"]["headline"]]
+        for group in p["groups"]:
+            for m in group["metrics"]:
+                if m["value"] is not None:
+                    unit = f" {m['unit']}" if m["unit"] else ""
+                    shown.append(f"{m['label']} {m['value']}{unit}")
+        verdict = f"; verdict {self.verdict}" if self.verdict else ""
+        return f"Estimate({self.name!r}: {', '.join(shown)}{verdict})"
+
 
 def _band(value: Optional[dict[str, Any]]) -> Optional[tuple[np.ndarray, np.ndarray]]:
     """A band of the library's JSON (``{"lower": [...], "upper": [...]}``) as two arrays."""

@@ -22,6 +22,7 @@ use spdcam_core::photo::{load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
 use spdcam_core::{fsio, named_light};
+use spdcam_infer::presentation::Presentation;
 use spdcam_infer::{Estimate, Estimator, FeatureRows, Model, ModelSet, PhotoOptions};
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -98,9 +99,11 @@ impl Models {
     }
 }
 
-/// An estimate as the JSON text of `Estimate::to_json`.
+/// An estimate as the JSON text of `Estimate::to_json`, with its `presentation` (the
+/// numbers as the command line, the report and the web page write them, for `repr`).
 fn estimate_json(estimate: &Estimate) -> PyResult<String> {
-    let value = estimate.to_json().map_err(py_err)?;
+    let mut value = estimate.to_json().map_err(py_err)?;
+    value["presentation"] = serde_json::to_value(Presentation::of(estimate)).map_err(py_err)?;
     serde_json::to_string(&value).map_err(py_err)
 }
 

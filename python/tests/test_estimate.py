@@ -117,3 +117,17 @@ def test_the_model_file_and_the_shipped_models_agree(example):
     b = spdcam.estimate(example, model=loaded)
     np.testing.assert_array_equal(a.spd, b.spd)
     assert b.model.endswith("colorchecker_sg96.spdm")
+
+
+def test_repr_shows_the_numbers_as_the_command_line_does(example, cli):
+    e = spdcam.estimate(example)
+    shown = repr(e)
+    text = cli("estimate", str(example)).stdout
+    # The meter's headline and every metric shown: the same digits as the command line.
+    for r in e.json["presentation"]["meter"]["headline"]:
+        assert r["value"] in shown and r["value"] in text, r
+    for group in e.json["presentation"]["groups"]:
+        for m in group["metrics"]:
+            if m["value"] is not None:
+                assert m["value"] in shown and m["value"] in text, m
+    assert "PPF per 1000 lx" in shown

@@ -25,7 +25,9 @@
 //!   rows read a block at a time, and the CSV layouts of many SPDs.
 //! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
 //!   verdict); [`presentation`]: what an estimate means in words and rounded numbers;
-//!   [`plot`] and [`report`]: SVG plots and the HTML report.
+//!   [`rounding`]: the one rule every front end writes numbers by; [`meter`]: what a
+//!   colour meter's screen shows; [`plot`] and [`report`]: SVG plots (with the CIE 1976
+//!   u′v′ diagram of [`chromaticity`]) and the HTML report.
 //! - [`ridge`]: closed-form ridge regression, the `linear` model's fit and the simple
 //!   learner every protocol compares against (here, so that it runs without burn).
 //! - [`error`]: the crate's error type.
@@ -63,24 +65,31 @@
 #![deny(missing_docs)]
 
 pub mod absolute;
+pub mod chromaticity;
 pub mod colour_head;
 pub mod error;
 pub mod estimate;
 pub mod estimator;
 pub mod feature_rows;
+pub mod meter;
 pub mod model;
 pub mod network;
 pub mod pca;
+pub mod people_words;
 pub mod photo_options;
 pub mod plot;
 pub mod presentation;
 pub mod record;
 pub mod report;
+mod report_meter;
 pub mod ridge;
+pub mod rounding;
 pub mod scale;
 pub mod shipped;
 pub mod stream;
 pub mod target;
+#[cfg(test)]
+mod test_support;
 pub mod trust;
 
 pub use error::{InferError, Result};

@@ -2,11 +2,9 @@
 //! supports: the one source of the HTML report ([`crate::report`]) and of the web page's
 //! summary and metric tables, so the two never say different things.
 //!
-//! - Numbers with an uncertainty are rounded by the Particle Data Group's rule (Review of
-//!   Particle Physics, Introduction §5.3): the 95 % half-width keeps two significant digits
-//!   when its three leading digits are 100–354, one when 355–949, and is rounded up to two
-//!   when 950–999; the value is rounded to the same decimal place (`154 ± 11`,
-//!   `0.00025 ± 0.00007`).
+//! - Numbers are written by the one rule of [`crate::rounding`] (the PDG's rounding; "not
+//!   determinable from this photo" where the 95 % interval is too wide), as the command
+//!   line and Python write them.
 //! - A metric that is not meaningful for the light has no number, only the reason: CCT and
 //!   TM-30 (whose reference illuminant is chosen by the CCT) farther than |Duv| 0.05 from the
 //!   Planckian locus (CIE 015:2018 §9.5; Ohno 2014), CIE 13.3 Ra and R1–R14 farther than
@@ -15,6 +13,9 @@
 //!   ([`describe_light`]).
 
 use crate::estimate::Estimate;
+use crate::meter::Meter;
+pub use crate::rounding::{round_sig, round_with_uncertainty};
+use crate::rounding::{shown, NOT_DETERMINABLE};
 use crate::trust::Verdict;
 use serde::Serialize;
 use spdcam_core::quality::CRI_MAX_DUV;
@@ -45,6 +46,14 @@ pub struct Presentation {
     pub verdict: Option<VerdictWords>,
     /// What the goodness-of-fit coefficient is, and what this estimate's expected one means.
     pub gfc: String,
+    /// What a colour meter's screen shows: the headline readings and the film/TV numbers.
+    pub meter: Meter,
+    /// The CIE 1976 u′v′ diagram of the estimate, SVG ([`crate::chromaticity`]): the
+    /// drawing the report shows, served to the web page.
+    pub uv_diagram: String,
+    /// The photo's and the metrics' warnings in a person's words
+    /// ([`crate::people_words::for_people`]), less those a greyed metric says already.
+    pub warnings: Vec<String>,
     /// The metrics in groups (colour, colour rendering, circadian and eye, plants), each
     /// group's meaningful metrics first.
     pub groups: Vec<MetricGroup>,
@@ -90,8 +99,8 @@ pub struct MetricLine {
     pub not_meaningful: Option<String>,
 }
 
-/// A metric shown: key, label, unit, explanation.
-type MetricSpec = (&'static str, &'static str, &'static str, &'static str);
+/// A metric shown: key, label, explanation (its unit is [`crate::rounding::unit`]).
+type MetricSpec = (&'static str, &'static str, &'static str);
 
 /// The metrics shown, by group.
 const GROUPS: [(&str, &[MetricSpec]); 4] = [
@@ -101,13 +110,11 @@ const GROUPS: [(&str, &[MetricSpec]); 4] = [
             (
                 "cct_k",
                 "CCT",
-                "K",
                 "How warm (low) or cool (high) a white light looks.",
             ),
             (
                 "duv",
                 "Duv",
-                "",
                 "How far from white the colour is: above 0 greenish, below 0 pinkish.",
             ),
         ],
@@ -118,25 +125,21 @@ const GROUPS: [(&str, &[MetricSpec]); 4] = [
             (
                 "cri_ra",
                 "CRI Ra",
-                "",
                 "How true eight pastel colours look (100 = like daylight or a bulb).",
             ),
             (
                 "cri_r9",
                 "CRI R9",
-                "",
                 "How true a saturated red looks (skin, food, wood).",
             ),
             (
                 "tm30_rf",
                 "TM-30 Rf",
-                "",
                 "Colour fidelity over 99 samples (100 = like the reference light).",
             ),
             (
                 "tm30_rg",
                 "TM-30 Rg",
-                "",
                 "Colour gamut: above 100 colours look more saturated, below 100 duller.",
             ),
         ],
@@ -147,19 +150,16 @@ const GROUPS: [(&str, &[MetricSpec]); 4] = [
             (
                 "mel_der",
                 "Melanopic DER",
-                "",
                 "Effect on the body clock per lux, relative to daylight D65 (1 = same).",
             ),
             (
                 "sp_ratio",
                 "S/P ratio",
-                "",
                 "Night (rod) vision per lux relative to day vision; higher looks brighter at dusk.",
             ),
             (
                 "blh_efficacy_w_per_lm",
                 "Blue-light hazard",
-                "W/lm",
                 "Retinal blue-light hazard per lumen (IEC TR 62778); lower is gentler.",
             ),
         ],
@@ -168,9 +168,8 @@ const GROUPS: [(&str, &[MetricSpec]); 4] = [
         "Plants",
         &[(
             "ppf_per_lux",
-            "PPF per lux",
-            "µmol s⁻¹ m⁻² lx⁻¹",
-            "Photosynthetic photons (400–700 nm) per lux of light.",
+            "PPF per 1000 lx",
+            "Photosynthetic photons (400–700 nm) per 1000 lux of light.",
         )],
     ),
 ];
@@ -185,18 +184,21 @@ impl Presentation {
             .map(|(title, metrics)| {
                 let mut lines: Vec<MetricLine> = metrics
                     .iter()
-                    .map(|&(key, label, unit, explanation)| {
+                    .map(|&(key, label, explanation)| {
                         let half95 = uncertainty
                             .and_then(|u| u.metrics.get(key))
                             .map(|i| i.half95);
                         let (value, not_meaningful) = match meaningful_value(estimate, key) {
-                            Ok(v) => (Some(shown_value(key, v, half95)), None),
+                            Ok(v) => match shown(key, v, half95) {
+                                Ok(text) => (Some(text), None),
+                                Err(_) => (None, Some(not_determinable_words(key, half95))),
+                            },
                             Err(why) => (None, Some(why)),
                         };
                         MetricLine {
                             key,
                             label,
-                            unit,
+                            unit: crate::rounding::unit(key),
                             explanation,
                             value,
                             not_meaningful,
@@ -212,13 +214,19 @@ impl Presentation {
             })
             .collect();
         let spread = band_spread(estimate);
-        let cct = estimate
+        let mut summary = capitalised(&light);
+        let cct_half = uncertainty
+            .and_then(|u| u.metrics.get("cct_k"))
+            .map(|i| i.half95);
+        match estimate
             .metrics
             .cct_k
-            .filter(|_| cct_meaningful(estimate).is_ok());
-        let mut summary = capitalised(&light);
-        match cct {
-            Some(cct) => summary.push_str(&format!(", about {} K", round_sig(cct, 2))),
+            .filter(|_| cct_meaningful(estimate).is_ok())
+        {
+            Some(cct) => match shown("cct_k", cct, cct_half) {
+                Ok(text) => summary.push_str(&format!(", CCT {text} K")),
+                Err(words) => summary.push_str(&format!(", its colour temperature {words}")),
+            },
             None => summary.push_str(", too far from white for a colour temperature"),
         }
         summary.push('.');
@@ -247,6 +255,22 @@ impl Presentation {
             light,
             verdict,
             gfc: gfc_words(uncertainty.map(|u| u.expected_gfc)),
+            meter: Meter::of(estimate),
+            uv_diagram: crate::chromaticity::uv_diagram_svg(estimate, None),
+            warnings: estimate
+                .photo
+                .iter()
+                .flat_map(|a| &a.warnings)
+                // A metric's warning that it is not meaningful is said by its greyed row.
+                .chain(
+                    estimate
+                        .metrics
+                        .warnings
+                        .iter()
+                        .filter(|w| !w.contains("not meaningful")),
+                )
+                .map(|w| crate::people_words::for_people(w))
+                .collect(),
             groups,
         }
     }
@@ -342,64 +366,19 @@ pub fn cri_meaningful(estimate: &Estimate) -> Result<(), String> {
     }
 }
 
-/// A metric's value as shown: with its 95 % half-width rounded by the PDG rule, or without
-/// one to the metric's usual precision.
-fn shown_value(key: &str, value: f64, half95: Option<f64>) -> String {
-    let signed = key == "duv";
-    match half95.filter(|h| *h > 0.0 && h.is_finite()) {
-        Some(half) => {
-            let (v, h) = round_with_uncertainty(value, half);
-            format!("{}{v} ± {h}", if signed && value >= 0.0 { "+" } else { "" })
-        }
-        None => match key {
-            "cct_k" => format!("{value:.0}"),
-            "duv" => format!("{value:+.4}"),
-            "cri_ra" | "cri_r9" | "tm30_rf" | "tm30_rg" => format!("{value:.0}"),
-            _ => round_sig(value, 3),
-        },
+/// Why a metric has no number although it is meaningful: its 95 % interval is too wide.
+fn not_determinable_words(key: &str, half95: Option<f64>) -> String {
+    match half95 {
+        Some(h) => format!(
+            "{NOT_DETERMINABLE} (95 % interval ± {}{})",
+            round_sig(crate::rounding::scale(key) * h, 2),
+            match crate::rounding::unit(key) {
+                "" => String::new(),
+                u => format!(" {u}"),
+            }
+        ),
+        None => NOT_DETERMINABLE.to_string(),
     }
-}
-
-/// `value` and its half-width `half` (> 0) rounded by the Particle Data Group's rule (Review
-/// of Particle Physics, Introduction §5.3), as text: `(154.3, 10.83)` → `("154", "11")`.
-pub fn round_with_uncertainty(value: f64, half: f64) -> (String, String) {
-    let exponent = half.log10().floor() as i32;
-    let leading = half / 10f64.powi(exponent - 2);
-    // The decimal place (10^place) both numbers are rounded to.
-    // Two significant digits for 100–354, one for 355–949; 950–999 rounds up to 1000,
-    // which is two significant digits at the same place.
-    let place = if leading < 354.5 {
-        exponent - 1
-    } else {
-        exponent
-    };
-    let unit = 10f64.powi(place);
-    let round = |x: f64| (x / unit).round() * unit;
-    let decimals = (-place).max(0) as usize;
-    let text = |x: f64| {
-        let s = format!("{:.decimals$}", round(x));
-        // No "-0".
-        if s.trim_start_matches('-')
-            .chars()
-            .all(|c| c == '0' || c == '.')
-        {
-            s.trim_start_matches('-').to_string()
-        } else {
-            s
-        }
-    };
-    (text(value), text(half))
-}
-
-/// `x` to `digits` significant digits, never in exponent notation: `2718` → `2700` (2).
-pub fn round_sig(x: f64, digits: i32) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let place = x.abs().log10().floor() as i32 - (digits - 1);
-    let unit = 10f64.powi(place);
-    let decimals = (-place).max(0) as usize;
-    format!("{:.decimals$}", (x / unit).round() * unit)
 }
 
 /// The mean half-width of the 95 % band over the wavelengths (the SPD's peak is 1).
@@ -545,25 +524,6 @@ fn capitalised(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn numbers_are_rounded_to_what_their_uncertainty_supports() {
-        let r = |v, h| round_with_uncertainty(v, h);
-        assert_eq!(r(154.3, 10.83), ("154".into(), "11".into()));
-        assert_eq!(
-            r(0.0002476, 0.0000662),
-            ("0.00025".into(), "0.00007".into())
-        );
-        assert_eq!(r(2718.0, 828.0), ("2700".into(), "800".into()));
-        assert_eq!(r(40.36, 14.14), ("40".into(), "14".into()));
-        assert_eq!(r(0.5, 0.0096), ("0.500".into(), "0.010".into()));
-        assert_eq!(r(81.26, 4.04), ("81".into(), "4".into()));
-        assert_eq!(r(-0.0004, 0.0031), ("-0.0004".into(), "0.0031".into()));
-        assert_eq!(r(-0.00001, 0.004), ("0.000".into(), "0.004".into()));
-        assert_eq!(round_sig(2718.0, 2), "2700");
-        assert_eq!(round_sig(0.06349, 1), "0.06");
-        assert_eq!(round_sig(12.3456, 3), "12.3");
-    }
 
     #[test]
     fn peaks_and_shapes_follow_the_documented_rules() {

@@ -1,15 +1,20 @@
 //! The HTML report of estimates (`spdcam estimate --report`, and the web page's "Report"
-//! download): for each estimate one page with the plain-words summary and verdict, the photo
-//! with the chart found, the SPD with its labelled 68/95 % bands (and the true SPD when
-//! known), the metrics grouped and rounded as [`Presentation`] gives them (those not
-//! meaningful for the light greyed with the reason), the TM-30 colour vector graphic and
-//! the detection. Everything is inline (CSS, SVG, the photo as a data URI): the page loads
+//! download): for each estimate one page with the plain-words summary, the colour meter's
+//! headline ([`crate::meter`]) and the verdict, the photo with the chart found, the SPD with
+//! its labelled 68/95 % bands (and the true SPD when known), the CIE 1976 u′v′ diagram
+//! ([`crate::chromaticity`]), the metrics grouped and rounded as [`Presentation`] gives them
+//! (those not meaningful for the light greyed with the reason), the TM-30 colour vector
+//! graphic, R1–R15 as bars with SSI and the filter corrections, and the detection. Everything is inline (CSS, SVG, the photo as a data URI): the page loads
 //! nothing. Each estimate prints on one A4 or Letter page.
 
+use crate::chromaticity::uv_diagram_svg;
+use crate::estimate::Colorimetry;
 use crate::estimate::Estimate;
-use crate::presentation::{cct_meaningful, cri_meaningful, Presentation};
+use crate::presentation::{cct_meaningful, Presentation};
+use crate::report_meter::{film_tv_html, headline_html};
 use crate::trust::Band;
 use spdcam_core::quality::HueBin;
+use spdcam_core::spectral::Spd;
 use std::fmt::Write as _;
 
 /// Widest photo embedded in a report, in pixels.
@@ -71,7 +76,9 @@ p{margin:3px 0}section{margin-bottom:28px}\
 .verdict.doubtful{border-color:#8a5a00;background:#fbf3df}.verdict.unusable{border-color:#b3261e;background:#fbe6e4}\
 .verdict strong{font-size:14px}.verdict ul{margin:2px 0 0;padding-left:18px}\
 .row{display:grid;grid-template-columns:minmax(0,1fr) minmax(0,1fr);gap:12px;align-items:start;margin-top:6px}\
-.row.with-tm30{grid-template-columns:minmax(0,3fr) minmax(0,2fr)}.row.single{grid-template-columns:minmax(0,1fr)}\
+.row.three{grid-template-columns:minmax(0,1fr) minmax(0,1.2fr) minmax(0,0.9fr)}.row.with-tm30{grid-template-columns:minmax(0,3fr) minmax(0,2fr)}\
+.meter{display:flex;flex-wrap:wrap;gap:4px 18px;margin:4px 0}.meter .reading .label{color:#555;font-size:11px;display:block}.meter .reading .value{font-size:17px;font-weight:600;font-variant-numeric:tabular-nums}\
+svg.uv-diagram{max-width:300px;margin:auto}svg.r-bars{max-width:420px}.row.single{grid-template-columns:minmax(0,1fr)}\
 figure{margin:0}figcaption,.small{font-size:11px;color:#555}\
 img.photo{max-width:100%;max-height:320px;height:auto;display:block;margin:auto}\
 svg{width:100%;height:auto;display:block}svg.tm30-cvg{max-width:250px;margin:auto}\
@@ -86,8 +93,8 @@ table.grid-table th:first-child{text-align:left;width:22%}table.metrics th{white
 @page{margin:9mm}\
 @media print{body{margin:0;max-width:none;padding:0;font-size:7.5pt}h1{font-size:13pt}h3{font-size:8.5pt;margin:4px 0 2px}\
 .summary{font-size:9pt}.verdict{padding:3px 8px;margin:3px 0}.verdict strong{font-size:9pt}\
-img.photo{max-height:58mm;width:auto}svg.spd-plot{max-height:62mm}svg.tm30-cvg{max-width:50mm}\
-figcaption,.small,table.metrics td.explain{font-size:6.5pt}table.grid-table{font-size:6.5pt}\
+img.photo{max-height:42mm;width:auto}svg.spd-plot{max-height:42mm}svg.uv-diagram{max-height:44mm}svg.r-bars{max-height:19mm}.meter .reading .value{font-size:10pt}.meter .reading .label{font-size:6.5pt}svg.tm30-cvg{max-width:44mm}\
+figcaption,.small,table.metrics td.explain{font-size:6.5pt}tr.metric:not(.not-meaningful) td.explain{display:none}.film-tv td,.film-tv th{padding:0 4px 0 0}table.grid-table{font-size:6.5pt}\
 section{break-after:page;margin:0}section:last-of-type{break-after:auto}\
 .row{gap:8px;margin-top:3px}}";
 
@@ -120,6 +127,7 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
         esc(&e.name),
         esc(&p.summary)
     );
+    headline_html(out, &p.meter);
     if let Some(v) = &p.verdict {
         let _ = write!(
             out,
@@ -138,7 +146,7 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
         }
         out.push_str("</div>\n");
     }
-    out.push_str("<div class=\"row\">\n");
+    out.push_str("<div class=\"row three\">\n");
     match &item.image {
         Some(image) => {
             let _ = writeln!(
@@ -179,6 +187,27 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
             ""
         }
     );
+    let truth_xy = truth
+        .as_ref()
+        .and_then(|t| Spd::new(*e.spd.grid(), t.clone()).ok())
+        .and_then(|t| Colorimetry::of(&t).ok())
+        .map(|c| c.xy);
+    let _ = writeln!(
+        out,
+        "<figure>{}<figcaption>CIE 1976 u′v′: the estimate (blue dot){}{}, the Planckian \
+         locus with isotemperature lines; the inset enlarges its neighbourhood.</figcaption></figure>",
+        uv_diagram_svg(e, truth_xy),
+        if crate::chromaticity::region95(e).is_some() {
+            " with its 95 % region (from the CCT and Δuv intervals)"
+        } else {
+            ""
+        },
+        if truth_xy.is_some() {
+            ", the truth (×)"
+        } else {
+            ""
+        }
+    );
     out.push_str("</div>\n");
     let bins = tm30_bins(e);
     let _ = writeln!(
@@ -208,14 +237,9 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
             );
         }
     }
-    cri_table(out, e);
+    film_tv_html(out, &p.meter);
     facts(out, e);
-    let warnings: Vec<&String> = e
-        .photo
-        .iter()
-        .flat_map(|a| &a.warnings)
-        .chain(&e.metrics.warnings)
-        .collect();
+    let warnings = &p.warnings;
     if !warnings.is_empty() {
         out.push_str("<ul class=\"warnings small\">");
         for w in warnings {
@@ -286,34 +310,6 @@ fn metrics_table(out: &mut String, p: &Presentation) {
     );
 }
 
-/// CIE 13.3's R1–R14 in one row, or why they are not shown.
-fn cri_table(out: &mut String, e: &Estimate) {
-    let Some(r) = e.metrics.cri_r else {
-        return;
-    };
-    if let Err(why) = cri_meaningful(e) {
-        let _ = writeln!(
-            out,
-            "<p class=\"undefined\" data-key=\"cri_r\">CIE 13.3 R1–R14: {}</p>",
-            esc(&why)
-        );
-        return;
-    }
-    out.push_str("<table class=\"grid-table cri-r\"><tr><th>CIE 13.3</th>");
-    for i in 1..=r.len() {
-        let _ = write!(out, "<th>R{i}</th>");
-    }
-    out.push_str("</tr><tr><th>special index</th>");
-    for (i, v) in r.iter().enumerate() {
-        let _ = write!(
-            out,
-            "<td class=\"num\" data-key=\"cri_r.{}\">{v:.0}</td>",
-            i + 1
-        );
-    }
-    out.push_str("</tr></table>\n");
-}
-
 /// The photo, the detection and the score against the truth, in one small table.
 fn facts(out: &mut String, e: &Estimate) {
     let mut rows: Vec<(&str, &str, String)> = Vec::new();
@@ -345,16 +341,6 @@ fn facts(out: &mut String, e: &Estimate) {
                 a.width,
                 a.height,
                 a.patches.len()
-            ),
-        ));
-    }
-    if let Some(Ok(level)) = &e.absolute {
-        rows.push((
-            "illuminance",
-            "illuminance (approx., from EXIF)",
-            format!(
-                "{} lx",
-                crate::presentation::round_sig(level.illuminance_lux, 2)
             ),
         ));
     }
@@ -671,7 +657,7 @@ fn tm30_svg(bins: &[HueBin], rf: Option<f64>, rg: Option<f64>) -> String {
 }
 
 /// Text escaped for HTML (element content and quoted attributes).
-fn esc(s: &str) -> String {
+pub(crate) fn esc(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for ch in s.chars() {
         match ch {

@@ -29,7 +29,9 @@ fn meaningful_cct(light: &LightSpectrum, what: &str) -> Result<(f64, f64)> {
         .map_err(|e| Error::invalid(format!("no {what}: {e}")))?;
     if duv.abs() > CCT_MAX_ABS_DUV {
         return Err(Error::invalid(format!(
-            "no {what}: the light is Δuv {duv:.4} from the Planckian locus, beyond the              ±{CCT_MAX_ABS_DUV} within which a colour temperature means anything; it is a              coloured light, described by its dominant wavelength"
+            "no {what}: the light is Δuv {duv:.4} from the Planckian locus, beyond the \
+             ±{CCT_MAX_ABS_DUV} within which a colour temperature means anything; it is a \
+             coloured light, described by its dominant wavelength"
         )));
     }
     Ok((cct, duv))

@@ -5,6 +5,7 @@
 //! reads truths, and prints and writes what the estimates say.
 
 mod features;
+mod meter_lines;
 mod photos;
 mod print;
 mod row_lines;

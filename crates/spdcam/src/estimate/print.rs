@@ -1,17 +1,17 @@
 //! What `spdcam estimate` prints and writes besides the SPDs: the estimates as text, the
 //! verdicts, the bands' columns and the HTML report.
 
+use super::meter_lines::{film_tv_line, headline_line, metrics_line};
 use super::{EstimateArgs, DETAILED_MAX};
 use crate::outln;
 use anyhow::Result;
 use spdcam_core::fsio;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
-use spdcam_infer::estimate::Colorimetry;
-use spdcam_infer::presentation::meaningful_value;
+use spdcam_infer::meter::Meter;
 use spdcam_infer::report::{report_html, ReportImage, ReportItem};
-use spdcam_infer::trust::{MetricInterval, Trust, Verdict};
+use spdcam_infer::rounding::NOT_DETERMINABLE;
+use spdcam_infer::trust::{Trust, Verdict};
 use spdcam_infer::Estimate;
-use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The estimates as text: colorimetry and the SPD every 25 nm (for up to 20), the score
@@ -29,23 +29,17 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Re
         if unusable {
             outln!("{}: UNUSABLE, no estimate to rely on", e.name)?;
         } else if detailed {
-            let intervals = e
-                .trust
-                .as_ref()
-                .and_then(|t| t.uncertainty.as_ref())
-                .map(|u| &u.metrics);
-            outln!(
-                "{}: {}",
-                e.name,
-                colorimetry_line(&e.colorimetry, intervals)
-            )?;
+            let meter = Meter::of(e);
+            outln!("{}: {}", e.name, headline_line(e, &meter))?;
             outln!("  relative SPD: {}", spd_line(&e.spd))?;
-            outln!("  {}", metrics_line(e, intervals))?;
+            outln!("  {}", metrics_line(e))?;
+            if let Some(line) = film_tv_line(&meter) {
+                outln!("  {line}")?;
+            }
             match (&e.absolute, e.photo.as_ref().and_then(|p| p.exposure)) {
                 (Some(Ok(a)), _) => outln!(
-                    "  absolute (approximate, from {}): {:.0} lx, PPFD {}, melanopic EDI {}",
+                    "  absolute (approximate, from {}): PPFD {}, melanopic EDI {}",
                     a.exposure.label(),
-                    a.illuminance_lux,
                     a.ppfd_umol_m2_s
                         .map_or_else(|| "—".into(), |v| format!("{v:.1} µmol/m²/s")),
                     a.melanopic_edi_lux
@@ -91,7 +85,8 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Re
         outln!(
             "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and gamut; \
              M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: scotopic/photopic; \
-             PPF: µmol/s of 400–700 nm photons per klm; ± the 95 % interval when calibrated; \
+             PPF: 400–700 nm photons per 1000 lx; ± the 95 % interval when calibrated, \
+             \"{NOT_DETERMINABLE}\" where it is too wide to say anything; \
              — where not defined or not meaningful (CRI and TM-30 need a light near white); \
              computed on the estimate's {}–{} nm only \
              (`spdcam metrics` on a wider SPD, `--json` for every number)",
@@ -211,49 +206,6 @@ pub(super) fn with_bands(estimates: &[Estimate], grid: &Grid) -> Result<Spectral
         }
     }
     Ok(SpectralSet::on_grid(grid, names, values)?)
-}
-
-/// The main lighting-quality numbers on one line, `—` where undefined or not meaningful for
-/// this light (CRI and TM-30 far from white, as the report shows them), each with its 95 %
-/// interval when the estimate has one: `Ra 82 ± 4 (R9 20 ± 15), …`.
-pub(super) fn metrics_line(
-    e: &Estimate,
-    intervals: Option<&BTreeMap<String, MetricInterval>>,
-) -> String {
-    let f = |key: &str, d: usize, unit: f64| {
-        let Ok(v) = meaningful_value(e, key) else {
-            return "—".to_string();
-        };
-        match intervals.and_then(|i| i.get(key)) {
-            Some(i) => format!("{:.d$} ± {:.d$}", unit * v, unit * i.half95),
-            None => format!("{:.d$}", unit * v),
-        }
-    };
-    format!(
-        "Ra {} (R9 {}), Rf {}, Rg {}, M-EDER {}, S/P {}, PPF {}",
-        f("cri_ra", 0, 1.0),
-        f("cri_r9", 0, 1.0),
-        f("tm30_rf", 0, 1.0),
-        f("tm30_rg", 0, 1.0),
-        f("mel_der", 2, 1.0),
-        f("sp_ratio", 2, 1.0),
-        f("ppf_per_lux", 1, 1000.0),
-    )
-}
-
-/// xy, CCT and Duv of an estimate, CCT and Duv with their 95 % intervals when it has them.
-pub(super) fn colorimetry_line(
-    c: &Colorimetry,
-    intervals: Option<&BTreeMap<String, MetricInterval>>,
-) -> String {
-    let half = |key: &str| intervals.and_then(|i| i.get(key)).map(|i| i.half95);
-    match (c.cct, c.duv, half("cct_k"), half("duv")) {
-        (Some(cct), Some(duv), Some(hc), Some(hd)) => format!(
-            "xy ({:.4}, {:.4}), CCT {cct:.0} ± {hc:.0} K, Duv {duv:+.4} ± {hd:.4}",
-            c.xy[0], c.xy[1]
-        ),
-        _ => c.label(),
-    }
 }
 
 /// The SPD every 25 nm, peak-normalised, on one terminal line: `400:0.12 425:0.40 …`.

@@ -1,7 +1,7 @@
 //! The answer of every route: a status, a content type and a body, with the headers every
 //! answer carries; errors as JSON with a message for a person.
 
-use super::plain_error::plain_error;
+use super::plain_error::{for_http, plain_error};
 use crate::serve::jobs::Outcome;
 use axum::body::Body;
 use axum::http::{header, HeaderValue, StatusCode};
@@ -15,14 +15,15 @@ impl Answer {
         Answer(status, "application/json", value.to_string().into())
     }
 
-    /// `{"error", "code", "message"}`: the library's message, and a code and a message
-    /// for a person ([`plain_error`]).
+    /// `{"error", "code", "message"}`: the library's message in an HTTP client's words
+    /// ([`for_http`]: form fields, not flags), and a code and a message for a person
+    /// ([`plain_error`]).
     pub(super) fn error(status: u16, error: impl Into<String>) -> Answer {
         let error = error.into();
         let (code, message) = plain_error(status, &error);
         Answer::json(
             status,
-            &serde_json::json!({ "error": error, "code": code, "message": message }),
+            &serde_json::json!({ "error": for_http(&error), "code": code, "message": message }),
         )
     }
 

@@ -9,7 +9,8 @@ pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
     let (code, message) = if error.contains("no chart found") {
         (
             "no_chart",
-            "No colour chart was found in this photo. Click its four corners on the photo to              show where it is."
+            "No colour chart was found in this photo. Click its four corners on the photo to \
+             show where it is."
                 .to_string(),
         )
     } else if error.contains("not an image") || error.contains("decod") {
@@ -20,7 +21,8 @@ pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
     } else if error.contains("no model for chart") {
         (
             "unknown_chart",
-            "The chart in this photo is not one spdcam reads: use a ColorChecker 24 or a              ColorChecker Digital SG."
+            "The chart in this photo is not one spdcam reads: use a ColorChecker 24 or a \
+             ColorChecker Digital SG."
                 .to_string(),
         )
     } else if error.contains("corners") {
@@ -53,6 +55,20 @@ pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
         }
     };
     (code, message)
+}
+
+/// The library's `error` for an HTTP client: command-line options become the form fields
+/// that do their job (`--corners` → the `corners` field, `--chart` → the `chart` field),
+/// and clauses naming other options or commands go.
+pub(super) fn for_http(error: &str) -> String {
+    let named = error
+        .replace(
+            "give its corners with --corners x1,y1,…,x4,y4",
+            "give its corners in the form field `corners` (x1,y1,…,x4,y4)",
+        )
+        .replace("--corners", "the form field `corners`")
+        .replace("--chart", "the form field `chart`");
+    without_flags(&named)
 }
 
 /// `error` without the clauses (split at `;` and parentheses) that name command-line
@@ -100,6 +116,16 @@ mod tests {
             assert_eq!(code, want, "{error}");
             for word in ["--", "spdcam serve", "spdcam estimate", "corners with"] {
                 assert!(!message.contains(word), "{message}");
+            }
+        }
+        let http = for_http(cases[0].1);
+        assert!(
+            http.contains("form field `corners`") && !http.contains("--"),
+            "{http}"
+        );
+        for (status, error, _) in cases {
+            for text in [plain_error(status, error).1, for_http(error)] {
+                assert!(!text.contains("  ") && !text.contains("--"), "{text}");
             }
         }
         assert_eq!(

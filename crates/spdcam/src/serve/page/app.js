@@ -10,7 +10,7 @@ const SVG = 'http://www.w3.org/2000/svg';
 const COLORS = ['#d62728', '#1f77b4', '#2ca02c', '#9467bd', '#ff7f0e', '#17becf', '#8c564b', '#e377c2'];
 const POLL_MS = 80;
 
-const state = { entries: [], selected: null, locus: null, reference: null, nextId: 1 };
+const state = { entries: [], selected: null, reference: null, nextId: 1 };
 
 const $ = (id) => document.getElementById(id);
 
@@ -223,7 +223,7 @@ function render() {
   renderOverview();
   renderStage();
   renderSpd();
-  renderXy();
+  renderUv();
   renderSummary();
 }
 
@@ -576,38 +576,17 @@ function renderSpd() {
   }
 }
 
-const XY_BOX = { left: 44, right: 388, top: 10, bottom: 392, xmax: 0.8, ymax: 0.9 };
-
-function renderXy() {
-  const svg = $('xy-plot');
-  svg.replaceChildren();
-  const { left, right, top, bottom, xmax, ymax } = XY_BOX;
-  const X = (x) => left + (x / xmax) * (right - left);
-  const Y = (y) => bottom - (y / ymax) * (bottom - top);
-  el('rect', { x: 0, y: 0, width: 400, height: 420, fill: '#fff' }, svg);
-  for (let v = 0; v <= 0.80001; v += 0.1) {
-    el('line', { x1: X(v), x2: X(v), y1: top, y2: bottom, stroke: '#eceef2' }, svg);
-    el('text', { x: X(v), y: bottom + 14, 'text-anchor': 'middle', 'font-size': 11, fill: '#5b6475', 'font-family': 'sans-serif' }, svg, v.toFixed(1));
-  }
-  for (let v = 0; v <= 0.90001; v += 0.1) {
-    el('line', { x1: left, x2: right, y1: Y(v), y2: Y(v), stroke: '#eceef2' }, svg);
-    el('text', { x: left - 5, y: Y(v) + 4, 'text-anchor': 'end', 'font-size': 11, fill: '#5b6475', 'font-family': 'sans-serif' }, svg, v.toFixed(1));
-  }
-  el('text', { x: (left + right) / 2, y: 418, 'text-anchor': 'middle', 'font-size': 12, 'font-family': 'sans-serif' }, svg, 'x');
-  el('text', { x: 10, y: (top + bottom) / 2, 'font-size': 12, 'font-family': 'sans-serif' }, svg, 'y');
-  if (state.locus) {
-    const spectral = state.locus.spectral;
-    el('polygon', { class: 'locus', points: spectral.map((p) => `${X(p[1]).toFixed(2)},${Y(p[2]).toFixed(2)}`).join(' '), fill: '#f7f3ea', stroke: '#1d2330', 'stroke-width': 1 }, svg);
-    for (const p of spectral) {
-      if (![460, 480, 500, 520, 540, 560, 580, 600, 620].includes(p[0])) continue;
-      el('text', { x: X(p[1]) + (p[1] < 0.2 ? -6 : 6), y: Y(p[2]) + 4, 'text-anchor': p[1] < 0.2 ? 'end' : 'start', 'font-size': 10, fill: '#5b6475', 'font-family': 'sans-serif' }, svg, p[0]);
-    }
-    el('polyline', { class: 'planckian', points: state.locus.planckian.map((p) => `${X(p[1]).toFixed(2)},${Y(p[2]).toFixed(2)}`).join(' '), fill: 'none', stroke: '#8a5a00', 'stroke-width': 1 }, svg);
-  }
-  for (const e of state.entries.filter((en) => en.result && en.visible)) {
-    const [x, y] = e.result.colorimetry.xy;
-    el('circle', { class: 'xy-point', 'data-entry': e.name, cx: X(x), cy: Y(y), r: e.id === state.selected ? 5 : 4, fill: e.color, stroke: '#fff', 'stroke-width': 1 }, svg);
-  }
+/** The CIE 1976 u′v′ diagram of the selected estimate: the server's SVG (the drawing its
+ *  report shows). */
+function renderUv() {
+  const box = $('uv-plot');
+  box.replaceChildren();
+  const e = selected();
+  const svgText = e && e.result && e.result.presentation && e.result.presentation.uv_diagram;
+  if (!svgText) { html('p', { class: 'placeholder' }, box, 'The light\'s colour appears here.'); return; }
+  // Parsed as inline SVG in an inert document: nothing in it runs.
+  const svg = new DOMParser().parseFromString(svgText, 'text/html').body.firstElementChild;
+  if (svg && svg.nodeName.toLowerCase() === 'svg') box.append(document.importNode(svg, true));
 }
 
 function row(table, label, value, id) {
@@ -635,6 +614,7 @@ function renderOverview() {
   }
   const p = e.result.presentation;
   html('p', { id: 'plain-summary', class: 'plain-summary' }, box, p.summary);
+  meterReadings(box, p.meter);
   if (p.verdict) {
     const v = html('div', { class: `verdict ${p.verdict.label}`, id: 'verdict', 'data-verdict': p.verdict.label }, box);
     html('strong', {}, v, `Verdict: ${p.verdict.headline}`);
@@ -645,6 +625,29 @@ function renderOverview() {
     }
   }
   html('p', { class: 'note', id: 'gfc-words' }, box, p.gfc);
+}
+
+/** What a colour meter's screen leads with: CCT and Δuv, or the dominant wavelength, purity
+ *  and peak of a coloured light; the illuminance when the photo's exposure gives it. */
+function meterReadings(box, meter) {
+  if (!meter) return;
+  const div = html('div', { class: `meter ${meter.kind}`, id: 'meter' }, box);
+  const reading = (label, value, key) => {
+    const r = html('div', { class: 'reading' }, div);
+    html('div', { class: 'label' }, r, label);
+    html('div', { class: 'value', 'data-key': key }, r, value);
+  };
+  meter.headline.forEach((r) => reading(r.label, r.value, r.key));
+  if (meter.illuminance) reading('Illuminance', meter.illuminance, 'illuminance');
+}
+
+/** The film and TV numbers: R1–R15, SSI and the filter corrections. */
+function filmTv(box, meter) {
+  if (!meter || (!meter.r1_r15 && !meter.film_tv.length)) return;
+  html('h3', {}, box, 'Film and TV');
+  const table = html('table', { id: 'film-tv', class: 'film-tv' }, box);
+  if (meter.r1_r15) row(table, 'R1–R15', meter.r1_r15.map((v) => (v === null ? '—' : v.toFixed(0))).join(' ') + (meter.r1_r15[8] === null ? ' (R9 not determinable from this photo)' : ''), 'r1-r15');
+  meter.film_tv.forEach((r) => row(table, r.label, r.value, `film-${r.key}`));
 }
 
 /** The grouped metrics of a presentation: a rounded value with ± (95 %) and a line of what it
@@ -682,7 +685,8 @@ function renderSummary() {
   if (r.presentation) {
     html('h3', {}, box, 'Lighting metrics');
     metricGroups(box, r.presentation);
-    if (r.metric_uncertainty) html('p', { class: 'note' }, box, '± : the 95 % interval of the metric, calibrated on photos held out from training; numbers are rounded to what it supports.');
+    if (r.metric_uncertainty) html('p', { class: 'note' }, box, '± : the 95 % interval of the metric, calibrated on photos held out from training; numbers are rounded to what it supports, and not shown where it is too wide.');
+    filmTv(box, r.presentation.meter);
   }
   html('h3', {}, box, 'Details');
   const table = html('table', { id: 'facts' }, box);
@@ -696,7 +700,6 @@ function renderSummary() {
   }
   if (r.absolute) {
     // Approximate absolute levels from the photo's EXIF exposure (see the JSON's note).
-    row(table, 'illuminance (approx.)', `${fmt(r.absolute.illuminance_lux, 0)} lx`, 'illuminance');
     if (r.absolute.ppfd_umol_m2_s != null) row(table, 'PPFD (approx.)', `${fmt(r.absolute.ppfd_umol_m2_s, 1)} µmol m⁻² s⁻¹`);
     if (r.absolute.melanopic_edi_lux != null) row(table, 'melanopic EDI (approx.)', `${fmt(r.absolute.melanopic_edi_lux, 0)} lx`);
   }
@@ -713,7 +716,7 @@ function renderSummary() {
     row(table, 'GFC against the reference', fmt(score.gfc, 4), 'ref-gfc');
     row(table, 'RMSE against the reference', fmt(score.rmse, 4), 'ref-rmse');
   }
-  const warnings = ((r.photo && r.photo.warnings) || []).concat((r.metrics && r.metrics.warnings) || []);
+  const warnings = (r.presentation && r.presentation.warnings) || [];
   if (warnings.length) {
     html('h3', {}, box, 'Warnings');
     const ul = html('ul', { class: 'warnings', id: 'warnings' }, box);
@@ -799,12 +802,6 @@ function svgToPng(svg, scale) {
 async function start() {
   setupInputs();
   render();
-  try {
-    state.locus = await (await fetch('api/locus')).json();
-  } catch (err) {
-    state.locus = null;
-  }
-  renderXy();
 }
 
 start();

@@ -1,0 +1,343 @@
+//! The CIE 1976 u′v′ chromaticity diagram of an estimate, as SVG: one drawing for the
+//! report and the web page.
+//!
+//! - The spectral locus is the CIE 1931 2° observer's (360–700 nm, 5 nm, as the core ships
+//!   it), closed by the line of purples; u′ = 4X/(X + 15Y + 3Z), v′ = 9Y/(X + 15Y + 3Z)
+//!   (CIE 015:2018 §8.1; u′ = u, v′ = 1.5 v of CIE 1960 uv).
+//! - The Planckian locus (1000–20,000 K, Planck's law through the same observer) with
+//!   isotemperature lines at 2000, 2700, 3000, 4000, 5000, 6500 and 10,000 K, each drawn
+//!   ±0.05 along the locus normal in CIE 1960 uv (the range in which a CCT means anything,
+//!   Ohno 2014; isotemperature lines are normal to the locus in uv, CIE 015:2018 §9.5).
+//! - The estimate's point and, when its CCT and Δuv have calibrated 95 % intervals, the 95 %
+//!   region: the ellipse with those half-widths as semi-axes in the (CCT, Δuv) plane, mapped
+//!   into u′v′ (an approximation: the two intervals are treated as independent). The truth's
+//!   point when known. An inset enlarges the neighbourhood of the estimate, where the region
+//!   is seen.
+
+use crate::estimate::Estimate;
+use spdcam_core::colorimetry::{cct_duv_to_uv, cct_to_uv_planck, Observer};
+use spdcam_core::spectral::Grid;
+use std::fmt::Write as _;
+
+/// The isotemperature lines drawn, kelvin.
+pub const ISOTEMPERATURE_K: [f64; 7] = [2000.0, 2700.0, 3000.0, 4000.0, 5000.0, 6500.0, 10000.0];
+
+/// The SVG's size, in its own units.
+const SIZE: (f64, f64) = (400.0, 400.0);
+
+/// The main panel: pixel box (left, top, right, bottom) and the u′, v′ ranges it shows.
+const MAIN: View = View {
+    px: (40.0, 10.0, 390.0, 365.0),
+    u: (0.0, 0.63),
+    v: (0.0, 0.64),
+};
+
+/// A window of u′v′ drawn into a pixel box.
+#[derive(Debug, Clone, Copy)]
+struct View {
+    px: (f64, f64, f64, f64),
+    u: (f64, f64),
+    v: (f64, f64),
+}
+
+impl View {
+    /// The pixel position of `uv` (u′, v′).
+    fn at(&self, uv: [f64; 2]) -> (f64, f64) {
+        let (l, t, r, b) = self.px;
+        (
+            l + (uv[0] - self.u.0) / (self.u.1 - self.u.0) * (r - l),
+            b - (uv[1] - self.v.0) / (self.v.1 - self.v.0) * (b - t),
+        )
+    }
+
+    /// `points` as an SVG `points` attribute.
+    fn points(&self, points: &[[f64; 2]]) -> String {
+        points
+            .iter()
+            .map(|p| {
+                let (x, y) = self.at(*p);
+                format!("{x:.2},{y:.2}")
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}
+
+/// CIE 1931 xy → CIE 1976 u′v′.
+pub fn xy_to_uv_prime(xy: [f64; 2]) -> [f64; 2] {
+    let d = -2.0 * xy[0] + 12.0 * xy[1] + 3.0;
+    [4.0 * xy[0] / d, 9.0 * xy[1] / d]
+}
+
+/// CIE 1960 uv → CIE 1976 u′v′.
+fn uv1960_to_prime(uv: [f64; 2]) -> [f64; 2] {
+    [uv[0], 1.5 * uv[1]]
+}
+
+/// The spectral locus in u′v′ with its wavelengths, 360–700 nm every 5 nm.
+fn spectral_locus() -> Vec<(f64, [f64; 2])> {
+    let Ok(grid) = Grid::new(360.0, 700.0, 5.0) else {
+        return Vec::new();
+    };
+    let Ok(observer) = Observer::cie1931(&grid) else {
+        return Vec::new();
+    };
+    let (x, y, z) = (observer.cmf(0), observer.cmf(1), observer.cmf(2));
+    grid.wavelengths()
+        .into_iter()
+        .enumerate()
+        .filter_map(|(i, nm)| {
+            let d = x[i] + 15.0 * y[i] + 3.0 * z[i];
+            (d > 0.0).then(|| (nm, [4.0 * x[i] / d, 9.0 * y[i] / d]))
+        })
+        .collect()
+}
+
+/// The Planckian locus in u′v′, 1000–20,000 K in 2 % steps.
+fn planckian_locus() -> Vec<[f64; 2]> {
+    let mut out = Vec::new();
+    let mut t = 1000.0_f64;
+    while t <= 20000.0 {
+        if let Ok(uv) = cct_to_uv_planck(t) {
+            out.push(uv1960_to_prime(uv));
+        }
+        t *= 1.02;
+    }
+    out
+}
+
+/// The estimate's 95 % region in u′v′ (see the module's documentation), when its CCT is
+/// meaningful (near the Planckian locus) and its CCT and Δuv have calibrated intervals.
+pub fn region95(e: &Estimate) -> Option<Vec<[f64; 2]>> {
+    crate::presentation::cct_meaningful(e).ok()?;
+    let (cct, duv) = (e.metrics.cct_k?, e.metrics.duv?);
+    let u = e.trust.as_ref()?.uncertainty.as_ref()?;
+    let (ht, hd) = (u.metrics.get("cct_k")?.half95, u.metrics.get("duv")?.half95);
+    (0..48)
+        .map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / 48.0;
+            let t = (cct + ht * a.cos()).max(1000.0);
+            cct_duv_to_uv(t, duv + hd * a.sin())
+                .ok()
+                .map(uv1960_to_prime)
+        })
+        .collect()
+}
+
+/// The u′v′ diagram of estimate `e` (and of its truth's chromaticity `truth_xy` when known)
+/// as a self-contained SVG element.
+pub fn uv_diagram_svg(e: &Estimate, truth_xy: Option<[f64; 2]>) -> String {
+    let point = xy_to_uv_prime(e.colorimetry.xy);
+    let truth = truth_xy.map(xy_to_uv_prime);
+    let region = region95(e);
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "<svg class=\"uv-diagram\" viewBox=\"0 0 {} {}\" \
+         role=\"img\" aria-label=\"CIE 1976 u′v′ chromaticity diagram with the estimate\" \
+         font-family=\"sans-serif\">",
+        SIZE.0, SIZE.1
+    );
+    let _ = write!(
+        s,
+        "<rect width=\"{}\" height=\"{}\" fill=\"#fff\"/>",
+        SIZE.0, SIZE.1
+    );
+    let (l, t, r, b) = MAIN.px;
+    for i in 0..=6 {
+        let g = 0.1 * f64::from(i);
+        let (x, _) = MAIN.at([g, 0.0]);
+        let (_, y) = MAIN.at([0.0, g]);
+        let _ = write!(
+            s,
+            "<line x1=\"{x:.1}\" x2=\"{x:.1}\" y1=\"{t}\" y2=\"{b}\" stroke=\"#eceef2\"/>\
+             <text x=\"{x:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"middle\" fill=\"#5b6475\">{g:.1}</text>\
+             <line x1=\"{l}\" x2=\"{r}\" y1=\"{y:.1}\" y2=\"{y:.1}\" stroke=\"#eceef2\"/>\
+             <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"end\" fill=\"#5b6475\">{g:.1}</text>",
+            b + 14.0,
+            l - 4.0,
+            y + 4.0
+        );
+    }
+    let _ = write!(
+        s,
+        "<text x=\"{:.0}\" y=\"396\" font-size=\"12\" text-anchor=\"middle\">u′</text>\
+         <text x=\"8\" y=\"{:.0}\" font-size=\"12\">v′</text>",
+        (l + r) / 2.0,
+        (t + b) / 2.0
+    );
+    draw_view(&mut s, &MAIN, point, truth, region.as_deref(), true);
+    // The inset: 0.06 × 0.06 around the estimate (wider when the region or truth needs it).
+    let mut half = 0.03_f64;
+    for p in region.iter().flatten().chain(truth.iter()) {
+        half = half
+            .max((p[0] - point[0]).abs() * 1.15)
+            .max((p[1] - point[1]).abs() * 1.15);
+    }
+    let inset = View {
+        px: (235.0, 215.0, 385.0, 355.0),
+        u: (point[0] - half, point[0] + half),
+        v: (point[1] - half, point[1] + half),
+    };
+    let (il, it, ir, ib) = inset.px;
+    let _ = write!(
+        s,
+        "<defs><clipPath id=\"uv-inset-clip\"><rect x=\"{il}\" y=\"{it}\" width=\"{}\" height=\"{}\"/></clipPath></defs>\
+         <rect x=\"{il}\" y=\"{it}\" width=\"{}\" height=\"{}\" fill=\"#fff\" stroke=\"#1d2330\"/>\
+         <g class=\"inset\" clip-path=\"url(#uv-inset-clip)\">",
+        ir - il,
+        ib - it,
+        ir - il,
+        ib - it
+    );
+    draw_view(&mut s, &inset, point, truth, region.as_deref(), false);
+    let _ = write!(
+        s,
+        "</g><text x=\"{:.0}\" y=\"{:.0}\" font-size=\"10\" fill=\"#5b6475\">enlarged ±{}</text></svg>",
+        il + 4.0,
+        ib - 4.0,
+        crate::rounding::round_sig(half, 1)
+    );
+    s
+}
+
+/// The loci, the isotemperature lines, the region, the truth and the point, in `view`;
+/// wavelength and temperature labels when `labels`.
+fn draw_view(
+    s: &mut String,
+    view: &View,
+    point: [f64; 2],
+    truth: Option<[f64; 2]>,
+    region: Option<&[[f64; 2]]>,
+    labels: bool,
+) {
+    let locus = spectral_locus();
+    let pts: Vec<[f64; 2]> = locus.iter().map(|(_, p)| *p).collect();
+    let _ = write!(
+        s,
+        "<polygon class=\"spectral-locus\" points=\"{}\" fill=\"#f7f3ea\" stroke=\"#1d2330\"/>",
+        view.points(&pts)
+    );
+    if labels {
+        for (nm, p) in locus.iter().filter(|(nm, _)| {
+            [
+                460.0, 480.0, 500.0, 520.0, 540.0, 560.0, 580.0, 600.0, 620.0,
+            ]
+            .contains(nm)
+        }) {
+            let (x, y) = view.at(*p);
+            let left = p[0] < 0.15;
+            let _ = write!(
+                s,
+                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" fill=\"#5b6475\" text-anchor=\"{}\">{nm:.0}</text>",
+                if left { x - 5.0 } else { x + 5.0 },
+                y + 4.0,
+                if left { "end" } else { "start" }
+            );
+        }
+    }
+    let _ = write!(
+        s,
+        "<polyline class=\"planckian\" points=\"{}\" fill=\"none\" stroke=\"#8a5a00\"/>",
+        view.points(&planckian_locus())
+    );
+    for k in ISOTEMPERATURE_K {
+        let (Ok(a), Ok(c)) = (cct_duv_to_uv(k, -0.05), cct_duv_to_uv(k, 0.05)) else {
+            continue;
+        };
+        let (a, c) = (view.at(uv1960_to_prime(a)), view.at(uv1960_to_prime(c)));
+        let _ = write!(
+            s,
+            "<line class=\"isotemperature\" data-k=\"{k:.0}\" x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\" stroke=\"#c9a34a\" stroke-width=\"0.8\"/>",
+            a.0, a.1, c.0, c.1
+        );
+        if labels && k != 2700.0 {
+            let _ = write!(
+                s,
+                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"8\" fill=\"#8a5a00\" text-anchor=\"middle\">{}</text>",
+                a.0,
+                a.1 + 9.0,
+                k as u32
+            );
+        }
+    }
+    if let Some(region) = region {
+        let _ = write!(
+            s,
+            "<polygon class=\"region95\" points=\"{}\" fill=\"#1f5fbf\" fill-opacity=\"0.18\" stroke=\"#1f5fbf\"/>",
+            view.points(region)
+        );
+    }
+    if let Some(t) = truth {
+        let (x, y) = view.at(t);
+        let _ = write!(
+            s,
+            "<path class=\"truth\" d=\"M{:.2} {:.2}l8 8m0 -8l-8 8\" stroke=\"#1d2330\" stroke-width=\"1.6\"/>",
+            x - 4.0,
+            y - 4.0
+        );
+    }
+    let (x, y) = view.at(point);
+    let _ = write!(
+        s,
+        "<circle class=\"estimate-point\" data-u=\"{:.4}\" data-v=\"{:.4}\" cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"3.5\" fill=\"#1f5fbf\" stroke=\"#fff\"/>",
+        point[0], point[1]
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pixel positions of attribute `name` pairs in elements of `class`.
+    fn attr(svg: &str, class: &str, name: &str) -> Vec<f64> {
+        svg.split(&format!("class=\"{class}\""))
+            .skip(1)
+            .filter_map(|rest| {
+                let at = rest.find(&format!(" {name}=\""))? + name.len() + 3;
+                rest[at..].split('"').next()?.parse().ok()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn d65_sits_at_its_published_u_v_and_the_locus_passes_520_nm() {
+        // D65: x 0.31271, y 0.32902 → u′ 0.1978, v′ 0.4683 (CIE 015:2018 Table T.3).
+        let uv = xy_to_uv_prime([0.31271, 0.32902]);
+        assert!(
+            (uv[0] - 0.1978).abs() < 1e-4 && (uv[1] - 0.4683).abs() < 1e-4,
+            "{uv:?}"
+        );
+        let e = crate::test_support::estimate_of_d65();
+        let svg = uv_diagram_svg(&e, Some([0.31271, 0.32902]));
+        assert!(svg.starts_with("<svg") && svg.ends_with("</svg>"));
+        // The point on the main panel, back from its pixels.
+        let (cx, cy) = (
+            attr(&svg, "estimate-point", "cx")[0],
+            attr(&svg, "estimate-point", "cy")[0],
+        );
+        let (px, py) = MAIN.at([0.1978, 0.4683]);
+        assert!(
+            (cx - px).abs() < 1.0 && (cy - py).abs() < 1.0,
+            "{cx} {cy} vs {px} {py}"
+        );
+        // D65 cut to 400–700 nm moves by less than 5·10⁻⁴.
+        assert!((attr(&svg, "estimate-point", "data-u")[0] - 0.1978).abs() < 5e-4);
+        assert!((attr(&svg, "estimate-point", "data-v")[0] - 0.4683).abs() < 5e-4);
+        // The spectral locus passes 520 nm at x 0.0743, y 0.8338 (CIE 1931 table).
+        let at520 = MAIN.at(xy_to_uv_prime([0.0743, 0.8338]));
+        let polygon = svg
+            .split("class=\"spectral-locus\" points=\"")
+            .nth(1)
+            .unwrap();
+        let near = polygon.split('"').next().unwrap().split(' ').any(|p| {
+            let mut xy = p.split(',').map(|v| v.parse::<f64>().unwrap());
+            let (x, y) = (xy.next().unwrap(), xy.next().unwrap());
+            (x - at520.0).hypot(y - at520.1) < 1.5
+        });
+        assert!(near, "no locus point near 520 nm at {at520:?}");
+        // Seven isotemperature lines on each panel, and the truth drawn.
+        assert_eq!(svg.matches("class=\"isotemperature\"").count(), 14);
+        assert!(svg.contains("class=\"truth\""));
+    }
+}
