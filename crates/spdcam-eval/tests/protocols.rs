@@ -1,10 +1,13 @@
 //! The evaluation protocols on small hand-made inputs, without the measured data: the real
 //! cameras' constant and ridge baselines and their score, the reliability diagram's bins,
-//! and the held-out protocols' file helpers.
+//! the held-out protocols' file helpers, and the coverage of lamps by lighting recipes.
 
 use spdcam_core::builtin::DataDir;
+use spdcam_core::cie_illuminant::planck;
 use spdcam_core::dataset::MeasuredPhotos;
+use spdcam_core::light_families::LampType;
 use spdcam_core::spectral::{Grid, Spd};
+use spdcam_eval::coverage::{Coverage, CoverageOptions};
 use spdcam_eval::held_out::{camera_names, file_name, in_data_dir};
 use spdcam_eval::real_cameras::{
     constant, real_ridge, ridge_estimates, score, score_grid, targets,
@@ -138,4 +141,61 @@ fn the_held_out_protocols_name_files_and_find_cameras() {
     let missing = camera_names(&dir.join("absent")).unwrap_err().to_string();
     assert!(missing.contains("absent"), "{missing}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn planckian_draws_cover_filament_lamps_and_narrow_bands_do_not() {
+    // Two filament lamps (Planckian radiators of 2700 K and 3200 K) and their types.
+    let dir = std::env::temp_dir().join(format!("spdcam-eval-coverage-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let grid = Grid::new(380.0, 780.0, 5.0).unwrap();
+    let lamps: Vec<Vec<f64>> = [2700.0, 3200.0]
+        .iter()
+        .map(|&t| planck(t, &grid).unwrap().values().to_vec())
+        .collect();
+    let mut csv = String::from("wavelength_nm,warm,halogen\n");
+    for (i, l) in grid.wavelengths().iter().enumerate() {
+        csv += &format!("{l},{},{}\n", lamps[0][i], lamps[1][i]);
+    }
+    let spds = dir.join("lamps.csv");
+    let types = dir.join("types.csv");
+    std::fs::write(&spds, csv).unwrap();
+    std::fs::write(
+        &types,
+        "column,type,category\nwarm,Incandescent/Filament,Residential\nhalogen,Incandescent/Filament,Residential\n",
+    )
+    .unwrap();
+    let options = CoverageOptions {
+        spds,
+        types: Some(types),
+        split: None,
+        lighting: vec!["planck".into(), "gaussian:3".into()],
+        draws: 400,
+        seed: 1,
+        fit: true,
+    };
+    let mut heard = Vec::new();
+    let coverage = Coverage::measure(&options, &DataDir::new(None), &mut |r| {
+        heard.push(r.to_string())
+    })
+    .unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(heard, ["planck", "gaussian:3"]);
+    assert_eq!(coverage.lamps, ["warm", "halogen"]);
+    assert_eq!(coverage.types, [LampType::Incandescent; 2]);
+    let [planckian, gaussian] = [&coverage.recipes[0].best, &coverage.recipes[1].best];
+    // 400 draws uniform in mired over 1500–10000 K land within a few kelvin of each lamp.
+    assert!(planckian.iter().all(|&g| g > 0.9999), "{planckian:?}");
+    // Three broad channels cannot make a Planckian spectrum as well.
+    assert!(
+        gaussian.iter().zip(planckian).all(|(g, p)| g < p),
+        "{gaussian:?} against {planckian:?}"
+    );
+    // The filament family fitted to each lamp reaches it.
+    let fitted = coverage.fitted.as_ref().unwrap();
+    assert!(
+        fitted.iter().all(|g| g.is_some_and(|g| g > 0.999)),
+        "{fitted:?}"
+    );
+    assert!(coverage.markdown().contains("| `planck` |"));
 }

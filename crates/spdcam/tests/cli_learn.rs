@@ -156,7 +156,11 @@ fn train_estimate_evaluate_finetune() {
         "--plot",
         &s(&plot),
     ]);
-    assert!(out.contains("xy (") && out.contains("CCT"), "{out}");
+    // The meter's headline: CCT and Δuv for white light, a wavelength for coloured light.
+    assert!(
+        out.contains("xy (") && (out.contains("CCT") || out.contains("wavelength")),
+        "{out}"
+    );
     let csv = std::fs::read_to_string(&spd).unwrap();
     assert!(csv.starts_with("wavelength_nm,estimate_1\n400,"), "{csv}");
     assert_eq!(csv.lines().count(), 62);

@@ -7,7 +7,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::light_families::LampLibrary;
 use spdcam_core::spectral::Grid;
 use spdcam_eval::held_out::{HeldOutPhotos, LampFiles};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Where the lamp library is read from.
 #[derive(Debug, Args)]
@@ -76,22 +76,39 @@ impl HeldOutArgs {
 
     /// The options as a command line, for the records that say how to regenerate a result.
     pub fn command_line(&self) -> String {
-        let mut out: String = self
-            .model
-            .iter()
-            .map(|m| format!(" --model {}", m.display()))
-            .collect();
-        out += &format!(" --split {}", self.split.display());
-        if let Some(l) = &self.library.lamps {
-            out += &format!(" --lamps {}", l.display());
-        }
-        if let Some(t) = &self.library.types {
-            out += &format!(" --types {}", t.display());
-        }
-        if let Some(c) = &self.cameras {
-            out += &format!(" --cameras {}", c.display());
-        }
+        let mut out = flags(
+            &self.model,
+            &self.split,
+            &self.library,
+            self.cameras.as_deref(),
+        );
         out += &format!(" --shots {} --seed {}", self.shots, self.seed);
         out
     }
+}
+
+/// The models, split, lamp library and cameras of a protocol over held-out lamps as
+/// command-line flags (each with a leading space), for the records that say how to
+/// regenerate a result.
+pub fn flags(
+    models: &[PathBuf],
+    split: &Path,
+    library: &LibraryArgs,
+    cameras: Option<&Path>,
+) -> String {
+    let mut out: String = models
+        .iter()
+        .map(|m| format!(" --model {}", m.display()))
+        .collect();
+    out += &format!(" --split {}", split.display());
+    if let Some(l) = &library.lamps {
+        out += &format!(" --lamps {}", l.display());
+    }
+    if let Some(t) = &library.types {
+        out += &format!(" --types {}", t.display());
+    }
+    if let Some(c) = cameras {
+        out += &format!(" --cameras {}", c.display());
+    }
+    out
 }

@@ -4,7 +4,7 @@
 //! beside the constant. The protocol is `spdcam_eval::colour`'s; this parses its options
 //! and writes its results.
 
-use crate::args::held_out::LibraryArgs;
+use crate::args::held_out::{flags, LibraryArgs};
 use anyhow::Result;
 use clap::Args;
 use spdcam_core::builtin::DataDir;
@@ -49,19 +49,12 @@ impl ColourArgs {
     /// The options as a command line, for the record that says how to regenerate the report.
     fn command_line(&self, reference_photos: u64) -> String {
         let mut out = String::from("spdcam --data-dir DATA experiment colour");
-        for m in &self.model {
-            out += &format!(" --model {}", m.display());
-        }
-        out += &format!(" --split {}", self.split.display());
-        if let Some(l) = &self.library.lamps {
-            out += &format!(" --lamps {}", l.display());
-        }
-        if let Some(t) = &self.library.types {
-            out += &format!(" --types {}", t.display());
-        }
-        if let Some(c) = &self.cameras {
-            out += &format!(" --cameras {}", c.display());
-        }
+        out += &flags(
+            &self.model,
+            &self.split,
+            &self.library,
+            self.cameras.as_deref(),
+        );
         out += &format!(
             " --photos {} --reference-photos {reference_photos} --patch-photos {} --seed {} -o {}",
             self.photos,
