@@ -8,7 +8,7 @@
 //! - [`synthetic`]: a small synthetic dataset in memory, for tests and benchmarks (real
 //!   datasets come from `spdcam_core::dataset`).
 //! - [`train`]: PCA or channel-weight targets, the scalings, and the training loop (Adam,
-//!   early stopping) for the networks, or [`ridge`] regression in closed form for the
+//!   early stopping) for the networks, or [`spdcam_infer::ridge`] regression in closed form for the
 //!   `linear` model; fine-tuning a trained model on a new dataset.
 //! - [`recipe`]: choosing a fine-tuning recipe for a few photos by cross-validation.
 //! - [`evaluate`]: scoring a model on a dataset (RMSE, GFC, SAM, SID; plots).
