@@ -24,6 +24,7 @@ use crate::error::{InferError, Result};
 use crate::pca::Pca;
 use serde::{Deserialize, Serialize};
 use spdcam_core::colorimetry::Observer;
+use spdcam_core::quality::uv::xyz_to_uv1976;
 use spdcam_core::spectral::Grid;
 
 /// Gauss–Newton steps of [`ColourHead::conform`] at most.
@@ -170,10 +171,11 @@ impl ColourHead {
     }
 }
 
-/// CIE 1976 u′v′ of XYZ (CIE 015:2018, eq. 8.10); `None` where X + 15Y + 3Z is not positive.
-fn uv_of([x, y, z]: [f64; 3]) -> Option<[f64; 2]> {
-    let d = x + 15.0 * y + 3.0 * z;
-    (d > 0.0 && d.is_finite()).then(|| [4.0 * x / d, 9.0 * y / d])
+/// CIE 1976 u′v′ of XYZ ([`xyz_to_uv1976`]); `None` for black or a spectrum whose X + 15Y +
+/// 3Z is not positive (negative coefficients can make one).
+fn uv_of(xyz: [f64; 3]) -> Option<[f64; 2]> {
+    let d = xyz[0] + 15.0 * xyz[1] + 3.0 * xyz[2];
+    (d > 0.0 && d.is_finite()).then(|| xyz_to_uv1976(xyz))
 }
 
 /// How u′ and v′ change per unit of a component whose XYZ is `b`, at the spectrum of XYZ
