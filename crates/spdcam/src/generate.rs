@@ -59,8 +59,8 @@ pub struct GenerateArgs {
     /// lighting across the chart).
     #[arg(long, value_delimiter = ',', value_name = "GROUPS")]
     randomise: Vec<String>,
-    /// Cameras to draw from with --randomise camera: a directory of sensitivity CSVs or a
-    /// comma-separated list of names or files.
+    /// Cameras to draw from with --randomise camera, comma-separated: directories of
+    /// sensitivity CSVs, camera names or files.
     #[arg(long, value_name = "DIR|LIST")]
     cameras: Option<String>,
     /// A validation split (`spdcam lamps split`): its held-out cameras are left out of the pool.

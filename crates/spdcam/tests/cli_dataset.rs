@@ -397,3 +397,70 @@ fn list_shows_the_lighting_recipes() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("gaussian"), "{text}");
 }
+
+/// A camera sensitivity CSV of three Gaussian channels (peaks 600, 540, 460 nm), shifted by
+/// `shift` nm: a valid camera of its own for each shift.
+fn camera_csv(path: &Path, shift: f64) {
+    let mut text = String::from("wavelength_nm,r,g,b\n");
+    for w in (400..=700).step_by(10) {
+        let g = |peak: f64| (-((f64::from(w) - peak - shift) / 40.0).powi(2) / 2.0).exp();
+        text.push_str(&format!("{w},{},{},{}\n", g(600.0), g(540.0), g(460.0)));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn the_camera_pool_joins_several_directories_and_names() {
+    let dir = scratch("pool");
+    let (a, b) = (dir.join("measured"), dir.join("predicted"));
+    for d in [&a, &b] {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    camera_csv(&a.join("alpha__lab.csv"), 0.0);
+    camera_csv(&b.join("beta.csv"), 6.0);
+    let pool = format!("{},{},nikon_d5100_npl", s(&a), s(&b));
+    let out = dir.join("out");
+    generate(
+        &out,
+        &[
+            "--fast",
+            "--randomise",
+            "camera",
+            "--cameras",
+            &pool,
+            "--camera-variants",
+            "0",
+        ],
+    );
+    let manifest = std::fs::read_to_string(out.join("manifest.json")).unwrap();
+    let manifest: serde_json::Value = serde_json::from_str(&manifest).unwrap();
+    let cameras = &manifest["origin"]["randomisation"]["cameras"];
+    let names: Vec<&str> = cameras
+        .as_array()
+        .expect("the manifest lists the pool")
+        .iter()
+        .filter_map(|c| c.as_str())
+        .collect();
+    for name in ["alpha__lab", "beta", "nikon_d5100_npl"] {
+        assert!(names.contains(&name), "{name} missing from {names:?}");
+    }
+    // The same directory twice would draw its cameras twice as often.
+    let twice = format!("{},{}", s(&a), s(&a));
+    fails(
+        &[
+            "generate",
+            "--lighting",
+            LIGHTING,
+            "--count",
+            "4",
+            "--fast",
+            "--randomise",
+            "camera",
+            "--cameras",
+            &twice,
+            "-o",
+            s(&dir.join("twice")),
+        ],
+        "camera 'alpha__lab' is in the camera pool twice",
+    );
+}

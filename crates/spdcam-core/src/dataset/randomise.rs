@@ -333,6 +333,36 @@ pub fn camera_pool(
     Ok(pool)
 }
 
+/// The cameras `spec` names, comma-separated: each a directory (every sensitivity CSV in
+/// it; the files that are not one come back as skipped, with why), a camera's name or a
+/// file. A camera named twice is an error: it would be drawn twice as often.
+fn pool_cameras(
+    spec: &str,
+    data_dir: &DataDir,
+    grid: &Grid,
+) -> Result<(Vec<Sensitivities>, SkippedFiles)> {
+    let (mut sens, mut skipped) = (Vec::<Sensitivities>::new(), Vec::new());
+    for part in spec.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let dir = Path::new(part);
+        if dir.is_dir() {
+            let (found, skip) = Sensitivities::in_dir(dir, data_dir, grid)?;
+            sens.extend(found);
+            skipped.extend(skip);
+        } else {
+            sens.push(Sensitivities::resolve(part, data_dir, grid)?);
+        }
+    }
+    let mut names = std::collections::BTreeSet::new();
+    if let Some(twice) = sens.iter().find(|s| !names.insert(s.name.as_str())) {
+        return Err(Error::invalid(format!(
+            "camera '{}' is in the camera pool twice (--cameras {spec}); name each camera and \
+             directory once",
+            twice.name
+        )));
+    }
+    Ok((sens, skipped))
+}
+
 /// Perturbed copies of each camera in a pool unless a run asks for another number.
 pub const DEFAULT_CAMERA_VARIANTS: usize = 3;
 
@@ -344,8 +374,8 @@ pub struct RandomiseRequest {
     /// jpeg, floor (draw those in-camera parameters), gradient (uneven lighting); none: no
     /// randomisation.
     pub groups: Vec<String>,
-    /// The cameras to draw from with `camera`: a directory of sensitivity CSVs or a
-    /// comma-separated list of names or files.
+    /// The cameras to draw from with `camera`: comma-separated directories of sensitivity
+    /// CSVs, camera names or files.
     pub cameras: Option<String>,
     /// A validation split whose held-out cameras are left out of the pool.
     pub camera_split: Option<PathBuf>,
@@ -419,17 +449,7 @@ impl RandomiseRequest {
             let spec = self.cameras.as_deref().ok_or_else(|| {
                 Error::invalid("--randomise camera needs --cameras DIR or a list")
             })?;
-            let dir = Path::new(spec);
-            if dir.is_dir() {
-                (sens, skipped) = Sensitivities::in_dir(dir, data_dir, grid)?;
-            } else {
-                sens = spec
-                    .split(',')
-                    .map(str::trim)
-                    .filter(|n| !n.is_empty())
-                    .map(|name| Sensitivities::resolve(name, data_dir, grid))
-                    .collect::<Result<_>>()?;
-            }
+            (sens, skipped) = pool_cameras(spec, data_dir, grid)?;
         }
         if let Some(path) = &self.camera_split {
             let split = ValidationSplit::read(path)?;

@@ -208,15 +208,61 @@ impl ValidationSplit {
         crate::fsio::write_atomic(path, text.as_bytes())
     }
 
-    /// Whether `camera` (a name or a file stem) may be used in training: it is not held out.
+    /// Whether `camera` (a name or a file stem) may be used in training: its camera model is
+    /// not one the split holds out ([`same_camera_model`]), so that a pool from another
+    /// source (the predicted sensitivities name cameras without a `__source` suffix and
+    /// spell models their own way) cannot bring a held-out camera back.
     pub fn allows_training_camera(&self, camera: &str) -> bool {
-        !self.cameras.held_out.iter().any(|c| c == camera)
+        !self
+            .cameras
+            .held_out
+            .iter()
+            .any(|c| same_camera_model(c, camera))
     }
 }
 
 /// A camera's model: its name before the `__source` suffix.
 pub fn camera_model(name: &str) -> &str {
     name.split_once("__").map_or(name, |(m, _)| m)
+}
+
+/// One camera model sold under several names (the key of [`model_key`], then the key it
+/// stands for): Canon's EOS 300D is the Digital Rebel and the Kiss Digital, its EOS 400D
+/// the Digital Rebel XTi and the Kiss Digital X (Canon Camera Museum, EOS digital
+/// cameras), which the measured sets name `canon_xti`.
+const CAMERA_ALIASES: &[(&str, &str)] = &[
+    ("canonxti", "canoneos400d"),
+    ("canondigitalrebelxti", "canoneos400d"),
+    ("canoneosdigitalrebelxti", "canoneos400d"),
+    ("canonkissdigitalx", "canoneos400d"),
+    ("canoneoskissdigitalx", "canoneos400d"),
+    ("canondigitalrebel", "canoneos300d"),
+    ("canoneosdigitalrebel", "canoneos300d"),
+    ("canonkissdigital", "canoneos300d"),
+    ("canoneoskissdigital", "canoneos300d"),
+];
+
+/// A camera's model as a key that ignores how a source spells it: the name before its
+/// `__source` suffix and before a perturbed copy's `~seed`, lower case, letters and digits
+/// only (`pentax_ist_dl` and `pentax_istdl` are one model), an alias replaced by the name it
+/// stands for.
+fn model_key(name: &str) -> String {
+    let model = camera_model(name);
+    let model = model.split_once('~').map_or(model, |(m, _)| m);
+    let key: String = model
+        .chars()
+        .filter(char::is_ascii_alphanumeric)
+        .map(|c| c.to_ascii_lowercase())
+        .collect();
+    CAMERA_ALIASES
+        .iter()
+        .find(|(alias, _)| *alias == key)
+        .map_or(key, |(_, model)| (*model).to_string())
+}
+
+/// Whether two camera names (names or file stems, from any source) name one camera model.
+pub fn same_camera_model(a: &str, b: &str) -> bool {
+    model_key(a) == model_key(b)
 }
 
 /// The library's lamps joined into products (lists of positions, in library order of their
@@ -361,6 +407,42 @@ mod tests {
         assert_eq!(split, ValidationSplit::make(&lib, &cameras, 3).unwrap());
         let other = ValidationSplit::make(&lib, &cameras, 4).unwrap();
         assert!(other.lamps != split.lamps || other.cameras != split.cameras);
+    }
+
+    #[test]
+    fn held_out_models_stay_out_under_any_spelling() {
+        let lib = library();
+        let cameras: Vec<String> = [
+            "canon_xti__rawtoaces",
+            "pentax_ist_dl__ilia3101",
+            "nikon_d50__camspec",
+        ]
+        .map(String::from)
+        .to_vec();
+        let mut split = ValidationSplit::make(&lib, &cameras, 1).unwrap();
+        split.cameras.held_out = cameras.clone();
+        split.cameras.training.clear();
+        for name in [
+            "canon_eos_400d",
+            "Canon EOS Kiss Digital X",
+            "canon_xti__camspec",
+            "pentax_istdl",
+            "nikon_d50",
+            "nikon_d50__ssfdata_spectroscope~123",
+        ] {
+            assert!(!split.allows_training_camera(name), "{name} is held out");
+        }
+        for name in [
+            "canon_eos_450d",
+            "pentax_istdl2",
+            "nikon_d500",
+            "nikon_d5",
+            "canon_eos_300d",
+        ] {
+            assert!(split.allows_training_camera(name), "{name} is not held out");
+        }
+        assert!(same_camera_model("canon_eos_300d", "canon_digital_rebel"));
+        assert!(!same_camera_model("sony_ilce_7", "sony_ilce_7m2"));
     }
 
     #[test]
