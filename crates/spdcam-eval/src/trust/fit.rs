@@ -4,12 +4,13 @@
 //! the real photo sets' validation photos.
 
 use crate::error::{EvalError, Result};
-use crate::held_out::{HeldOutPhotos, SkippedCamera, GRID};
+use crate::held_out::{on_grid, HeldOutPhotos, SkippedCamera, GRID};
 use crate::trust::judged::{
     band_z, conformal_quantile, difficulty, gfc, judge_rows, median, quantile_scales, residual,
     Judged,
 };
 use crate::trust::real::{balanced, real_split};
+use crate::trust::scenes::scene_rows;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::light_families::validation_split::LampPart;
@@ -27,38 +28,28 @@ use std::path::{Path, PathBuf};
 const MIN_METRIC_PHOTOS: usize = 40;
 
 /// The photos a calibration is fitted on: held-out virtual photos (`shots` consecutive ones
-/// per lamp) and, with `--real`, real photos of the real sets' validation split.
+/// per lamp), with `--scenes` scene photos of the same lamps and with `--real` real photos
+/// of the real sets' validation split.
 pub struct CalibrationPhotos {
-    /// Every photo's features, the virtual ones first.
+    /// Every photo's features, the virtual patch-level ones first.
     features: Vec<Vec<f64>>,
     /// Every photo judged, in the same order.
     judged: Vec<Judged>,
-    /// How many of them are virtual.
+    /// How many of them are virtual patch-level photos.
     virtual_count: usize,
-    /// Virtual photos per lamp.
-    shots: usize,
+    /// How many are scene photos (after the virtual ones).
+    scene_count: usize,
+    /// Scene photos asked for per lamp.
+    scenes_per_lamp: usize,
+    /// The cross-validation group of each photo: a lamp's photos (patch level and scene)
+    /// together, so that a lamp never informs its own prediction; each real photo alone.
+    groups: Vec<usize>,
 }
 
 impl CalibrationPhotos {
-    /// The virtual photos judged.
+    /// The virtual patch-level photos judged.
     fn virtual_judged(&self) -> &[Judged] {
         &self.judged[..self.virtual_count]
-    }
-
-    /// The cross-validation group of each photo: a lamp's photos together (so a lamp never
-    /// informs its own prediction), each real photo alone.
-    fn groups(&self) -> Vec<usize> {
-        let shots = self.shots.max(1);
-        let lamps = self.virtual_count.div_ceil(shots);
-        (0..self.judged.len())
-            .map(|i| {
-                if i < self.virtual_count {
-                    i / shots
-                } else {
-                    lamps + i - self.virtual_count
-                }
-            })
-            .collect()
     }
 }
 
@@ -157,7 +148,7 @@ pub fn fit_calibration(
         floor,
         scale68,
         scale95,
-        gfc_model: fit_gfc_model(judged, &photos.groups())?,
+        gfc_model: fit_gfc_model(judged, &photos.groups)?,
         residual_reference,
         difficulty_doubtful: conformal_quantile(&mut difficulties, 0.99),
         self_check_doubtful: all_checked.then(|| conformal_quantile(&mut checks, 0.99)),
@@ -172,7 +163,8 @@ pub fn fit_calibration(
             .then(|| conformal_quantile(&mut two_lights, 0.99)),
         clipped_doubtful: conformal_quantile(&mut clipped, 0.99) as usize,
         metrics: metric_calibrations,
-        real_photos: photos.judged.len() - photos.virtual_count,
+        real_photos: photos.judged.len() - photos.virtual_count - photos.scene_count,
+        scenes_per_lamp: photos.scenes_per_lamp,
     })
 }
 
@@ -315,16 +307,21 @@ pub struct Calibrations {
     pub skipped: Vec<SkippedCamera>,
 }
 
-/// Fits the calibration of each of `photos`' models on the split's validation lamps and,
-/// with `real`, the real photo sets' validation photos (SG models only; `thesis_data` holds
-/// the sets, default the data directory's thesis/).
+/// Fits the calibration of each of `photos`' models on the split's validation lamps: their
+/// held-out virtual photos, `scenes` scene photos of each ([`scene_rows`]) and, with `real`,
+/// the real photo sets' validation photos (SG models only; `thesis_data` holds the sets,
+/// default the data directory's thesis/).
 pub fn calibrate(
     photos: &HeldOutPhotos,
+    scenes: usize,
     real: bool,
     thesis_data: Option<&Path>,
     data_dir: &DataDir,
 ) -> Result<Calibrations> {
     let setup = photos.setup(data_dir)?;
+    let lamps = setup
+        .library
+        .positions(setup.split.lamps(LampPart::Validation), "the split's lamps")?;
     let mut out = Vec::new();
     for (path, model, chart_name) in photos.models()? {
         let chart = Chart::resolve(&chart_name, None, data_dir, &GRID)?;
@@ -338,13 +335,48 @@ pub fn calibrate(
             Some(&shots.clean.truths),
         )?;
         let virtual_count = judged.len();
+        let per_lamp = photos.shots as usize;
+        let mut groups: Vec<usize> = (0..virtual_count).map(|i| i / per_lamp.max(1)).collect();
+        let mut features = shots.clean.features;
+        let mut method = format!(
+            "the split's {} validation lamps, {} photos each by its held-out cameras with the \
+             randomised in-camera stage, patch level, seed {}; spread of {JITTER_COPIES} copies \
+             perturbed by {JITTER_SIGMA}",
+            lamps.len(),
+            photos.shots,
+            photos.seed
+        );
+        let scene_count = if scenes > 0 {
+            let found = scene_rows(
+                &model,
+                &chart_name,
+                &setup,
+                LampPart::Validation,
+                scenes,
+                data_dir,
+                photos.seed,
+            )?;
+            let truth = on_grid(&setup.library, &model.grid())?;
+            let (lamp_of, rows): (Vec<usize>, Vec<Vec<f64>>) = found.rows.into_iter().unzip();
+            let truths: Vec<Vec<f64>> = lamp_of.iter().map(|&l| truth[lamps[l]].clone()).collect();
+            judged.extend(judge_rows(&model, check.as_ref(), &rows, Some(&truths))?);
+            groups.extend(lamp_of);
+            features.extend(rows);
+            method += &format!(
+                "; {scenes} scene photos of each (the whole camera chain, found and sampled as a \
+                 user's photo is; {} of them refused: no chart found)",
+                found.refused
+            );
+            judged.len() - virtual_count
+        } else {
+            0
+        };
         let real = if real {
             real_split(thesis_data, data_dir, &model, &chart_name)?
         } else {
             Vec::new()
         };
         let real = balanced(real, virtual_count);
-        let mut features = shots.clean.features;
         for set in &real {
             judged.extend(judge_rows(
                 &model,
@@ -354,18 +386,11 @@ pub fn calibrate(
             )?);
             features.extend(set.val.features.iter().cloned());
         }
-        let mut method = format!(
-            "the split's {} validation lamps, {} photos each by its held-out cameras with the \
-             randomised in-camera stage, patch level, seed {}; spread of {JITTER_COPIES} copies \
-             perturbed by {JITTER_SIGMA}",
-            setup.split.lamps(LampPart::Validation).len(),
-            photos.shots,
-            photos.seed
-        );
+        let real_count = judged.len() - virtual_count - scene_count;
+        groups.extend((0..real_count).map(|i| lamps.len() + i));
         if !real.is_empty() {
             method += &format!(
-                "; and {} real photos, the validation photos of {}",
-                judged.len() - virtual_count,
+                "; and {real_count} real photos, the validation photos of {}",
                 real.iter().map(|s| s.label).collect::<Vec<_>>().join(", ")
             );
         }
@@ -373,7 +398,9 @@ pub fn calibrate(
             features,
             judged,
             virtual_count,
-            shots: photos.shots as usize,
+            scene_count,
+            scenes_per_lamp: scenes,
+            groups,
         };
         let calibration = fit_calibration(&model, &chart_name, &calibration_photos, method)?;
         out.push(Calibrated {

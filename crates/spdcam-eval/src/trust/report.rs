@@ -4,13 +4,13 @@
 //! expected GFC, verdicts, the self-check's flags and the reliability diagram's points.
 
 use crate::error::{EvalError, Result};
-use crate::held_out::{file_name, HeldOutPhotos, SkippedCamera, GRID};
+use crate::held_out::{file_name, on_grid, HeldOutPhotos, SkippedCamera, GRID};
 use crate::reliability::{self, SetReliability};
 use crate::trust::judged::{
     band_z, difficulty, gfc, judge_rows, median, quantile_scales, residual, spearman, Judged,
 };
 use crate::trust::real::{balanced, real_split, RealSplit};
-use crate::trust::scenes::{scene_verdicts, SCENES};
+use crate::trust::scenes::{scene_rows, scene_verdicts, SCENES};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::chart_lighting::{Corrections, UnevenLight};
@@ -124,6 +124,9 @@ struct MetricCoverage {
     total: usize,
     half95: Vec<f64>,
 }
+
+/// Scene photos of each test lamp the report measures (the whole camera chain).
+pub const REPORT_SCENES_PER_LAMP: usize = 2;
 
 /// Per level of [`reliability::LEVELS`], the scales of `cal`'s bands measured on its
 /// calibration photos ([`quantile_scales`]).
@@ -324,6 +327,8 @@ pub struct TrustReport {
     diagram: Vec<SetReliability>,
     /// The split's held-out cameras left out (unreadable curves).
     skipped: Vec<SkippedCamera>,
+    /// Scene photos per validation lamp the calibrations were fitted on (the largest).
+    scenes_per_lamp: usize,
 }
 
 impl TrustReport {
@@ -340,6 +345,13 @@ impl TrustReport {
     ) -> Result<TrustReport> {
         let setup = photos.setup(data_dir)?;
         let models = photos.models()?;
+        let test_lamps = setup
+            .library
+            .positions(setup.split.lamps(LampPart::Test), "the split's test lamps")?;
+        let validation_lamps = setup.library.positions(
+            setup.split.lamps(LampPart::Validation),
+            "the split's validation lamps",
+        )?;
         if calibrations.len() != models.len() {
             return Err(EvalError::invalid(format!(
                 "{} calibrations for {} models; give one per model, in order",
@@ -431,9 +443,11 @@ impl TrustReport {
         );
         md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable | mean GFC: ok / doubtful |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         let mut diagram = Vec::new();
+        let mut scenes_per_lamp = 0;
         for ((path, model, chart_name), cal_path) in models.iter().zip(calibrations) {
             let text = spdcam_core::fsio::read_text(cal_path)?;
             let cal = TrustCalibration::from_json(&text, &cal_path.display().to_string())?;
+            scenes_per_lamp = scenes_per_lamp.max(cal.scenes_per_lamp);
             if cal.model != model.fingerprint() {
                 return Err(EvalError::invalid(format!(
                     "{} is not a calibration of {}",
@@ -443,6 +457,7 @@ impl TrustReport {
             }
             let chart = Chart::resolve(chart_name, None, data_dir, &GRID)?;
             let check = ChartCheck::for_model(model, data_dir)?;
+            let truth = on_grid(&setup.library, &model.grid())?;
             let shots = photos.shots(&setup, &chart, model, LampPart::Test)?;
             let name = file_name(path);
             let calibration_shots = photos.shots(&setup, &chart, model, LampPart::Validation)?;
@@ -452,6 +467,25 @@ impl TrustReport {
                 &calibration_shots.clean.features,
                 Some(&calibration_shots.clean.truths),
             )?;
+            if cal.scenes_per_lamp > 0 {
+                let (lamp_of, rows): (Vec<usize>, Vec<Vec<f64>>) = scene_rows(
+                    model,
+                    chart_name,
+                    &setup,
+                    LampPart::Validation,
+                    cal.scenes_per_lamp,
+                    data_dir,
+                    photos.seed,
+                )?
+                .rows
+                .into_iter()
+                .unzip();
+                let truths: Vec<Vec<f64>> = lamp_of
+                    .iter()
+                    .map(|&l| truth[validation_lamps[l]].clone())
+                    .collect();
+                calibration_photos.extend(judge_rows(model, check.as_ref(), &rows, Some(&truths))?);
+            }
             let real = real_split(thesis_data, data_dir, model, chart_name)?;
             if cal.real_photos > 0 {
                 let calibration_real =
@@ -478,6 +512,36 @@ impl TrustReport {
             )?;
             md += &measured.row;
             metric_sets.push(("held-out virtual".to_string(), measured.metrics));
+            diagram.push(measured.reliability);
+            let test_scenes = scene_rows(
+                model,
+                chart_name,
+                &setup,
+                LampPart::Test,
+                REPORT_SCENES_PER_LAMP,
+                data_dir,
+                photos.seed,
+            )?;
+            let (lamp_of, scene_features): (Vec<usize>, Vec<Vec<f64>>) =
+                test_scenes.rows.into_iter().unzip();
+            let scene_truths: Vec<Vec<f64>> = lamp_of
+                .iter()
+                .map(|&l| truth[test_lamps[l]].clone())
+                .collect();
+            let measured = measure_row(
+                &format!(
+                    "`{name}` · scene photos (test lamps; {} refused)",
+                    test_scenes.refused
+                ),
+                model,
+                &cal,
+                check.as_ref(),
+                &scales,
+                &scene_features,
+                &scene_truths,
+            )?;
+            md += &measured.row;
+            metric_sets.push(("scene photos".to_string(), measured.metrics));
             diagram.push(measured.reliability);
             corrections_md += &corrections_row(
                 &format!("`{name}` · held-out virtual (test lamps)"),
@@ -610,7 +674,14 @@ impl TrustReport {
             sections,
             diagram,
             skipped: setup.skipped,
+            scenes_per_lamp,
         })
+    }
+
+    /// Scene photos per validation lamp the calibrations were fitted on (the largest of
+    /// them; 0: none), for the command line the report prints.
+    pub fn scenes_per_lamp(&self) -> usize {
+        self.scenes_per_lamp
     }
 
     /// The split's held-out cameras left out because their curves could not be read, for

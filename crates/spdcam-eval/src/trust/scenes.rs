@@ -135,3 +135,84 @@ pub fn scene_verdicts(
     }
     Ok(counts.map(|(n, f)| (n as f64 / SCENES as f64, f as f64 / SCENES as f64)))
 }
+
+/// Scene photos of one part's lamps, found and sampled like a user's photo.
+pub struct SceneRows {
+    /// Per photo found: the lamp's position among the part's lamps and its feature row
+    /// (encoded sRGB, 0–255, the model's feature order).
+    pub rows: Vec<(usize, Vec<f64>)>,
+    /// Photos whose chart was not found (left out).
+    pub refused: usize,
+}
+
+/// `per_lamp` scene photos of each of the lamps `part` of the split (the code of `spdcam
+/// render --scene`: 1200×900 pixels, the chart in a cluttered scene with perspective,
+/// blur, vignetting and the default camera stage — Bayer mosaic, noise, demosaicing, white
+/// balance over the whole scene, colour matrix, tone, JPEG), each by the split's held-out
+/// cameras in turn, then found and sampled as `model`'s estimator finds and samples a
+/// user's photo. In parallel; each photo seeded from `seed` and its number.
+pub fn scene_rows(
+    model: &Model,
+    model_chart: &str,
+    setup: &Setup,
+    part: LampPart,
+    per_lamp: usize,
+    data_dir: &DataDir,
+    seed: u64,
+) -> Result<SceneRows> {
+    use rayon::prelude::*;
+    let name = photo_chart(model_chart);
+    let chart = Chart::resolve(name, None, data_dir, &GRID)?;
+    let template = ChartTemplate::from_chart(&chart)?;
+    let chart = chart.with_layout(scene::scene_layout(&template))?;
+    let pool = camera_pool(
+        &setup.cameras,
+        0,
+        seed,
+        &chart,
+        CameraConfig::default(),
+        &GRID,
+    )?;
+    let ids = setup
+        .library
+        .positions(setup.split.lamps(part), "the split's lamps")?;
+    let estimator = Estimator::new(
+        ModelSet::single(model.clone(), "model"),
+        data_dir.clone(),
+        model.grid(),
+    )?;
+    let options = PhotoOptions {
+        chart: Some(name.to_string()),
+        ..PhotoOptions::default()
+    };
+    let scene_options = SceneOptions {
+        width: 1200,
+        height: 900,
+        ..SceneOptions::default()
+    };
+    let found: Vec<Option<(usize, Vec<f64>)>> = (0..ids.len() * per_lamp)
+        .into_par_iter()
+        .map(|g| {
+            let lamp = g / per_lamp;
+            let spd = &setup.library.spds[ids[lamp]];
+            let shot = scene::photograph(
+                &pool[g % pool.len()],
+                SceneLight::single(spd),
+                seed::derive(seed, g as u64),
+                &scene_options,
+            )?;
+            let photo = spdcam_core::photo::decode_photo(&shot.jpeg, "scene.jpg")?;
+            Ok(estimator.analyse_decoded(&photo, &options).ok().map(|a| {
+                (
+                    lamp,
+                    a.analysis.features.iter().map(|&v| f64::from(v)).collect(),
+                )
+            }))
+        })
+        .collect::<Result<_>>()?;
+    let refused = found.iter().filter(|f| f.is_none()).count();
+    Ok(SceneRows {
+        rows: found.into_iter().flatten().collect(),
+        refused,
+    })
+}

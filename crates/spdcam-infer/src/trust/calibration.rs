@@ -153,6 +153,11 @@ pub struct TrustCalibration {
     /// intervals and the clipping and difficulty levels; 0 for virtual photos alone.
     #[serde(default)]
     pub real_photos: usize,
+    /// Scene photos per validation lamp it was fitted on (`spdcam trust calibrate
+    /// --scenes`): the chart in a cluttered scene through the whole camera chain, found and
+    /// sampled as a user's photo is; they join what the real photos join. 0: none.
+    #[serde(default)]
+    pub scenes_per_lamp: usize,
 }
 
 /// The GFC to expect of an estimate, from the estimate itself: a ridge regression (Hoerl &
@@ -452,6 +457,7 @@ mod tests {
             two_lights_doubtful: None,
             clipped_doubtful: 0,
             real_photos: 0,
+            scenes_per_lamp: 0,
         };
         let (spd, spread) = ([1.0, 0.5], [0.05, 0.05]);
         let plain = cal

@@ -22,6 +22,11 @@ pub(super) struct CalibrateArgs {
     /// of the virtual photos.
     #[arg(long)]
     real: bool,
+    /// Also calibrate on this many scene photos of each validation lamp (the chart in a
+    /// cluttered scene through the whole camera chain, by the held-out cameras, found and
+    /// sampled as a user's photo is): they join what the real photos join. 0: none.
+    #[arg(long, default_value_t = 0)]
+    scenes: usize,
     /// The thesis's data (holding measured/…); default: the data directory's thesis/.
     #[arg(long)]
     thesis_data: Option<PathBuf>,
@@ -36,6 +41,7 @@ pub(super) fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
         .with_context(|| format!("creating {}", args.output.display()))?;
     let fitted = fit(
         &args.photos.protocol(),
+        args.scenes,
         args.real,
         args.thesis_data.as_deref(),
         data_dir,
@@ -48,10 +54,11 @@ pub(super) fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
         let json = serde_json::to_string_pretty(&c.calibration)?;
         write_atomic(&out, format!("{json}\n").as_bytes())?;
         eprintln!(
-            "{}: calibration → {} (expected GFC from ln(difficulty) and {} principal components; {} real photos)",
+            "{}: calibration → {} (expected GFC from ln(difficulty) and {} principal components; {} scene photos per lamp; {} real photos)",
             c.model.display(),
             out.display(),
             c.calibration.gfc_model.components.len(),
+            c.calibration.scenes_per_lamp,
             c.calibration.real_photos
         );
     }

@@ -65,7 +65,8 @@ pub(super) fn run(args: ReportArgs, data_dir: &DataDir) -> Result<()> {
         )
         .collect();
     let commands = format!(
-        "spdcam trust calibrate --real{photos} -o models\nspdcam trust report{photos}{report_options} -o {}",
+        "spdcam trust calibrate --real --scenes {}{photos} -o models\nspdcam trust report{photos}{report_options} -o {}",
+        measured.scenes_per_lamp(),
         args.output.display()
     );
     let md = measured.markdown(diagram.as_deref(), &commands);
