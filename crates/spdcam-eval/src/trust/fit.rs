@@ -46,10 +46,40 @@ pub struct CalibrationPhotos {
     groups: Vec<usize>,
 }
 
+/// The kinds of calibration photo, each of which the metric intervals must hold on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum PhotoKind {
+    /// Virtual, patch level.
+    Virtual,
+    /// Virtual scene photos through the whole camera chain.
+    Scene,
+    /// The real sets' validation photos.
+    Real,
+}
+
+impl PhotoKind {
+    const ALL: [PhotoKind; 3] = [PhotoKind::Virtual, PhotoKind::Scene, PhotoKind::Real];
+}
+
 impl CalibrationPhotos {
     /// The virtual patch-level photos judged.
     fn virtual_judged(&self) -> &[Judged] {
         &self.judged[..self.virtual_count]
+    }
+
+    /// Each photo's kind, in order.
+    fn kinds(&self) -> Vec<PhotoKind> {
+        (0..self.judged.len())
+            .map(|i| {
+                if i < self.virtual_count {
+                    PhotoKind::Virtual
+                } else if i < self.virtual_count + self.scene_count {
+                    PhotoKind::Scene
+                } else {
+                    PhotoKind::Real
+                }
+            })
+            .collect()
     }
 }
 
@@ -103,14 +133,20 @@ pub fn fit_calibration(
     let mut gradients = checks_of(|s| s.colour_gradient);
     let mut glares = checks_of(|s| Some(s.glare));
     let mut two_lights = checks_of(|s| Some(s.two_lights));
+    let kinds = photos.kinds();
     let metric_calibrations = SCALAR_KEYS
         .iter()
         .filter_map(|&key| {
-            let pairs: Vec<(f64, f64)> = judged
+            let pairs: Vec<(f64, f64, PhotoKind)> = judged
                 .iter()
                 .zip(&widenings)
-                .filter_map(|(j, w)| {
-                    Some((*j.metric_error.get(key)? / w, *j.metric_spread.get(key)?))
+                .zip(&kinds)
+                .filter_map(|((j, w), &kind)| {
+                    Some((
+                        *j.metric_error.get(key)? / w,
+                        *j.metric_spread.get(key)?,
+                        kind,
+                    ))
                 })
                 .collect();
             if pairs.len() < MIN_METRIC_PHOTOS {
@@ -118,14 +154,25 @@ pub fn fit_calibration(
             }
             let floor =
                 median(&mut pairs.iter().map(|p| p.0).collect::<Vec<_>>()).max(f64::EPSILON);
+            // Group-conditional (Mondrian) conformal scales: the largest of each kind's own
+            // quantile, so that the interval holds on each kind of photo, not only on all of
+            // them pooled (Vovk, Gammerman & Shafer 2005, "Algorithmic Learning in a Random
+            // World", section 4.5). A kind with too few photos joins the pool only.
             let scale = |q: f64| {
-                conformal_quantile(
-                    &mut pairs
+                let ratios = |kind: Option<PhotoKind>| -> Vec<f64> {
+                    pairs
                         .iter()
-                        .map(|(e, s)| e / (floor + s))
-                        .collect::<Vec<_>>(),
-                    q,
-                )
+                        .filter(|p| kind.is_none_or(|k| p.2 == k))
+                        .map(|(e, s, _)| e / (floor + s))
+                        .collect()
+                };
+                PhotoKind::ALL
+                    .iter()
+                    .map(|&k| ratios(Some(k)))
+                    .filter(|r| r.len() >= MIN_METRIC_PHOTOS)
+                    .chain(std::iter::once(ratios(None)))
+                    .map(|mut r| conformal_quantile(&mut r, q))
+                    .fold(0.0, f64::max)
             };
             Some(MetricCalibration {
                 key: key.to_string(),

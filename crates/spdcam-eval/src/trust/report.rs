@@ -125,6 +125,9 @@ struct MetricCoverage {
     half95: Vec<f64>,
 }
 
+/// Below this GFC an estimate is poor: a photo called `ok` should never be (issue goal).
+const POOR_GFC: f64 = 0.90;
+
 /// Scene photos of each test lamp the report measures (the whole camera chain).
 pub const REPORT_SCENES_PER_LAMP: usize = 2;
 
@@ -167,6 +170,7 @@ fn measure_row(
     let mut actual = Vec::new();
     let mut verdicts = [0usize; 3];
     let mut gfc_by_verdict = [0.0f64; 3];
+    let mut poor_ok = 0usize;
     let mut coverage: BTreeMap<String, MetricCoverage> = BTreeMap::new();
     for (j, row) in judged.iter().zip(features) {
         let u = cal.uncertainty(&j.spd, &j.spread, &j.metric_spread, residual(j))?;
@@ -194,6 +198,7 @@ fn measure_row(
         let t = assess(model, Some(cal), check, row, &j.spd, &PhotoFlags::default())?;
         verdicts[t.verdict as usize] += 1;
         gfc_by_verdict[t.verdict as usize] += gfc(j);
+        poor_ok += usize::from(t.verdict == Verdict::Ok && gfc(j) < POOR_GFC);
     }
     let n = judged.len() as f64;
     let difficulty: Vec<f64> = judged.iter().map(|j| -difficulty(j)).collect();
@@ -202,7 +207,7 @@ fn measure_row(
         count => format!("{:.3}", gfc_by_verdict[v as usize] / count as f64),
     };
     let row = format!(
-        "| {label} | {} | {:.4} | {:.1} % | {:.1} % | {:.2} | {:.2} | {:.0} / {:.0} / {:.0} % | {} / {} |\n",
+        "| {label} | {} | {:.4} | {:.1} % | {:.1} % | {:.2} | {:.2} | {:.0} / {:.0} / {:.0} % | {} / {} | {poor_ok} |\n",
         judged.len(),
         actual.iter().sum::<f64>() / n,
         100.0 * in68 as f64 / total as f64,
@@ -365,9 +370,13 @@ impl TrustReport {
              (peak 1, every wavelength of the model's grid) inside the 68 % and 95 % bands, the \
              Spearman rank correlation of the expected GFC (and of the negated difficulty, which has \
              no ties) with the actual GFC, the verdicts (ok / doubtful / unusable) and the mean \
-             GFC of the ok and of the doubtful estimates. The calibration used the split's \
-             validation lamps and, for the SG, the real sets' validation photos; everything here \
-             is held out from it (the real rows are the sets' test photos).\n\n",
+             GFC of the ok and of the doubtful estimates, and how many ok estimates have a GFC \
+             below 0.90 (none should). The calibration used the split's validation lamps (patch \
+             level and, where its file says so, scene photos) and, for the SG, the real sets' \
+             validation photos; everything here is held out from it (the scene rows are \
+             scene photos of the test lamps, 1200×900, two per lamp, by the held-out cameras in \
+             turn, found and sampled as a user's photo is; the real rows are the sets' test \
+             photos).\n\n",
         );
         let mut flags = String::from(
             "## The self-check on clean and bad photos\n\n\
@@ -441,7 +450,7 @@ impl TrustReport {
              | model · photos | n | fitted | flare | gradient x | as they are | flare | gradient | both |\n\
              |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         );
-        md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable | mean GFC: ok / doubtful |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable | mean GFC: ok / doubtful | ok with GFC below 0.90 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         let mut diagram = Vec::new();
         let mut scenes_per_lamp = 0;
         for ((path, model, chart_name), cal_path) in models.iter().zip(calibrations) {
