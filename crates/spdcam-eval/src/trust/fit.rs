@@ -154,26 +154,11 @@ pub fn fit_calibration(
             }
             let floor =
                 median(&mut pairs.iter().map(|p| p.0).collect::<Vec<_>>()).max(f64::EPSILON);
-            // Group-conditional (Mondrian) conformal scales: the largest of each kind's own
-            // quantile, so that the interval holds on each kind of photo, not only on all of
-            // them pooled (Vovk, Gammerman & Shafer 2005, "Algorithmic Learning in a Random
-            // World", section 4.5). A kind with too few photos joins the pool only.
-            let scale = |q: f64| {
-                let ratios = |kind: Option<PhotoKind>| -> Vec<f64> {
-                    pairs
-                        .iter()
-                        .filter(|p| kind.is_none_or(|k| p.2 == k))
-                        .map(|(e, s, _)| e / (floor + s))
-                        .collect()
-                };
-                PhotoKind::ALL
-                    .iter()
-                    .map(|&k| ratios(Some(k)))
-                    .filter(|r| r.len() >= MIN_METRIC_PHOTOS)
-                    .chain(std::iter::once(ratios(None)))
-                    .map(|mut r| conformal_quantile(&mut r, q))
-                    .fold(0.0, f64::max)
-            };
+            let ratios: Vec<(f64, PhotoKind)> = pairs
+                .iter()
+                .map(|&(e, s, kind)| (e / (floor + s), kind))
+                .collect();
+            let scale = |q: f64| group_conditional_quantile(&ratios, q, MIN_METRIC_PHOTOS);
             Some(MetricCalibration {
                 key: key.to_string(),
                 floor,
@@ -213,6 +198,28 @@ pub fn fit_calibration(
         real_photos: photos.judged.len() - photos.virtual_count - photos.scene_count,
         scenes_per_lamp: photos.scenes_per_lamp,
     })
+}
+
+/// The group-conditional (Mondrian) conformal `q` quantile of `values`, each tagged with its
+/// kind of photo: the largest of each kind's own quantile (kinds with at least `min` values)
+/// and the pooled one, so that an interval scaled by it holds on each kind of photo, not
+/// only on all of them pooled (Vovk, Gammerman & Shafer 2005, "Algorithmic Learning in a
+/// Random World", section 4.5).
+fn group_conditional_quantile(values: &[(f64, PhotoKind)], q: f64, min: usize) -> f64 {
+    let of = |kind: Option<PhotoKind>| -> Vec<f64> {
+        values
+            .iter()
+            .filter(|v| kind.is_none_or(|k| v.1 == k))
+            .map(|v| v.0)
+            .collect()
+    };
+    PhotoKind::ALL
+        .iter()
+        .map(|&k| of(Some(k)))
+        .filter(|v| v.len() >= min)
+        .chain(std::iter::once(of(None)))
+        .map(|mut v| conformal_quantile(&mut v, q))
+        .fold(0.0, f64::max)
 }
 
 /// Numbers of principal components the expected-GFC regression chooses among.
@@ -466,6 +473,26 @@ pub fn calibrate(
 mod tests {
     use super::*;
     use crate::trust::judged::fixtures::judged;
+
+    #[test]
+    fn intervals_are_scaled_to_hold_on_the_hardest_kind_of_photo() {
+        // 200 patch-level ratios spread evenly over (0, 1], 100 scene ratios over (0, 3].
+        let mut values: Vec<(f64, PhotoKind)> = (1..=200)
+            .map(|i| (f64::from(i) / 200.0, PhotoKind::Virtual))
+            .collect();
+        values.extend((1..=100).map(|i| (3.0 * f64::from(i) / 100.0, PhotoKind::Scene)));
+        // The scenes' own 95 % quantile: the ⌈101 · 0.95⌉ = 96th of 100, 2.88; pooled it
+        // would be the 286th of 300, 2.58.
+        let q = group_conditional_quantile(&values, 0.95, 40);
+        assert!((q - 2.88).abs() < 1e-9, "{q}");
+        let mut pooled: Vec<f64> = values.iter().map(|v| v.0).collect();
+        assert!((conformal_quantile(&mut pooled, 0.95) - 2.58).abs() < 1e-9);
+        // Too few scene photos (30) to stand on their own: the patch-level photos' quantile
+        // (the 191st of 200, 0.955) and the pool's (the 220th of 230, 0.95) decide.
+        let few: Vec<(f64, PhotoKind)> = values[..230].to_vec();
+        let q = group_conditional_quantile(&few, 0.95, 40);
+        assert!((q - 0.955).abs() < 1e-9, "{q}");
+    }
 
     #[test]
     fn the_expected_gfc_regression_learns_how_the_gfc_falls_with_difficulty() {
