@@ -193,6 +193,7 @@ mod tests {
             band68: band(0.05),
             band95: band(0.1),
             expected_gfc: 0.99,
+            gfc_at_least95: 0.97,
             difficulty: 0.01,
             widening: 1.0,
             metrics: BTreeMap::new(),

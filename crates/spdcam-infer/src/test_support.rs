@@ -27,6 +27,7 @@ pub(crate) fn estimate_of(spd: Spd, halves: &[(&str, f64)]) -> Estimate {
                 band68: band.clone(),
                 band95: band,
                 expected_gfc: 0.995,
+                gfc_at_least95: 0.98,
                 difficulty: 0.01,
                 widening: 1.0,
                 metrics: halves

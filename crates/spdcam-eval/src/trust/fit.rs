@@ -46,9 +46,10 @@ pub struct CalibrationPhotos {
     groups: Vec<usize>,
 }
 
-/// The kinds of calibration photo, each of which the metric intervals must hold on.
+/// The kinds of calibration photo, each of which the metric intervals and the expected
+/// GFC's margin must hold on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum PhotoKind {
+pub enum PhotoKind {
     /// Virtual, patch level.
     Virtual,
     /// Virtual scene photos through the whole camera chain.
@@ -58,7 +59,8 @@ enum PhotoKind {
 }
 
 impl PhotoKind {
-    const ALL: [PhotoKind; 3] = [PhotoKind::Virtual, PhotoKind::Scene, PhotoKind::Real];
+    /// Every kind.
+    pub const ALL: [PhotoKind; 3] = [PhotoKind::Virtual, PhotoKind::Scene, PhotoKind::Real];
 }
 
 impl CalibrationPhotos {
@@ -180,7 +182,7 @@ pub fn fit_calibration(
         floor,
         scale68,
         scale95,
-        gfc_model: fit_gfc_model(judged, &photos.groups)?,
+        gfc_model: fit_gfc_model(judged, &photos.groups, &kinds)?,
         residual_reference,
         difficulty_doubtful: conformal_quantile(&mut difficulties, 0.99),
         self_check_doubtful: all_checked.then(|| conformal_quantile(&mut checks, 0.99)),
@@ -236,13 +238,14 @@ const GFC_GAP_FLOOR: f64 = 1e-5;
 /// cross-validation over whole groups (`groups[i]` is photo i's: a lamp's photos share one,
 /// so a lamp never informs its own prediction; ties go to fewer components and the stronger
 /// penalty), then refitted on every photo. The constant is not penalised.
-pub fn fit_gfc_model(judged: &[Judged], groups: &[usize]) -> Result<GfcModel> {
+pub fn fit_gfc_model(judged: &[Judged], groups: &[usize], kinds: &[PhotoKind]) -> Result<GfcModel> {
     let n = judged.len();
-    if groups.len() != n {
+    if groups.len() != n || kinds.len() != n {
         return Err(EvalError::invalid(format!(
-            "{} photos but {} cross-validation groups",
+            "{} photos but {} cross-validation groups and {} kinds",
             n,
-            groups.len()
+            groups.len(),
+            kinds.len()
         )));
     }
     let d = judged
@@ -264,6 +267,7 @@ pub fn fit_gfc_model(judged: &[Judged], groups: &[usize]) -> Result<GfcModel> {
         low: Vec::new(),
         high: Vec::new(),
         gap_range: [0.0; 2],
+        gap_margin95: 0.0,
     };
     let inputs = |m: &GfcModel| -> Vec<Vec<f64>> {
         judged
@@ -327,6 +331,16 @@ pub fn fit_gfc_model(judged: &[Judged], groups: &[usize]) -> Result<GfcModel> {
         best.ok_or_else(|| EvalError::invalid("no expected-GFC regression could be fitted"))?;
     let mut model = with(k);
     let x = inputs(&model);
+    // Each photo's residual predicted without its own group, with the chosen settings.
+    let mut residuals = Vec::with_capacity(n);
+    for (test, train) in &folds {
+        let ridge = solve(&gram(&x, train)?, penalty)?;
+        residuals.extend(
+            test.iter()
+                .map(|&i| (target[i][0] - ridge.predict(&x[i])[0], kinds[i])),
+        );
+    }
+    model.gap_margin95 = group_conditional_quantile(&residuals, 0.95, MIN_METRIC_PHOTOS);
     let ridge = solve(&gram(&x, &(0..n).collect::<Vec<_>>())?, penalty)?;
     model.weights = (0..ridge.inputs()).map(|j| ridge.weight(0, j)).collect();
     let range = |values: &mut dyn Iterator<Item = f64>| {
@@ -510,7 +524,9 @@ mod tests {
             assert!((gfc(r) - want).abs() < 1e-9, "{} {want}", gfc(r));
         }
         let groups: Vec<usize> = (0..rows.len()).map(|i| i / 4).collect();
-        let model = fit_gfc_model(&rows, &groups).unwrap();
+        let model = fit_gfc_model(&rows, &groups, &[PhotoKind::Virtual; 80]).unwrap();
+        // An exact law leaves no residual: the 95 % floor is the median.
+        assert!(model.gap_margin95.abs() < 0.05, "{}", model.gap_margin95);
         for r in &rows {
             let gap = 1.0 - model.expected(&r.spd, difficulty(r));
             let want = 0.2 * difficulty(r);

@@ -34,6 +34,9 @@ pub struct Uncertainty {
     pub band95: Band,
     /// The GFC such estimates reach, in the median: the calibration's [`GfcModel`].
     pub expected_gfc: f64,
+    /// The GFC 95 % of such estimates reach at least ([`GfcModel::at_least95`]): an
+    /// estimate is called `ok` only where this is not poor.
+    pub gfc_at_least95: f64,
     /// The mean spread of the perturbed estimates (see [`Perturbed::spread`](super::spread::Perturbed::spread)).
     pub difficulty: f64,
     /// How many times the bands and intervals are widened because the estimated light
@@ -183,6 +186,12 @@ pub struct GfcModel {
     pub high: Vec<f64>,
     /// The smallest and largest ln(1 − GFC) of the calibration photos.
     pub gap_range: [f64; 2],
+    /// How far ln(1 − GFC) lies above the regression's prediction for 95 % of the
+    /// calibration photos, predicted without their own lamp (cross-validation): the
+    /// group-conditional conformal quantile of those residuals (each kind of photo on its
+    /// own, as the metric intervals). 0 in calibrations made before it existed.
+    #[serde(default)]
+    pub gap_margin95: f64,
 }
 
 impl GfcModel {
@@ -202,8 +211,9 @@ impl GfcModel {
         x
     }
 
-    /// The median GFC of estimates like `spd` (peak 1) of mean spread `difficulty`.
-    pub fn expected(&self, spd: &[f64], difficulty: f64) -> f64 {
+    /// The predicted ln(1 − GFC) of estimates like `spd` (peak 1) of mean spread
+    /// `difficulty`, inside the calibration photos' range.
+    fn predicted_gap(&self, spd: &[f64], difficulty: f64) -> f64 {
         let z: f64 = self
             .inputs(spd, difficulty)
             .iter()
@@ -212,7 +222,19 @@ impl GfcModel {
             .map(|((x, (lo, hi)), w)| w * x.clamp(*lo, *hi))
             .sum();
         let [lowest, highest] = self.gap_range;
-        (1.0 - z.clamp(lowest, highest).exp()).clamp(0.0, 1.0)
+        z.clamp(lowest, highest)
+    }
+
+    /// The median GFC of estimates like `spd` (peak 1) of mean spread `difficulty`.
+    pub fn expected(&self, spd: &[f64], difficulty: f64) -> f64 {
+        (1.0 - self.predicted_gap(spd, difficulty).exp()).clamp(0.0, 1.0)
+    }
+
+    /// The GFC that 95 % of estimates like `spd` reach at least: the prediction moved by
+    /// the calibration's 95 % residual margin ([`GfcModel::gap_margin95`]).
+    pub fn at_least95(&self, spd: &[f64], difficulty: f64) -> f64 {
+        let gap = self.predicted_gap(spd, difficulty) + self.gap_margin95.max(0.0);
+        (1.0 - gap.exp()).clamp(0.0, 1.0)
     }
 
     /// Whether the model's arrays fit `d` wavelengths.
@@ -225,6 +247,7 @@ impl GfcModel {
             && self.low.iter().zip(&self.high).all(|(l, h)| l <= h)
             && self.gap_range[0] <= self.gap_range[1]
             && self.weights.iter().all(|w| w.is_finite())
+            && self.gap_margin95.is_finite()
     }
 }
 
@@ -334,6 +357,7 @@ impl TrustCalibration {
             band68: band(&self.scale68)?,
             band95: band(&self.scale95)?,
             expected_gfc: self.gfc_model.expected(spd, difficulty),
+            gfc_at_least95: self.gfc_model.at_least95(spd, difficulty),
             difficulty,
             widening,
             metrics: self
@@ -404,6 +428,7 @@ mod tests {
             low: vec![-10.0, -1.0, 1.0],
             high: vec![0.0, 1.0, 1.0],
             gap_range: [-20.0, 0.0],
+            gap_margin95: 0.0,
         };
         let (spd, difficulty) = ([1.0, 0.25], 0.04);
         let coordinate = 0.6 * 0.5 + 0.8 * -0.25;
@@ -412,6 +437,17 @@ mod tests {
         assert_eq!(
             model.inputs(&spd, difficulty),
             vec![0.04f64.ln(), coordinate, 1.0]
+        );
+        // Without a margin the 95 % floor is the median; a margin of ln 3 triples 1 − GFC.
+        assert!((model.at_least95(&spd, difficulty) - want).abs() < 1e-12);
+        let wider = GfcModel {
+            gap_margin95: 3.0f64.ln(),
+            ..model.clone()
+        };
+        let floor = wider.at_least95(&spd, difficulty);
+        assert!(
+            ((1.0 - floor) / (1.0 - want) - 3.0).abs() < 1e-9,
+            "{floor} {want}"
         );
         // Inputs beyond the calibration's range are held at its edge, and so is the value.
         let narrow = GfcModel {
@@ -423,6 +459,7 @@ mod tests {
         let wild = GfcModel {
             weights: vec![0.0, 0.0, 5.0],
             gap_range: [-20.0, -3.0],
+            gap_margin95: 0.0,
             ..model
         };
         assert!((wild.expected(&spd, difficulty) - (1.0 - (-3.0f64).exp())).abs() < 1e-12);
@@ -446,6 +483,7 @@ mod tests {
                 low: vec![-10.0, 1.0],
                 high: vec![0.0, 1.0],
                 gap_range: [-10.0, 0.0],
+                gap_margin95: 0.0,
             },
             residual_reference: Some(0.05),
             difficulty_doubtful: 1.0,
