@@ -23,8 +23,12 @@ use crate::feature_rows::FeatureRows;
 use crate::photo_options::{chart_templates, PhotoOptions};
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
-use crate::trust::{self, ChartCheck, PhotoFlags, Trust, TrustCalibration};
+use crate::trust::{
+    self, feature_scale, skipped_patches, ChartCheck, ChartIdentity, Identity, PhotoFlags,
+    Trust, TrustCalibration,
+};
 use rayon::prelude::*;
+use spdcam_core::advice::Sampled;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::photo::{
@@ -42,6 +46,8 @@ struct ModelTrust {
     calibration: Option<TrustCalibration>,
     /// The chart re-rendered under an estimate (the self-check), built once.
     check: Option<ChartCheck>,
+    /// The test that patches are the model's chart at all, made once.
+    identity: ChartIdentity,
 }
 
 /// What does not depend on the output grid, shared by the estimators of every grid.
@@ -104,9 +110,11 @@ impl Estimator {
             .models()
             .iter()
             .map(|m| {
+                let check = ChartCheck::for_model(&m.model, &data_dir)?;
                 Ok(ModelTrust {
                     calibration: trust::calibration_for(&m.model)?,
-                    check: ChartCheck::for_model(&m.model, &data_dir)?,
+                    identity: ChartIdentity::for_model(&m.model, check.as_ref()),
+                    check,
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -347,8 +355,44 @@ impl Estimator {
 
     /// The estimate for an analysed photo, by the model for the chart it shows, labelled
     /// `name`, judged with what the analysis found (detection, clipped and dark patches).
+    /// Patches that do not behave like the chart are refused first
+    /// ([`InferError::NotTheChart`]; see [`trust::chart_identity`]): no number is made of
+    /// them, whether the chart was detected or its corners given.
     pub fn estimate_analysis(&self, analysis: PhotoAnalysis, name: String) -> Result<Estimate> {
-        let rows = FeatureRows::of_analyses(&[&analysis])?;
+        let identified = self.identify(&analysis)?;
+        let judge = &self.prepared.trust[identified.index];
+        let sampled = match analysis.method {
+            "corners" => Sampled::Corners,
+            _ => Sampled::Detected,
+        };
+        judge
+            .identity
+            .require(&identified.identity, sampled, &analysis.source)?;
+        let model_spds = identified.model_spds?;
+        self.judged(
+            identified.index,
+            name,
+            model_spds,
+            &identified.rows.values,
+            &identified.flags,
+            Some(analysis),
+        )
+    }
+
+    /// Whether an analysed photo shows the chart it is said to: the statistics of
+    /// [`trust::chart_identity`], the shuffled one under the model's estimate (or, where the
+    /// model refuses the features, under an equal-energy light) when the chart's
+    /// reflectances are at hand. [`Estimator::estimate_photo`] refuses the photo when they
+    /// find anything against the chart (`Identity::mismatches`).
+    pub fn photo_identity(&self, analysis: &PhotoAnalysis) -> Result<Identity> {
+        Ok(self.identify(analysis)?.identity)
+    }
+
+    /// The model for `analysis`, its features and flags, its identity and the model's SPDs
+    /// (or why the model made none). What needs no light is measured first, and the model
+    /// is not run when it finds anything against the chart.
+    fn identify(&self, analysis: &PhotoAnalysis) -> Result<Identified> {
+        let rows = FeatureRows::of_analyses(&[analysis])?;
         let index = self.choose(&rows.names, &analysis.source).map_err(|_| {
             InferError::invalid(format!(
                 "{}: no model for chart {}; the models are for {}",
@@ -357,22 +401,98 @@ impl Estimator {
                 self.charts()
             ))
         })?;
-        let model_spds = self.run_model(index, &rows, &analysis.source)?;
         let chosen = self.named(index);
         let feature_patches = chosen
             .model
             .photo_chart()
             .filter(|t| t.name == analysis.chart)
             .map(|t| t.feature_patches.as_slice());
-        let flags = trust::photo_flags(&analysis, feature_patches);
-        self.judged(
+        let flags = trust::photo_flags(analysis, feature_patches);
+        let judge = &self.prepared.trust[index];
+        let scale = feature_scale(&rows.values);
+        let skip = skipped_patches(&rows.values, scale, &flags);
+        let mut identity = judge.identity.of_photo(analysis, scale, &skip);
+        let model_spds = if identity.mismatches().is_empty() {
+            self.run_model(index, &rows, &analysis.source)
+        } else {
+            Err(InferError::invalid("the patches are not the chart"))
+        };
+        if let Some(check) = &judge.check {
+            let light = match &model_spds {
+                Ok(spds) => spds.clone(),
+                Err(_) => vec![1.0; chosen.model.grid().count],
+            };
+            identity.shuffled =
+                judge
+                    .identity
+                    .shuffled(&rows.values, scale, &skip, &check.rendered(&light)?);
+        }
+        Ok(Identified {
             index,
-            name,
+            rows,
+            flags,
+            identity,
             model_spds,
-            &rows.values,
-            &flags,
-            Some(analysis),
-        )
+        })
+    }
+
+    /// Whether each of the feature rows `features` holds the patches of the model's chart:
+    /// the statistics of [`trust::chart_identity`], the shuffled one under the model's
+    /// estimate when the chart's reflectances are at hand. [`Estimator::estimate_rows`] and
+    /// [`Estimator::stream`] refuse a row when they find anything against the chart.
+    pub fn row_identities(&self, features: &FeatureRows, source: &str) -> Result<Vec<Identity>> {
+        let index = self.choose(&features.names, source)?;
+        let model_spds = self.run_model(index, features, source)?;
+        let width = features.names.len().max(1);
+        let d = self.named(index).model.grid().count.max(1);
+        features
+            .values
+            .par_chunks(width)
+            .zip(model_spds.par_chunks(d))
+            .map(|(row, spd)| self.row_identity(index, row, spd))
+            .collect()
+    }
+
+    /// The identity of one feature row whose SPD under model `index` is `spd`.
+    fn row_identity(&self, index: usize, row: &[f64], spd: &[f64]) -> Result<Identity> {
+        let judge = &self.prepared.trust[index];
+        let scale = feature_scale(row);
+        let skip = skipped_patches(row, scale, &PhotoFlags::default());
+        let mut identity = judge.identity.of_row(row, scale, &skip);
+        if let Some(check) = &judge.check {
+            identity.shuffled = judge
+                .identity
+                .shuffled(row, scale, &skip, &check.rendered(spd)?);
+        }
+        Ok(identity)
+    }
+
+    /// Refuses the first of feature rows `values` (row-major, the first being row
+    /// `first_row`, 0-based) that does not behave like model `index`'s chart, with the SPDs
+    /// `model_spds` the model made of them (see [`trust::chart_identity`]).
+    fn require_chart_rows(
+        &self,
+        index: usize,
+        values: &[f64],
+        model_spds: &[f64],
+        source: &str,
+        first_row: usize,
+    ) -> Result<()> {
+        let identity = &self.prepared.trust[index].identity;
+        let width = self.named(index).model.feature_names().len().max(1);
+        let d = self.named(index).model.grid().count.max(1);
+        let failed = values
+            .par_chunks(width)
+            .zip(model_spds.par_chunks(d))
+            .enumerate()
+            .find_map_first(|(k, (row, spd))| {
+                self.row_identity(index, row, spd)
+                    .and_then(|found| {
+                        identity.require(&found, Sampled::Row(first_row + k + 1), source)
+                    })
+                    .err()
+            });
+        failed.map_or(Ok(()), Err)
     }
 
     /// Judged estimates for feature rows, each labelled `estimate_N` (1-based), by the
@@ -413,6 +533,7 @@ impl Estimator {
     pub fn estimate_rows(&self, features: &FeatureRows, source: &str) -> Result<Vec<Estimate>> {
         let index = self.choose(&features.names, source)?;
         let model_spds = self.run_model(index, features, source)?;
+        self.require_chart_rows(index, &features.values, &model_spds, source, 0)?;
         let width = features.names.len();
         let d = self.named(index).model.grid().count;
         features
@@ -650,6 +771,20 @@ fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
+/// What [`Estimator::identify`] found of an analysed photo.
+struct Identified {
+    /// The index of the model for its chart.
+    index: usize,
+    /// Its feature row.
+    rows: FeatureRows,
+    /// What the analysis found that bears on trust.
+    flags: PhotoFlags,
+    /// Whether it is the chart.
+    identity: Identity,
+    /// The model's SPD (on its grid), or why there is none.
+    model_spds: Result<Vec<f64>>,
+}
+
 /// One photo's way through the [`Estimator`] ([`Estimator::estimate_photos`],
 /// [`Estimator::photo_bytes`]): its analysis, the debug image written for it and its
 /// estimate.
@@ -736,7 +871,8 @@ impl RowStream<'_> {
     }
 
     /// The next block of rows with their SPDs, or `None` after the last. Rows that say
-    /// nothing about the light are refused, naming the row (1-based in the file).
+    /// nothing about the light, or that are not the model's chart
+    /// ([`trust::chart_identity`]), are refused, naming the row (1-based in the file).
     pub fn next_block(&mut self) -> Result<Option<EstimatedBlock>> {
         let Some(block) = self.stream.next_block(self.rows)? else {
             return Ok(None);
@@ -748,6 +884,13 @@ impl RowStream<'_> {
             .named(self.index)
             .model
             .estimate_rows(&block.values)?;
+        self.estimator.require_chart_rows(
+            self.index,
+            &block.values,
+            &model_spds,
+            &self.source,
+            block.first_row,
+        )?;
         let spds = self.estimator.map(self.index)?.apply(model_spds.clone());
         self.rows += block.rows;
         Ok(Some(EstimatedBlock {

@@ -17,7 +17,7 @@ use spdcam_core::spectral::Grid;
 /// How many patches the self-check names as the worst.
 const WORST_NAMED: usize = 3;
 /// Fewer usable patches than this leave the self-check's 6 parameters per channel too free.
-const MIN_CHECK_PATCHES: usize = 12;
+pub(crate) const MIN_CHECK_PATCHES: usize = 12;
 /// Fewer patches than this on a half leave its 4 parameters per channel too free.
 const MIN_HALF_PATCHES: usize = 8;
 /// How well the estimated light explains the photo's patches.
@@ -121,6 +121,29 @@ impl ChartCheck {
         self.weights.len()
     }
 
+    /// The neutral feature patches (feature index, mean reflectance), as
+    /// [`Chart::neutral_features`] gives them.
+    pub fn neutrals(&self) -> &[(usize, f64)] {
+        &self.neutrals
+    }
+
+    /// Each feature patch's raw RGB through the reference camera under `spd` (on the check's
+    /// grid): Σλ camera · reflectance · SPD.
+    pub fn rendered(&self, spd: &[f64]) -> Result<Vec<[f64; 3]>> {
+        if spd.len() != self.grid.count {
+            return Err(InferError::invalid(format!(
+                "the chart rendered under an SPD of {} values on a grid of {}",
+                spd.len(),
+                self.grid.count
+            )));
+        }
+        Ok(self
+            .weights
+            .iter()
+            .map(|w| std::array::from_fn(|c| w[c].iter().zip(spd).map(|(a, b)| a * b).sum()))
+            .collect())
+    }
+
     /// Checks `spd` (on the check's grid) against one feature row (encoded sRGB on
     /// `0…scale`, three per patch). Patches with `skip[i]` (clipped, dark) are left out.
     ///
@@ -158,11 +181,7 @@ impl ChartCheck {
                 used.len()
             )));
         }
-        let predicted: Vec<[f64; 3]> = self
-            .weights
-            .iter()
-            .map(|w| std::array::from_fn(|c| w[c].iter().zip(spd).map(|(a, b)| a * b).sum()))
-            .collect();
+        let predicted = self.rendered(spd)?;
         let mut best: Option<MapFit> = None;
         for &gamma in &TONE_GAMMAS {
             for &contrast in &TONE_CONTRASTS {
@@ -203,7 +222,7 @@ impl ChartCheck {
         let (pl, ol) = (level(predicted), level(observed));
         if !(pl > 0.0 && ol > 0.0) {
             return Err(InferError::invalid(
-                "self-check: the chart or the light is black",
+                "the chart or the light is black",
             ));
         }
         // Per patch: the predicted RGB, a constant (flare), the light's gradient and an
@@ -379,7 +398,7 @@ impl ChartCheck {
                     .clone_owned()
                     .svd(true, true)
                     .solve(&b, 1e-10)
-                    .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))?;
+                    .map_err(|e| InferError::invalid(format!("the fit to the chart failed: {e}")))?;
                 Ok((first * x - &b).norm_squared())
             };
             let (one, two) = (rss(shared)?, rss(columns)?);
@@ -491,7 +510,7 @@ fn least_squares(
     let b = DMatrix::from_fn(rows.len(), 3, |r, c| target(rows[r])[c]);
     a.svd(true, true)
         .solve(&b, 1e-10)
-        .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))
+        .map_err(|e| InferError::invalid(format!("the fit to the chart failed: {e}")))
 }
 
 #[cfg(test)]
