@@ -301,8 +301,6 @@ impl fmt::Display for Advice {
 pub enum Mismatch {
     /// The patches are all of one colour.
     Flat,
-    /// The patches that are grey on the chart are not of one colour.
-    NotGrey,
     /// The patches that are grey on the chart are not ordered from light to dark as the
     /// chart's are.
     NotOrdered,
@@ -310,13 +308,14 @@ pub enum Mismatch {
     Unexplained,
     /// The patches are not flat inside.
     Textured,
+    /// Too few patches are neither clipped nor nearly black to tell.
+    TooFewUsable,
 }
 
 impl fmt::Display for Mismatch {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
             Mismatch::Flat => "the patches are all of one colour",
-            Mismatch::NotGrey => "the patches that are grey on the chart are not of one colour",
             Mismatch::NotOrdered => {
                 "the patches that are grey on the chart do not run from light to dark as the \
                  chart's do"
@@ -326,6 +325,11 @@ impl fmt::Display for Mismatch {
                  explains them no better than the same colours shuffled"
             }
             Mismatch::Textured => "the patches are not flat: they hold detail, not one colour each",
+            Mismatch::TooFewUsable => {
+                "too few of the patches are neither clipped nor nearly black to tell; if they \
+                 are on the chart, retake the photo exposed so that its white is bright but \
+                 not clipped"
+            }
         })
     }
 }

@@ -656,7 +656,10 @@ mod tests {
         // Other charts, and patches past the last, by number.
         assert_eq!(feature_patch_name("my_chart.csv", 6), "patch 7");
         assert_eq!(feature_patch_name("colorchecker24", 24), "patch 25");
-        assert_eq!(shown_chart_name("colorchecker_sg96"), "ColorChecker Digital SG");
+        assert_eq!(
+            shown_chart_name("colorchecker_sg96"),
+            "ColorChecker Digital SG"
+        );
         assert_eq!(shown_chart_name("colorchecker24"), "ColorChecker 24");
     }
 

@@ -20,7 +20,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::photo::{load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_infer::trust::chart_identity::{
-    MAX_NEUTRAL_COLOUR, MAX_SHUFFLED, MAX_TEXTURE, MIN_CONTRAST, MIN_NEUTRAL_ORDER,
+    MAX_SHUFFLED, MAX_TEXTURE, MIN_CONTRAST, MIN_NEUTRAL_ORDER,
 };
 use spdcam_infer::trust::Identity;
 use spdcam_infer::{Estimator, FeatureRows, InferError, PhotoOptions};
@@ -89,14 +89,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 },
             ),
         ] {
-            items.push(measure(&estimator, &photo, &options, &format!("scenes, {how}"), &name));
+            items.push(measure(
+                &estimator,
+                &photo,
+                &options,
+                &format!("scenes, {how}"),
+                &name,
+            ));
         }
         crops.push(crop_without_chart(&photo, &corners)?);
     }
     let mut no_chart = generated()?;
     no_chart.extend(crops.into_iter().map(|p| ("scene crops".to_string(), p)));
     for (group, photo) in &no_chart {
-        for (k, corners) in corner_sets(photo.width, photo.height).into_iter().enumerate() {
+        for (k, corners) in corner_sets(photo.width, photo.height)
+            .into_iter()
+            .enumerate()
+        {
             for chart in CHARTS {
                 let options = PhotoOptions {
                     chart: Some(chart.into()),
@@ -109,18 +118,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     print!("{}", summary(&items));
-    let mut tsv = String::from("group\tname\toutcome\tcontrast\tneutral_colour\tneutral_order\tshuffled\ttexture\n");
+    let mut tsv =
+        String::from("group\tname\toutcome\tcontrast\tneutral_order\tshuffled\ttexture\n");
     for item in &items {
         let id = item.identity.as_ref();
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
         writeln!(
             tsv,
-            "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}",
+            "{}\t{}\t{}\t{}\t{}\t{}\t{}",
             item.group,
             item.name,
             item.outcome,
             f(id.map(|i| i.contrast)),
-            f(id.and_then(|i| i.neutral_colour)),
             f(id.and_then(|i| i.neutral_order)),
             f(id.and_then(|i| i.shuffled)),
             f(id.and_then(|i| i.texture)),
@@ -249,7 +258,10 @@ fn generated() -> Result<Vec<(String, Photo)>, InferError> {
         let flat = colour(&mut rng);
         out.push(("flat".into(), image(&format!("flat-{seed}"), |_, _| flat)?));
         let grey: f64 = rng.random();
-        out.push(("flat".into(), image(&format!("grey-{seed}"), |_, _| [grey; 3])?));
+        out.push((
+            "flat".into(),
+            image(&format!("grey-{seed}"), |_, _| [grey; 3])?,
+        ));
         // Stripes: vertical, horizontal and diagonal, of random colours and width.
         let colours: Vec<[f64; 3]> = (0..12).map(|_| colour(&mut rng)).collect();
         let period: f64 = rng.random_range(0.03..0.2);
@@ -304,7 +316,13 @@ fn crop_without_chart(photo: &Photo, corners: &[[f64; 2]]) -> Result<Photo, Infe
             data.extend(photo.pixel(x, y).map(|v| (255.0 * v).round() as u8));
         }
     }
-    let name = format!("crop of {}", Path::new(&photo.source).file_name().unwrap().to_string_lossy());
+    let name = format!(
+        "crop of {}",
+        Path::new(&photo.source)
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+    );
     Ok(Photo::from_rgb8(&name, bw, bh, data)?)
 }
 
@@ -317,14 +335,24 @@ fn corner_sets(width: usize, height: usize) -> Vec<Vec<[f64; 2]>> {
     let square = {
         let (cx, cy) = (w / 2.0, h / 2.0);
         let s = side / 2.0;
-        vec![[cx - s, cy - s * 0.95], [cx + s, cy - s], [cx + s * 0.97, cy + s], [cx - s, cy + s]]
+        vec![
+            [cx - s, cy - s * 0.95],
+            [cx + s, cy - s],
+            [cx + s * 0.97, cy + s],
+            [cx - s, cy + s],
+        ]
     };
     let rotated = {
         let (cx, cy, a) = (w / 2.0, h / 2.0, 20f64.to_radians());
         let (hw, hh) = (0.3 * w, 0.2 * h);
         [[-hw, -hh], [hw, -hh], [hw, hh], [-hw, hh]]
             .iter()
-            .map(|p| [cx + p[0] * a.cos() - p[1] * a.sin(), cy + p[0] * a.sin() + p[1] * a.cos()])
+            .map(|p| {
+                [
+                    cx + p[0] * a.cos() - p[1] * a.sin(),
+                    cy + p[0] * a.sin() + p[1] * a.cos(),
+                ]
+            })
             .collect()
     };
     vec![
@@ -344,8 +372,8 @@ fn summary(items: &[Item]) -> String {
         groups.entry(&item.group).or_default().push(item);
     }
     let mut out = String::from(
-        "| group | items | accepted | refused: not the chart | refused otherwise | contrast | neutral colour | neutral order | shuffled | texture |\n\
-         | --- | --: | --: | --: | --: | --- | --- | --- | --- | --- |\n",
+        "| group | items | accepted | refused: not the chart | refused otherwise | contrast | neutral order | shuffled | texture |\n\
+         | --- | --: | --: | --: | --: | --- | --- | --- | --- |\n",
     );
     for (group, members) in &groups {
         let n = members.len();
@@ -367,12 +395,11 @@ fn summary(items: &[Item]) -> String {
         };
         let _ = writeln!(
             out,
-            "| {group} | {n} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {group} | {n} | {} | {} | {} | {} | {} | {} | {} |",
             share(&|o| o == "accepted"),
             share(&|o| o == "refused"),
             share(&|o| o.starts_with("other")),
             range(&|i| Some(i.contrast)),
-            range(&|i| i.neutral_colour),
             range(&|i| i.neutral_order),
             range(&|i| i.shuffled),
             range(&|i| i.texture),
@@ -380,8 +407,7 @@ fn summary(items: &[Item]) -> String {
     }
     let _ = writeln!(
         out,
-        "\nThresholds: contrast ≥ {MIN_CONTRAST}, neutral colour ≤ {MAX_NEUTRAL_COLOUR}, \
-         neutral order ≥ {MIN_NEUTRAL_ORDER}, shuffled ≤ {MAX_SHUFFLED}, texture ≤ {MAX_TEXTURE}."
+        "\nThresholds: contrast ≥ {MIN_CONTRAST}, neutral order ≥ {MIN_NEUTRAL_ORDER}, shuffled ≤ {MAX_SHUFFLED}, texture ≤ {MAX_TEXTURE}."
     );
     out
 }

@@ -24,8 +24,7 @@ use crate::photo_options::{chart_templates, PhotoOptions};
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
 use crate::trust::{
-    self, feature_scale, skipped_patches, ChartCheck, ChartIdentity, Identity, PhotoFlags,
-    Trust, TrustCalibration,
+    self, feature_scale, ChartCheck, ChartIdentity, Identity, PhotoFlags, Trust, TrustCalibration,
 };
 use rayon::prelude::*;
 use spdcam_core::advice::Sampled;
@@ -113,7 +112,7 @@ impl Estimator {
                 let check = ChartCheck::for_model(&m.model, &data_dir)?;
                 Ok(ModelTrust {
                     calibration: trust::calibration_for(&m.model)?,
-                    identity: ChartIdentity::for_model(&m.model, check.as_ref()),
+                    identity: ChartIdentity::for_model(&m.model),
                     check,
                 })
             })
@@ -410,8 +409,7 @@ impl Estimator {
         let flags = trust::photo_flags(analysis, feature_patches);
         let judge = &self.prepared.trust[index];
         let scale = feature_scale(&rows.values);
-        let skip = skipped_patches(&rows.values, scale, &flags);
-        let mut identity = judge.identity.of_photo(analysis, scale, &skip);
+        let mut identity = judge.identity.of_photo(analysis, scale);
         let model_spds = if identity.mismatches().is_empty() {
             self.run_model(index, &rows, &analysis.source)
         } else {
@@ -422,10 +420,13 @@ impl Estimator {
                 Ok(spds) => spds.clone(),
                 Err(_) => vec![1.0; chosen.model.grid().count],
             };
-            identity.shuffled =
-                judge
-                    .identity
-                    .shuffled(&rows.values, scale, &skip, &check.rendered(&light)?);
+            judge.identity.add_shuffled(
+                &mut identity,
+                &rows.values,
+                scale,
+                &flags.clipped,
+                (check, &light),
+            )?;
         }
         Ok(Identified {
             index,
@@ -457,12 +458,11 @@ impl Estimator {
     fn row_identity(&self, index: usize, row: &[f64], spd: &[f64]) -> Result<Identity> {
         let judge = &self.prepared.trust[index];
         let scale = feature_scale(row);
-        let skip = skipped_patches(row, scale, &PhotoFlags::default());
-        let mut identity = judge.identity.of_row(row, scale, &skip);
+        let mut identity = judge.identity.of_row(row, scale);
         if let Some(check) = &judge.check {
-            identity.shuffled = judge
+            judge
                 .identity
-                .shuffled(row, scale, &skip, &check.rendered(spd)?);
+                .add_shuffled(&mut identity, row, scale, &[], (check, spd))?;
         }
         Ok(identity)
     }

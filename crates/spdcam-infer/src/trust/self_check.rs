@@ -121,6 +121,11 @@ impl ChartCheck {
         self.weights.len()
     }
 
+    /// Each feature patch's centre across the chart, −½…½ ([`Chart::feature_centres`]).
+    pub fn centres(&self) -> &[[f64; 2]] {
+        &self.centres
+    }
+
     /// The neutral feature patches (feature index, mean reflectance), as
     /// [`Chart::neutral_features`] gives them.
     pub fn neutrals(&self) -> &[(usize, f64)] {
@@ -221,9 +226,7 @@ impl ChartCheck {
         };
         let (pl, ol) = (level(predicted), level(observed));
         if !(pl > 0.0 && ol > 0.0) {
-            return Err(InferError::invalid(
-                "the chart or the light is black",
-            ));
+            return Err(InferError::invalid("the chart or the light is black"));
         }
         // Per patch: the predicted RGB, a constant (flare), the light's gradient and an
         // additive light changing across the chart (the last two columns, for the glare).
@@ -398,7 +401,9 @@ impl ChartCheck {
                     .clone_owned()
                     .svd(true, true)
                     .solve(&b, 1e-10)
-                    .map_err(|e| InferError::invalid(format!("the fit to the chart failed: {e}")))?;
+                    .map_err(|e| {
+                        InferError::invalid(format!("the fit to the chart failed: {e}"))
+                    })?;
                 Ok((first * x - &b).norm_squared())
             };
             let (one, two) = (rss(shared)?, rss(columns)?);
@@ -480,15 +485,15 @@ fn norm(v: [f64; 3]) -> f64 {
 }
 
 /// Gammas of the tone curves the self-check tries (the virtual camera's range, 0.7–1.3).
-const TONE_GAMMAS: [f64; 5] = [0.7, 0.85, 1.0, 1.15, 1.3];
+pub(crate) const TONE_GAMMAS: [f64; 5] = [0.7, 0.85, 1.0, 1.15, 1.3];
 /// Contrasts of the S-curves the self-check tries (the virtual camera's range, ±0.4).
-const TONE_CONTRASTS: [f64; 5] = [-0.4, -0.2, 0.0, 0.2, 0.4];
+pub(crate) const TONE_CONTRASTS: [f64; 5] = [-0.4, -0.2, 0.0, 0.2, 0.4];
 
 /// Linear RGB from an encoded value `y` (0–1) of a camera whose tone curve is a power
 /// `gamma` on linear values, the sRGB encoding (IEC 61966-2-1) and the contrast S-curve
 /// `e + contrast·e(1−e)(2e−1)` (the virtual camera's in-camera stage): the S-curve inverted
 /// by Newton's method (monotone for |contrast| ≤ 0.5), decoded, raised to 1/gamma.
-fn untone(y: f64, gamma: f64, contrast: f64) -> f64 {
+pub(crate) fn untone(y: f64, gamma: f64, contrast: f64) -> f64 {
     let mut e = y;
     for _ in 0..8 {
         let f = e + contrast * e * (1.0 - e) * (2.0 * e - 1.0) - y;
