@@ -179,7 +179,12 @@ impl fmt::Display for Advice {
                 names,
                 calibration_most,
             } => {
-                write!(f, "{count} of {of} patches are clipped{}", listed(names))?;
+                write!(
+                    f,
+                    "{count} of {of} patches {} clipped{}",
+                    are(*count),
+                    listed(names)
+                )?;
                 if let Some(most) = calibration_most {
                     write!(f, " (at most {most} in the calibration photos)")?;
                 }
@@ -191,8 +196,9 @@ impl fmt::Display for Advice {
             }
             Advice::Dark { count, of, names } => write!(
                 f,
-                "{count} of {of} patches are nearly black{}: their colour is mostly noise; \
+                "{count} of {of} patches {} nearly black{}: their colour is mostly noise; \
                  expose more, or light the chart more brightly",
+                are(*count),
                 listed(names)
             ),
             Advice::TruncatedJpeg => write!(
@@ -369,6 +375,15 @@ pub fn not_the_chart(chart: &str, sampled: Sampled, mismatches: &[Mismatch]) -> 
     }
 }
 
+/// `is` for one, `are` for more.
+fn are(count: usize) -> &'static str {
+    if count == 1 {
+        "is"
+    } else {
+        "are"
+    }
+}
+
 /// ` (dark skin, blue sky and 3 more)`: up to [`NAMES_LISTED`] names, the rest counted;
 /// empty for none.
 fn listed(names: &[String]) -> String {
@@ -386,6 +401,49 @@ fn listed(names: &[String]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_warning_and_refusal_is_in_plain_words() {
+        let mut texts: Vec<String> = [
+            Advice::LowConfidence {
+                confidence: 0.6,
+                placed: false,
+            },
+            Advice::LowConfidence {
+                confidence: 0.6,
+                placed: true,
+            },
+            Advice::TruncatedJpeg,
+            Advice::CorruptJpeg,
+        ]
+        .iter()
+        .map(Advice::to_string)
+        .collect();
+        let every = [
+            Mismatch::Flat,
+            Mismatch::NotOrdered,
+            Mismatch::Unexplained,
+            Mismatch::Textured,
+            Mismatch::TooFewUsable,
+        ];
+        for sampled in [Sampled::Corners, Sampled::Detected, Sampled::Row(3)] {
+            texts.push(not_the_chart("ColorChecker 24", sampled, &every));
+        }
+        for text in &texts {
+            let b = text.as_bytes();
+            let index = (0..b.len() - 2)
+                .any(|i| b[i] == b'p' && b[i + 1].is_ascii_digit() && b[i + 2].is_ascii_digit());
+            assert!(!index, "{text}");
+            for word in ["--", "feature", "debug image", "data directory holds", "::"] {
+                assert!(!text.contains(word), "{text}");
+            }
+        }
+        assert!(texts[4].starts_with(
+            "these corners do not hold a ColorChecker 24: place them on the chart's four outer \
+             corners (the patches are all of one colour; "
+        ));
+        assert!(texts[2].contains("truncated") && texts[3].contains("corrupt"));
+    }
 
     #[test]
     fn patch_lists_are_short_and_counted() {
@@ -413,6 +471,6 @@ mod tests {
             names: vec!["black 2".into()],
         }
         .to_string();
-        assert!(dark.starts_with("1 of 24 patches are nearly black (black 2): "));
+        assert!(dark.starts_with("1 of 24 patches is nearly black (black 2): "));
     }
 }

@@ -227,14 +227,7 @@ fn weigh(
             }
         },
         None => {
-            reasons.push(match KnownChart::from_name(chart) {
-                Some(known) if known.needs_data_dir() => Advice::NoChartData {
-                    chart: known.shown_name().into(),
-                },
-                _ => Advice::UnknownChart {
-                    chart: shown_chart_name(chart),
-                },
-            });
+            reasons.push(no_check(chart));
             None
         }
     };
@@ -341,6 +334,19 @@ fn weigh(
     Ok((verdict, reasons, self_check, uncertainty))
 }
 
+/// Why the chart called `chart` has no self-check: its reflectances are measured data
+/// spdcam was started without, or they are not known.
+fn no_check(chart: &str) -> Advice {
+    match KnownChart::from_name(chart) {
+        Some(known) if known.needs_data_dir() => Advice::NoChartData {
+            chart: known.shown_name().into(),
+        },
+        _ => Advice::UnknownChart {
+            chart: shown_chart_name(chart),
+        },
+    }
+}
+
 /// The flags of an analysed photo's feature patches: `feature_patches` are their indices
 /// among the chart's patches (row-major) when the chart has patches that are not features.
 pub fn photo_flags(analysis: &PhotoAnalysis, feature_patches: Option<&[usize]>) -> PhotoFlags {
@@ -374,6 +380,7 @@ pub fn photo_flags(analysis: &PhotoAnalysis, feature_patches: Option<&[usize]>) 
 mod tests {
     use super::super::self_check::tests::{cc24_check, features_of};
     use super::*;
+    use crate::error::InferError;
     use crate::estimator::Estimator;
     use crate::feature_rows::FeatureRows;
     use crate::shipped::ModelSet;
@@ -406,11 +413,31 @@ mod tests {
         )
         .unwrap();
         let estimator = Estimator::new(models.clone(), DataDir::new(None), grid).unwrap();
-        let estimates = estimator.estimate_rows(&rows, "test").unwrap();
-        let t = estimates[1].trust.as_ref().unwrap();
+        // The chart's colours in reverse order are no ColorChecker 24: the row is refused
+        // before any number is made of it.
+        let refused = estimator.estimate_rows(&rows, "test").unwrap_err();
+        assert!(matches!(refused, InferError::NotTheChart(_)), "{refused}");
+        assert!(refused
+            .to_string()
+            .starts_with("test row 2 does not hold a ColorChecker 24"));
+        // Judged all the same (as a row that passed the test would be), the light found
+        // does not explain it.
+        let spd = model.estimate(&wrong).unwrap();
+        let calibration = crate::trust::calibration_for(model).unwrap();
+        let t = assess(
+            model,
+            calibration.as_ref(),
+            Some(&check),
+            &wrong,
+            &spd,
+            &PhotoFlags::default(),
+        )
+        .unwrap();
         assert_ne!(t.verdict, Verdict::Ok, "{:?}", t.reasons);
         assert!(t.self_check.as_ref().unwrap().mean > 0.2);
 
+        let rows = FeatureRows::from_values(model.feature_names().to_vec(), row, "test").unwrap();
+        let estimates = estimator.estimate_rows(&rows, "test").unwrap();
         let e = &estimates[0];
         let json = e.to_json().unwrap();
         for key in [
@@ -442,6 +469,148 @@ mod tests {
             assert!(0.0 <= l95 && l95 <= l68 && l68 <= e.spd[k] + 1e-9, "at {k}");
             assert!(e.spd[k] <= u68 + 1e-9 && u68 <= u95, "at {k}");
         }
+    }
+
+    /// Whether `text` names no command-line option, patch index, feature column, debug
+    /// image, file layout or module path.
+    fn plain(text: &str) -> bool {
+        let b = text.as_bytes();
+        let patch_index = (0..b.len().saturating_sub(2))
+            .any(|i| b[i] == b'p' && b[i + 1].is_ascii_digit() && b[i + 2].is_ascii_digit());
+        !patch_index
+            && ["--", "feature", "debug image", "data directory holds", "::"]
+                .iter()
+                .all(|w| !text.contains(w))
+    }
+
+    #[test]
+    fn every_reason_says_what_went_wrong_and_what_to_do_in_plain_words() {
+        let models = ModelSet::shipped().unwrap();
+        let cc24 = &models.for_chart("colorchecker24").unwrap().model;
+        let sg = &models.for_chart("colorchecker_sg96").unwrap().model;
+        let check = cc24_check(&cc24.grid());
+        // A calibration whose every level is crossed by any estimate.
+        let mut strict = crate::trust::calibration_for(cc24).unwrap().unwrap();
+        strict.self_check_doubtful = Some(0.0);
+        strict.split_doubtful = Some(0.0);
+        strict.colour_gradient_doubtful = Some(0.0);
+        strict.two_lights_doubtful = Some(0.0);
+        strict.glare_doubtful = Some(0.0);
+        strict.difficulty_doubtful = 0.0;
+        strict.clipped_doubtful = 0;
+        strict.gfc_model.gap_range = [0.1f64.ln(); 2];
+        let row = features_of(&check, &StandardIlluminant::D65.spd(&cc24.grid()).unwrap());
+        let spd = cc24.estimate(&row).unwrap();
+        let n = check.patches();
+        let some = |k: usize| (0..n).map(|i| i < k).collect::<Vec<bool>>();
+        let flags = |confidence: f64, placed: bool, clipped: usize, dark: usize| PhotoFlags {
+            confidence: Some(confidence),
+            clipped: some(clipped),
+            dark: (0..n).map(|i| i >= n - dark).collect(),
+            placed,
+        };
+        // The left half under daylight, the right under a bulb: two lights, halves apart.
+        let bulb = features_of(&check, &StandardIlluminant::A.spd(&cc24.grid()).unwrap());
+        let centres = Chart::colorchecker24(&cc24.grid())
+            .unwrap()
+            .feature_centres();
+        let two: Vec<f64> = (0..n)
+            .flat_map(|p| {
+                let from = if centres[p][0] >= 0.0 { &bulb } else { &row };
+                from[3 * p..3 * p + 3].to_vec()
+            })
+            .collect();
+        let two_spd = cc24.estimate(&two).unwrap();
+        let sg_row: Vec<f64> = (0..288).map(|i| 30.0 + ((i * 37) % 200) as f64).collect();
+        let sg_spd = sg.estimate(&sg_row).unwrap();
+        let cases: Vec<(
+            &Model,
+            Option<&TrustCalibration>,
+            Option<&ChartCheck>,
+            &[f64],
+            Vec<f64>,
+            PhotoFlags,
+        )> = vec![
+            // Every level crossed, a patch clipped, many dark, a doubtful detection.
+            (
+                cc24,
+                Some(&strict),
+                Some(&check),
+                &row,
+                spd.clone(),
+                flags(0.6, false, 1, 8),
+            ),
+            // Corners placed with a low confidence; most patches clipped: too few to check.
+            (
+                cc24,
+                Some(&strict),
+                Some(&check),
+                &row,
+                spd.clone(),
+                flags(0.6, true, 20, 0),
+            ),
+            // Two lights.
+            (
+                cc24,
+                Some(&strict),
+                Some(&check),
+                &two,
+                two_spd,
+                PhotoFlags::default(),
+            ),
+            // A black light: the check fails; no calibration.
+            (
+                cc24,
+                None,
+                Some(&check),
+                &row,
+                vec![0.0; spd.len()],
+                PhotoFlags::default(),
+            ),
+            // The SG without the measured data: no check.
+            (sg, None, None, &sg_row, sg_spd, PhotoFlags::default()),
+        ];
+        let mut advice: Vec<Advice> = Vec::new();
+        for (model, calibration, check, row, spd, flags) in cases {
+            advice.extend(
+                weigh(model, calibration, check, row, &spd, &flags)
+                    .unwrap()
+                    .1,
+            );
+        }
+        advice.push(no_check("my_chart.csv"));
+        let mut kinds: Vec<&str> = advice.iter().map(Advice::kind).collect();
+        kinds.sort_unstable();
+        kinds.dedup();
+        let every = [
+            "ambiguous",
+            "check_failed",
+            "clipped",
+            "colour_gradient",
+            "dark",
+            "glare",
+            "halves",
+            "low_confidence",
+            "low_gfc",
+            "no_calibration",
+            "no_chart_data",
+            "residual",
+            "too_few_to_check",
+            "two_lights",
+            "unknown_chart",
+        ];
+        assert_eq!(kinds, every, "reasons the verdict can give, driven");
+        for a in &advice {
+            let text = a.to_string();
+            assert!(plain(&text), "{text}");
+        }
+        // Patches by the names the chart prints; the placed corners and the data said so.
+        let all: Vec<String> = advice.iter().map(Advice::to_string).collect();
+        let said = |w: &str| all.iter().any(|t| t.contains(w));
+        assert!(said("(dark skin)") && said("(magenta, cyan"), "{all:?}");
+        assert!(said("place them again") && said("place the corners by hand"));
+        assert!(said("spdcam was started without the measured data"));
+        assert!(!plain("worst at p07") && !plain("use --data-dir") && !plain("features 1, 2"));
     }
 
     #[test]
