@@ -17,7 +17,7 @@
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use spdcam_core::builtin::DataDir;
-use spdcam_core::photo::{load_photo, Photo};
+use spdcam_core::photo::{analyse as analyse_decoded, load_photo, AnalyseOptions, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_infer::trust::chart_identity::{
     MAX_SHUFFLED, MAX_TEXTURE, MIN_CONTRAST, MIN_NEUTRAL_ORDER,
@@ -159,11 +159,22 @@ fn measure(
     group: &str,
     name: &str,
 ) -> Item {
-    let (outcome, identity) = match estimator.analyse_decoded(photo, options) {
+    // Analysed as the estimator analyses (the same charts looked for), but not refused yet.
+    let analysis = estimator
+        .templates(options.chart.as_deref())
+        .and_then(|templates| {
+            let analyse = AnalyseOptions {
+                templates,
+                corners: options.corners.clone(),
+                debug: None,
+            };
+            Ok(analyse_decoded(photo, &analyse)?)
+        });
+    let (outcome, identity) = match analysis {
         Err(e) => (format!("other: {e}"), None),
-        Ok(analysed) => {
-            let identity = estimator.photo_identity(&analysed.analysis).ok();
-            let outcome = match estimator.estimate_analysis(analysed.analysis, name.into()) {
+        Ok(analysis) => {
+            let identity = estimator.photo_identity(&analysis).ok();
+            let outcome = match estimator.estimate_analysis(analysis, name.into()) {
                 Ok(_) => "accepted".to_string(),
                 Err(InferError::NotTheChart(_)) => "refused".to_string(),
                 Err(e) => format!("other: {e}"),

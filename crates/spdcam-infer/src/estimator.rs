@@ -316,7 +316,8 @@ impl Estimator {
     }
 
     /// Analyses a decoded photo with `options` (the chart found among the charts
-    /// [`Estimator::templates`] gives, or placed by `options.corners`, and sampled).
+    /// [`Estimator::templates`] gives, or placed by `options.corners`, and sampled); patches
+    /// that are not the chart are refused ([`InferError::NotTheChart`]).
     pub fn analyse_decoded(&self, photo: &Photo, options: &PhotoOptions) -> Result<AnalysedPhoto> {
         let templates = self.templates(options.chart.as_deref())?;
         self.analyse_with(photo, options, templates, options.debug.clone())
@@ -339,6 +340,7 @@ impl Estimator {
         };
         let (analysis, debug) = photo::analyse_telling_debug(photo, &analyse);
         let analysed = analysis.map_err(InferError::from).and_then(|analysis| {
+            self.refuse_not_the_chart(&analysis)?;
             let overlay = match options.overlay_width {
                 Some(width) => Some(overlay_of(photo, &analyse.templates, &analysis, width)?),
                 None => None,
@@ -359,14 +361,11 @@ impl Estimator {
     /// them, whether the chart was detected or its corners given.
     pub fn estimate_analysis(&self, analysis: PhotoAnalysis, name: String) -> Result<Estimate> {
         let identified = self.identify(&analysis)?;
-        let judge = &self.prepared.trust[identified.index];
-        let sampled = match analysis.method {
-            "corners" => Sampled::Corners,
-            _ => Sampled::Detected,
-        };
-        judge
-            .identity
-            .require(&identified.identity, sampled, &analysis.source)?;
+        self.prepared.trust[identified.index].identity.require(
+            &identified.identity,
+            sampled(&analysis),
+            &analysis.source,
+        )?;
         let model_spds = identified.model_spds?;
         self.judged(
             identified.index,
@@ -376,6 +375,20 @@ impl Estimator {
             &identified.flags,
             Some(analysis),
         )
+    }
+
+    /// Refuses an analysed photo whose patches are not the chart ([`InferError::NotTheChart`]),
+    /// so that it is told with the photos that cannot be used, before any estimate; other
+    /// errors are left for the estimate to give.
+    fn refuse_not_the_chart(&self, analysis: &PhotoAnalysis) -> Result<()> {
+        match self.identify(analysis) {
+            Ok(found) => self.prepared.trust[found.index].identity.require(
+                &found.identity,
+                sampled(analysis),
+                &analysis.source,
+            ),
+            Err(_) => Ok(()),
+        }
     }
 
     /// Whether an analysed photo shows the chart it is said to: the statistics of
@@ -558,17 +571,31 @@ impl Estimator {
     /// model is the one for the stream's columns.
     ///
     /// ```
-    /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::builtin::{self, DataDir};
+    /// use spdcam_core::camera::sensor::Sensitivities;
+    /// use spdcam_core::camera::{Camera, CameraConfig};
+    /// use spdcam_core::chart::Chart;
+    /// use spdcam_core::cie_illuminant::StandardIlluminant;
     /// use spdcam_core::spectral::Grid;
     /// use spdcam_infer::stream::FeatureStream;
     /// use spdcam_infer::Estimator;
     ///
+    /// // Two rows of the ColorChecker 24 through the virtual camera, under A and D65.
+    /// let grid = Grid::SIMULATION;
+    /// let table = &builtin::CAMERAS[0];
+    /// let sensitivities = Sensitivities::new(table.name, &table.load()?, &grid)?;
+    /// let chart = Chart::colorchecker24(&grid)?;
+    /// let names = chart.feature_names();
+    /// let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid)?;
+    /// let mut text = names.join(",") + "\n";
+    /// for light in [StandardIlluminant::A, StandardIlluminant::D65] {
+    ///     let (mut raw, mut row) = (Vec::new(), Vec::new());
+    ///     camera.features_fast(&camera.light(&light.spd(&grid)?)?, &mut raw, &mut row);
+    ///     let cells: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+    ///     text.push_str(&(cells.join(",") + "\n"));
+    /// }
+    ///
     /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
-    /// let names: Vec<String> = estimator.models().for_chart("colorchecker24").unwrap()
-    ///     .model.feature_names().to_vec();
-    /// // Two rows of a chart with colour: the patches' channels at different levels.
-    /// let row: Vec<String> = (0..names.len()).map(|i| format!("{}", 30 + (i * 37) % 200)).collect();
-    /// let text = format!("{}\n{}\n{}\n", names.join(","), row.join(","), row.join(","));
     /// let file = FeatureStream::new(Box::new(std::io::Cursor::new(text)), "rows.csv")?;
     /// let mut stream = estimator.stream(file, "rows.csv")?;
     /// let block = stream.next_block()?.unwrap();
@@ -578,7 +605,7 @@ impl Estimator {
     /// assert_eq!(second.name, "estimate_2");
     /// assert_eq!(second.spd.values(), &block.spds[61..]);
     /// assert!(stream.next_block()?.is_none());
-    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn stream(&self, stream: FeatureStream, source: &str) -> Result<RowStream<'_>> {
         let index = self.choose(stream.names(), source)?;
@@ -748,6 +775,14 @@ fn overlay_of(
     )?)
 }
 
+/// Where the patches of `analysis` came from: corners placed by hand, or detection.
+fn sampled(analysis: &PhotoAnalysis) -> Sampled {
+    match analysis.method {
+        "corners" => Sampled::Corners,
+        _ => Sampled::Detected,
+    }
+}
+
 /// Column labels for photos: their file names, or their paths where names repeat.
 fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
     let names: Vec<String> = photos
@@ -793,7 +828,8 @@ pub struct PhotoEstimate {
     /// The debug image written for the photo (`PhotoOptions::debug`), also when no chart
     /// was found in it; `None` when none was written.
     pub debug: Option<PathBuf>,
-    /// What the photo gave, or why it could not be used (unreadable, no chart found).
+    /// What the photo gave, or why it could not be used (unreadable, no chart found, not
+    /// the chart).
     pub analysed: Result<AnalysedPhoto>,
     /// The estimate, or why the model gave none; `None` while not made (the photo could
     /// not be used, or [`PhotoProgress::Analysed`] reports before any estimate).
