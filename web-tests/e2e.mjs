@@ -441,6 +441,56 @@ await test('a photo where no chart is found: shown large, four clicks, the chart
   await tab.close();
 });
 
+await test('corners placed where no chart is: the page says why and asks for them again', async () => {
+  // Issue 41: four clicks on an image with no chart gave a light and its numbers.
+  const tab = await context.newPage();
+  await tab.goto(url);
+  const data = await tab.evaluate(() => {
+    const canvas = document.createElement('canvas');
+    canvas.width = 800;
+    canvas.height = 600;
+    const ctx = canvas.getContext('2d');
+    const pixels = ctx.createImageData(800, 600);
+    let seed = 41;
+    for (let i = 0; i < pixels.data.length; i += 1) {
+      seed = (seed * 1103515245 + 12345) % 2147483648;
+      pixels.data[i] = i % 4 === 3 ? 255 : seed % 256;
+    }
+    ctx.putImageData(pixels, 0, 0);
+    return canvas.toDataURL('image/png').split(',')[1];
+  });
+  const noise = join(artefacts, 'noise.png');
+  writeFileSync(noise, Buffer.from(data, 'base64'));
+  await tab.setInputFiles('#files', noise);
+  await tab.waitForSelector('#placer[data-ready="1"]', { timeout: 60000 });
+  const view = tab.locator('#placer');
+  const place = async () => {
+    for (const [px, py] of [[120, 100], [680, 110], [690, 500], [110, 480]]) {
+      const [s, tx, ty] = await Promise.all(['data-scale', 'data-x', 'data-y'].map(async (a) => Number(await view.getAttribute(a))));
+      const b = await view.boundingBox();
+      await tab.mouse.click(b.x + tx + px * s, b.y + ty + py * s);
+    }
+  };
+  await place();
+  await tab.check('input[name="chart"][value="colorchecker24"]');
+  await tab.click('#estimate-corners');
+  await tab.waitForSelector('#stage p.error[role="alert"]', { timeout: 60000 });
+  const why = await text(tab, '#stage p.error[role="alert"]');
+  check(why.startsWith("These corners do not hold a ColorChecker 24: place them on the chart's four outer corners ("), why);
+  check(!COMMAND_LINE.test(why), why);
+  check((await text(tab, '#plain-summary')) === why, 'the summary does not say why');
+  // No number: no SPD, no verdict; the corners cleared to be placed again, the chart kept.
+  check(await tab.locator('#spd-plot polyline.spd').count() === 0, 'an SPD was drawn');
+  check(await tab.locator('#verdict').count() === 0, 'a verdict was shown');
+  await tab.waitForSelector('#placer[data-ready="1"]');
+  check(await tab.locator('#placer circle.corner').count() === 0, 'the refused corners are still placed');
+  await place();
+  check(await tab.locator('#placer circle.corner').count() === 4, 'the corners cannot be placed again');
+  check(await tab.isChecked('input[name="chart"][value="colorchecker24"]'), 'the chart named is forgotten');
+  await tab.screenshot({ path: join(artefacts, 'not-the-chart.png') });
+  await tab.close();
+});
+
 await test('every error message on the page is free of command-line words', async () => {
   const tab = await context.newPage();
   await tab.goto(url);
