@@ -21,8 +21,8 @@ cargo build --release -q -p spdcam-infer --example chart_identity
 spdcam="$CARGO_TARGET_DIR/release/spdcam"
 measure="$CARGO_TARGET_DIR/release/examples/chart_identity"
 
-# Scene photos: each chart under eight lights, through three cameras in turn, at seeds
-# that place the chart differently; the true corners from what render prints.
+# Scene photos: each chart under eight lights, twice (through three cameras in turn, at
+# seeds that place the chart differently); the true corners from what render prints.
 lights=("--spd A" "--spd D65" "--lighting lamp:phosphor-led --draw 0"
         "--lighting telelumen:config2 --draw 3" "--lighting lamp:fluorescent --draw 1"
         "--lighting lamp:hid --draw 2" "--lighting lamp:mixed-led --draw 5"
@@ -31,13 +31,15 @@ cameras=(nikon_d5100_npl sigma_sd_merrill_npl canon_eos_5d_mark_ii__camspec)
 : > "$work/scenes.tsv"
 for chart in colorchecker24 colorchecker_sg140; do
     for i in "${!lights[@]}"; do
-        camera="${cameras[$((i % 3))]}"
-        photo="$work/scene-$chart-$i.jpg"
-        # shellcheck disable=SC2086
-        said="$("$spdcam" render --data-dir "$data" --chart "$chart" --camera "$camera" \
-            ${lights[$i]} --scene 1200x900 --seed "$((i + 11))" -o "$photo" 2>&1)"
-        corners="$(sed -n 's/.*(chart corners \(.*\))$/\1/p' <<< "$said")"
-        printf '%s\t%s\n' "$photo" "$corners" >> "$work/scenes.tsv"
+        for take in 0 1; do
+            camera="${cameras[$(((i + take) % 3))]}"
+            photo="$work/scene-$chart-$i-$take.jpg"
+            # shellcheck disable=SC2086
+            said="$("$spdcam" render --data-dir "$data" --chart "$chart" --camera "$camera" \
+                ${lights[$i]} --scene 1200x900 --seed "$((i + 11 + 20 * take))" -o "$photo" 2>&1)"
+            corners="$(sed -n 's/.*(chart corners \(.*\))$/\1/p' <<< "$said")"
+            printf '%s\t%s\n' "$photo" "$corners" >> "$work/scenes.tsv"
+        done
     done
 done
 
@@ -61,3 +63,10 @@ done
 cd "$work"
 "$measure" "$data" "$work/scenes.tsv" "${rows[@]}"
 echo "items: $work/chart-identity-items.tsv" >&2
+# As a fresh clone meets them: no data directory, so no SG reflectances (the SG is tested
+# by its grey patches' order and the patches' texture alone). Photos only.
+mkdir -p "$work/fresh-clone/empty"
+cd "$work/fresh-clone"
+printf '\nWithout the measured data (photos only):\n\n'
+"$measure" "$work/fresh-clone/empty" "$work/scenes.tsv"
+echo "items: $work/fresh-clone/chart-identity-items.tsv" >&2

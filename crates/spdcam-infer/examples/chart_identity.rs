@@ -416,6 +416,47 @@ fn summary(items: &[Item]) -> String {
             range(&|i| i.texture),
         );
     }
+    // Per statistic: the charts' worst value, the no-chart images' value nearest to it, the
+    // threshold between, and the share of no-chart items it alone refuses.
+    let chart = |i: &&Item| i.group.starts_with("rows") || i.group.starts_with("scenes");
+    out.push_str(
+        "\n| statistic | threshold | charts' worst | no chart: nearest | no chart refused by it alone |\n\
+         | --- | --- | --: | --: | --: |\n",
+    );
+    type Get = fn(&Identity) -> Option<f64>;
+    let stats: [(&str, &str, f64, bool, Get); 4] = [
+        ("contrast", "≥", MIN_CONTRAST, false, |i| Some(i.contrast)),
+        ("neutral order", "≥", MIN_NEUTRAL_ORDER, false, |i| i.neutral_order),
+        ("shuffled", "≤", MAX_SHUFFLED, true, |i| i.shuffled),
+        ("texture", "≤", MAX_TEXTURE, true, |i| i.texture),
+    ];
+    for (name, sign, level, high_is_bad, get) in stats {
+        let values = |want: bool| -> Vec<f64> {
+            items
+                .iter()
+                .filter(|i| chart(i) == want)
+                .filter_map(|i| i.identity.as_ref().and_then(get))
+                .collect()
+        };
+        let (charts, others) = (values(true), values(false));
+        let worst = |v: &[f64], high: bool| {
+            v.iter().copied().fold(None, |a: Option<f64>, x| {
+                Some(a.map_or(x, |a| if high { a.max(x) } else { a.min(x) }))
+            })
+        };
+        let shown = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.3}"));
+        let refused = others
+            .iter()
+            .filter(|&&v| if high_is_bad { v > level } else { v < level })
+            .count();
+        let no_chart = items.iter().filter(|i| !chart(i)).count();
+        let _ = writeln!(
+            out,
+            "| {name} | {sign} {level} | {} | {} | {refused} of {no_chart} |",
+            shown(worst(&charts, high_is_bad)),
+            shown(worst(&others, !high_is_bad)),
+        );
+    }
     let _ = writeln!(
         out,
         "\nThresholds: contrast ≥ {MIN_CONTRAST}, neutral order ≥ {MIN_NEUTRAL_ORDER}, shuffled ≤ {MAX_SHUFFLED}, texture ≤ {MAX_TEXTURE}."
