@@ -469,6 +469,7 @@ await test('corners placed where no chart is: the page says why and asks for the
   const place = async () => {
     for (const [px, py] of [[120, 100], [680, 110], [690, 500], [110, 480]]) {
       await tab.waitForSelector('#placer[data-ready="1"]');
+      await view.scrollIntoViewIfNeeded();
       const [s, tx, ty] = await Promise.all(['data-scale', 'data-x', 'data-y'].map(async (a) => Number(await view.getAttribute(a))));
       const b = await view.boundingBox();
       await tab.mouse.click(b.x + tx + px * s, b.y + ty + py * s);
