@@ -123,9 +123,10 @@ const context = await chromium.launchPersistentContext(profile, {
   acceptDownloads: true,
 });
 /**
- * The example photo mirrored left to right: its chart's patches lie in an order no chart
- * has, so no chart is found, yet the chart is there and its corners are the unmarked
- * photo's, mirrored. Made in the browser (canvas, JPEG) into a file.
+ * The example photo blurred (a Gaussian of 12 px): the patches' edges are gone, so no chart
+ * is found, yet the chart is there, its patches flat in their middles, and its corners are
+ * the sharp photo's. Made in the browser (canvas, JPEG) into a file. (A mirrored chart is
+ * found by no one: its patches are not the chart's, and placed corners are refused.)
  */
 async function noChartPhoto() {
   const tab = await context.newPage();
@@ -138,8 +139,7 @@ async function noChartPhoto() {
     canvas.width = img.naturalWidth;
     canvas.height = img.naturalHeight;
     const ctx = canvas.getContext('2d');
-    ctx.translate(canvas.width, 0);
-    ctx.scale(-1, 1);
+    ctx.filter = 'blur(12px)';
     ctx.drawImage(img, 0, 0);
     return canvas.toDataURL('image/jpeg', 0.92).split(',')[1];
   });
@@ -264,8 +264,10 @@ await test('dragging a corner re-runs the estimate with those corners', async ()
   const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];
   await page.mouse.move(cx, cy);
   await page.mouse.down();
-  await page.mouse.move(cx + 15, cy + 10, { steps: 5 });
-  await page.mouse.move(cx + 30, cy + 25, { steps: 5 });
+  // A small move, the corner still on the chart's (a corner dragged off the chart is refused:
+  // the patches inside are not the chart's).
+  await page.mouse.move(cx + 4, cy + 3, { steps: 5 });
+  await page.mouse.move(cx + 8, cy + 6, { steps: 5 });
   await page.mouse.up();
   await page.waitForFunction(() => {
     const m = document.getElementById('method');
@@ -409,14 +411,14 @@ await test('a photo where no chart is found: shown large, four clicks, the chart
   check(Number(await view.getAttribute('data-x')) > x0 + 50, 'the drag did not pan');
   check(await tab.locator('#placer circle.corner').count() === 0, 'the drag placed a corner');
   await tab.click('#zoom-fit');
-  // Four clicks on the chart's corners (those the detection finds on the unmarked photo).
+  // Four clicks on the chart's corners (those the detection finds on the sharp photo).
   const toScreen = async ([px, py]) => {
     const [s, tx, ty] = await Promise.all(['data-scale', 'data-x', 'data-y'].map(async (a) => Number(await view.getAttribute(a))));
     const b = await view.boundingBox();
     return [b.x + tx + px * s, b.y + ty + py * s];
   };
   for (const [x, y] of expected.photo.corners) {
-    const [cx, cy] = await toScreen([expected.photo.width - x, y]);
+    const [cx, cy] = await toScreen([x, y]);
     await tab.mouse.click(cx, cy);
   }
   check(await tab.locator('#placer circle.corner').count() === 4, 'four corners not placed');
@@ -438,6 +440,59 @@ await test('a photo where no chart is found: shown large, four clicks, the chart
   check(await tab.locator('#spd-plot polyline.spd').count() === 1, 'no SPD');
   check(await tab.locator('#plain-summary.plain-summary').count() === 1, 'no summary');
   await tab.screenshot({ path: join(artefacts, 'corners-estimated.png'), fullPage: true });
+  await tab.close();
+});
+
+await test('corners placed where no chart is: the page says why and asks for them again', async () => {
+  // Issue 41: four clicks on an image with no chart gave a light and its numbers.
+  const tab = await context.newPage();
+  await tab.goto(url);
+  const data = await tab.evaluate(() => {
+    const canvas = document.createElement('canvas');
+    canvas.width = 800;
+    canvas.height = 600;
+    const ctx = canvas.getContext('2d');
+    const pixels = ctx.createImageData(800, 600);
+    let seed = 41;
+    for (let i = 0; i < pixels.data.length; i += 1) {
+      seed = (seed * 1103515245 + 12345) % 2147483648;
+      pixels.data[i] = i % 4 === 3 ? 255 : seed % 256;
+    }
+    ctx.putImageData(pixels, 0, 0);
+    return canvas.toDataURL('image/png').split(',')[1];
+  });
+  const noise = join(artefacts, 'noise.png');
+  writeFileSync(noise, Buffer.from(data, 'base64'));
+  await tab.setInputFiles('#files', noise);
+  await tab.waitForSelector('#placer[data-ready="1"]', { timeout: 60000 });
+  const view = tab.locator('#placer');
+  const place = async () => {
+    for (const [px, py] of [[120, 100], [680, 110], [690, 500], [110, 480]]) {
+      await tab.waitForSelector('#placer[data-ready="1"]');
+      await view.scrollIntoViewIfNeeded();
+      const [s, tx, ty] = await Promise.all(['data-scale', 'data-x', 'data-y'].map(async (a) => Number(await view.getAttribute(a))));
+      const b = await view.boundingBox();
+      await tab.mouse.click(b.x + tx + px * s, b.y + ty + py * s);
+    }
+  };
+  await place();
+  await tab.check('input[name="chart"][value="colorchecker24"]');
+  await tab.click('#estimate-corners');
+  await tab.waitForSelector('#stage p.error[role="alert"]', { timeout: 60000 });
+  const why = await text(tab, '#stage p.error[role="alert"]');
+  check(why.startsWith("These corners do not hold a ColorChecker 24: place them on the chart's four outer corners ("), why);
+  check(!COMMAND_LINE.test(why), why);
+  check((await text(tab, '#plain-summary')) === why, 'the summary does not say why');
+  // No number: no SPD, no verdict; the corners cleared to be placed again, the chart kept.
+  check(await tab.locator('#spd-plot polyline.spd').count() === 0, 'an SPD was drawn');
+  check(await tab.locator('#verdict').count() === 0, 'a verdict was shown');
+  await tab.waitForSelector('#placer[data-ready="1"]');
+  check(await tab.locator('#placer circle.corner').count() === 0, 'the refused corners are still placed');
+  await place();
+  await tab.waitForFunction(() => document.querySelectorAll('#placer circle.corner').length === 4, null, { timeout: 10000 })
+    .catch(() => check(false, 'the corners cannot be placed again'));
+  check(await tab.isChecked('input[name="chart"][value="colorchecker24"]'), 'the chart named is forgotten');
+  await tab.screenshot({ path: join(artefacts, 'not-the-chart.png') });
   await tab.close();
 });
 

@@ -84,3 +84,17 @@ def test_a_photo_of_the_wrong_type_is_a_type_error():
     with pytest.raises(TypeError, match="path, the bytes"):
         spdcam.estimate(12)
     assert (ROOT / "examples").is_dir()
+
+
+def test_corners_on_no_chart_raise_a_value_error_saying_what_to_do():
+    # Issue 41: four corners placed on an image with no chart gave numbers.
+    noise = np.random.default_rng(7).integers(0, 256, size=(300, 400, 3), dtype=np.uint8)
+    corners = [(40, 30), (360, 40), (350, 270), (50, 260)]
+    with pytest.raises(ValueError) as caught:
+        spdcam.estimate(noise, corners=corners, chart="colorchecker24", source="noise")
+    message = str(caught.value)
+    assert message.startswith(
+        "noise: these corners do not hold a ColorChecker 24: place them on the chart's "
+        "four outer corners ("
+    ), message
+    assert isinstance(caught.value, spdcam.SpdcamError)

@@ -217,6 +217,63 @@ fn needs_data(chart: KnownChart, error: Error, data_dir: &DataDir) -> Error {
     ))
 }
 
+/// The official names of the ColorChecker Classic 24's patches (X-Rite, "ColorChecker
+/// Classic" product sheet), row by row from dark skin to black.
+pub const COLORCHECKER24_PATCH_NAMES: [&str; 24] = [
+    "dark skin",
+    "light skin",
+    "blue sky",
+    "foliage",
+    "blue flower",
+    "bluish green",
+    "orange",
+    "purplish blue",
+    "moderate red",
+    "purple",
+    "yellow green",
+    "orange yellow",
+    "blue",
+    "green",
+    "red",
+    "yellow",
+    "magenta",
+    "cyan",
+    "white 9.5",
+    "neutral 8",
+    "neutral 6.5",
+    "neutral 5",
+    "neutral 3.5",
+    "black 2",
+];
+
+/// The ColorChecker Digital SG's printed name of the patch in column `col` and row `row`
+/// (both 0-based): the column's letter A–N and the row's number 1–10, as X-Rite names them.
+fn sg_patch_name(col: usize, row: usize) -> String {
+    format!("{}{}", char::from(b'A' + col as u8), row + 1)
+}
+
+/// The name people know the chart called `name` by (see [`KnownChart::shown_name`]); any
+/// other chart by its own name.
+pub fn shown_chart_name(name: &str) -> String {
+    KnownChart::from_name(name).map_or_else(|| name.to_string(), |c| c.shown_name().to_string())
+}
+
+/// The name of feature patch `k` (0-based) of the chart called `name`
+/// ([`KnownChart::feature_patch_name`]); `patch N` (1-based) for other charts.
+pub fn feature_patch_name(name: &str, k: usize) -> String {
+    KnownChart::from_name(name)
+        .and_then(|c| c.feature_patch_name(k))
+        .unwrap_or_else(|| format!("patch {}", k + 1))
+}
+
+/// The name of patch `p` (0-based, row-major over the whole chart) of the chart called
+/// `name` ([`KnownChart::patch_name`]); `patch N` (1-based) for other charts.
+pub fn patch_name(name: &str, p: usize) -> String {
+    KnownChart::from_name(name)
+        .and_then(|c| c.patch_name(p))
+        .unwrap_or_else(|| format!("patch {}", p + 1))
+}
+
 /// The charts [`Chart::resolve`] knows by name; any other chart is a reflectance CSV.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum KnownChart {
@@ -277,6 +334,45 @@ impl KnownChart {
     /// The known chart called `name` (exactly), if any.
     pub fn from_name(name: &str) -> Option<KnownChart> {
         KnownChart::ALL.into_iter().find(|c| c.name() == name)
+    }
+
+    /// The chart's name as people know it and as messages for them name it:
+    /// `ColorChecker 24` or `ColorChecker Digital SG`.
+    pub const fn shown_name(self) -> &'static str {
+        match self {
+            KnownChart::ColorChecker24 => "ColorChecker 24",
+            KnownChart::Sg96 | KnownChart::Sg96Thesis | KnownChart::Sg140 => {
+                "ColorChecker Digital SG"
+            }
+        }
+    }
+
+    /// The name of feature patch `k` (0-based, in this chart's feature order) as the chart
+    /// prints it or its maker names it: the ColorChecker 24's official names (`dark skin`,
+    /// `blue sky`), the Digital SG's column letter and row number (`E4`). `None` past the
+    /// last feature.
+    pub fn feature_patch_name(self, k: usize) -> Option<String> {
+        match self {
+            KnownChart::ColorChecker24 => COLORCHECKER24_PATCH_NAMES.get(k).map(|n| n.to_string()),
+            // Features run row by row over the 96 centre patches (B2…M9).
+            KnownChart::Sg96 | KnownChart::Sg140 => {
+                (k < 96).then(|| sg_patch_name(1 + k % 12, 1 + k / 12))
+            }
+            // The file order runs column by column, 8 patches down each column.
+            KnownChart::Sg96Thesis => (k < 96).then(|| sg_patch_name(1 + k / 8, 1 + k % 8)),
+        }
+    }
+
+    /// The name of patch `p` (row-major among all the physical chart's patches, as a photo
+    /// is sampled) as the chart prints it: for the ColorChecker 24 as
+    /// [`KnownChart::feature_patch_name`], for the whole Digital SG its column letter and
+    /// row number (`A1`…`N10`). `None` for a chart no photo shows, or past the last patch.
+    pub fn patch_name(self, p: usize) -> Option<String> {
+        match self {
+            KnownChart::ColorChecker24 => self.feature_patch_name(p),
+            KnownChart::Sg140 => (p < 140).then(|| sg_patch_name(p % 14, p / 14)),
+            KnownChart::Sg96 | KnownChart::Sg96Thesis => None,
+        }
     }
 
     /// The physical chart a photo shows when features come from this one: the whole SG for
@@ -541,6 +637,31 @@ pub fn is_feature_name(name: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn patches_are_named_as_the_charts_print_them() {
+        assert_eq!(feature_patch_name("colorchecker24", 0), "dark skin");
+        assert_eq!(feature_patch_name("colorchecker24", 23), "black 2");
+        assert_eq!(patch_name("colorchecker24", 2), "blue sky");
+        // The SG's features run row by row from B2; its file order column by column.
+        assert_eq!(feature_patch_name("colorchecker_sg96", 0), "B2");
+        assert_eq!(feature_patch_name("colorchecker_sg96", 13), "C3");
+        assert_eq!(feature_patch_name("colorchecker_sg96", 95), "M9");
+        assert_eq!(feature_patch_name("colorchecker_sg140", 13), "C3");
+        assert_eq!(feature_patch_name("colorchecker_sg96_thesis", 9), "C3");
+        // The whole SG, row-major over its 14 columns.
+        assert_eq!(patch_name("colorchecker_sg140", 0), "A1");
+        assert_eq!(patch_name("colorchecker_sg140", 15), "B2");
+        assert_eq!(patch_name("colorchecker_sg140", 139), "N10");
+        // Other charts, and patches past the last, by number.
+        assert_eq!(feature_patch_name("my_chart.csv", 6), "patch 7");
+        assert_eq!(feature_patch_name("colorchecker24", 24), "patch 25");
+        assert_eq!(
+            shown_chart_name("colorchecker_sg96"),
+            "ColorChecker Digital SG"
+        );
+        assert_eq!(shown_chart_name("colorchecker24"), "ColorChecker 24");
+    }
 
     #[test]
     fn feature_names_have_the_form_they_are_recognised_by() {

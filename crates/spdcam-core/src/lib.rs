@@ -24,6 +24,7 @@
 //!   feature row; [`feature_check`] rejects rows that cannot say anything about the light.
 //! - [`spectral_error`] (RMSE, GFC, SAM, SID between spectra), [`colorimetry`] (XYZ, CCT/Duv,
 //!   sRGB, CIELAB) and [`quality`] (CRI, TM-30, α-opic and other metrics of a light).
+//! - [`advice`]: every warning and reason a person reads, with what to do, in one place.
 //! - [`error`], [`fsio`] (atomic file writes), [`output_guard`] (no output onto an input)
 //!   and [`limits`] (resource limits) serve all of them.
 //!
@@ -90,6 +91,7 @@
 
 #![deny(missing_docs)]
 
+pub mod advice;
 pub mod builtin;
 pub mod camera;
 pub mod chart;

@@ -19,6 +19,12 @@ pub enum InferError {
         /// What is wrong with it.
         message: String,
     },
+    /// The patches sampled from a photo, or a feature row, do not behave like the chart
+    /// they are said to be (no chart there, the corners placed off it, another chart): no
+    /// number is made of them. The message names what is wrong and what to do
+    /// ([`crate::trust::chart_identity`]).
+    #[error("{0}")]
+    NotTheChart(String),
     /// A numerical step (SVD, a linear solve) failed.
     #[error("{0}")]
     Numerical(String),

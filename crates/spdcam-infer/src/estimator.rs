@@ -23,8 +23,11 @@ use crate::feature_rows::FeatureRows;
 use crate::photo_options::{chart_templates, PhotoOptions};
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
-use crate::trust::{self, ChartCheck, PhotoFlags, Trust, TrustCalibration};
+use crate::trust::{
+    self, feature_scale, ChartCheck, ChartIdentity, Identity, PhotoFlags, Trust, TrustCalibration,
+};
 use rayon::prelude::*;
+use spdcam_core::advice::Sampled;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::photo::{
@@ -42,6 +45,8 @@ struct ModelTrust {
     calibration: Option<TrustCalibration>,
     /// The chart re-rendered under an estimate (the self-check), built once.
     check: Option<ChartCheck>,
+    /// The test that patches are the model's chart at all, made once.
+    identity: ChartIdentity,
 }
 
 /// What does not depend on the output grid, shared by the estimators of every grid.
@@ -104,9 +109,11 @@ impl Estimator {
             .models()
             .iter()
             .map(|m| {
+                let check = ChartCheck::for_model(&m.model, &data_dir)?;
                 Ok(ModelTrust {
                     calibration: trust::calibration_for(&m.model)?,
-                    check: ChartCheck::for_model(&m.model, &data_dir)?,
+                    identity: ChartIdentity::for_model(&m.model),
+                    check,
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -309,7 +316,8 @@ impl Estimator {
     }
 
     /// Analyses a decoded photo with `options` (the chart found among the charts
-    /// [`Estimator::templates`] gives, or placed by `options.corners`, and sampled).
+    /// [`Estimator::templates`] gives, or placed by `options.corners`, and sampled); patches
+    /// that are not the chart are refused ([`InferError::NotTheChart`]).
     pub fn analyse_decoded(&self, photo: &Photo, options: &PhotoOptions) -> Result<AnalysedPhoto> {
         let templates = self.templates(options.chart.as_deref())?;
         self.analyse_with(photo, options, templates, options.debug.clone())
@@ -332,6 +340,7 @@ impl Estimator {
         };
         let (analysis, debug) = photo::analyse_telling_debug(photo, &analyse);
         let analysed = analysis.map_err(InferError::from).and_then(|analysis| {
+            self.refuse_not_the_chart(&analysis)?;
             let overlay = match options.overlay_width {
                 Some(width) => Some(overlay_of(photo, &analyse.templates, &analysis, width)?),
                 None => None,
@@ -347,8 +356,55 @@ impl Estimator {
 
     /// The estimate for an analysed photo, by the model for the chart it shows, labelled
     /// `name`, judged with what the analysis found (detection, clipped and dark patches).
+    /// Patches that do not behave like the chart are refused first
+    /// ([`InferError::NotTheChart`]; see [`trust::chart_identity`]): no number is made of
+    /// them, whether the chart was detected or its corners given.
     pub fn estimate_analysis(&self, analysis: PhotoAnalysis, name: String) -> Result<Estimate> {
-        let rows = FeatureRows::of_analyses(&[&analysis])?;
+        let identified = self.identify(&analysis)?;
+        self.prepared.trust[identified.index].identity.require(
+            &identified.identity,
+            sampled(&analysis),
+            &analysis.source,
+        )?;
+        let model_spds = identified.model_spds?;
+        self.judged(
+            identified.index,
+            name,
+            model_spds,
+            &identified.rows.values,
+            &identified.flags,
+            Some(analysis),
+        )
+    }
+
+    /// Refuses an analysed photo whose patches are not the chart ([`InferError::NotTheChart`]),
+    /// so that it is told with the photos that cannot be used, before any estimate; other
+    /// errors are left for the estimate to give.
+    fn refuse_not_the_chart(&self, analysis: &PhotoAnalysis) -> Result<()> {
+        match self.identify(analysis) {
+            Ok(found) => self.prepared.trust[found.index].identity.require(
+                &found.identity,
+                sampled(analysis),
+                &analysis.source,
+            ),
+            Err(_) => Ok(()),
+        }
+    }
+
+    /// Whether an analysed photo shows the chart it is said to: the statistics of
+    /// [`trust::chart_identity`], the shuffled one under the model's estimate (or, where the
+    /// model refuses the features, under an equal-energy light) when the chart's
+    /// reflectances are at hand. [`Estimator::estimate_photo`] refuses the photo when they
+    /// find anything against the chart (`Identity::mismatches`).
+    pub fn photo_identity(&self, analysis: &PhotoAnalysis) -> Result<Identity> {
+        Ok(self.identify(analysis)?.identity)
+    }
+
+    /// The model for `analysis`, its features and flags, its identity and the model's SPDs
+    /// (or why the model made none). What needs no light is measured first, and the model
+    /// is not run when it finds anything against the chart.
+    fn identify(&self, analysis: &PhotoAnalysis) -> Result<Identified> {
+        let rows = FeatureRows::of_analyses(&[analysis])?;
         let index = self.choose(&rows.names, &analysis.source).map_err(|_| {
             InferError::invalid(format!(
                 "{}: no model for chart {}; the models are for {}",
@@ -357,22 +413,99 @@ impl Estimator {
                 self.charts()
             ))
         })?;
-        let model_spds = self.run_model(index, &rows, &analysis.source)?;
         let chosen = self.named(index);
         let feature_patches = chosen
             .model
             .photo_chart()
             .filter(|t| t.name == analysis.chart)
             .map(|t| t.feature_patches.as_slice());
-        let flags = trust::photo_flags(&analysis, feature_patches);
-        self.judged(
+        let flags = trust::photo_flags(analysis, feature_patches);
+        let judge = &self.prepared.trust[index];
+        let scale = feature_scale(&rows.values);
+        let mut identity = judge.identity.of_photo(analysis, scale);
+        let model_spds = if identity.mismatches().is_empty() {
+            self.run_model(index, &rows, &analysis.source)
+        } else {
+            Err(InferError::invalid("the patches are not the chart"))
+        };
+        if let Some(check) = &judge.check {
+            let light = match &model_spds {
+                Ok(spds) => spds.clone(),
+                Err(_) => vec![1.0; chosen.model.grid().count],
+            };
+            judge.identity.add_shuffled(
+                &mut identity,
+                &rows.values,
+                scale,
+                &flags.clipped,
+                (check, &light),
+            )?;
+        }
+        Ok(Identified {
             index,
-            name,
+            rows,
+            flags,
+            identity,
             model_spds,
-            &rows.values,
-            &flags,
-            Some(analysis),
-        )
+        })
+    }
+
+    /// Whether each of the feature rows `features` holds the patches of the model's chart:
+    /// the statistics of [`trust::chart_identity`], the shuffled one under the model's
+    /// estimate when the chart's reflectances are at hand. [`Estimator::estimate_rows`] and
+    /// [`Estimator::stream`] refuse a row when they find anything against the chart.
+    pub fn row_identities(&self, features: &FeatureRows, source: &str) -> Result<Vec<Identity>> {
+        let index = self.choose(&features.names, source)?;
+        let model_spds = self.run_model(index, features, source)?;
+        let width = features.names.len().max(1);
+        let d = self.named(index).model.grid().count.max(1);
+        features
+            .values
+            .par_chunks(width)
+            .zip(model_spds.par_chunks(d))
+            .map(|(row, spd)| self.row_identity(index, row, spd))
+            .collect()
+    }
+
+    /// The identity of one feature row whose SPD under model `index` is `spd`.
+    fn row_identity(&self, index: usize, row: &[f64], spd: &[f64]) -> Result<Identity> {
+        let judge = &self.prepared.trust[index];
+        let scale = feature_scale(row);
+        let mut identity = judge.identity.of_row(row, scale);
+        if let Some(check) = &judge.check {
+            judge
+                .identity
+                .add_shuffled(&mut identity, row, scale, &[], (check, spd))?;
+        }
+        Ok(identity)
+    }
+
+    /// Refuses the first of feature rows `values` (row-major, the first being row
+    /// `first_row`, 0-based) that does not behave like model `index`'s chart, with the SPDs
+    /// `model_spds` the model made of them (see [`trust::chart_identity`]).
+    fn require_chart_rows(
+        &self,
+        index: usize,
+        values: &[f64],
+        model_spds: &[f64],
+        source: &str,
+        first_row: usize,
+    ) -> Result<()> {
+        let identity = &self.prepared.trust[index].identity;
+        let width = self.named(index).model.feature_names().len().max(1);
+        let d = self.named(index).model.grid().count.max(1);
+        let failed = values
+            .par_chunks(width)
+            .zip(model_spds.par_chunks(d))
+            .enumerate()
+            .find_map_first(|(k, (row, spd))| {
+                self.row_identity(index, row, spd)
+                    .and_then(|found| {
+                        identity.require(&found, Sampled::Row(first_row + k + 1), source)
+                    })
+                    .err()
+            });
+        failed.map_or(Ok(()), Err)
     }
 
     /// Judged estimates for feature rows, each labelled `estimate_N` (1-based), by the
@@ -413,6 +546,7 @@ impl Estimator {
     pub fn estimate_rows(&self, features: &FeatureRows, source: &str) -> Result<Vec<Estimate>> {
         let index = self.choose(&features.names, source)?;
         let model_spds = self.run_model(index, features, source)?;
+        self.require_chart_rows(index, &features.values, &model_spds, source, 0)?;
         let width = features.names.len();
         let d = self.named(index).model.grid().count;
         features
@@ -437,17 +571,31 @@ impl Estimator {
     /// model is the one for the stream's columns.
     ///
     /// ```
-    /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::builtin::{self, DataDir};
+    /// use spdcam_core::camera::sensor::Sensitivities;
+    /// use spdcam_core::camera::{Camera, CameraConfig};
+    /// use spdcam_core::chart::Chart;
+    /// use spdcam_core::cie_illuminant::StandardIlluminant;
     /// use spdcam_core::spectral::Grid;
     /// use spdcam_infer::stream::FeatureStream;
     /// use spdcam_infer::Estimator;
     ///
+    /// // Two rows of the ColorChecker 24 through the virtual camera, under A and D65.
+    /// let grid = Grid::SIMULATION;
+    /// let table = &builtin::CAMERAS[0];
+    /// let sensitivities = Sensitivities::new(table.name, &table.load()?, &grid)?;
+    /// let chart = Chart::colorchecker24(&grid)?;
+    /// let names = chart.feature_names();
+    /// let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid)?;
+    /// let mut text = names.join(",") + "\n";
+    /// for light in [StandardIlluminant::A, StandardIlluminant::D65] {
+    ///     let (mut raw, mut row) = (Vec::new(), Vec::new());
+    ///     camera.features_fast(&camera.light(&light.spd(&grid)?)?, &mut raw, &mut row);
+    ///     let cells: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+    ///     text.push_str(&(cells.join(",") + "\n"));
+    /// }
+    ///
     /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
-    /// let names: Vec<String> = estimator.models().for_chart("colorchecker24").unwrap()
-    ///     .model.feature_names().to_vec();
-    /// // Two rows of a chart with colour: the patches' channels at different levels.
-    /// let row: Vec<String> = (0..names.len()).map(|i| format!("{}", 30 + (i * 37) % 200)).collect();
-    /// let text = format!("{}\n{}\n{}\n", names.join(","), row.join(","), row.join(","));
     /// let file = FeatureStream::new(Box::new(std::io::Cursor::new(text)), "rows.csv")?;
     /// let mut stream = estimator.stream(file, "rows.csv")?;
     /// let block = stream.next_block()?.unwrap();
@@ -457,7 +605,7 @@ impl Estimator {
     /// assert_eq!(second.name, "estimate_2");
     /// assert_eq!(second.spd.values(), &block.spds[61..]);
     /// assert!(stream.next_block()?.is_none());
-    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn stream(&self, stream: FeatureStream, source: &str) -> Result<RowStream<'_>> {
         let index = self.choose(stream.names(), source)?;
@@ -627,6 +775,14 @@ fn overlay_of(
     )?)
 }
 
+/// Where the patches of `analysis` came from: corners placed by hand, or detection.
+fn sampled(analysis: &PhotoAnalysis) -> Sampled {
+    match analysis.method {
+        "corners" => Sampled::Corners,
+        _ => Sampled::Detected,
+    }
+}
+
 /// Column labels for photos: their file names, or their paths where names repeat.
 fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
     let names: Vec<String> = photos
@@ -650,6 +806,20 @@ fn photo_labels(photos: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
+/// What [`Estimator::identify`] found of an analysed photo.
+struct Identified {
+    /// The index of the model for its chart.
+    index: usize,
+    /// Its feature row.
+    rows: FeatureRows,
+    /// What the analysis found that bears on trust.
+    flags: PhotoFlags,
+    /// Whether it is the chart.
+    identity: Identity,
+    /// The model's SPD (on its grid), or why there is none.
+    model_spds: Result<Vec<f64>>,
+}
+
 /// One photo's way through the [`Estimator`] ([`Estimator::estimate_photos`],
 /// [`Estimator::photo_bytes`]): its analysis, the debug image written for it and its
 /// estimate.
@@ -658,7 +828,8 @@ pub struct PhotoEstimate {
     /// The debug image written for the photo (`PhotoOptions::debug`), also when no chart
     /// was found in it; `None` when none was written.
     pub debug: Option<PathBuf>,
-    /// What the photo gave, or why it could not be used (unreadable, no chart found).
+    /// What the photo gave, or why it could not be used (unreadable, no chart found, not
+    /// the chart).
     pub analysed: Result<AnalysedPhoto>,
     /// The estimate, or why the model gave none; `None` while not made (the photo could
     /// not be used, or [`PhotoProgress::Analysed`] reports before any estimate).
@@ -736,7 +907,8 @@ impl RowStream<'_> {
     }
 
     /// The next block of rows with their SPDs, or `None` after the last. Rows that say
-    /// nothing about the light are refused, naming the row (1-based in the file).
+    /// nothing about the light, or that are not the model's chart
+    /// ([`trust::chart_identity`]), are refused, naming the row (1-based in the file).
     pub fn next_block(&mut self) -> Result<Option<EstimatedBlock>> {
         let Some(block) = self.stream.next_block(self.rows)? else {
             return Ok(None);
@@ -748,6 +920,13 @@ impl RowStream<'_> {
             .named(self.index)
             .model
             .estimate_rows(&block.values)?;
+        self.estimator.require_chart_rows(
+            self.index,
+            &block.values,
+            &model_spds,
+            &self.source,
+            block.first_row,
+        )?;
         let spds = self.estimator.map(self.index)?.apply(model_spds.clone());
         self.rows += block.rows;
         Ok(Some(EstimatedBlock {

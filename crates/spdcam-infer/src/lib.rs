@@ -75,7 +75,6 @@ pub mod meter;
 pub mod model;
 pub mod network;
 pub mod pca;
-pub mod people_words;
 pub mod photo_options;
 pub mod plot;
 pub mod presentation;

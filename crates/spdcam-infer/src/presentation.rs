@@ -51,8 +51,8 @@ pub struct Presentation {
     /// The CIE 1976 u′v′ diagram of the estimate, SVG ([`crate::chromaticity`]): the
     /// drawing the report shows, served to the web page.
     pub uv_diagram: String,
-    /// The photo's and the metrics' warnings in a person's words
-    /// ([`crate::people_words::for_people`]), less those a greyed metric says already.
+    /// The photo's and the metrics' warnings (in a person's words at their source,
+    /// [`spdcam_core::advice`]), less those a greyed metric says already.
     pub warnings: Vec<String>,
     /// The metrics in groups (colour, colour rendering, circadian and eye, plants), each
     /// group's meaningful metrics first.
@@ -269,7 +269,7 @@ impl Presentation {
                         .iter()
                         .filter(|w| !w.contains("not meaningful")),
                 )
-                .map(|w| crate::people_words::for_people(w))
+                .cloned()
                 .collect(),
             groups,
         }

@@ -7,6 +7,8 @@ use super::load::{load_photo, Photo};
 use super::overlay::{debug_overlay_full, write_overlay};
 use super::sample::{sample, PatchSample};
 use super::{ChartTemplate, Detection};
+use crate::advice::Advice;
+use crate::chart::patch_name;
 use crate::error::{Error, Result};
 use crate::fsio;
 use serde::Serialize;
@@ -161,40 +163,47 @@ fn assemble(
         .flat_map(|&p| patches[p].rgb)
         .collect();
     let mut warnings = photo.warnings.clone();
-    let clipped: Vec<usize> = template
-        .feature_patches
-        .iter()
-        .enumerate()
-        .filter(|(_, &p)| patches[p].clipped)
-        .map(|(k, _)| k + 1)
-        .collect();
     let n = template.feature_patches.len();
+    // The feature patches flagged by `flag`, by the names the chart prints.
+    let flagged = |flag: fn(&PatchSample) -> bool| -> Vec<String> {
+        template
+            .feature_patches
+            .iter()
+            .filter(|&&p| flag(&patches[p]))
+            .map(|&p| patch_name(&template.name, p))
+            .collect()
+    };
+    let clipped = flagged(|p| p.clipped);
     if clipped.len() as f64 > CLIPPED_WARNING_SHARE * n as f64 {
-        warnings.push(format!(
-            "{} of {n} feature patches are clipped (features {}): the photo is over-exposed \
-             and the estimate will be biased",
-            clipped.len(),
-            list(&clipped)
-        ));
+        warnings.push(
+            Advice::Clipped {
+                count: clipped.len(),
+                of: n,
+                names: clipped,
+                calibration_most: None,
+            }
+            .to_string(),
+        );
     }
-    let dark: Vec<usize> = template
-        .feature_patches
-        .iter()
-        .enumerate()
-        .filter(|(_, &p)| patches[p].dark)
-        .map(|(k, _)| k + 1)
-        .collect();
+    let dark = flagged(|p| p.dark);
     if !dark.is_empty() {
-        warnings.push(format!(
-            "feature patches {} are very dark: their colour is mostly noise",
-            list(&dark)
-        ));
+        warnings.push(
+            Advice::Dark {
+                count: dark.len(),
+                of: n,
+                names: dark,
+            }
+            .to_string(),
+        );
     }
     if detection.confidence < LOW_CONFIDENCE {
-        warnings.push(format!(
-            "chart placement confidence is only {:.2}; check the debug image",
-            detection.confidence
-        ));
+        warnings.push(
+            Advice::LowConfidence {
+                confidence: detection.confidence,
+                placed: method == "corners",
+            }
+            .to_string(),
+        );
     }
     PhotoAnalysis {
         source: photo.source.clone(),
@@ -211,14 +220,6 @@ fn assemble(
         warnings,
         exposure: photo.exposure,
     }
-}
-
-fn list(items: &[usize]) -> String {
-    items
-        .iter()
-        .map(|k| k.to_string())
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 /// The debug image of each of `photos`, all different: [`debug_path`], and where two photos

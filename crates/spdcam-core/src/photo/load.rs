@@ -2,6 +2,7 @@
 //! compact buffer of encoded sRGB values (8 or 16 bits per channel, as the file had).
 
 use super::exposure::Exposure;
+use crate::advice::{Advice, CORRUPT, TRUNCATED};
 use crate::error::{Error, Result};
 use crate::{fsio, limits};
 use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader};
@@ -13,11 +14,6 @@ pub const MIN_PHOTO_SIDE: usize = 16;
 /// Bytes the decoder may allocate per pixel allowed by [`limits::IMAGE_PIXELS`]: a 16-bit
 /// RGBA pixel; a safety net behind the pixel count checked from the header.
 const DECODE_BYTES_PER_PIXEL: u64 = 8;
-/// What [`JpegEnd::Truncated`] means, for messages.
-const TRUNCATED: &str = "the JPEG file is truncated (it ends before its end-of-image marker)";
-/// What [`JpegEnd::Corrupt`] means, for messages.
-const CORRUPT: &str = "the JPEG data is corrupt (a damaged byte breaks its marker segments, \
-     though the file is complete)";
 /// Bytes of a 16-bit RGB pixel, the widest a photo is kept in.
 const RGB16_BYTES: u64 = 6;
 
@@ -284,12 +280,8 @@ pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
     let mut photo = Photo::from_image(source, image)?;
     photo.exposure = exposure;
     match end {
-        JpegEnd::Truncated => photo.warnings.push(format!(
-            "{TRUNCATED}; the missing part of the picture is filled in by the decoder"
-        )),
-        JpegEnd::Corrupt => photo.warnings.push(format!(
-            "{CORRUPT}; the decoder read past it, and part of the picture may be wrong"
-        )),
+        JpegEnd::Truncated => photo.warnings.push(Advice::TruncatedJpeg.to_string()),
+        JpegEnd::Corrupt => photo.warnings.push(Advice::CorruptJpeg.to_string()),
         JpegEnd::Complete => {}
     }
     Ok(photo)

@@ -9,13 +9,15 @@
 //!            detection, clipping, self-check, spread ─► verdict: ok / doubtful / unusable
 //! ```
 //!
-//! One module per job, in that order: [`self_check`] (the chart re-rendered under the
+//! Before any of it, [`chart_identity`] tests that the patches are the chart at all, and
+//! refuses them when not. Then one module per job, in that order: [`self_check`] (the chart re-rendered under the
 //! estimate), [`spread`] (the estimates of perturbed copies of the features), [`calibration`]
 //! (bands, expected GFC and the doubtful levels, from a calibration file per model measured
 //! on held-out virtual photos of held-out lamps: `spdcam trust calibrate`, docs/trust.md) and
 //! [`verdict`] (every check weighed into ok / doubtful / unusable).
 
 pub mod calibration;
+pub mod chart_identity;
 pub mod self_check;
 pub mod spread;
 pub mod verdict;
@@ -24,10 +26,11 @@ pub use calibration::{
     calibration_for, widening, Band, GfcModel, MetricCalibration, MetricInterval, TrustCalibration,
     Uncertainty,
 };
+pub use chart_identity::{ChartIdentity, Identity};
 pub use self_check::{ChartCheck, SelfCheck};
 pub use spread::{feature_scale, Perturbed, JITTER_COPIES, JITTER_SIGMA};
 pub use verdict::{
-    assess, clipped_patch, clipped_patches, flag_patches, photo_flags, PhotoFlags, Trust, Verdict,
-    DOUBTFUL_DARK_SHARE, DOUBTFUL_GFC, SURE_DETECTION, UNUSABLE_CLIPPED_SHARE,
+    assess, clipped_patch, clipped_patches, flag_patches, photo_flags, skipped_patches, PhotoFlags,
+    Trust, Verdict, DOUBTFUL_DARK_SHARE, DOUBTFUL_GFC, SURE_DETECTION, UNUSABLE_CLIPPED_SHARE,
     UNUSABLE_SELF_CHECK_FACTOR,
 };

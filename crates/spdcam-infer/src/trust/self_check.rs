@@ -17,7 +17,7 @@ use spdcam_core::spectral::Grid;
 /// How many patches the self-check names as the worst.
 const WORST_NAMED: usize = 3;
 /// Fewer usable patches than this leave the self-check's 6 parameters per channel too free.
-const MIN_CHECK_PATCHES: usize = 12;
+pub(crate) const MIN_CHECK_PATCHES: usize = 12;
 /// Fewer patches than this on a half leave its 4 parameters per channel too free.
 const MIN_HALF_PATCHES: usize = 8;
 /// How well the estimated light explains the photo's patches.
@@ -121,6 +121,34 @@ impl ChartCheck {
         self.weights.len()
     }
 
+    /// Each feature patch's centre across the chart, −½…½ ([`Chart::feature_centres`]).
+    pub fn centres(&self) -> &[[f64; 2]] {
+        &self.centres
+    }
+
+    /// The neutral feature patches (feature index, mean reflectance), as
+    /// [`Chart::neutral_features`] gives them.
+    pub fn neutrals(&self) -> &[(usize, f64)] {
+        &self.neutrals
+    }
+
+    /// Each feature patch's raw RGB through the reference camera under `spd` (on the check's
+    /// grid): Σλ camera · reflectance · SPD.
+    pub fn rendered(&self, spd: &[f64]) -> Result<Vec<[f64; 3]>> {
+        if spd.len() != self.grid.count {
+            return Err(InferError::invalid(format!(
+                "the chart rendered under an SPD of {} values on a grid of {}",
+                spd.len(),
+                self.grid.count
+            )));
+        }
+        Ok(self
+            .weights
+            .iter()
+            .map(|w| std::array::from_fn(|c| w[c].iter().zip(spd).map(|(a, b)| a * b).sum()))
+            .collect())
+    }
+
     /// Checks `spd` (on the check's grid) against one feature row (encoded sRGB on
     /// `0…scale`, three per patch). Patches with `skip[i]` (clipped, dark) are left out.
     ///
@@ -158,11 +186,7 @@ impl ChartCheck {
                 used.len()
             )));
         }
-        let predicted: Vec<[f64; 3]> = self
-            .weights
-            .iter()
-            .map(|w| std::array::from_fn(|c| w[c].iter().zip(spd).map(|(a, b)| a * b).sum()))
-            .collect();
+        let predicted = self.rendered(spd)?;
         let mut best: Option<MapFit> = None;
         for &gamma in &TONE_GAMMAS {
             for &contrast in &TONE_CONTRASTS {
@@ -202,9 +226,7 @@ impl ChartCheck {
         };
         let (pl, ol) = (level(predicted), level(observed));
         if !(pl > 0.0 && ol > 0.0) {
-            return Err(InferError::invalid(
-                "self-check: the chart or the light is black",
-            ));
+            return Err(InferError::invalid("the chart or the light is black"));
         }
         // Per patch: the predicted RGB, a constant (flare), the light's gradient and an
         // additive light changing across the chart (the last two columns, for the glare).
@@ -379,7 +401,9 @@ impl ChartCheck {
                     .clone_owned()
                     .svd(true, true)
                     .solve(&b, 1e-10)
-                    .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))?;
+                    .map_err(|e| {
+                        InferError::invalid(format!("the fit to the chart failed: {e}"))
+                    })?;
                 Ok((first * x - &b).norm_squared())
             };
             let (one, two) = (rss(shared)?, rss(columns)?);
@@ -461,15 +485,15 @@ fn norm(v: [f64; 3]) -> f64 {
 }
 
 /// Gammas of the tone curves the self-check tries (the virtual camera's range, 0.7–1.3).
-const TONE_GAMMAS: [f64; 5] = [0.7, 0.85, 1.0, 1.15, 1.3];
+pub(crate) const TONE_GAMMAS: [f64; 5] = [0.7, 0.85, 1.0, 1.15, 1.3];
 /// Contrasts of the S-curves the self-check tries (the virtual camera's range, ±0.4).
-const TONE_CONTRASTS: [f64; 5] = [-0.4, -0.2, 0.0, 0.2, 0.4];
+pub(crate) const TONE_CONTRASTS: [f64; 5] = [-0.4, -0.2, 0.0, 0.2, 0.4];
 
 /// Linear RGB from an encoded value `y` (0–1) of a camera whose tone curve is a power
 /// `gamma` on linear values, the sRGB encoding (IEC 61966-2-1) and the contrast S-curve
 /// `e + contrast·e(1−e)(2e−1)` (the virtual camera's in-camera stage): the S-curve inverted
 /// by Newton's method (monotone for |contrast| ≤ 0.5), decoded, raised to 1/gamma.
-fn untone(y: f64, gamma: f64, contrast: f64) -> f64 {
+pub(crate) fn untone(y: f64, gamma: f64, contrast: f64) -> f64 {
     let mut e = y;
     for _ in 0..8 {
         let f = e + contrast * e * (1.0 - e) * (2.0 * e - 1.0) - y;
@@ -491,7 +515,7 @@ fn least_squares(
     let b = DMatrix::from_fn(rows.len(), 3, |r, c| target(rows[r])[c]);
     a.svd(true, true)
         .solve(&b, 1e-10)
-        .map_err(|e| InferError::invalid(format!("self-check fit: {e}")))
+        .map_err(|e| InferError::invalid(format!("the fit to the chart failed: {e}")))
 }
 
 #[cfg(test)]

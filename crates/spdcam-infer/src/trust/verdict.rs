@@ -3,11 +3,13 @@
 //! reasons.
 
 use super::calibration::{TrustCalibration, Uncertainty};
-use super::self_check::{ChartCheck, SelfCheck};
+use super::self_check::{ChartCheck, SelfCheck, MIN_CHECK_PATCHES};
 use super::spread::{feature_scale, Perturbed};
 use crate::error::Result;
 use crate::model::Model;
 use serde::Serialize;
+use spdcam_core::advice::Advice;
+use spdcam_core::chart::{feature_patch_name, shown_chart_name, KnownChart};
 use spdcam_core::photo::{PatchSample, PhotoAnalysis};
 
 /// Estimates above this detection confidence are placed surely; the photo analysis warns
@@ -44,6 +46,17 @@ pub fn flag_patches(row: &[f64], scale: f64) -> Vec<bool> {
     row.chunks_exact(3)
         .map(|p| clipped_patch(p, scale) || p.iter().all(|&v| v < 0.02 * scale))
         .collect()
+}
+
+/// The patches of `row` (on `0…scale`) every check leaves out: those [`flag_patches`] flags
+/// and those the photo analysis found clipped or dark (`flags`).
+pub fn skipped_patches(row: &[f64], scale: f64, flags: &PhotoFlags) -> Vec<bool> {
+    let mut skip = flag_patches(row, scale);
+    for (i, s) in skip.iter_mut().enumerate() {
+        *s |= flags.clipped.get(i).copied().unwrap_or(false)
+            || flags.dark.get(i).copied().unwrap_or(false);
+    }
+    skip
 }
 
 /// One word for how far an estimate can be trusted.
@@ -91,6 +104,8 @@ pub struct PhotoFlags {
     pub clipped: Vec<bool>,
     /// Per feature patch: dark.
     pub dark: Vec<bool>,
+    /// Whether the chart's corners were placed by hand.
+    pub placed: bool,
 }
 
 /// Judges one estimate: `row` the features, `spd` the model's estimate on its own grid
@@ -105,60 +120,92 @@ pub fn assess(
     spd: &[f64],
     flags: &PhotoFlags,
 ) -> Result<Trust> {
+    let (verdict, advice, self_check, uncertainty) =
+        weigh(model, calibration, check, row, spd, flags)?;
+    Ok(Trust {
+        verdict,
+        reasons: advice.iter().map(Advice::to_string).collect(),
+        self_check,
+        uncertainty,
+    })
+}
+
+/// What [`weigh`] finds: the verdict, the advice behind it, the self-check and the bands.
+type Weighed = (Verdict, Vec<Advice>, Option<SelfCheck>, Option<Uncertainty>);
+
+/// [`assess`] with its reasons as [`Advice`] (their words are the advice's).
+fn weigh(
+    model: &Model,
+    calibration: Option<&TrustCalibration>,
+    check: Option<&ChartCheck>,
+    row: &[f64],
+    spd: &[f64],
+    flags: &PhotoFlags,
+) -> Result<Weighed> {
     let mut verdict = Verdict::Ok;
     let mut reasons = Vec::new();
-    let mut lower = |v: Verdict, reason: String, reasons: &mut Vec<String>| {
+    let mut lower = |v: Verdict, reason: Advice, reasons: &mut Vec<Advice>| {
         if v as u8 > verdict as u8 {
             verdict = v;
         }
         reasons.push(reason);
     };
+    let chart = model.header().chart.as_deref().unwrap_or("");
+    let names = |patches: &[usize]| -> Vec<String> {
+        patches
+            .iter()
+            .map(|&k| feature_patch_name(chart, k))
+            .collect()
+    };
     if let Some(c) = flags.confidence.filter(|&c| c < SURE_DETECTION) {
         lower(
             Verdict::Doubtful,
-            format!("the chart was found with confidence {c:.2} only"),
+            Advice::LowConfidence {
+                confidence: c,
+                placed: flags.placed,
+            },
             &mut reasons,
         );
     }
     let scale = feature_scale(row);
     let patches = row.len() / 3;
-    let mut skip = flag_patches(row, scale);
-    for (i, s) in skip.iter_mut().enumerate() {
-        *s |= flags.clipped.get(i).copied().unwrap_or(false)
-            || flags.dark.get(i).copied().unwrap_or(false);
-    }
-    let clipped = (0..patches)
+    let skip = skipped_patches(row, scale, flags);
+    let clipped: Vec<usize> = (0..patches)
         .filter(|&i| {
             flags.clipped.get(i).copied().unwrap_or(false)
                 || clipped_patch(&row[3 * i..3 * i + 3], scale)
         })
-        .count();
+        .collect();
     let clipped_doubtful = calibration.map_or(0, |c| c.clipped_doubtful);
-    if clipped as f64 > UNUSABLE_CLIPPED_SHARE * patches as f64 {
-        lower(
-            Verdict::Unusable,
-            format!("{clipped} of {patches} patches are clipped (overexposed)"),
-            &mut reasons,
-        );
-    } else if clipped > clipped_doubtful {
+    let clipped_advice = |most: Option<usize>| Advice::Clipped {
+        count: clipped.len(),
+        of: patches,
+        names: names(&clipped),
+        calibration_most: most,
+    };
+    if clipped.len() as f64 > UNUSABLE_CLIPPED_SHARE * patches as f64 {
+        lower(Verdict::Unusable, clipped_advice(None), &mut reasons);
+    } else if clipped.len() > clipped_doubtful {
         lower(
             Verdict::Doubtful,
-            format!(
-                "{clipped} of {patches} patches are clipped (overexposed; at most {clipped_doubtful} in the calibration photos)"
-            ),
+            clipped_advice(Some(clipped_doubtful)),
             &mut reasons,
         );
     }
-    let dark = (0..patches)
+    let dark: Vec<usize> = (0..patches)
         .filter(|&i| {
             flags.dark.get(i).copied().unwrap_or(false)
                 || row[3 * i..3 * i + 3].iter().all(|&v| v < 0.02 * scale)
         })
-        .count();
-    if dark as f64 > DOUBTFUL_DARK_SHARE * patches as f64 {
+        .collect();
+    if dark.len() as f64 > DOUBTFUL_DARK_SHARE * patches as f64 {
         lower(
             Verdict::Doubtful,
-            format!("{dark} of {patches} patches are nearly black (underexposed)"),
+            Advice::Dark {
+                count: dark.len(),
+                of: patches,
+                names: names(&dark),
+            },
             &mut reasons,
         );
     }
@@ -166,16 +213,21 @@ pub fn assess(
         Some(c) => match c.check(spd, row, scale, &skip) {
             Ok(s) => Some(s),
             Err(e) => {
-                lower(
-                    Verdict::Unusable,
-                    format!("no self-check: {e}"),
-                    &mut reasons,
-                );
+                let usable = skip.iter().filter(|s| !**s).count();
+                let advice = if usable < MIN_CHECK_PATCHES {
+                    Advice::TooFewToCheck {
+                        usable,
+                        needed: MIN_CHECK_PATCHES,
+                    }
+                } else {
+                    Advice::CheckFailed { why: e.to_string() }
+                };
+                lower(Verdict::Unusable, advice, &mut reasons);
                 None
             }
         },
         None => {
-            reasons.push("no self-check: the chart's reflectances are not at hand (the data directory holds them)".into());
+            reasons.push(no_check(chart));
             None
         }
     };
@@ -190,41 +242,40 @@ pub fn assess(
             )?)
         }
         None => {
-            reasons.push("no uncertainty: the model has no calibration".into());
+            reasons.push(Advice::NoCalibration);
             None
+        }
+    };
+    // Doubtful above a level, unusable above UNUSABLE_SELF_CHECK_FACTOR times it.
+    let graded = |value: f64, level: f64| {
+        if value > UNUSABLE_SELF_CHECK_FACTOR * level {
+            Verdict::Unusable
+        } else {
+            Verdict::Doubtful
         }
     };
     if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.self_check_doubtful)) {
         if s.mean > level {
-            let v = if s.mean > UNUSABLE_SELF_CHECK_FACTOR * level {
-                Verdict::Unusable
-            } else {
-                Verdict::Doubtful
-            };
+            let worst: Vec<usize> = s.worst_patches.iter().map(|p| p - 1).collect();
             lower(
-                v,
-                format!(
-                    "the estimated light does not explain the photo: self-check residual {:.3} (clean photos stay below {level:.3}; worst patches {})",
-                    s.mean,
-                    s.worst_patches.iter().map(|p| format!("p{p:02}")).collect::<Vec<_>>().join(", ")
-                ),
+                graded(s.mean, level),
+                Advice::Residual {
+                    residual: s.mean,
+                    level,
+                    worst: names(&worst),
+                },
                 &mut reasons,
             );
         }
     }
     if let (Some(s), Some(level)) = (&self_check, calibration.and_then(|c| c.split_doubtful)) {
         if s.split > level {
-            let v = if s.split > UNUSABLE_SELF_CHECK_FACTOR * level {
-                Verdict::Unusable
-            } else {
-                Verdict::Doubtful
-            };
             lower(
-                v,
-                format!(
-                    "the two halves of the chart look lit differently (two lights, glare): half-to-half residual {:.3} (clean photos stay below {level:.3})",
-                    s.split
-                ),
+                graded(s.split, level),
+                Advice::Halves {
+                    split: s.split,
+                    level,
+                },
                 &mut reasons,
             );
         }
@@ -236,9 +287,7 @@ pub fn assess(
         if g > level {
             lower(
                 Verdict::Doubtful,
-                format!(
-                    "the light's colour changes across the chart (two lights, or one light and a reflection): its neutral patches' colour gradient is {g:.2} (clean photos stay below {level:.2})"
-                ),
+                Advice::ColourGradient { gradient: g, level },
                 &mut reasons,
             );
         }
@@ -247,10 +296,10 @@ pub fn assess(
         if s.two_lights > level {
             lower(
                 Verdict::Doubtful,
-                format!(
-                    "the chart looks lit by two different lights, one on each half (even if the camera balanced each half to grey): giving one half a light of its own explains {:.1} times more of the patches than noise would (clean photos stay below {level:.1})",
-                    s.two_lights
-                ),
+                Advice::TwoLights {
+                    ratio: s.two_lights,
+                    level,
+                },
                 &mut reasons,
             );
         }
@@ -259,37 +308,43 @@ pub fn assess(
         if s.glare > level {
             lower(
                 Verdict::Doubtful,
-                format!(
-                    "light is added unevenly across the chart (glare, a reflection, or flare from a light beside it): an additive light changing across the chart explains {:.0} % of the self-check residual (clean photos stay below {:.0} %)",
-                    100.0 * s.glare,
-                    100.0 * level
-                ),
+                Advice::Glare {
+                    share: s.glare,
+                    level,
+                },
                 &mut reasons,
             );
         }
     }
     if let (Some(u), Some(cal)) = (&uncertainty, calibration) {
         if u.difficulty > cal.difficulty_doubtful {
-            lower(
-                Verdict::Doubtful,
-                "many lights give nearly this photo, or it is unlike the training lights: the SPD's shape is uncertain (wide band)".into(),
-                &mut reasons,
-            );
+            lower(Verdict::Doubtful, Advice::Ambiguous, &mut reasons);
         }
         if u.expected_gfc < DOUBTFUL_GFC {
             lower(
                 Verdict::Doubtful,
-                format!("expected GFC {:.3} is below {DOUBTFUL_GFC}", u.expected_gfc),
+                Advice::LowGfc {
+                    expected: u.expected_gfc,
+                    level: DOUBTFUL_GFC,
+                },
                 &mut reasons,
             );
         }
     }
-    Ok(Trust {
-        verdict,
-        reasons,
-        self_check,
-        uncertainty,
-    })
+    Ok((verdict, reasons, self_check, uncertainty))
+}
+
+/// Why the chart called `chart` has no self-check: its reflectances are measured data
+/// spdcam was started without, or they are not known.
+fn no_check(chart: &str) -> Advice {
+    match KnownChart::from_name(chart) {
+        Some(known) if known.needs_data_dir() => Advice::NoChartData {
+            chart: known.shown_name().into(),
+        },
+        _ => Advice::UnknownChart {
+            chart: shown_chart_name(chart),
+        },
+    }
 }
 
 /// The flags of an analysed photo's feature patches: `feature_patches` are their indices
@@ -317,6 +372,7 @@ pub fn photo_flags(analysis: &PhotoAnalysis, feature_patches: Option<&[usize]>) 
         confidence: Some(analysis.confidence),
         clipped: flag(|p| p.clipped),
         dark: flag(|p| p.dark),
+        placed: analysis.method == "corners",
     }
 }
 
@@ -324,6 +380,7 @@ pub fn photo_flags(analysis: &PhotoAnalysis, feature_patches: Option<&[usize]>) 
 mod tests {
     use super::super::self_check::tests::{cc24_check, features_of};
     use super::*;
+    use crate::error::InferError;
     use crate::estimator::Estimator;
     use crate::feature_rows::FeatureRows;
     use crate::shipped::ModelSet;
@@ -356,11 +413,31 @@ mod tests {
         )
         .unwrap();
         let estimator = Estimator::new(models.clone(), DataDir::new(None), grid).unwrap();
-        let estimates = estimator.estimate_rows(&rows, "test").unwrap();
-        let t = estimates[1].trust.as_ref().unwrap();
+        // The chart's colours in reverse order are no ColorChecker 24: the row is refused
+        // before any number is made of it.
+        let refused = estimator.estimate_rows(&rows, "test").unwrap_err();
+        assert!(matches!(refused, InferError::NotTheChart(_)), "{refused}");
+        assert!(refused
+            .to_string()
+            .starts_with("test row 2 does not hold a ColorChecker 24"));
+        // Judged all the same (as a row that passed the test would be), the light found
+        // does not explain it.
+        let spd = model.estimate(&wrong).unwrap();
+        let calibration = crate::trust::calibration_for(model).unwrap();
+        let t = assess(
+            model,
+            calibration.as_ref(),
+            Some(&check),
+            &wrong,
+            &spd,
+            &PhotoFlags::default(),
+        )
+        .unwrap();
         assert_ne!(t.verdict, Verdict::Ok, "{:?}", t.reasons);
         assert!(t.self_check.as_ref().unwrap().mean > 0.2);
 
+        let rows = FeatureRows::from_values(model.feature_names().to_vec(), row, "test").unwrap();
+        let estimates = estimator.estimate_rows(&rows, "test").unwrap();
         let e = &estimates[0];
         let json = e.to_json().unwrap();
         for key in [
@@ -392,6 +469,148 @@ mod tests {
             assert!(0.0 <= l95 && l95 <= l68 && l68 <= e.spd[k] + 1e-9, "at {k}");
             assert!(e.spd[k] <= u68 + 1e-9 && u68 <= u95, "at {k}");
         }
+    }
+
+    /// Whether `text` names no command-line option, patch index, feature column, debug
+    /// image, file layout or module path.
+    fn plain(text: &str) -> bool {
+        let b = text.as_bytes();
+        let patch_index = (0..b.len().saturating_sub(2))
+            .any(|i| b[i] == b'p' && b[i + 1].is_ascii_digit() && b[i + 2].is_ascii_digit());
+        !patch_index
+            && ["--", "feature", "debug image", "data directory holds", "::"]
+                .iter()
+                .all(|w| !text.contains(w))
+    }
+
+    #[test]
+    fn every_reason_says_what_went_wrong_and_what_to_do_in_plain_words() {
+        let models = ModelSet::shipped().unwrap();
+        let cc24 = &models.for_chart("colorchecker24").unwrap().model;
+        let sg = &models.for_chart("colorchecker_sg96").unwrap().model;
+        let check = cc24_check(&cc24.grid());
+        // A calibration whose every level is crossed by any estimate.
+        let mut strict = crate::trust::calibration_for(cc24).unwrap().unwrap();
+        strict.self_check_doubtful = Some(0.0);
+        strict.split_doubtful = Some(0.0);
+        strict.colour_gradient_doubtful = Some(0.0);
+        strict.two_lights_doubtful = Some(0.0);
+        strict.glare_doubtful = Some(0.0);
+        strict.difficulty_doubtful = 0.0;
+        strict.clipped_doubtful = 0;
+        strict.gfc_model.gap_range = [0.1f64.ln(); 2];
+        let row = features_of(&check, &StandardIlluminant::D65.spd(&cc24.grid()).unwrap());
+        let spd = cc24.estimate(&row).unwrap();
+        let n = check.patches();
+        let some = |k: usize| (0..n).map(|i| i < k).collect::<Vec<bool>>();
+        let flags = |confidence: f64, placed: bool, clipped: usize, dark: usize| PhotoFlags {
+            confidence: Some(confidence),
+            clipped: some(clipped),
+            dark: (0..n).map(|i| i >= n - dark).collect(),
+            placed,
+        };
+        // The left half under daylight, the right under a bulb: two lights, halves apart.
+        let bulb = features_of(&check, &StandardIlluminant::A.spd(&cc24.grid()).unwrap());
+        let centres = Chart::colorchecker24(&cc24.grid())
+            .unwrap()
+            .feature_centres();
+        let two: Vec<f64> = (0..n)
+            .flat_map(|p| {
+                let from = if centres[p][0] >= 0.0 { &bulb } else { &row };
+                from[3 * p..3 * p + 3].to_vec()
+            })
+            .collect();
+        let two_spd = cc24.estimate(&two).unwrap();
+        let sg_row: Vec<f64> = (0..288).map(|i| 30.0 + ((i * 37) % 200) as f64).collect();
+        let sg_spd = sg.estimate(&sg_row).unwrap();
+        let cases: Vec<(
+            &Model,
+            Option<&TrustCalibration>,
+            Option<&ChartCheck>,
+            &[f64],
+            Vec<f64>,
+            PhotoFlags,
+        )> = vec![
+            // Every level crossed, a patch clipped, many dark, a doubtful detection.
+            (
+                cc24,
+                Some(&strict),
+                Some(&check),
+                &row,
+                spd.clone(),
+                flags(0.6, false, 1, 8),
+            ),
+            // Corners placed with a low confidence; most patches clipped: too few to check.
+            (
+                cc24,
+                Some(&strict),
+                Some(&check),
+                &row,
+                spd.clone(),
+                flags(0.6, true, 20, 0),
+            ),
+            // Two lights.
+            (
+                cc24,
+                Some(&strict),
+                Some(&check),
+                &two,
+                two_spd,
+                PhotoFlags::default(),
+            ),
+            // A black light: the check fails; no calibration.
+            (
+                cc24,
+                None,
+                Some(&check),
+                &row,
+                vec![0.0; spd.len()],
+                PhotoFlags::default(),
+            ),
+            // The SG without the measured data: no check.
+            (sg, None, None, &sg_row, sg_spd, PhotoFlags::default()),
+        ];
+        let mut advice: Vec<Advice> = Vec::new();
+        for (model, calibration, check, row, spd, flags) in cases {
+            advice.extend(
+                weigh(model, calibration, check, row, &spd, &flags)
+                    .unwrap()
+                    .1,
+            );
+        }
+        advice.push(no_check("my_chart.csv"));
+        let mut kinds: Vec<&str> = advice.iter().map(Advice::kind).collect();
+        kinds.sort_unstable();
+        kinds.dedup();
+        let every = [
+            "ambiguous",
+            "check_failed",
+            "clipped",
+            "colour_gradient",
+            "dark",
+            "glare",
+            "halves",
+            "low_confidence",
+            "low_gfc",
+            "no_calibration",
+            "no_chart_data",
+            "residual",
+            "too_few_to_check",
+            "two_lights",
+            "unknown_chart",
+        ];
+        assert_eq!(kinds, every, "reasons the verdict can give, driven");
+        for a in &advice {
+            let text = a.to_string();
+            assert!(plain(&text), "{text}");
+        }
+        // Patches by the names the chart prints; the placed corners and the data said so.
+        let all: Vec<String> = advice.iter().map(Advice::to_string).collect();
+        let said = |w: &str| all.iter().any(|t| t.contains(w));
+        assert!(said("(dark skin)") && said("(magenta, cyan"), "{all:?}");
+        assert!(said("place them again") && said("place the corners by hand"));
+        assert!(said("spdcam was started without the measured data"));
+        assert!(!plain("worst at p07") && !plain("use --data-dir") && !plain("features 1, 2"));
     }
 
     #[test]

@@ -2,11 +2,14 @@
 //! code the page acts on.
 
 /// The message for a person (no command-line words) and a code for the page, of a failed
-/// request's `status` and `error`: `no_chart` when the chart was not found (the page then
-/// asks for its corners), else `bad_photo`, `unknown_chart`, `bad_corners`, `too_large`,
+/// request's `status` and `error`: `no_chart` when the chart was not found and
+/// `not_the_chart` when what was found or placed is not the chart (the page then asks for
+/// its corners, again), else `bad_photo`, `unknown_chart`, `bad_corners`, `too_large`,
 /// `busy`, `not_found` (a job no longer kept), `no_such_page` or `failed`.
 pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
-    let (code, message) = if error.contains("no chart found") {
+    let (code, message) = if let Some(words) = not_the_chart(error) {
+        ("not_the_chart", words)
+    } else if error.contains("no chart found") {
         (
             "no_chart",
             "No colour chart was found in this photo. Click its four corners on the photo to \
@@ -55,6 +58,24 @@ pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
         }
     };
     (code, message)
+}
+
+/// The refusal of patches that are not the chart (`spdcam_core::advice::not_the_chart`)
+/// for a person: from its first words on, without the photo's name and the command-line
+/// clause, as a sentence; where the chart was detected, how to show it on the page.
+fn not_the_chart(error: &str) -> Option<String> {
+    let (start, detected) = ["these corners do not hold a ", "what was found is not a "]
+        .iter()
+        .enumerate()
+        .find_map(|(k, words)| error.find(words).map(|i| (i, k == 1)))?;
+    let words = without_flags(&error[start..]);
+    let mut chars = words.chars();
+    let first = chars.next()?.to_uppercase().collect::<String>();
+    let mut message = format!("{first}{}.", chars.as_str());
+    if detected {
+        message.push_str(" Click the chart's four outer corners on the photo.");
+    }
+    Some(message)
 }
 
 /// The library's `error` for an HTTP client: command-line options become the form fields
@@ -110,6 +131,20 @@ mod tests {
             (500, "the model broke (try spdcam estimate --debug d.png); really", "failed"),
             (404, "the job 3 is no longer kept (only the newest jobs are kept)", "not_found"),
             (404, "no such API: /api/nope", "no_such_page"),
+            (
+                400,
+                "noise.png: these corners do not hold a ColorChecker 24: place them on the \
+                 chart's four outer corners (the patches are not flat: they hold detail, not \
+                 one colour each)",
+                "not_the_chart",
+            ),
+            (
+                400,
+                "room.jpg: what was found is not a ColorChecker Digital SG: show where the \
+                 chart is by its four outer corners (the patches' colours do not follow the \
+                 chart's); give its corners with --corners x1,y1,…,x4,y4",
+                "not_the_chart",
+            ),
         ];
         for (status, error, want) in cases {
             let (code, message) = plain_error(status, error);
@@ -136,5 +171,18 @@ mod tests {
             .1,
             "The photo could not be estimated: the model broke; really"
         );
+        assert_eq!(
+            plain_error(400, cases[8].1).1,
+            "These corners do not hold a ColorChecker 24: place them on the chart's four outer \
+             corners (the patches are not flat: they hold detail, not one colour each)."
+        );
+        let detected = plain_error(400, cases[9].1).1;
+        assert!(
+            detected.starts_with("What was found is not a ColorChecker Digital SG: ")
+                && detected
+                    .ends_with("chart's). Click the chart's four outer corners on the photo."),
+            "{detected}"
+        );
+        assert!(for_http(cases[9].1).contains("in the form field `corners` (x1,y1,…,x4,y4)"));
     }
 }

@@ -35,7 +35,8 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 // ---- talking to the server ------------------------------------------------------------
 
 /** An error for a person: the server's plain `message` (never its command-line words) and
- *  its `code` (`no_chart` when the chart was not found). */
+ *  its `code` (`no_chart` when the chart was not found, `not_the_chart` when what was found
+ *  or placed is not the chart). */
 function serverError(body, status) {
   const e = new Error(body.message || `The server answered ${status}; try again.`);
   e.code = body.code || null;
@@ -95,8 +96,11 @@ async function run(entry, corners, chart) {
     entry.error = e.message;
     entry.errorCode = e.code || null;
     // No chart found: the photo is shown large to place its corners (not for a TIFF, which
-    // browsers cannot show).
-    if (e.code === 'no_chart' && !/\.tiff?$/i.test(entry.name)) entry.placing = entry.placing || { points: [], chart: null };
+    // browsers cannot show). What was found or placed is not the chart: the same, with the
+    // corners cleared to be placed again (the chart named, if it was) and the reason shown.
+    const placeable = !/\.tiff?$/i.test(entry.name);
+    if (e.code === 'no_chart' && placeable) entry.placing = entry.placing || { points: [], chart: null };
+    if (e.code === 'not_the_chart' && placeable) entry.placing = { points: [], chart: entry.placing ? entry.placing.chart : null };
     if (corners && entry.result) entry.corners = entry.result.photo.corners.map((p) => p.slice());
   }
   entry.busy = false;

@@ -92,3 +92,56 @@ fn bad_input_gets_a_clear_error_and_the_server_keeps_serving() {
     assert_eq!(json(&got)["spd"], expected("p.jpg")["spd"]);
     server.stop();
 }
+
+/// A PNG of `w × h` pixel noise (a seeded linear congruential generator).
+fn noise_png(w: u32, h: u32) -> Vec<u8> {
+    let mut state = 41u64;
+    let image = image::RgbImage::from_fn(w, h, |_, _| {
+        image::Rgb(std::array::from_fn(|_| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 56) as u8
+        }))
+    });
+    let mut bytes = Vec::new();
+    image
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .unwrap();
+    bytes
+}
+
+#[test]
+fn corners_on_no_chart_are_refused_with_why_in_a_persons_words() {
+    // Issue 41: four clicks on a screenshot and "ColorChecker 24" gave a warm white light.
+    let server = start(16 << 20);
+    let addr = server.addr();
+    let png = noise_png(400, 300);
+    let body = form(&[
+        ("photo", Some("screenshot.png"), png.as_slice()),
+        ("corners", None, b"40,30,360,40,350,270,50,260"),
+        ("chart", None, b"colorchecker24"),
+    ]);
+    let (status, got) = request(addr, "POST", "/api/estimate", Some(body.as_slice()));
+    let got = json(&got);
+    assert_eq!(status, 400, "{got}");
+    assert_eq!(got["code"], "not_the_chart", "{got}");
+    assert!(got.get("spd").is_none(), "{got}");
+    let message = got["message"].as_str().unwrap();
+    assert!(
+        message.starts_with(
+            "These corners do not hold a ColorChecker 24: place them on the chart's four \
+             outer corners ("
+        ),
+        "{message}"
+    );
+    let error = got["error"].as_str().unwrap();
+    assert!(
+        error.contains("screenshot.png") && !error.contains("--"),
+        "{error}"
+    );
+    server.stop();
+}
