@@ -117,6 +117,14 @@ pub enum Advice {
     },
     /// Many lights give nearly this photo: the shape is uncertain.
     Ambiguous,
+    /// The expected goodness of fit of the shape is good, but estimates like this one are
+    /// often poor.
+    MayBePoor {
+        /// The GFC 95 % of such estimates reach at least.
+        at_least: f64,
+        /// The level below which a match is poor.
+        level: f64,
+    },
     /// The expected goodness of fit of the shape is low.
     LowGfc {
         /// The expected GFC.
@@ -148,6 +156,7 @@ impl Advice {
             Advice::Glare { .. } => "glare",
             Advice::Ambiguous => "ambiguous",
             Advice::LowGfc { .. } => "low_gfc",
+            Advice::MayBePoor { .. } => "may_be_poor",
         }
     }
 }
@@ -291,6 +300,13 @@ impl fmt::Display for Advice {
                  learned from: the spectrum's shape is uncertain (wide band), so take it as \
                  a rough guide; the ColorChecker Digital SG, with more patches, tells such \
                  lights apart better"
+            ),
+            Advice::MayBePoor { at_least, level } => write!(
+                f,
+                "the spectrum's shape may match the true one only poorly: one estimate in \
+                 twenty like this one has a GFC below {at_least:.2} ({level:.2} or less is a \
+                 poor match): take it as a rough guide, or retake the photo with the chart \
+                 larger, evenly lit and out of glare"
             ),
             Advice::LowGfc { expected, level } => write!(
                 f,

@@ -426,7 +426,9 @@ fn summary(items: &[Item]) -> String {
     type Get = fn(&Identity) -> Option<f64>;
     let stats: [(&str, &str, f64, bool, Get); 4] = [
         ("contrast", "≥", MIN_CONTRAST, false, |i| Some(i.contrast)),
-        ("neutral order", "≥", MIN_NEUTRAL_ORDER, false, |i| i.neutral_order),
+        ("neutral order", "≥", MIN_NEUTRAL_ORDER, false, |i| {
+            i.neutral_order
+        }),
         ("shuffled", "≤", MAX_SHUFFLED, true, |i| i.shuffled),
         ("texture", "≤", MAX_TEXTURE, true, |i| i.texture),
     ];

@@ -17,7 +17,9 @@ use spdcam_core::chart_lighting::{Corrections, UnevenLight};
 use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::quality::SCALAR_KEYS;
 use spdcam_core::spectral_error;
-use spdcam_infer::trust::{self, assess, ChartCheck, PhotoFlags, TrustCalibration, Verdict};
+use spdcam_infer::trust::{
+    self, assess, ChartCheck, PhotoFlags, TrustCalibration, Verdict, POOR_GFC,
+};
 use spdcam_infer::Model;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -124,9 +126,6 @@ struct MetricCoverage {
     total: usize,
     half95: Vec<f64>,
 }
-
-/// Below this GFC an estimate is poor: a photo called `ok` should never be (issue goal).
-const POOR_GFC: f64 = 0.90;
 
 /// Scene photos of each test lamp the report measures (the whole camera chain).
 pub const REPORT_SCENES_PER_LAMP: usize = 2;

@@ -21,6 +21,10 @@ pub const UNUSABLE_SELF_CHECK_FACTOR: f64 = 3.0;
 /// Below this expected GFC an estimate is doubtful (GFC 0.95 is the thesis's "acceptable"
 /// level of spectral match; Hernández-Andrés et al. 2001, JOSA A 18: 412–420).
 pub const DOUBTFUL_GFC: f64 = 0.95;
+/// Below this GFC an estimate's shape is a poor match: an estimate is `ok` only where 95 %
+/// of the calibration's estimates like it reach it ([`Uncertainty::gfc_at_least95`]), so
+/// that a photo called `ok` is not a poor one.
+pub const POOR_GFC: f64 = 0.90;
 /// A share of clipped feature patches above this makes an estimate unusable: half the
 /// chart says only that it is brighter than the camera records.
 pub const UNUSABLE_CLIPPED_SHARE: f64 = 0.5;
@@ -329,6 +333,15 @@ fn weigh(
                 },
                 &mut reasons,
             );
+        } else if u.gfc_at_least95 < POOR_GFC {
+            lower(
+                Verdict::Doubtful,
+                Advice::MayBePoor {
+                    at_least: u.gfc_at_least95,
+                    level: POOR_GFC,
+                },
+                &mut reasons,
+            );
         }
     }
     Ok((verdict, reasons, self_check, uncertainty))
@@ -499,6 +512,10 @@ mod tests {
         strict.difficulty_doubtful = 0.0;
         strict.clipped_doubtful = 0;
         strict.gfc_model.gap_range = [0.1f64.ln(); 2];
+        // A calibration whose median is good (0.96) and whose 95 % floor is poor (0.80).
+        let mut loose = crate::trust::calibration_for(cc24).unwrap().unwrap();
+        loose.gfc_model.gap_range = [0.04f64.ln(); 2];
+        loose.gfc_model.gap_margin95 = 5.0f64.ln();
         let row = features_of(&check, &StandardIlluminant::D65.spd(&cc24.grid()).unwrap());
         let spd = cc24.estimate(&row).unwrap();
         let n = check.patches();
@@ -567,6 +584,15 @@ mod tests {
                 vec![0.0; spd.len()],
                 PhotoFlags::default(),
             ),
+            // An estimate good in the median that may well be poor.
+            (
+                cc24,
+                Some(&loose),
+                Some(&check),
+                &row,
+                spd.clone(),
+                PhotoFlags::default(),
+            ),
             // The SG without the measured data: no check.
             (sg, None, None, &sg_row, sg_spd, PhotoFlags::default()),
         ];
@@ -592,6 +618,7 @@ mod tests {
             "halves",
             "low_confidence",
             "low_gfc",
+            "may_be_poor",
             "no_calibration",
             "no_chart_data",
             "residual",
