@@ -33,6 +33,35 @@ pub(crate) fn photo_chart(model_chart: &str) -> &str {
     }
 }
 
+/// `model` as a user's photo meets it, looking for `photo_chart` only: its estimator and
+/// the options of every photo.
+fn user_estimator(
+    model: &Model,
+    photo_chart: &str,
+    data_dir: &DataDir,
+) -> Result<(Estimator, PhotoOptions)> {
+    let estimator = Estimator::new(
+        ModelSet::single(model.clone(), "model"),
+        data_dir.clone(),
+        model.grid(),
+    )?;
+    let options = PhotoOptions {
+        chart: Some(photo_chart.to_string()),
+        ..PhotoOptions::default()
+    };
+    Ok((estimator, options))
+}
+
+/// The scenes of the trust protocols: 1200×900 pixels, everything else as `spdcam render
+/// --scene` draws it.
+fn scene_options() -> SceneOptions {
+    SceneOptions {
+        width: 1200,
+        height: 900,
+        ..SceneOptions::default()
+    }
+}
+
 /// Scene photos (the code of `spdcam render --scene`: the chart placed in a cluttered scene
 /// with perspective, blur, vignetting, noise and JPEG) of [`SCENES`] test lamps, each by a
 /// held-out camera, found, sampled and estimated like a user's photo: clean, of another
@@ -72,20 +101,8 @@ pub fn scene_verdicts(
     let ids = setup
         .library
         .positions(setup.split.lamps(LampPart::Test), "the split's test lamps")?;
-    let estimator = Estimator::new(
-        ModelSet::single(model.clone(), "model"),
-        data_dir.clone(),
-        model.grid(),
-    )?;
-    let options = PhotoOptions {
-        chart: Some(name.to_string()),
-        ..PhotoOptions::default()
-    };
-    let plain = SceneOptions {
-        width: 1200,
-        height: 900,
-        ..SceneOptions::default()
-    };
+    let (estimator, options) = user_estimator(model, name, data_dir)?;
+    let plain = scene_options();
     let balanced = SceneOptions {
         balance_halves: true,
         ..plain.clone()
@@ -176,20 +193,8 @@ pub fn scene_rows(
     let ids = setup
         .library
         .positions(setup.split.lamps(part), "the split's lamps")?;
-    let estimator = Estimator::new(
-        ModelSet::single(model.clone(), "model"),
-        data_dir.clone(),
-        model.grid(),
-    )?;
-    let options = PhotoOptions {
-        chart: Some(name.to_string()),
-        ..PhotoOptions::default()
-    };
-    let scene_options = SceneOptions {
-        width: 1200,
-        height: 900,
-        ..SceneOptions::default()
-    };
+    let (estimator, options) = user_estimator(model, name, data_dir)?;
+    let scene_options = scene_options();
     let found: Vec<Option<(usize, Vec<f64>)>> = (0..ids.len() * per_lamp)
         .into_par_iter()
         .map(|g| {
