@@ -355,7 +355,12 @@ fn corner_sets(width: usize, height: usize) -> Vec<Vec<[f64; 2]>> {
     };
     let rotated = {
         let (cx, cy, a) = (w / 2.0, h / 2.0, 20f64.to_radians());
+        // Half sides, shrunk until the turned rectangle lies inside the image.
         let (hw, hh) = (0.3 * w, 0.2 * h);
+        let fit = (0.45 * h / (hw * a.sin() + hh * a.cos()))
+            .min(0.45 * w / (hw * a.cos() + hh * a.sin()))
+            .min(1.0);
+        let (hw, hh) = (hw * fit, hh * fit);
         [[-hw, -hh], [hw, -hh], [hw, hh], [-hw, hh]]
             .iter()
             .map(|p| {
@@ -426,7 +431,9 @@ fn summary(items: &[Item]) -> String {
     type Get = fn(&Identity) -> Option<f64>;
     let stats: [(&str, &str, f64, bool, Get); 4] = [
         ("contrast", "≥", MIN_CONTRAST, false, |i| Some(i.contrast)),
-        ("neutral order", "≥", MIN_NEUTRAL_ORDER, false, |i| i.neutral_order),
+        ("neutral order", "≥", MIN_NEUTRAL_ORDER, false, |i| {
+            i.neutral_order
+        }),
         ("shuffled", "≤", MAX_SHUFFLED, true, |i| i.shuffled),
         ("texture", "≤", MAX_TEXTURE, true, |i| i.texture),
     ];
