@@ -159,28 +159,31 @@ fn measure(
     group: &str,
     name: &str,
 ) -> Item {
-    // Analysed as the estimator analyses (the same charts looked for), but not refused yet.
-    let analysis = estimator
-        .templates(options.chart.as_deref())
-        .and_then(|templates| {
-            let analyse = AnalyseOptions {
-                templates,
-                corners: options.corners.clone(),
-                debug: None,
-            };
-            Ok(analyse_decoded(photo, &analyse)?)
-        });
-    let (outcome, identity) = match analysis {
-        Err(e) => (format!("other: {e}"), None),
-        Ok(analysis) => {
-            let identity = estimator.photo_identity(&analysis).ok();
-            let outcome = match estimator.estimate_analysis(analysis, name.into()) {
-                Ok(_) => "accepted".to_string(),
-                Err(InferError::NotTheChart(_)) => "refused".to_string(),
-                Err(e) => format!("other: {e}"),
-            };
-            (outcome, identity)
+    // Estimated as the estimator estimates; the statistics of what it took for the chart,
+    // or, where it refused the patches, of the analysis it refused.
+    let (outcome, identity) = match estimator.analyse_decoded(photo, options) {
+        Ok(analysed) => {
+            let identity = estimator.photo_identity(&analysed.analysis).ok();
+            match estimator.estimate_analysis(analysed.analysis, name.into()) {
+                Ok(_) => ("accepted".to_string(), identity),
+                Err(e) => (format!("other: {e}"), identity),
+            }
         }
+        Err(InferError::NotTheChart(_)) => {
+            let analysis = estimator
+                .templates(options.chart.as_deref())
+                .and_then(|templates| {
+                    let analyse = AnalyseOptions {
+                        templates,
+                        corners: options.corners.clone(),
+                        debug: None,
+                    };
+                    Ok(analyse_decoded(photo, &analyse)?)
+                });
+            let identity = analysis.and_then(|a| estimator.photo_identity(&a)).ok();
+            ("refused".to_string(), identity)
+        }
+        Err(e) => (format!("other: {e}"), None),
     };
     Item {
         group: group.into(),
@@ -355,7 +358,12 @@ fn corner_sets(width: usize, height: usize) -> Vec<Vec<[f64; 2]>> {
     };
     let rotated = {
         let (cx, cy, a) = (w / 2.0, h / 2.0, 20f64.to_radians());
+        // Half sides, shrunk until the turned rectangle lies inside the image.
         let (hw, hh) = (0.3 * w, 0.2 * h);
+        let fit = (0.45 * h / (hw * a.sin() + hh * a.cos()))
+            .min(0.45 * w / (hw * a.cos() + hh * a.sin()))
+            .min(1.0);
+        let (hw, hh) = (hw * fit, hh * fit);
         [[-hw, -hh], [hw, -hh], [hw, hh], [-hw, hh]]
             .iter()
             .map(|p| {
@@ -416,11 +424,12 @@ fn summary(items: &[Item]) -> String {
             range(&|i| i.texture),
         );
     }
-    // Per statistic: the charts' worst value, the no-chart images' value nearest to it, the
-    // threshold between, and the share of no-chart items it alone refuses.
+    // Per statistic: the charts' worst value, the no-chart items it refuses and, of them,
+    // the value nearest to the threshold.
     let chart = |i: &&Item| i.group.starts_with("rows") || i.group.starts_with("scenes");
+    let no_chart = items.iter().filter(|i| !chart(i)).count();
     out.push_str(
-        "\n| statistic | threshold | charts' worst | no chart: nearest | no chart refused by it alone |\n\
+        "\n| statistic | threshold | charts: worst | no chart refused by it | of those, nearest |\n\
          | --- | --- | --: | --: | --: |\n",
     );
     type Get = fn(&Identity) -> Option<f64>;
@@ -440,23 +449,21 @@ fn summary(items: &[Item]) -> String {
                 .filter_map(|i| i.identity.as_ref().and_then(get))
                 .collect()
         };
-        let (charts, others) = (values(true), values(false));
+        let bad = |v: f64| if high_is_bad { v > level } else { v < level };
+        let refused: Vec<f64> = values(false).into_iter().filter(|&v| bad(v)).collect();
+        // The worst of `v`: the largest where high is bad, else the smallest.
         let worst = |v: &[f64], high: bool| {
             v.iter().copied().fold(None, |a: Option<f64>, x| {
                 Some(a.map_or(x, |a| if high { a.max(x) } else { a.min(x) }))
             })
         };
         let shown = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.3}"));
-        let refused = others
-            .iter()
-            .filter(|&&v| if high_is_bad { v > level } else { v < level })
-            .count();
-        let no_chart = items.iter().filter(|i| !chart(i)).count();
         let _ = writeln!(
             out,
-            "| {name} | {sign} {level} | {} | {} | {refused} of {no_chart} |",
-            shown(worst(&charts, high_is_bad)),
-            shown(worst(&others, !high_is_bad)),
+            "| {name} | {sign} {level} | {} | {} of {no_chart} | {} |",
+            shown(worst(&values(true), high_is_bad)),
+            refused.len(),
+            shown(worst(&refused, !high_is_bad)),
         );
     }
     let _ = writeln!(

@@ -340,7 +340,7 @@ impl Estimator {
         };
         let (analysis, debug) = photo::analyse_telling_debug(photo, &analyse);
         let analysed = analysis.map_err(InferError::from).and_then(|analysis| {
-            self.refuse_not_the_chart(&analysis)?;
+            let analysis = self.the_chart_placed(photo, &analyse, analysis)?;
             let overlay = match options.overlay_width {
                 Some(width) => Some(overlay_of(photo, &analyse.templates, &analysis, width)?),
                 None => None,
@@ -375,6 +375,38 @@ impl Estimator {
             &identified.flags,
             Some(analysis),
         )
+    }
+
+    /// `analysis` when its patches are the chart; else, with corners given and several
+    /// charts looked for, the first other chart those corners hold (the patches of one chart
+    /// can fit the grid of another better: the ColorChecker 24's six columns and the SG's
+    /// twelve), its debug image written again; else the refusal.
+    fn the_chart_placed(
+        &self,
+        photo: &Photo,
+        analyse: &AnalyseOptions,
+        analysis: PhotoAnalysis,
+    ) -> Result<PhotoAnalysis> {
+        let refusal = match self.refuse_not_the_chart(&analysis) {
+            Ok(()) => return Ok(analysis),
+            Err(refusal) => refusal,
+        };
+        if analyse.corners.is_none() {
+            return Err(refusal);
+        }
+        analyse
+            .templates
+            .iter()
+            .filter(|t| t.name != analysis.chart)
+            .find_map(|t| {
+                let one = AnalyseOptions {
+                    templates: vec![t.clone()],
+                    ..analyse.clone()
+                };
+                let other = photo::analyse(photo, &one).ok()?;
+                self.refuse_not_the_chart(&other).ok().map(|()| other)
+            })
+            .ok_or(refusal)
     }
 
     /// Refuses an analysed photo whose patches are not the chart ([`InferError::NotTheChart`]),
