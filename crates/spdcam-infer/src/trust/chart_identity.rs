@@ -2,24 +2,26 @@
 //! a feature row) are tested for behaving like the chart they are said to be; patches that
 //! do not are refused ([`InferError::NotTheChart`]), whatever the model would make of them.
 //!
-//! Five statistics, each cheap, each measured on real and generated charts and on images
+//! Four statistics, each cheap, each measured on real and generated charts and on images
 //! that hold none (`docs/chart-identity.md`, which gives the thresholds and their margins):
 //!
 //! - **contrast**: the spread of the patches' linear RGB over their mean level; a flat
 //!   image has none.
-//! - **neutral order**: the same patches keep their lightness order under any light:
-//!   Spearman's rank correlation (Spearman 1904, "The proof and measurement of association
-//!   between two things", Am. J. Psychol. 15: 72–101) of their levels with their
-//!   reflectances.
-//! - **shuffled**: the chart's reflectances rendered under the estimated light through the
-//!   reference camera ([`ChartCheck::rendered`]) are mapped to the patches' linear RGB by an
-//!   affine colour map, a 3×3 matrix and an offset fitted by least squares (Hong, Luo &
-//!   Rhodes 2001, Color Res. Appl. 26: 76–84); its residual is compared with the residuals of
-//!   the same fit to [`PERMUTATIONS`] seeded random permutations of the patches, a
-//!   permutation test (Fisher 1935, "The Design of Experiments", §21; Good 2005,
-//!   "Permutation, Parametric and Bootstrap Tests of Hypotheses", ch. 3). The statistic is
-//!   the residual over the permutations' median: far below 1 for the chart, about 1 for
-//!   colours in no relation to it.
+//! - **neutral order** (photos of a chart with many grey patches, the SG's border and
+//!   centre): the grey patches reflect every light alike, so they keep their lightness order
+//!   under any light: Spearman's rank correlation (Spearman 1904, "The proof and measurement
+//!   of association between two things", Am. J. Psychol. 15: 72–101) of their levels with
+//!   their reflectances.
+//! - **shuffled** (when the chart's reflectances are at hand): the chart's reflectances
+//!   rendered under the estimated light through the reference camera
+//!   ([`ChartCheck::rendered`]) are mapped to the patches' linear RGB by an affine colour map,
+//!   a 3×3 matrix and an offset fitted by least squares (Hong, Luo & Rhodes 2001, Color Res.
+//!   Appl. 26: 76–84); its residual is compared with the residuals of the same fit to
+//!   [`PERMUTATIONS`] seeded random permutations of the patches, a permutation test (Fisher
+//!   1935, "The Design of Experiments", §21; Good 2005, "Permutation, Parametric and
+//!   Bootstrap Tests of Hypotheses", ch. 3), with what the place on the chart alone explains
+//!   held (Freedman & Lane 1983). The statistic is the residual over the permutations'
+//!   median: far below 1 for the chart, about 1 for colours in no relation to it.
 //! - **texture** (photos only): the median over the patches of their pixels' standard
 //!   deviation: a patch is flat inside, a scene is not.
 
@@ -154,7 +156,7 @@ impl ChartIdentity {
     }
 
     /// The statistics of an analysed photo that need no light: its feature row's contrast,
-    /// the texture of all its patches and, for a chart with [`MIN_ORDER_NEUTRALS`] grey
+    /// the texture of all its patches and, for a chart with ten grey
     /// patches or more (the SG's border and centre), their lightness order over those
     /// neither clipped nor nearly black.
     pub fn of_photo(&self, analysis: &PhotoAnalysis, scale: f64) -> Identity {
@@ -345,7 +347,7 @@ fn shuffled(
 ) -> Option<f64> {
     let n = rendered.len();
     let mean_level = rendered.iter().map(level).sum::<f64>() / n as f64;
-    if !(mean_level > 0.0) || centres.len() != n {
+    if mean_level.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || centres.len() != n {
         return None;
     }
     let gradient = n >= GRADIENT_MIN_PATCHES;
@@ -370,7 +372,7 @@ fn shuffled(
         }
     };
     // Per channel: its patches and orthonormal bases of the full design and of the place's.
-    let mut channels: Vec<(usize, Vec<usize>, DMatrix<f64>, DMatrix<f64>)> = Vec::new();
+    let mut channels: Vec<Channel> = Vec::new();
     for c in 0..3 {
         let used: Vec<usize> = (0..n)
             .filter(|&i| !skip.get(i).copied().unwrap_or(false) && row[3 * i + c] < CLIPPED * scale)
@@ -438,7 +440,8 @@ fn shuffled(
             y.iter().map(|v| (v - mean).powi(2)).sum::<f64>()
         })
         .sum();
-    if !(place_rss > PLACE_EXPLAINS_ALL * total) {
+    // Nothing left (or no number at all): the place explains everything.
+    if place_rss.partial_cmp(&(PLACE_EXPLAINS_ALL * total)) != Some(std::cmp::Ordering::Greater) {
         return Some(1.0);
     }
     let rss_of = |orders: Option<&[Vec<usize>]>| -> f64 {
@@ -466,6 +469,10 @@ fn shuffled(
     let typical = median(&mut shuffled)?;
     (typical > 0.0).then(|| own / typical)
 }
+
+/// One channel's fit: the channel, its patches, and orthonormal bases of the full design
+/// and of the place's.
+type Channel = (usize, Vec<usize>, DMatrix<f64>, DMatrix<f64>);
 
 /// An orthonormal basis of `design`'s columns: the left singular vectors of its non-zero
 /// singular values.

@@ -10,8 +10,9 @@
 //! ```
 //!
 //! Before any of it, [`chart_identity`] tests that the patches are the chart at all, and
-//! refuses them when not. Then one module per job, in that order: [`self_check`] (the chart re-rendered under the
-//! estimate), [`spread`] (the estimates of perturbed copies of the features), [`calibration`]
+//! refuses them when not. Then one module per job, in that order: [`self_check`] (the chart
+//! re-rendered under the estimate), [`spread`] (the estimates of perturbed copies of the
+//! features), [`calibration`]
 //! (bands, expected GFC and the doubtful levels, from a calibration file per model measured
 //! on held-out virtual photos of held-out lamps: `spdcam trust calibrate`, docs/trust.md) and
 //! [`verdict`] (every check weighed into ok / doubtful / unusable).

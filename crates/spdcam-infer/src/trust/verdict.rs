@@ -540,14 +540,16 @@ mod tests {
         let two_spd = cc24.estimate(&two).unwrap();
         let sg_row: Vec<f64> = (0..288).map(|i| 30.0 + ((i * 37) % 200) as f64).collect();
         let sg_spd = sg.estimate(&sg_row).unwrap();
-        let cases: Vec<(
-            &Model,
-            Option<&TrustCalibration>,
-            Option<&ChartCheck>,
-            &[f64],
+        // What the verdict weighs: model, calibration, check, row, SPD and photo flags.
+        type Case<'a> = (
+            &'a Model,
+            Option<&'a TrustCalibration>,
+            Option<&'a ChartCheck>,
+            &'a [f64],
             Vec<f64>,
             PhotoFlags,
-        )> = vec![
+        );
+        let cases: Vec<Case> = vec![
             // Every level crossed, a patch clipped, many dark, a doubtful detection.
             (
                 cc24,
