@@ -73,7 +73,11 @@ pub fn fails_fast(args: &[&str]) -> String {
 
 /// An empty scratch directory of this test binary named `name`.
 pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("spdcam-{}-{name}", env!("CARGO_CRATE_NAME")));
+    let dir = std::env::temp_dir().join(format!(
+        "spdcam-{}-{name}-{}",
+        env!("CARGO_CRATE_NAME"),
+        std::process::id()
+    ));
     std::fs::remove_dir_all(&dir).ok();
     std::fs::create_dir_all(&dir).unwrap();
     dir
