@@ -325,21 +325,10 @@ fn bad_photos_give_clear_errors_and_no_output() {
 }
 
 #[cfg(feature = "measured-data")]
-/// The shared data directory (for the SG 96 reflectances and the Canon curves).
-fn data_dir() -> std::path::PathBuf {
-    use std::path::PathBuf;
-    let root = std::env::var_os("SPDCAM_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    assert!(root.is_dir(), "shared data not found at {}", root.display());
-    root
-}
-
-#[cfg(feature = "measured-data")]
 #[test]
 fn a_chart_image_from_render_is_estimated() {
     let dir = scratch("render");
-    let data = s(&data_dir());
+    let data = s(&common::data_dir());
     let chart = dir.join("chart.png");
     let truth = dir.join("chart.truth.csv");
     ok(&[

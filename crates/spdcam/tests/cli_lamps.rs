@@ -134,22 +134,13 @@ fn lamp_recipes_are_listed_and_bad_ones_named() {
 }
 
 #[cfg(feature = "measured-data")]
-fn data_dir() -> PathBuf {
-    let root = std::env::var_os("SPDCAM_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    assert!(root.is_dir(), "shared data not found at {}", root.display());
-    root
-}
-
-#[cfg(feature = "measured-data")]
 #[test]
 fn the_committed_split_is_what_the_command_makes() {
     let dir = scratch("split");
     let out = dir.join("split.json");
     ok(&[
         "--data-dir",
-        &s(&data_dir()),
+        &s(&common::data_dir()),
         "lamps",
         "split",
         "--seed",
@@ -170,7 +161,7 @@ fn the_shipped_models_beat_the_average_spd_on_held_out_lamps() {
     let table = dir.join("validation.md");
     let out = ok(&[
         "--data-dir",
-        &s(&data_dir()),
+        &s(&common::data_dir()),
         "lamps",
         "validate",
         "--split",

@@ -184,22 +184,12 @@ fn the_chart_is_estimated_with_its_corners_given_and_detected() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-#[cfg(feature = "measured-data")]
-/// The shared data directory (the SG's reflectances, the thesis's measured sets).
-fn data_dir() -> PathBuf {
-    let root = std::env::var_os("SPDCAM_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    assert!(root.is_dir(), "shared data not found at {}", root.display());
-    root
-}
-
 /// Every row of the five real measured sets (ColorChecker SG photos with strong veiling
 /// glare and hot spots) is taken for the chart: streamed through the model, an SPD each.
 #[cfg(feature = "measured-data")]
 #[test]
 fn every_real_measured_row_is_the_chart() {
-    let data = data_dir();
+    let data = common::data_dir();
     let dir = scratch("measured");
     for set in [
         "telelumen_canon5d4_dev",
@@ -236,7 +226,7 @@ fn every_real_measured_row_is_the_chart() {
 #[cfg(feature = "measured-data")]
 #[test]
 fn with_the_measured_data_no_chart_is_refused_for_either_chart() {
-    let data = s(&data_dir());
+    let data = s(&common::data_dir());
     let dir = scratch("no-chart-data");
     let images = no_chart_images(&dir);
     for image in [&images[1], &images[2], &images[5]] {

@@ -87,3 +87,13 @@ pub fn scratch(name: &str) -> PathBuf {
 pub fn s(p: &Path) -> String {
     p.to_string_lossy().into_owned()
 }
+
+/// The measured data directory (second tier): `$SPDCAM_DATA`, else `../shared/data` beside
+/// the repository.
+pub fn data_dir() -> PathBuf {
+    let root = std::env::var_os("SPDCAM_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    assert!(root.is_dir(), "shared data not found at {}", root.display());
+    root
+}
