@@ -34,6 +34,7 @@ __all__ = [
     "read_photo",
     "estimate",
     "estimate_features",
+    "LIGHT_KINDS",
     "Rendering",
     "render",
     "Dataset",
@@ -49,6 +50,17 @@ PathLike = Union[str, "os.PathLike[str]"]
 Progress = Callable[[int, int], None]
 
 DEFAULT_RANGE = "400-700:5"
+#: The kinds of light ``estimate(light=…)`` takes (``spdcam light-kinds list``).
+LIGHT_KINDS = (
+    "unknown",
+    "daylight",
+    "incandescent",
+    "fluorescent",
+    "white-led",
+    "hid",
+    "rgb-led",
+    "luminaire",
+)
 
 
 class Model:
@@ -205,6 +217,8 @@ class Estimate:
     #: ``spectral_irradiance_w_m2_nm``, ``note``); ``None`` otherwise, with the reason in
     #: ``json["absolute_reason"]``.
     absolute: Optional[dict[str, Any]] = None
+    #: The kind of light the estimate was told of (``light=``; ``"unknown"`` when none).
+    light: str = "unknown"
     #: The library's JSON of the estimate (as ``spdcam estimate --json`` prints it).
     json: dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -230,6 +244,7 @@ class Estimate:
             band_widening=v.get("band_widening"),
             metric_uncertainty=dict(v.get("metric_uncertainty") or {}),
             absolute=v.get("absolute"),
+            light=v.get("light", "unknown"),
             json=v,
         )
 
@@ -367,6 +382,7 @@ def _estimate_one(
     corners: Optional[list[tuple[float, float]]],
     range: str,
     source: Optional[str],
+    light: str,
 ) -> Estimate:
     native: _native.PhotoInput
     if isinstance(photo, (bytes, bytearray, memoryview)):
@@ -387,7 +403,7 @@ def _estimate_one(
             f"got {type(photo).__name__}"
         )
     return Estimate._from_json(
-        _native.estimate_photo_json(native, name, models, chart, corners, range)
+        _native.estimate_photo_json(native, name, models, chart, corners, range, light)
     )
 
 
@@ -409,6 +425,7 @@ def estimate(
     model: Union[Model, str, "os.PathLike[str]", None] = None,
     source: Optional[str] = None,
     progress: Union[bool, Progress, None] = None,
+    light: str = "unknown",
 ) -> Union[Estimate, list[Estimate]]:
     """Estimates the light from a photo of a colour chart, as ``spdcam estimate PHOTO``.
 
@@ -417,7 +434,10 @@ def estimate(
     ``chart`` looks only for that chart; ``corners`` gives the chart's four outer corners
     in pixels (any order) instead of detecting it; ``range`` is the output grid
     ``START-END[:STEP]`` in nm; ``model`` a :class:`Model` or a ``.spdm`` path (default:
-    the shipped models); ``source`` names in-memory photos in messages. For lists,
+    the shipped models); ``source`` names in-memory photos in messages; ``light`` the kind
+    of light, when known (one of :data:`LIGHT_KINDS`: ``"daylight"``, ``"incandescent"``,
+    ``"fluorescent"``, ``"white-led"``, ``"hid"``, ``"rgb-led"``, ``"luminaire"``; default
+    ``"unknown"``), which keeps the estimate among lights of that kind. For lists,
     ``progress`` is a callback ``(done, total)``, or ``True`` for a tqdm bar (when tqdm is
     installed). The work runs without the GIL. Raises :class:`SpdcamError` (a
     ``ValueError``) with the command line's message when the photo cannot be used.
@@ -429,14 +449,14 @@ def estimate(
         out = []
         try:
             for i, p in enumerate(photo):
-                out.append(_estimate_one(p, models, chart, points, range, source))
+                out.append(_estimate_one(p, models, chart, points, range, source, light))
                 if report is not None:
                     report(i + 1, len(photo))
         finally:
             if isinstance(report, _Bar):
                 report.close()
         return out
-    return _estimate_one(photo, models, chart, points, range, source)
+    return _estimate_one(photo, models, chart, points, range, source, light)
 
 
 class _Bar:
@@ -488,6 +508,7 @@ def estimate_features(
     range: str = DEFAULT_RANGE,
     model: Union[Model, str, "os.PathLike[str]", None] = None,
     source: str = "features",
+    light: str = "unknown",
 ) -> Estimates:
     """Estimates the light for chart feature rows, as ``spdcam estimate --features``.
 
@@ -495,7 +516,8 @@ def estimate_features(
     scale, e.g. 0–255), a 1-D array for one row, or a pandas DataFrame whose columns name
     the features. ``names`` are the columns (``p01_r, p01_g, …``); by default the columns of
     the model that reads that many. Returns :class:`Estimates` (arrays over the rows), each
-    row judged as the command line judges it (verdict, reasons, bands, expected GFC).
+    row judged as the command line judges it (verdict, reasons, bands, expected GFC);
+    ``light`` as for :func:`estimate`.
     """
     if names is None and hasattr(features, "columns") and hasattr(features, "to_numpy"):
         names = [str(c) for c in features.columns]
@@ -514,7 +536,7 @@ def estimate_features(
         if len(names) != cols:
             raise SpdcamError(f"{source}: {len(names)} names for {cols} feature columns")
     model_name, wl, spd, xy, cct, duv, judged = _native.estimate_rows(
-        a.tobytes(), rows, _models(model), names, source, range
+        a.tobytes(), rows, _models(model), names, source, range, light
     )
     wavelengths = np.frombuffer(wl, dtype=np.float64)
     return Estimates(

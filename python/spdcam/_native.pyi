@@ -29,6 +29,7 @@ def estimate_photo_json(
     chart: Optional[str] = None,
     corners: Optional[Sequence[tuple[float, float]]] = None,
     range: str = "400-700:5",
+    light: str = "unknown",
 ) -> str:
     """Estimates the light from a photo; the estimate as JSON text."""
 
@@ -39,6 +40,7 @@ def estimate_rows(
     names: Optional[Sequence[str]] = None,
     source: str = "features",
     range: str = "400-700:5",
+    light: str = "unknown",
 ) -> tuple[str, bytes, bytes, bytes, bytes, bytes, str]: ...
 def read_photo(path: str) -> tuple[int, int, int, bytes]: ...
 def library_seconds_photo(path: str, models: Models, repeats: int) -> float: ...

@@ -18,6 +18,7 @@ use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, Layout, THESIS_PATCH_PX};
 use spdcam_core::dataset::randomise::RandomiseRequest;
 use spdcam_core::dataset::{GenerateEvent, GenerateOptions, GenerateRequest, Pipeline};
+use spdcam_core::light_families::LightKind;
 use spdcam_core::photo::{load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
@@ -59,10 +60,15 @@ impl Models {
         })
     }
 
-    /// The estimator on the grid `range` names (the models shared).
-    fn on(&self, range: &str) -> PyResult<Estimator> {
+    /// The estimator on the grid `range` names (the models shared), told the kind of light
+    /// `light` names (`unknown`: none).
+    fn on(&self, range: &str, light: &str) -> PyResult<Estimator> {
         let grid = Grid::parse(range).map_err(py_err)?;
-        self.estimator.on_grid(grid).map_err(py_err)
+        let kind = LightKind::parse(light).map_err(py_err)?;
+        self.estimator
+            .on_grid(grid)
+            .and_then(|e| e.for_light(kind))
+            .map_err(py_err)
     }
 }
 
@@ -123,7 +129,7 @@ enum PhotoInput<'py> {
 /// `(pixels, width, height, bits)` of RGB pixels; `source` names in-memory photos in
 /// messages. The result as JSON text.
 #[pyfunction]
-#[pyo3(signature = (photo, source, models, chart=None, corners=None, range="400-700:5"))]
+#[pyo3(signature = (photo, source, models, chart=None, corners=None, range="400-700:5", light="unknown"))]
 fn estimate_photo_json(
     py: Python<'_>,
     photo: PhotoInput<'_>,
@@ -132,8 +138,9 @@ fn estimate_photo_json(
     chart: Option<String>,
     corners: Option<Vec<[f64; 2]>>,
     range: &str,
+    light: &str,
 ) -> PyResult<String> {
-    let estimator = models.on(range)?;
+    let estimator = models.on(range, light)?;
     let options = PhotoOptions {
         chart,
         corners,
@@ -231,7 +238,8 @@ fn judgements_json(estimates: &[Estimate]) -> PyResult<String> {
 /// judges it: `values` native-endian `f64` bytes of `rows` rows, one column per name of
 /// `names` (default: the columns of the model that reads that many).
 #[pyfunction]
-#[pyo3(signature = (values, rows, models, names=None, source="features", range="400-700:5"))]
+#[pyo3(signature = (values, rows, models, names=None, source="features", range="400-700:5", light="unknown"))]
+#[allow(clippy::too_many_arguments)]
 fn estimate_rows<'py>(
     py: Python<'py>,
     values: &[u8],
@@ -240,8 +248,9 @@ fn estimate_rows<'py>(
     names: Option<Vec<String>>,
     source: &str,
     range: &str,
+    light: &str,
 ) -> PyResult<RowsResult<'py>> {
-    let estimator = models.on(range)?;
+    let estimator = models.on(range, light)?;
     let features = feature_rows(values, rows, estimator.models(), names, source)?;
     let estimates = py
         .allow_threads(|| estimator.estimate_rows(&features, source))

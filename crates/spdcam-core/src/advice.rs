@@ -125,6 +125,12 @@ pub enum Advice {
         /// The level below which a match is poor.
         level: f64,
     },
+    /// The kind of light named does not fit the photo: the model's estimate lies farther
+    /// from every light of the kind than nearly all photos of the kind do.
+    UnlikeKind {
+        /// The kind, as a noun ([`crate::light_families::LightKind::label`]).
+        kind: String,
+    },
     /// The expected goodness of fit of the shape is low.
     LowGfc {
         /// The expected GFC.
@@ -157,6 +163,7 @@ impl Advice {
             Advice::Ambiguous => "ambiguous",
             Advice::LowGfc { .. } => "low_gfc",
             Advice::MayBePoor { .. } => "may_be_poor",
+            Advice::UnlikeKind { .. } => "unlike_kind",
         }
     }
 }
@@ -307,6 +314,12 @@ impl fmt::Display for Advice {
                  twenty like this one has a GFC below {at_least:.2} ({level:.2} or less is a \
                  poor match): take it as a rough guide, or retake the photo with the chart \
                  larger, evenly lit and out of glare"
+            ),
+            Advice::UnlikeKind { kind } => write!(
+                f,
+                "the light in this photo does not look like {kind}, the kind of light named: \
+                 the estimate was kept among such lights anyway and may be far off; check \
+                 what lights the room, or name no kind"
             ),
             Advice::LowGfc { expected, level } => write!(
                 f,

@@ -164,14 +164,35 @@ pub fn held_out_cameras(
     dir: Option<&Path>,
     data_dir: &DataDir,
 ) -> Result<HeldOutCameras> {
+    split_cameras(&split.cameras.held_out, "held-out", dir, data_dir)
+}
+
+/// The split's training cameras, read as [`held_out_cameras`] reads the held-out ones: what
+/// a model's own calibrations (light-kind priors) photograph with, so that the held-out
+/// cameras stay unseen.
+pub fn training_cameras(
+    split: &ValidationSplit,
+    dir: Option<&Path>,
+    data_dir: &DataDir,
+) -> Result<HeldOutCameras> {
+    split_cameras(&split.cameras.training, "training", dir, data_dir)
+}
+
+/// The cameras `names` (the split's `part` cameras) read from `dir`.
+fn split_cameras(
+    names: &[String],
+    part: &str,
+    dir: Option<&Path>,
+    data_dir: &DataDir,
+) -> Result<HeldOutCameras> {
     let dir = in_data_dir(dir, "cameras", data_dir)?;
     let available = camera_names(&dir)?;
     let mut cameras: Vec<Sensitivities> = Vec::new();
     let mut skipped = Vec::new();
-    for name in &split.cameras.held_out {
+    for name in names {
         if !available.contains(name) {
             return Err(EvalError::invalid(format!(
-                "held-out camera '{name}' is not in {}",
+                "{part} camera '{name}' is not in {}",
                 dir.display()
             )));
         }
@@ -185,9 +206,9 @@ pub fn held_out_cameras(
         }
     }
     if cameras.is_empty() {
-        return Err(EvalError::invalid(
-            "none of the split's held-out cameras could be read",
-        ));
+        return Err(EvalError::invalid(format!(
+            "none of the split's {part} cameras could be read"
+        )));
     }
     Ok(HeldOutCameras { cameras, skipped })
 }

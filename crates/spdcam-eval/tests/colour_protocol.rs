@@ -69,6 +69,8 @@ fn one_camera_a_few_photos() {
         },
         reference_photos: 1,
         patch_photos: 2,
+        light_named: false,
+        light_priors: Vec::new(),
     };
     let report = ColourReport::measure(&options, &data, &mut |_| {}).unwrap();
     assert_eq!(report.cameras, 1);

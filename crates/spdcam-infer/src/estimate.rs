@@ -13,6 +13,7 @@ use crate::error::{InferError, Result};
 use crate::trust::Trust;
 use serde::Serialize;
 use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
+use spdcam_core::light_families::LightKind;
 use spdcam_core::photo::PhotoAnalysis;
 use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::Spd;
@@ -126,6 +127,9 @@ pub struct Estimate {
     pub name: String,
     /// The model that made it.
     pub model: String,
+    /// The kind of light the estimate was told of ([`crate::kind_prior`]); `Unknown` when
+    /// none was named.
+    pub light: LightKind,
     /// The relative SPD, peak 1, on the estimator's wavelengths.
     pub spd: Spd,
     /// xy, CCT, Duv of the model's whole estimate (on the model's wavelengths, whatever
@@ -148,7 +152,8 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// The estimate as JSON: `name`, `model`, `wavelength_nm`, `spd`, `colorimetry`,
+    /// The estimate as JSON: `name`, `model`, `light` (the kind of light named, when one
+    /// was), `wavelength_nm`, `spd`, `colorimetry`,
     /// `metrics` (every [`LightingMetrics`] key), `truth`, and for photos `photo` (chart, method, confidence, corners, homography, features and
     /// `features_by_name`, every patch with its statistics and flags, warnings). Judged
     /// estimates add `verdict`, `reasons`, `self_check` ({mean, worst, worst_patches} or
@@ -169,6 +174,9 @@ impl Estimate {
             "metrics": self.metrics,
             "truth": self.truth,
         });
+        if self.light != LightKind::Unknown {
+            v["light"] = serde_json::json!(self.light);
+        }
         if let Some(a) = &self.photo {
             v["photo"] = analysis_json(a)?;
         }

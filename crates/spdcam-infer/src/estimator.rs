@@ -20,16 +20,19 @@ use crate::absolute::absolute_level;
 use crate::error::{InferError, Result};
 use crate::estimate::{Colorimetry, Estimate};
 use crate::feature_rows::FeatureRows;
+use crate::kind_prior::{self, KindPriors};
 use crate::photo_options::{chart_templates, PhotoOptions};
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
 use crate::trust::{
     self, feature_scale, ChartCheck, ChartIdentity, Identity, PhotoFlags, Trust, TrustCalibration,
+    Verdict,
 };
 use rayon::prelude::*;
-use spdcam_core::advice::Sampled;
+use spdcam_core::advice::{Advice, Sampled};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
+use spdcam_core::light_families::LightKind;
 use spdcam_core::photo::{
     self, analysis_overlay_jpeg, debug_paths, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis,
 };
@@ -98,6 +101,10 @@ pub struct Estimator {
     grid: Grid,
     /// Per model of the set, in order.
     on_grid: Vec<OnGrid>,
+    /// Per model of the set, in order: its light-kind priors, if it has any.
+    priors: Arc<Vec<Option<KindPriors>>>,
+    /// The kind of light the estimates are told of.
+    light: LightKind,
 }
 
 impl Estimator {
@@ -127,6 +134,11 @@ impl Estimator {
                 Some(Arc::new(chart))
             })
             .collect();
+        let priors = models
+            .models()
+            .iter()
+            .map(|m| kind_prior::priors_for(&m.model))
+            .collect::<Result<Vec<_>>>()?;
         let prepared = Arc::new(Prepared {
             models,
             trust,
@@ -134,7 +146,7 @@ impl Estimator {
             charts,
             data_dir,
         });
-        Estimator::with(prepared, grid)
+        Estimator::with(prepared, Arc::new(priors), LightKind::Unknown, grid)
     }
 
     /// The estimator of the shipped models (see [`ModelSet::shipped`]).
@@ -145,7 +157,12 @@ impl Estimator {
     /// The estimator of `prepared` on the output grid `grid`, which must hold two or more
     /// wavelengths within one model's at least (an SPD is not one wavelength's value, and
     /// no model says anything outside its own range).
-    fn with(prepared: Arc<Prepared>, grid: Grid) -> Result<Estimator> {
+    fn with(
+        prepared: Arc<Prepared>,
+        priors: Arc<Vec<Option<KindPriors>>>,
+        light: LightKind,
+        grid: Grid,
+    ) -> Result<Estimator> {
         if grid.count < 2 {
             return Err(InferError::invalid(format!(
                 "the range {}: a single wavelength is not a spectrum; give START-END[:STEP] \
@@ -173,6 +190,8 @@ impl Estimator {
             prepared,
             grid,
             on_grid,
+            priors,
+            light,
         })
     }
 
@@ -193,7 +212,102 @@ impl Estimator {
         if grid == self.grid {
             return Ok(self.clone());
         }
-        Estimator::with(self.prepared.clone(), grid)
+        Estimator::with(self.prepared.clone(), self.priors.clone(), self.light, grid)
+    }
+
+    /// The same models told that the light is of `kind` ([`crate::kind_prior`]): each
+    /// estimate is moved to the lights of that kind. Every model of the set must hold a
+    /// prior for it; `LightKind::Unknown` (the default) leaves the estimates as the models
+    /// make them.
+    ///
+    /// ```
+    /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::light_families::LightKind;
+    /// use spdcam_core::spectral::Grid;
+    /// use spdcam_infer::Estimator;
+    ///
+    /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
+    /// assert!(estimator.light_kinds().contains(&LightKind::Daylight));
+    /// let daylight = estimator.for_light(LightKind::Daylight)?;
+    /// assert_eq!(daylight.light(), LightKind::Daylight);
+    /// # Ok::<(), spdcam_infer::InferError>(())
+    /// ```
+    pub fn for_light(&self, kind: LightKind) -> Result<Estimator> {
+        if kind != LightKind::Unknown {
+            for (m, priors) in self.prepared.models.models().iter().zip(self.priors.iter()) {
+                if priors.as_ref().and_then(|p| p.prior(kind)).is_none() {
+                    return Err(InferError::invalid(format!(
+                        "the model {} cannot be told the kind of light ('{}'): it carries no \
+                         prior for it; the kinds it knows: {}",
+                        m.name,
+                        kind.name(),
+                        kind_names(priors.as_ref())
+                    )));
+                }
+            }
+        }
+        let mut out = self.clone();
+        out.light = kind;
+        Ok(out)
+    }
+
+    /// The same models with light-kind priors of their own (`spdcam light-kinds fit`), each
+    /// given to the model whose fingerprint it names, in place of any built in.
+    pub fn with_priors(&self, given: Vec<KindPriors>) -> Result<Estimator> {
+        let mut priors: Vec<Option<KindPriors>> = self.priors.as_ref().clone();
+        for p in given {
+            let index = self
+                .prepared
+                .models
+                .models()
+                .iter()
+                .position(|m| m.model.fingerprint() == p.model)
+                .ok_or_else(|| {
+                    InferError::invalid(format!(
+                        "light-kind priors for the model {}: no model of the set is it",
+                        p.model
+                    ))
+                })?;
+            priors[index] = Some(p);
+        }
+        let mut out = self.clone();
+        out.priors = Arc::new(priors);
+        Ok(out)
+    }
+
+    /// The kind of light the estimates are told of.
+    pub fn light(&self) -> LightKind {
+        self.light
+    }
+
+    /// The kinds of light every model of the set can be told of, `Unknown` first.
+    pub fn light_kinds(&self) -> Vec<LightKind> {
+        LightKind::ALL
+            .into_iter()
+            .filter(|&k| {
+                k == LightKind::Unknown
+                    || self
+                        .priors
+                        .iter()
+                        .all(|p| p.as_ref().and_then(|p| p.prior(k)).is_some())
+            })
+            .collect()
+    }
+
+    /// The model's SPDs `spds` (row-major on its grid) moved to the kind of light named.
+    fn told_of_light(&self, index: usize, spds: Vec<f64>) -> Result<Vec<f64>> {
+        if self.light == LightKind::Unknown {
+            return Ok(spds);
+        }
+        let priors = self.priors[index]
+            .as_ref()
+            .ok_or_else(|| InferError::invalid("the model carries no light-kind priors"))?;
+        let d = self.named(index).model.grid().count;
+        let moved = spds
+            .par_chunks(d)
+            .map(|spd| priors.apply(self.light, spd))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(moved.concat())
     }
 
     /// The wavelengths of the estimates.
@@ -691,7 +805,7 @@ impl Estimator {
             0,
             features.rows > 1,
         )?;
-        model.estimate_rows(&features.values)
+        self.told_of_light(index, model.estimate_rows(&features.values)?)
     }
 
     /// THE constructor of every estimate: the model's SPD `model_spd` (on its grid, peak 1)
@@ -718,6 +832,7 @@ impl Estimator {
             flags,
         )?;
         self.bands_on_grid(&mut trust, map)?;
+        self.check_kind(index, row, &mut trust)?;
         // The colorimetry, the metrics and the absolute level are of the model's whole
         // estimate, whatever part of it the output grid shows.
         let full = Spd::new(chosen.model.grid(), model_spd.clone())?;
@@ -746,6 +861,7 @@ impl Estimator {
         Ok(Estimate {
             name,
             model: chosen.name.clone(),
+            light: self.light,
             colorimetry: Colorimetry::of(&full)?,
             metrics,
             spd,
@@ -754,6 +870,28 @@ impl Estimator {
             trust: Some(trust),
             absolute,
         })
+    }
+
+    /// With a kind of light named: whether the model's own estimate for `row` lies among the
+    /// kind's lights; when it does not, `trust` says so and is at best doubtful.
+    fn check_kind(&self, index: usize, row: &[f64], trust: &mut Trust) -> Result<()> {
+        let Some(priors) = self.priors[index].as_ref() else {
+            return Ok(());
+        };
+        if self.light == LightKind::Unknown {
+            return Ok(());
+        }
+        let own = self.named(index).model.estimate_rows(row)?;
+        if priors.unlike(self.light, &own)? {
+            let advice = Advice::UnlikeKind {
+                kind: self.light.label().to_string(),
+            };
+            trust.reasons.push(advice.to_string());
+            if trust.verdict == Verdict::Ok {
+                trust.verdict = Verdict::Doubtful;
+            }
+        }
+        Ok(())
     }
 
     /// The bands of `trust` taken from the model's wavelengths to the output's by `map`,
@@ -783,6 +921,18 @@ impl Estimator {
 
 /// The picture of the chart found on `photo` (as `--debug` draws it), `width` pixels wide,
 /// as JPEG.
+/// `daylight, fluorescent`: the kinds `priors` hold, or `none`.
+fn kind_names(priors: Option<&KindPriors>) -> String {
+    let names: Vec<&str> = priors
+        .map(|p| p.kinds.iter().map(|k| k.kind.name()).collect())
+        .unwrap_or_default();
+    if names.is_empty() {
+        "none".to_string()
+    } else {
+        names.join(", ")
+    }
+}
+
 fn overlay_of(
     photo: &Photo,
     templates: &[ChartTemplate],
@@ -947,11 +1097,13 @@ impl RowStream<'_> {
         };
         let names = self.stream.names();
         check_feature_rows(&block.values, names, &self.source, block.first_row, true)?;
-        let model_spds = self
-            .estimator
-            .named(self.index)
-            .model
-            .estimate_rows(&block.values)?;
+        let model_spds = self.estimator.told_of_light(
+            self.index,
+            self.estimator
+                .named(self.index)
+                .model
+                .estimate_rows(&block.values)?,
+        )?;
         self.estimator.require_chart_rows(
             self.index,
             &block.values,

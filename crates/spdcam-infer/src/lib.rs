@@ -71,6 +71,7 @@ pub mod error;
 pub mod estimate;
 pub mod estimator;
 pub mod feature_rows;
+pub mod kind_prior;
 pub mod meter;
 pub mod model;
 pub mod network;

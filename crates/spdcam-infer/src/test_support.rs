@@ -15,6 +15,7 @@ pub(crate) fn estimate_of(spd: Spd, halves: &[(&str, f64)]) -> Estimate {
     Estimate {
         name: "test".into(),
         model: "test model".into(),
+        light: Default::default(),
         colorimetry: Colorimetry::of(&spd).unwrap(),
         metrics: LightingMetrics::from_samples(&spd.grid().wavelengths(), &spd),
         truth: None,

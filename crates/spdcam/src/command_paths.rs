@@ -63,6 +63,7 @@ const OUTPUTS: &[(&str, &str, Output)] = &[
     ("coverage", "per_lamp", Output::File),
     ("lamps split", "output", Output::File),
     ("lamps fit", "output", Output::File),
+    ("light-kinds fit", "output", Output::File),
     ("lamps validate", "output", Output::File),
     ("trust calibrate", "output", Output::AddsFilesTo),
     ("trust report", "output", Output::File),

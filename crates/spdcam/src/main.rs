@@ -21,6 +21,7 @@ mod experiment;
 mod finetune;
 mod generate;
 mod lamps;
+mod light_kinds;
 mod list;
 mod messages;
 mod metrics;
@@ -92,6 +93,8 @@ enum Command {
     Coverage(Box<coverage::CoverageArgs>),
     /// Real lamps: the validation split, the lamp-family fits, the validation protocol.
     Lamps(lamps::LampsArgs),
+    /// The kinds of light `estimate --light` takes, and each model's priors for them.
+    LightKinds(light_kinds::LightKindsArgs),
     /// Calibrate and measure how far estimates can be trusted (bands, verdicts).
     Trust(trust::TrustArgs),
 }
@@ -154,6 +157,7 @@ fn main() -> ExitCode {
         Command::Serve(args) => serve::run(args, &data_dir),
         Command::Coverage(args) => coverage::run(*args, &data_dir),
         Command::Lamps(args) => lamps::run(args, &data_dir),
+        Command::LightKinds(args) => light_kinds::run(args, &data_dir),
         Command::Trust(args) => trust::run(args, &data_dir),
     };
     match result {

@@ -5,7 +5,7 @@ use crate::error::Result;
 use crate::held_out::GRID;
 use spdcam_core::cie_illuminant::{daylight, planck, StandardIlluminant};
 use spdcam_core::light_families::validation_split::LampPart;
-use spdcam_core::light_families::{LampLibrary, LampType, ValidationSplit};
+use spdcam_core::light_families::{LampLibrary, LampType, LightKind, ValidationSplit};
 use spdcam_core::spectral::Spd;
 
 /// Which set a light belongs to.
@@ -42,6 +42,8 @@ pub struct Light {
     pub set: LightSet,
     /// The lamp's type; `None` for a reference.
     pub kind: Option<LampType>,
+    /// The kind of light a person who knows it would name.
+    pub light_kind: LightKind,
     /// The SPD on the simulation grid, peak 1: what the camera sees and what the truth is.
     pub spd: Spd,
 }
@@ -52,25 +54,34 @@ pub struct Light {
 /// photos under, from the program's own illuminant code.
 pub fn references() -> Result<Vec<Light>> {
     let mut out = Vec::new();
-    for s in [
-        StandardIlluminant::A,
-        StandardIlluminant::D50,
-        StandardIlluminant::D65,
+    for (s, kind) in [
+        (StandardIlluminant::A, LightKind::Incandescent),
+        (StandardIlluminant::D50, LightKind::Daylight),
+        (StandardIlluminant::D65, LightKind::Daylight),
     ] {
-        out.push((format!("CIE {}", s.name()), s.spd(&GRID)?));
+        out.push((format!("CIE {}", s.name()), s.spd(&GRID)?, kind));
     }
     for t in [2700.0, 3000.0, 4000.0] {
-        out.push((format!("Planckian {t} K"), planck(t, &GRID)?));
+        out.push((
+            format!("Planckian {t} K"),
+            planck(t, &GRID)?,
+            LightKind::Incandescent,
+        ));
     }
     for t in [5000.0, 6500.0] {
-        out.push((format!("CIE daylight {t} K"), daylight(t, &GRID)?));
+        out.push((
+            format!("CIE daylight {t} K"),
+            daylight(t, &GRID)?,
+            LightKind::Daylight,
+        ));
     }
     Ok(out
         .into_iter()
-        .map(|(name, spd)| Light {
+        .map(|(name, spd, light_kind)| Light {
             name,
             set: LightSet::References,
             kind: None,
+            light_kind,
             spd: spd.normalised_by_max(),
         })
         .collect())
@@ -90,6 +101,7 @@ pub fn lights(library: &LampLibrary, split: &ValidationSplit, set: LightSet) -> 
             name: library.names[i].clone(),
             set,
             kind: Some(library.types[i]),
+            light_kind: LightKind::of_lamp_type(library.types[i]).unwrap_or_default(),
             spd: library.spds[i].normalised_by_max(),
         })
         .collect())

@@ -29,13 +29,14 @@ use crate::error::{EvalError, Result};
 use crate::held_out::{HeldOutPhotos, SkippedCamera, GRID};
 use crate::lamp_validation::average_spd;
 use lights::{Light, LightSet};
-use photos::{PhotoScore, Scored, Shoot};
+use photos::{EstimatorFor, PhotoScore, Scored, Shoot};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::light_families::LampType;
 use spdcam_core::seed;
 use spdcam_core::spectral::{Grid, Spd};
+use spdcam_infer::kind_prior::KindPriors;
 use spdcam_infer::{Estimator, ModelSet};
 use std::path::PathBuf;
 
@@ -48,6 +49,12 @@ pub struct ColourOptions {
     pub reference_photos: u64,
     /// Patch-level photos of each light.
     pub patch_photos: u64,
+    /// Also measure each model told each light's kind (`estimate --light`), on the same
+    /// photos.
+    pub light_named: bool,
+    /// Light-kind priors (`spdcam light-kinds fit`) for models without built-in ones, each
+    /// used for the model whose fingerprint it names.
+    pub light_priors: Vec<KindPriors>,
 }
 
 /// What a row of a table groups.
@@ -97,6 +104,8 @@ pub struct ModelColour {
     pub model: PathBuf,
     /// The chart it names.
     pub chart: String,
+    /// Whether it was told each light's kind.
+    pub light_named: bool,
     /// Whether the program holds a trust calibration for it (CCT intervals).
     pub calibrated: bool,
     /// Per group of lights.
@@ -231,21 +240,40 @@ impl ColourReport {
             model.check_features(&chart.feature_names(), &chart_name)?;
             let calibrated = spdcam_infer::trust::calibration_for(&model)?.is_some();
             let name = crate::held_out::file_name(&path);
+            let fingerprint = model.fingerprint();
             let estimator = Estimator::new(
                 ModelSet::single(model.clone(), name.clone()),
                 data_dir.clone(),
                 model.grid(),
+            )?
+            .with_priors(
+                options
+                    .light_priors
+                    .iter()
+                    .filter(|p| p.model == fingerprint)
+                    .cloned()
+                    .collect(),
             )?;
-            progress(&format!("{name}: scene photos"));
-            let a = scenes.scenes(&estimator, &chart_name, data_dir)?;
-            progress(&format!("{name}: patch-level photos"));
-            let b = patches.patches(&estimator, &chart)?;
-            models.push(ModelColour {
-                model: path,
-                chart: chart_name,
-                calibrated,
-                rows: rows(&groups, &lights, [&a, &b])?,
-            });
+            let same = |_: &Light| Ok(estimator.clone());
+            let told = |l: &Light| Ok(estimator.for_light(l.light_kind)?);
+            let ways: [(&EstimatorFor<'_>, bool); 2] = [(&same, false), (&told, true)];
+            for (estimator_for, light_named) in ways {
+                if light_named && !options.light_named {
+                    continue;
+                }
+                let told = if light_named { ", told the kind" } else { "" };
+                progress(&format!("{name}{told}: scene photos"));
+                let a = scenes.scenes(estimator_for, &chart_name, data_dir)?;
+                progress(&format!("{name}{told}: patch-level photos"));
+                let b = patches.patches(estimator_for, &chart)?;
+                models.push(ModelColour {
+                    model: path.clone(),
+                    chart: chart_name.clone(),
+                    light_named,
+                    calibrated,
+                    rows: rows(&groups, &lights, [&a, &b])?,
+                });
+            }
         }
         let fit = setup
             .library

@@ -86,6 +86,10 @@ pub struct Shoot<'a> {
     pub seed: u64,
 }
 
+/// The estimator a light's photos are estimated by (the same for every light, or one told
+/// the light's kind).
+pub type EstimatorFor<'a> = dyn Fn(&Light) -> Result<Estimator> + Sync + 'a;
+
 impl Shoot<'_> {
     /// The light of every photo, in order: each light as many times as it is photographed.
     fn jobs(&self) -> Vec<usize> {
@@ -98,10 +102,11 @@ impl Shoot<'_> {
 
     /// (a): each light photographed in a cluttered scene by a held-out camera (each camera
     /// in turn) with the default camera stage, then found, sampled and estimated by
-    /// `estimator` like a user's photo of `model_chart`; in parallel, the same for a seed.
+    /// the estimator `estimator_for` gives for the light, like a user's photo of
+    /// `model_chart`; in parallel, the same for a seed.
     pub fn scenes(
         &self,
-        estimator: &Estimator,
+        estimator_for: &EstimatorFor<'_>,
         model_chart: &str,
         data_dir: &DataDir,
     ) -> Result<Vec<PhotoScore>> {
@@ -133,6 +138,7 @@ impl Shoot<'_> {
                     shot_seed,
                     &scene_options,
                 )?;
+                let estimator = estimator_for(light)?;
                 let estimate =
                     match estimator.estimate_photo_bytes(&shot.jpeg, "scene.jpg", &options) {
                         Ok(e) => Some(Scored::of(&e, light)?),
@@ -145,8 +151,13 @@ impl Shoot<'_> {
 
     /// (b): each light through a held-out camera with the randomised in-camera stage
     /// (exposure, white balance, tone, JPEG, gradient; `lamps validate`'s (a)), patch level
-    /// on `chart`, estimated by `estimator` as feature rows.
-    pub fn patches(&self, estimator: &Estimator, chart: &Chart) -> Result<Vec<PhotoScore>> {
+    /// on `chart`, estimated as feature rows by the estimator `estimator_for` gives for each
+    /// light (in parallel, a photo at a time).
+    pub fn patches(
+        &self,
+        estimator_for: &EstimatorFor<'_>,
+        chart: &Chart,
+    ) -> Result<Vec<PhotoScore>> {
         let randomisation = randomised_cameras(self.cameras, self.seed, chart)?;
         let names = chart.feature_names();
         let jobs = self.jobs();
@@ -159,22 +170,21 @@ impl Shoot<'_> {
             camera.features_fast_with(ic.as_ref(), &light, &mut raw, &mut out);
             values.extend(out.iter().map(|&v| f64::from(v)));
         }
-        let rows = FeatureRows::from_values(names, values, "the patch-level photos")?;
-        let estimates = estimator.estimate_rows(&rows, "the patch-level photos")?;
-        if estimates.len() != jobs.len() {
-            return Err(EvalError::invalid(format!(
-                "{} estimates for {} patch-level photos",
-                estimates.len(),
-                jobs.len()
-            )));
-        }
-        estimates
-            .par_iter()
+        let width = names.len();
+        values
+            .par_chunks(width)
             .zip(jobs)
-            .map(|(e, j)| {
+            .map(|(row, j)| {
+                let light = &self.lights[j].0;
+                let rows = FeatureRows::from_values(names.clone(), row.to_vec(), "a photo")?;
+                let estimates =
+                    estimator_for(light)?.estimate_rows(&rows, "a patch-level photo")?;
+                let e = estimates
+                    .first()
+                    .ok_or_else(|| EvalError::invalid("no estimate for a patch-level photo"))?;
                 Ok(PhotoScore {
                     light: j,
-                    estimate: Some(Scored::of(e, &self.lights[j].0)?),
+                    estimate: Some(Scored::of(e, light)?),
                 })
             })
             .collect()

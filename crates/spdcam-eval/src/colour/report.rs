@@ -2,7 +2,7 @@
 //! model and for the baselines a row per lamp type or reference, and the protocol in words.
 
 use super::lights::LightSet;
-use super::{ColourReport, Group, Row, Summary, CCT_MAX_DUV};
+use super::{ColourReport, Group, ModelColour, Row, Summary, CCT_MAX_DUV};
 use crate::held_out::file_name;
 use spdcam_core::light_families::LampType;
 use spdcam_core::spectral::Grid;
@@ -72,6 +72,18 @@ fn group_label(group: &Group) -> String {
     }
 }
 
+impl ModelColour {
+    /// `` `model.spdm` ``, or `` `model.spdm` told the kind of light ``.
+    fn label(&self) -> String {
+        let told = if self.light_named {
+            " told the kind of light"
+        } else {
+            ""
+        };
+        format!("`{}`{told}", file_name(&self.model))
+    }
+}
+
 impl ColourReport {
     /// The results as the Markdown `spdcam experiment colour` writes.
     pub fn markdown(&self) -> String {
@@ -89,8 +101,8 @@ impl ColourReport {
                 for set in LightSet::ALL {
                     if let Some((n, s)) = all(&m.rows, set) {
                         md += &format!(
-                            "| `{}` {path} | {} | {n} | {}\n",
-                            file_name(&m.model),
+                            "| {} {path} | {} | {n} | {}\n",
+                            m.label(),
                             set.label(),
                             cells(&s[k], true)
                         );
@@ -111,7 +123,7 @@ impl ColourReport {
         }
         md.push('\n');
         for m in &self.models {
-            md += &format!("## `{}` ({})\n\n", file_name(&m.model), m.chart);
+            md += &format!("## {} ({})\n\n", m.label(), m.chart);
             md += &format!(
                 "| set | group | lights | kind of photo | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n"
             );

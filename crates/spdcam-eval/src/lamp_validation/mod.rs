@@ -11,6 +11,7 @@
 mod photos;
 
 pub use photos::average_spd;
+pub(crate) use photos::randomised_rows;
 
 use crate::error::Result;
 use crate::held_out::{file_name, in_data_dir, on_grid, HeldOutPhotos, SkippedCamera, GRID};

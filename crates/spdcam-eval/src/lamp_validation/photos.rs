@@ -11,6 +11,7 @@ use spdcam_core::camera::Camera;
 use spdcam_core::chart::Chart;
 use spdcam_core::light_families::LampLibrary;
 use spdcam_core::simple_camera::{Shot, SimpleCamera};
+use spdcam_core::spectral::Spd;
 use spdcam_core::{seed, spectral_error};
 use spdcam_infer::Model;
 
@@ -51,20 +52,36 @@ pub(crate) fn pipeline_photos(
     shots: u64,
     seed: u64,
 ) -> Result<Photos> {
+    let lights: Vec<&Spd> = ids.iter().map(|&i| &library.spds[i]).collect();
+    Ok(Photos {
+        features: randomised_rows(cameras, chart, &lights, shots, seed)?,
+        width: chart.feature_names().len(),
+    })
+}
+
+/// Feature rows (row-major, `lights × shots` rows) of each of `lights` photographed `shots`
+/// times, each by one of `cameras` with the randomised in-camera stage, patch level.
+pub(crate) fn randomised_rows(
+    cameras: &[Sensitivities],
+    chart: &Chart,
+    lights: &[&Spd],
+    shots: u64,
+    seed: u64,
+) -> Result<Vec<f64>> {
     let randomisation = randomised_cameras(cameras, seed, chart)?;
     let width = chart.feature_names().len();
-    let mut features = Vec::with_capacity(ids.len() * shots as usize * width);
+    let mut features = Vec::with_capacity(lights.len() * shots as usize * width);
     let (mut raw, mut out) = (Vec::new(), Vec::new());
-    for (j, &i) in ids.iter().enumerate() {
+    for (j, spd) in lights.iter().enumerate() {
         for k in 0..shots {
             let (camera, ic): (&Camera, _) = randomisation.draw(seed, j as u64 * shots + k);
-            let light = camera.light(&library.spds[i])?;
+            let light = camera.light(spd)?;
             out.clear();
             camera.features_fast_with(ic.as_ref(), &light, &mut raw, &mut out);
             features.extend(out.iter().map(|&v| f64::from(v)));
         }
     }
-    Ok(Photos { features, width })
+    Ok(features)
 }
 
 /// (b): each lamp `shots` times through the simple camera, camera and shot drawn at random.

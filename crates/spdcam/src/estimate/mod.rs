@@ -21,6 +21,7 @@ use photos::{estimate_from_photos, PhotoEstimates};
 use print::{print_estimates, report_item, verdicts_to_stderr, with_bands, write_report};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
+use spdcam_core::light_families::LightKind;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_infer::plot::spds_band_svg;
 use spdcam_infer::trust::Uncertainty;
@@ -78,8 +79,18 @@ pub struct EstimateArgs {
     /// nothing from the network. With --features: the first 20 rows.
     #[arg(long, value_name = "FILE.html")]
     report: Option<PathBuf>,
+    /// What lights the scene, when you know it: daylight, incandescent, fluorescent,
+    /// white-led, hid, rgb-led, luminaire, or unknown (the default: any light). Each estimate
+    /// is then moved to the lights of that kind (`spdcam light-kinds list`).
+    #[arg(long, default_value = "unknown", value_name = "KIND", value_parser = parse_light)]
+    light: LightKind,
     #[command(flatten)]
     photo: PhotoArgs,
+}
+
+/// `--light`: a kind of light by name.
+fn parse_light(text: &str) -> std::result::Result<LightKind, String> {
+    LightKind::parse(text).map_err(|e| e.to_string())
 }
 
 /// `--layout`.
@@ -121,7 +132,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         plot_is_png(plot)?;
     }
     let grid = Grid::parse(&args.range)?;
-    let estimator = estimator(args.model.as_deref(), data_dir, grid)?;
+    let estimator = estimator(args.model.as_deref(), data_dir, grid)?.for_light(args.light)?;
     if let Some(path) = &args.features {
         return run_features(&args, path, &estimator);
     }

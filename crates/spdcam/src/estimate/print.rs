@@ -6,6 +6,7 @@ use super::{EstimateArgs, DETAILED_MAX};
 use crate::outln;
 use anyhow::Result;
 use spdcam_core::fsio;
+use spdcam_core::light_families::LightKind;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_infer::meter::Meter;
 use spdcam_infer::report::{report_html, ReportImage, ReportItem};
@@ -19,7 +20,17 @@ use std::path::Path;
 pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Result<()> {
     let mut models: Vec<&str> = estimates.iter().map(|e| e.model.as_str()).collect();
     models.dedup();
-    outln!("{} estimate(s) with {}", estimates.len(), models.join(", "))?;
+    let told = match estimates.first().map(|e| e.light) {
+        Some(kind) if kind != LightKind::Unknown => {
+            format!(", told the light is {}", kind.describe())
+        }
+        _ => String::new(),
+    };
+    outln!(
+        "{} estimate(s) with {}{told}",
+        estimates.len(),
+        models.join(", ")
+    )?;
     let detailed = estimates.len() <= DETAILED_MAX;
     for e in estimates {
         let unusable = e

@@ -11,6 +11,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
 use spdcam_eval::colour::{ColourOptions, ColourReport};
 use spdcam_eval::held_out::HeldOutPhotos;
+use spdcam_infer::kind_prior::KindPriors;
 use std::path::PathBuf;
 
 /// Options of `spdcam experiment colour`.
@@ -40,6 +41,14 @@ pub(super) struct ColourArgs {
     /// Seed of the photos.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Also measure each model told each light's kind (`estimate --light`: a lamp's kind from
+    /// its type, daylight or incandescent for the references), on the same photos.
+    #[arg(long)]
+    light_named: bool,
+    /// Light-kind priors (`spdcam light-kinds fit`) for models without built-in ones
+    /// (repeatable; each used for the model it was fitted to).
+    #[arg(long, value_name = "PRIORS.json")]
+    light_priors: Vec<PathBuf>,
     /// Output Markdown report.
     #[arg(short, long)]
     output: PathBuf,
@@ -56,12 +65,16 @@ impl ColourArgs {
             self.cameras.as_deref(),
         );
         out += &format!(
-            " --photos {} --reference-photos {reference_photos} --patch-photos {} --seed {} -o {}",
-            self.photos,
-            self.patch_photos,
-            self.seed,
-            self.output.display()
+            " --photos {} --reference-photos {reference_photos} --patch-photos {} --seed {}",
+            self.photos, self.patch_photos, self.seed,
         );
+        if self.light_named {
+            out += " --light-named";
+        }
+        for p in &self.light_priors {
+            out += &format!(" --light-priors {}", p.display());
+        }
+        out += &format!(" -o {}", self.output.display());
         out
     }
 }
@@ -80,6 +93,15 @@ pub(super) fn run(args: ColourArgs, data_dir: &DataDir) -> Result<()> {
         },
         reference_photos,
         patch_photos: args.patch_photos,
+        light_named: args.light_named,
+        light_priors: args
+            .light_priors
+            .iter()
+            .map(|p| {
+                let text = spdcam_core::fsio::read_text(p)?;
+                Ok(KindPriors::from_json(&text, &p.display().to_string())?)
+            })
+            .collect::<Result<_>>()?,
     };
     let started = std::time::Instant::now();
     let report = ColourReport::measure(&options, data_dir, &mut |what| {

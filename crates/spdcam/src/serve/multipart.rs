@@ -1,6 +1,7 @@
 //! Reading an upload form (`multipart/form-data`, RFC 7578) as it streams in, with multer:
 //! the `photo` file with the file name the browser sent (kept as a label, never used as a
-//! path), the `corners` and `chart` texts, each under a size limit; other fields are read and dropped.
+//! path), the `corners`, `chart` and `light` texts, each under a size limit; other fields are
+//! read and dropped.
 //!
 //! This file depends only on multer, bytes and futures-util, so that the fuzz target
 //! `fuzz/fuzz_targets/multipart.rs` compiles it as it is and feeds it what the server would.
@@ -21,6 +22,8 @@ pub struct Form {
     pub corners: Option<String>,
     /// The last `chart` field (the chart the corners belong to), as text.
     pub chart: Option<String>,
+    /// The last `light` field (the kind of light the person named), as text.
+    pub light: Option<String>,
 }
 
 /// The `photo` field of a form.
@@ -110,6 +113,7 @@ where
             }
             "corners" => form.corners = Some(String::from_utf8_lossy(&data).into_owned()),
             "chart" => form.chart = Some(String::from_utf8_lossy(&data).into_owned()),
+            "light" => form.light = Some(String::from_utf8_lossy(&data).into_owned()),
             _ => {}
         }
     }

@@ -8,6 +8,7 @@ use crate::serve::jobs::{Upload, CHARTS};
 use crate::serve::multipart::{self, FormError, Limits};
 use axum::extract::Request;
 use axum::http::header;
+use spdcam_core::light_families::LightKind;
 use std::sync::{Arc, Mutex};
 
 /// `bytes` in megabytes (2²⁰ bytes) for messages: whole from 10 MB, else to 0.1 MB.
@@ -112,6 +113,12 @@ impl Api {
             ),
             _ => None,
         };
+        let light = match form.light.as_deref().map(str::trim) {
+            Some(text) if !text.is_empty() => {
+                LightKind::parse(text).map_err(|e| Answer::error(400, e.to_string()))?
+            }
+            _ => LightKind::Unknown,
+        };
         let Some(photo) = form.photo else {
             return Err(Answer::error(400, "the form has no field 'photo'"));
         };
@@ -124,6 +131,7 @@ impl Api {
             corners,
             memory: held.permit,
             chart,
+            light,
         })
     }
 }

@@ -38,9 +38,11 @@ impl Engine {
             overlay_width: Some(REPORT_IMAGE_WIDTH),
             ..PhotoOptions::default()
         };
-        let estimated = self
-            .estimator
-            .photo_bytes(&upload.bytes, &upload.name, &options);
+        let estimator = match self.estimator.for_light(upload.light) {
+            Ok(e) => e,
+            Err(e) => return failed(400, e.to_string()),
+        };
+        let estimated = estimator.photo_bytes(&upload.bytes, &upload.name, &options);
         drop(upload.bytes);
         drop(upload.memory);
         let overlay = match estimated.analysed {

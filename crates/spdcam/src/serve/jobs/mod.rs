@@ -11,6 +11,7 @@ pub use engine::Engine;
 
 use engine::Estimated;
 use spdcam_core::chart::KnownChart;
+use spdcam_core::light_families::LightKind;
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::Instant;
@@ -35,6 +36,8 @@ pub struct Upload {
     pub memory: Option<OwnedSemaphorePermit>,
     /// The chart, when the client named it (one of [`CHARTS`]).
     pub chart: Option<KnownChart>,
+    /// The kind of light the client named (`Unknown` when none).
+    pub light: LightKind,
 }
 
 /// How a job ended: the estimate's JSON, or an HTTP status and a message.

@@ -50,6 +50,8 @@ function submit(entry, corners, chart) {
     form.append('photo', entry.file, entry.name);
     if (corners) form.append('corners', corners.map((p) => p.map((v) => v.toFixed(2)).join(',')).join(','));
     if (chart) form.append('chart', chart);
+    const light = $('light').value;
+    if (light && light !== 'unknown') form.append('light', light);
     const xhr = new XMLHttpRequest();
     xhr.open('POST', 'api/jobs');
     xhr.responseType = 'json';
@@ -147,6 +149,10 @@ function setupInputs() {
     e.preventDefault();
     drop.classList.remove('over');
     addFiles([...e.dataTransfer.files]);
+  });
+  // Another kind of light named: every photo already estimated is estimated again with it.
+  $('light').addEventListener('change', () => {
+    for (const e of state.entries) if (e.result && !e.busy) run(e, e.corners);
   });
   $('example').addEventListener('click', async () => {
     const blob = await (await fetch('example.jpg')).blob();

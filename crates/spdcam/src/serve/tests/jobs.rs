@@ -119,6 +119,7 @@ fn a_forgotten_job_is_told_from_one_that_never_was() {
         corners: None,
         memory: None,
         chart: None,
+        light: Default::default(),
     };
     let first = jobs.submit(upload()).unwrap();
     let second = jobs.submit(upload()).unwrap();

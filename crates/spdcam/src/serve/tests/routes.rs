@@ -23,6 +23,19 @@ fn the_page_and_its_assets_are_embedded() {
 }
 
 #[test]
+fn the_page_offers_every_kind_of_light_and_no_other() {
+    use spdcam_core::light_families::LightKind;
+    let page = include_str!("../page/index.html");
+    let offered: Vec<&str> = page
+        .split("<option value=\"")
+        .skip(1)
+        .filter_map(|s| s.split('"').next())
+        .collect();
+    let kinds: Vec<&str> = LightKind::ALL.iter().map(|k| k.name()).collect();
+    assert_eq!(offered, kinds);
+}
+
+#[test]
 fn head_answers_like_get_without_a_body() {
     let server = start(16 << 20);
     for path in ["/", "/app.js", "/api/locus"] {
