@@ -10,11 +10,12 @@
 
 use crate::colour::{median, ColourScore};
 use crate::error::{EvalError, Result};
-use crate::held_out::{training_cameras, SkippedCamera, GRID};
+use crate::held_out::{in_data_dir, training_cameras, SkippedCamera, GRID};
 use crate::lamp_validation::randomised_rows;
 use rayon::prelude::*;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
+use spdcam_core::dataset::REAL_PHOTO_SETS;
 use spdcam_core::light_families::{LightKind, Lighting, ValidationSplit};
 use spdcam_core::spectral::{normalise_by_max, Grid, Spd};
 use spdcam_core::{seed, spectral_error};
@@ -57,6 +58,98 @@ pub struct KindCheck {
     pub delta_uv: [f64; 2],
     /// The share of the photos whose estimate is called unlike the kind (1 % expected).
     pub unlike: f64,
+}
+
+/// A real photo set estimated without and with the kind of its light named.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealCheck {
+    /// The set's label.
+    pub set: &'static str,
+    /// The kind of its light.
+    pub kind: LightKind,
+    /// Photos.
+    pub photos: usize,
+    /// Mean GFC, "don't know" then the kind named.
+    pub gfc: [f64; 2],
+    /// Median Δu′v′, the same two.
+    pub delta_uv: [f64; 2],
+    /// The share of the photos whose estimate is called unlike the kind.
+    pub unlike: f64,
+}
+
+/// The kind of light of a real photo set: the Philips Hue lamps are colour-mixing LED lamps,
+/// the Telelumen a multi-channel luminaire.
+fn real_set_kind(label: &str) -> LightKind {
+    if label.contains("Hue") {
+        LightKind::RgbLed
+    } else {
+        LightKind::Luminaire
+    }
+}
+
+/// The real photo sets (`thesis/measured/` of the data directory: the development photos of
+/// the Telelumen/Canon set and the train and validation photos of the others, never their
+/// test photos) estimated by `model` without and with their kind named through `priors`.
+pub fn real_checks(
+    model: &Model,
+    priors: &KindPriors,
+    data_dir: &DataDir,
+) -> Result<Vec<RealCheck>> {
+    let thesis = in_data_dir(None, "thesis", data_dir)?;
+    let grid = model.grid();
+    REAL_PHOTO_SETS
+        .iter()
+        .map(|set| {
+            let photos = set.load(&thesis, &GRID)?;
+            let kind = real_set_kind(set.label);
+            let rows: Vec<f64> = photos.features.iter().flatten().copied().collect();
+            let estimates = model.estimate_rows(&rows)?;
+            let mut gfc = [Vec::new(), Vec::new()];
+            let mut delta_uv = [Vec::new(), Vec::new()];
+            let mut unlike = Vec::new();
+            for (truth, e) in photos.spds.iter().zip(estimates.chunks(grid.count)) {
+                unlike.push(f64::from(u8::from(priors.unlike(kind, e)?)));
+                let truth = truth.resampled(&grid)?.normalised_by_max();
+                for (k, spd) in [e.to_vec(), priors.apply(kind, e)?].into_iter().enumerate() {
+                    gfc[k].push(spectral_error::gfc(truth.values(), &spd)?);
+                    let score = ColourScore::of(&truth, &Spd::new(grid, spd)?)?;
+                    delta_uv[k].push(score.delta_uv_prime);
+                }
+            }
+            let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+            Ok(RealCheck {
+                set: set.label,
+                kind,
+                photos: photos.spds.len(),
+                gfc: [mean(&gfc[0]), mean(&gfc[1])],
+                delta_uv: [median(delta_uv[0].clone()), median(delta_uv[1].clone())],
+                unlike: mean(&unlike),
+            })
+        })
+        .collect()
+}
+
+/// The real sets' checks as a Markdown table.
+pub fn real_markdown(checks: &[RealCheck]) -> String {
+    let mut out = String::from(
+        "| real photo set | kind named | photos | mean GFC: don't know → kind named | \
+         median Δu′v′: don't know → kind named | called unlike the kind |\n\
+         |---|---|---:|---:|---:|---:|\n",
+    );
+    for c in checks {
+        out.push_str(&format!(
+            "| {} | {} | {} | {:.4} → {:.4} | {:.4} → {:.4} | {:.0} % |\n",
+            c.set,
+            c.kind.name(),
+            c.photos,
+            c.gfc[0],
+            c.gfc[1],
+            c.delta_uv[0],
+            c.delta_uv[1],
+            100.0 * c.unlike
+        ));
+    }
+    out
 }
 
 /// The priors made and what their trial measured.

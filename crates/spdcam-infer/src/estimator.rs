@@ -1169,6 +1169,103 @@ mod tests {
         Estimator::shipped(DataDir::new(None), Grid::ESTIMATION).unwrap()
     }
 
+    /// The ColorChecker 24 features of `spd` through the first built-in camera.
+    fn colorchecker24_row(spd: &Spd) -> FeatureRows {
+        use spdcam_core::builtin;
+        use spdcam_core::camera::sensor::Sensitivities;
+        use spdcam_core::camera::{Camera, CameraConfig};
+        let grid = Grid::SIMULATION;
+        let table = &builtin::CAMERAS[0];
+        let sensitivities = Sensitivities::new(table.name, &table.load().unwrap(), &grid).unwrap();
+        let chart = Chart::colorchecker24(&grid).unwrap();
+        let names = chart.feature_names();
+        let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid).unwrap();
+        let (mut raw, mut row) = (Vec::new(), Vec::new());
+        camera.features_fast(&camera.light(spd).unwrap(), &mut raw, &mut row);
+        let values = row.iter().map(|&v| f64::from(v)).collect();
+        FeatureRows::from_values(names, values, "rendered").unwrap()
+    }
+
+    #[test]
+    fn told_the_kind_an_estimate_keeps_to_such_lights_and_a_wrong_kind_is_named() {
+        use spdcam_core::cie_illuminant::{planck, StandardIlluminant};
+        let estimator = shipped();
+        let a = StandardIlluminant::A.spd(&Grid::SIMULATION).unwrap();
+        let truth = planck(2856.0, &Grid::ESTIMATION).unwrap();
+        let row = colorchecker24_row(&a);
+        let gfc = |e: &Estimate| {
+            spdcam_core::spectral_error::gfc(truth.values(), e.spd.values()).unwrap()
+        };
+        let plain = &estimator.estimate_rows(&row, "A").unwrap()[0];
+        let told = estimator.for_light(LightKind::Incandescent).unwrap();
+        let incandescent = &told.estimate_rows(&row, "A").unwrap()[0];
+        assert_eq!(
+            (plain.light, incandescent.light),
+            (LightKind::Unknown, LightKind::Incandescent)
+        );
+        assert!(
+            gfc(incandescent) > gfc(plain).max(0.995),
+            "told {} against {}",
+            gfc(incandescent),
+            gfc(plain)
+        );
+        let json = incandescent.to_json().unwrap();
+        assert_eq!(json["light"], "incandescent");
+        assert!(plain.to_json().unwrap().get("light").is_none());
+        let said = |e: &Estimate| e.trust.as_ref().unwrap().reasons.join(" ");
+        assert!(!said(incandescent).contains("does not look like"));
+        // Told the light is a colour-mixing LED lamp, the filament's photo is named unlike it
+        // and never ok.
+        let rgb = &estimator
+            .for_light(LightKind::RgbLed)
+            .unwrap()
+            .estimate_rows(&row, "A")
+            .unwrap()[0];
+        assert!(
+            said(rgb).contains("does not look like colour-mixing LED light"),
+            "{}",
+            said(rgb)
+        );
+        assert_ne!(rgb.trust.as_ref().unwrap().verdict, Verdict::Ok);
+        // A kind is carried to other grids, and every shipped model knows every kind.
+        assert_eq!(
+            told.on_grid(Grid::parse("420-680:20").unwrap())
+                .unwrap()
+                .light(),
+            LightKind::Incandescent
+        );
+        assert_eq!(estimator.light_kinds(), LightKind::ALL);
+    }
+
+    #[test]
+    fn a_model_without_priors_cannot_be_told_the_kind() {
+        let shipped = ModelSet::shipped().unwrap();
+        let model = shipped.models()[0].model.clone();
+        let estimator = Estimator::new(
+            ModelSet::single(model.clone(), "mine.spdm".to_string()),
+            DataDir::new(None),
+            Grid::ESTIMATION,
+        )
+        .unwrap()
+        .with_priors(Vec::new())
+        .unwrap();
+        // The shipped model keeps its built-in priors; priors of another model are refused.
+        assert!(estimator.for_light(LightKind::Daylight).is_ok());
+        let mut other = kind_prior::priors_for(&model).unwrap().unwrap();
+        other.model = "another model".into();
+        let err = estimator.with_priors(vec![other]).err().unwrap();
+        assert!(err.to_string().contains("no model of the set"), "{err}");
+        let mut bare = estimator.clone();
+        bare.priors = Arc::new(vec![None]);
+        let err = bare.for_light(LightKind::Daylight).err().unwrap();
+        assert!(
+            err.to_string().contains("mine.spdm") && err.to_string().contains("none"),
+            "{err}"
+        );
+        assert_eq!(bare.light_kinds(), [LightKind::Unknown]);
+        assert!(bare.for_light(LightKind::Unknown).is_ok());
+    }
+
     #[test]
     fn a_photo_its_bytes_its_pixels_and_its_row_give_one_estimate() {
         let estimator = shipped();

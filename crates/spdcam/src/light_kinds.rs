@@ -5,9 +5,11 @@
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use spdcam_core::builtin::DataDir;
+use spdcam_core::chart::KnownChart;
 use spdcam_core::fsio;
 use spdcam_core::light_families::LightKind;
-use spdcam_eval::light_kinds::{KindFit, KindFitOptions};
+use spdcam_eval::light_kinds::{real_checks, real_markdown, KindFit, KindFitOptions};
+use spdcam_infer::Model;
 use std::path::PathBuf;
 
 /// Options of `spdcam light-kinds`.
@@ -88,9 +90,17 @@ fn fit(args: FitArgs, data_dir: &DataDir) -> Result<()> {
     fsio::write_atomic(&args.output, fit.priors.to_json()?.as_bytes())?;
     println!(
         "Each kind's prior fitted on half its photos, tried on the other half (training \
-         cameras, in distribution):\n\n{}\nwrote {}",
-        fit.markdown(),
-        args.output.display()
+         cameras, in distribution):\n\n{}",
+        fit.markdown()
     );
+    let model = Model::load(&options.model)?;
+    if model.header().chart.as_deref() == Some(KnownChart::Sg96.name()) {
+        let checks = real_checks(&model, &fit.priors, data_dir)?;
+        println!(
+            "The real photo sets (outside their test photos):\n\n{}",
+            real_markdown(&checks)
+        );
+    }
+    println!("wrote {}", args.output.display());
     Ok(())
 }
