@@ -1,6 +1,7 @@
 """spdcam.estimate and spdcam.estimate_features against the command line and by hand."""
 
 import csv
+import json
 
 import numpy as np
 import pytest
@@ -131,3 +132,20 @@ def test_repr_shows_the_numbers_as_the_command_line_does(example, cli):
             if m["value"] is not None:
                 assert m["value"] in shown and m["value"] in text, m
     assert "PPF per 1000 lx" in shown
+
+
+def test_the_kind_of_light_can_be_named(example, cli):
+    plain = spdcam.estimate(example)
+    told = spdcam.estimate(example, light="luminaire")
+    assert plain.light == "unknown" and told.light == "luminaire"
+    assert told.json["light"] == "luminaire"
+    assert not np.array_equal(told.spd, plain.spd)
+    # The same estimate as the command line's with --light.
+    out = cli("estimate", str(example), "--light", "luminaire", "--json").stdout
+    np.testing.assert_allclose(told.spd, json.loads(out)[0]["spd"], rtol=0, atol=1e-12)
+    # Feature rows too; a wrong kind is named in the reasons, an unknown one refused.
+    rows = spdcam.estimate_features(plain.detection.features, light="daylight")
+    assert any("does not look like daylight" in r for r in rows.judgements[0]["reasons"])
+    assert set(spdcam.LIGHT_KINDS) >= {"unknown", "daylight", "white-led", "rgb-led"}
+    with pytest.raises(spdcam.SpdcamError, match="'candle' is not a kind of light"):
+        spdcam.estimate(example, light="candle")

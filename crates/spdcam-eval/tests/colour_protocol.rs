@@ -69,19 +69,35 @@ fn one_camera_a_few_photos() {
         },
         reference_photos: 1,
         patch_photos: 2,
-        light_named: false,
+        light_named: true,
         light_priors: Vec::new(),
     };
     let report = ColourReport::measure(&options, &data, &mut |_| {}).unwrap();
     assert_eq!(report.cameras, 1);
-    assert_eq!(report.models.len(), 1);
+    // The model, then the model told each light's kind, on the same photos.
+    assert_eq!(report.models.len(), 2);
     let model = &report.models[0];
     assert!(model.calibrated, "the shipped model has a calibration");
-    for row in &model.rows {
-        for (k, s) in row.scores.iter().enumerate() {
-            check(s, &format!("{:?} {:?} path {k}", row.set, row.group));
+    assert!(!model.light_named && report.models[1].light_named);
+    for m in &report.models {
+        for row in &m.rows {
+            for (k, s) in row.scores.iter().enumerate() {
+                check(s, &format!("{:?} {:?} path {k}", row.set, row.group));
+            }
         }
     }
+    // Told "daylight" or "incandescent", the white references' shapes come closer.
+    let reference_gfc = |m: &spdcam_eval::colour::ModelColour| {
+        m.rows
+            .iter()
+            .find(|r| r.set == LightSet::References && r.group == Group::All)
+            .unwrap()
+            .scores[1]
+            .gfc
+    };
+    let (plain, told) = (reference_gfc(model), reference_gfc(&report.models[1]));
+    assert!(told > plain, "told {told}, plain {plain}");
+    assert!(report.markdown().contains("told the kind of light"));
     // The references: 8 lights, 1 scene photo and 2 patch-level photos each, and the
     // shipped model's intervals.
     let refs = model

@@ -129,6 +129,39 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
 }
 
 #[test]
+fn the_kind_of_light_can_be_named() {
+    let told = ok(&["estimate", EXAMPLE, "--light", "luminaire", "--json"]);
+    let told: serde_json::Value = serde_json::from_str(&told).unwrap();
+    assert_eq!(told[0]["light"], "luminaire", "{told}");
+    let plain = ok(&["estimate", EXAMPLE, "--json"]);
+    let plain: serde_json::Value = serde_json::from_str(&plain).unwrap();
+    assert!(plain[0].get("light").is_none());
+    assert_ne!(told[0]["spd"], plain[0]["spd"]);
+    // Told the wrong kind, the estimate says the photo does not look like it.
+    let wrong = ok(&["estimate", EXAMPLE, "--light", "daylight"]);
+    assert!(wrong.contains("told the light is daylight"), "{wrong}");
+    assert!(wrong.contains("does not look like daylight"), "{wrong}");
+    let err = fails(&["estimate", EXAMPLE, "--light", "candle"]);
+    assert!(
+        err.contains("'candle' is not a kind of light") && err.contains("white-led"),
+        "{err}"
+    );
+    let list = ok(&["light-kinds", "list"]);
+    for kind in [
+        "unknown",
+        "daylight",
+        "incandescent",
+        "fluorescent",
+        "white-led",
+        "hid",
+        "rgb-led",
+        "luminaire",
+    ] {
+        assert!(list.contains(kind), "{list}");
+    }
+}
+
+#[test]
 fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
     let dir = scratch("cc24");
     let photo = dir.join("cc24.jpg");

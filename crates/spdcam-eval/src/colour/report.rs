@@ -240,6 +240,7 @@ mod tests {
             models: vec![ModelColour {
                 model: PathBuf::from("models/cc24.spdm"),
                 chart: "colorchecker24".into(),
+                light_named: false,
                 calibrated: false,
                 rows: vec![row([summary(Some((0.04, 0.9))), summary(None)])],
             }],

@@ -48,6 +48,43 @@ fn the_answer_equals_the_library_estimate() {
 }
 
 #[test]
+fn the_kind_of_light_named_on_the_page_reaches_the_estimate() {
+    let server = start(16 << 20);
+    let addr = server.addr();
+    let told = form(&[
+        ("photo", Some("sg-telelumen.jpg"), EXAMPLE),
+        ("light", None, b"luminaire"),
+    ]);
+    let (status, got) = request(addr, "POST", "/api/estimate", Some(told.as_slice()));
+    assert_eq!(status, 200);
+    let got = json(&got);
+    assert_eq!(got["light"], "luminaire", "{got}");
+    let plain = expected("sg-telelumen.jpg");
+    assert!(plain.get("light").is_none());
+    assert_ne!(got["spd"], plain["spd"]);
+    // "Don't know" is the estimate without a kind; an unknown kind is refused by name.
+    let unknown = form(&[
+        ("photo", Some("sg-telelumen.jpg"), EXAMPLE),
+        ("light", None, b"unknown"),
+    ]);
+    let (status, got) = request(addr, "POST", "/api/estimate", Some(unknown.as_slice()));
+    assert_eq!(status, 200);
+    assert_eq!(json(&got)["spd"], plain["spd"]);
+    let candle = form(&[
+        ("photo", Some("sg-telelumen.jpg"), EXAMPLE),
+        ("light", None, b"candle"),
+    ]);
+    let (status, got) = request(addr, "POST", "/api/estimate", Some(candle.as_slice()));
+    assert_eq!(status, 400);
+    let message = json(&got)["error"].as_str().unwrap().to_string();
+    assert!(
+        message.contains("'candle' is not a kind of light"),
+        "{message}"
+    );
+    server.stop();
+}
+
+#[test]
 fn bad_input_gets_a_clear_error_and_the_server_keeps_serving() {
     let server = start(16 << 20);
     let addr = server.addr();
