@@ -279,6 +279,37 @@ await test('dragging a corner re-runs the estimate with those corners', async ()
   await page.screenshot({ path: join(artefacts, 'corners.png'), fullPage: true });
 });
 
+await test('naming the kind of light estimates the photos again with it', async () => {
+  const tab = await context.newPage();
+  await tab.goto(url);
+  await tab.setInputFiles('#files', photoPath);
+  await tab.waitForSelector('#metrics');
+  const points = () => tab.evaluate(() => {
+    const line = document.querySelector('#spd-plot polyline.spd');
+    return line ? line.getAttribute('points') : null;
+  });
+  const before = await points();
+  // The estimate the page holds, as its JSON download gives it.
+  const saved = async () => {
+    const [json] = await Promise.all([tab.waitForEvent('download'), tab.click('#download-json')]);
+    return JSON.parse(readFileSync(await json.path(), 'utf8'));
+  };
+  check(!('light' in (await saved())), 'a kind of light before one was named');
+  await tab.selectOption('#light', 'luminaire');
+  const changed = (want, same) => tab.waitForFunction(({ w, s }) => {
+    const line = document.querySelector('#spd-plot polyline.spd');
+    return line && (line.getAttribute('points') === w) === s;
+  }, { w: want, s: same }, { timeout: 30000 });
+  await changed(before, false);
+  check((await saved()).light === 'luminaire', 'the estimate was not told the kind');
+  // Back to "don't know": the estimate without a kind again.
+  await tab.selectOption('#light', 'unknown');
+  await changed(before, true);
+  check(!('light' in (await saved())), 'a kind of light after "don\'t know"');
+  check(await points() === before, 'the SPD without a kind differs from the first');
+  await tab.close();
+});
+
 await test('a file that is no image shows a plain error in the page', async () => {
   await page.setInputFiles('#files', { name: 'notes.txt', mimeType: 'text/plain', buffer: Buffer.from('these are notes, not a photo') });
   const error = page.locator('#list li').filter({ hasText: 'notes.txt' }).locator('.error');

@@ -52,12 +52,62 @@ pub struct KindCheck {
     pub kind: LightKind,
     /// The worst GFC of a particle rebuilt from the basis (how much of the kind it keeps).
     pub worst_particle_gfc: f64,
+    /// The estimates without and with the kind named (1 % called unlike it expected).
+    pub told: Told,
+}
+
+/// Photos estimated without and with their kind named.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Told {
     /// Mean GFC of the model's estimates, then of the estimates told the kind.
     pub gfc: [f64; 2],
     /// Median Δu′v′ of the same two.
     pub delta_uv: [f64; 2],
-    /// The share of the photos whose estimate is called unlike the kind (1 % expected).
+    /// The share of the photos whose estimate is called unlike the kind.
     pub unlike: f64,
+}
+
+impl Told {
+    /// The scores of the model's estimates `estimates` (on `grid`, peak 1) of lights
+    /// `truths` (on `grid`), without and with `kind` named through `priors`.
+    fn of<'a>(
+        kind: LightKind,
+        priors: &KindPriors,
+        pairs: impl Iterator<Item = (&'a [f64], &'a [f64])>,
+        grid: &Grid,
+    ) -> Result<Told> {
+        let mut gfc = [Vec::new(), Vec::new()];
+        let mut delta_uv = [Vec::new(), Vec::new()];
+        let mut unlike = Vec::new();
+        for (truth, estimate) in pairs {
+            unlike.push(f64::from(u8::from(priors.unlike(kind, estimate)?)));
+            let truth_spd = Spd::new(*grid, truth.to_vec())?;
+            let told = priors.apply(kind, estimate)?;
+            for (k, spd) in [estimate.to_vec(), told].into_iter().enumerate() {
+                gfc[k].push(spectral_error::gfc(truth, &spd)?);
+                let score = ColourScore::of(&truth_spd, &Spd::new(*grid, spd)?)?;
+                delta_uv[k].push(score.delta_uv_prime);
+            }
+        }
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+        Ok(Told {
+            gfc: [mean(&gfc[0]), mean(&gfc[1])],
+            delta_uv: [median(delta_uv[0].clone()), median(delta_uv[1].clone())],
+            unlike: mean(&unlike),
+        })
+    }
+
+    /// `0.9500 → 0.9600 | 0.0100 → 0.0090 | 1.0 %`: the cells of a table row.
+    fn cells(&self) -> String {
+        format!(
+            "{:.4} → {:.4} | {:.4} → {:.4} | {:.1} %",
+            self.gfc[0],
+            self.gfc[1],
+            self.delta_uv[0],
+            self.delta_uv[1],
+            100.0 * self.unlike
+        )
+    }
 }
 
 /// A real photo set estimated without and with the kind of its light named.
@@ -69,12 +119,8 @@ pub struct RealCheck {
     pub kind: LightKind,
     /// Photos.
     pub photos: usize,
-    /// Mean GFC, "don't know" then the kind named.
-    pub gfc: [f64; 2],
-    /// Median Δu′v′, the same two.
-    pub delta_uv: [f64; 2],
-    /// The share of the photos whose estimate is called unlike the kind.
-    pub unlike: f64,
+    /// The estimates, "don't know" then the kind named.
+    pub told: Told,
 }
 
 /// The kind of light of a real photo set: the Philips Hue lamps are colour-mixing LED lamps,
@@ -104,26 +150,20 @@ pub fn real_checks(
             let kind = real_set_kind(set.label);
             let rows: Vec<f64> = photos.features.iter().flatten().copied().collect();
             let estimates = model.estimate_rows(&rows)?;
-            let mut gfc = [Vec::new(), Vec::new()];
-            let mut delta_uv = [Vec::new(), Vec::new()];
-            let mut unlike = Vec::new();
-            for (truth, e) in photos.spds.iter().zip(estimates.chunks(grid.count)) {
-                unlike.push(f64::from(u8::from(priors.unlike(kind, e)?)));
-                let truth = truth.resampled(&grid)?.normalised_by_max();
-                for (k, spd) in [e.to_vec(), priors.apply(kind, e)?].into_iter().enumerate() {
-                    gfc[k].push(spectral_error::gfc(truth.values(), &spd)?);
-                    let score = ColourScore::of(&truth, &Spd::new(grid, spd)?)?;
-                    delta_uv[k].push(score.delta_uv_prime);
-                }
-            }
-            let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+            let truths = photos
+                .spds
+                .iter()
+                .map(|t| Ok(t.resampled(&grid)?.normalised_by_max().into_values()))
+                .collect::<Result<Vec<_>>>()?;
+            let pairs = truths
+                .iter()
+                .map(Vec::as_slice)
+                .zip(estimates.chunks(grid.count));
             Ok(RealCheck {
                 set: set.label,
                 kind,
                 photos: photos.spds.len(),
-                gfc: [mean(&gfc[0]), mean(&gfc[1])],
-                delta_uv: [median(delta_uv[0].clone()), median(delta_uv[1].clone())],
-                unlike: mean(&unlike),
+                told: Told::of(kind, priors, pairs, &grid)?,
             })
         })
         .collect()
@@ -138,15 +178,11 @@ pub fn real_markdown(checks: &[RealCheck]) -> String {
     );
     for c in checks {
         out.push_str(&format!(
-            "| {} | {} | {} | {:.4} → {:.4} | {:.4} → {:.4} | {:.0} % |\n",
+            "| {} | {} | {} | {} |\n",
             c.set,
             c.kind.name(),
             c.photos,
-            c.gfc[0],
-            c.gfc[1],
-            c.delta_uv[0],
-            c.delta_uv[1],
-            100.0 * c.unlike
+            c.told.cells()
         ));
     }
     out
@@ -309,14 +345,10 @@ impl KindFit {
         );
         for c in &self.checks {
             out.push_str(&format!(
-                "| {} | {:.4} | {:.4} → {:.4} | {:.4} → {:.4} | {:.1} % |\n",
+                "| {} | {:.4} | {} |\n",
                 c.kind.name(),
                 c.worst_particle_gfc,
-                c.gfc[0],
-                c.gfc[1],
-                c.delta_uv[0],
-                c.delta_uv[1],
-                100.0 * c.unlike
+                c.told.cells()
             ));
         }
         out
@@ -359,26 +391,16 @@ fn check(
     grid: &Grid,
     worst_particle_gfc: f64,
 ) -> Result<KindCheck> {
-    let mut gfc = [Vec::new(), Vec::new()];
-    let mut delta_uv = [Vec::new(), Vec::new()];
-    let mut unlike = Vec::new();
-    for (t, e) in truths.iter().zip(estimates).skip(1).step_by(2) {
-        let told = priors.apply(kind, e)?;
-        unlike.push(f64::from(u8::from(priors.unlike(kind, e)?)));
-        let truth = Spd::new(*grid, t.clone())?;
-        for (k, spd) in [e.to_vec(), told].into_iter().enumerate() {
-            gfc[k].push(spectral_error::gfc(t, &spd)?);
-            let score = ColourScore::of(&truth, &Spd::new(*grid, spd)?)?;
-            delta_uv[k].push(score.delta_uv_prime);
-        }
-    }
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let odd = truths
+        .iter()
+        .map(Vec::as_slice)
+        .zip(estimates.iter().copied())
+        .skip(1)
+        .step_by(2);
     Ok(KindCheck {
         kind,
         worst_particle_gfc,
-        gfc: [mean(&gfc[0]), mean(&gfc[1])],
-        delta_uv: [median(delta_uv[0].clone()), median(delta_uv[1].clone())],
-        unlike: mean(&unlike),
+        told: Told::of(kind, priors, odd, grid)?,
     })
 }
 

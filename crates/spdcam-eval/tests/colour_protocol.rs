@@ -3,6 +3,9 @@
 //! and the cameras).
 #![cfg(feature = "measured-data")]
 
+mod common;
+
+use common::data_dir;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::light_families::ValidationSplit;
 use spdcam_core::spectral::{Grid, Spd};
@@ -11,19 +14,6 @@ use spdcam_eval::colour::{ColourOptions, ColourReport, ColourScore, Group, Summa
 use spdcam_eval::held_out::{HeldOutPhotos, LampFiles, GRID};
 use spdcam_eval::lamp_validation::average_spd;
 use std::path::PathBuf;
-
-/// The measured data: `$SPDCAM_DATA`, else `../shared/data` beside the repository.
-fn data_dir() -> PathBuf {
-    let dir = std::env::var_os("SPDCAM_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    assert!(
-        dir.join("lamps").is_dir(),
-        "measured data not found at {}: set SPDCAM_DATA",
-        dir.display()
-    );
-    dir
-}
 
 /// Every number of a summary is finite and in its range.
 fn check(s: &Summary, what: &str) {

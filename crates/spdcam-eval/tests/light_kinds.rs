@@ -3,25 +3,15 @@
 //! training cameras, the lamp fits' luminaire, the real photo sets).
 #![cfg(feature = "measured-data")]
 
+mod common;
+
+use common::data_dir;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::light_families::LightKind;
 use spdcam_eval::light_kinds::{real_checks, KindFit, KindFitOptions};
 use spdcam_infer::kind_prior::KindPriors;
 use spdcam_infer::Model;
 use std::path::PathBuf;
-
-/// The measured data: `$SPDCAM_DATA`, else `../shared/data` beside the repository.
-fn data_dir() -> PathBuf {
-    let dir = std::env::var_os("SPDCAM_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    assert!(
-        dir.join("cameras").is_dir(),
-        "measured data not found at {}: set SPDCAM_DATA",
-        dir.display()
-    );
-    dir
-}
 
 #[test]
 fn priors_fitted_on_a_few_photos_move_estimates_towards_their_kind() {
@@ -44,14 +34,17 @@ fn priors_fitted_on_a_few_photos_move_estimates_towards_their_kind() {
     assert_eq!(KindPriors::from_json(&text, "fitted").unwrap(), fit.priors);
     for c in &fit.checks {
         assert!(c.worst_particle_gfc > 0.95, "{c:?}");
-        assert!(c.unlike < 0.1, "{c:?}");
-        assert!(c.gfc.iter().all(|g| *g > 0.5 && *g <= 1.0), "{c:?}");
+        assert!(c.told.unlike < 0.1, "{c:?}");
+        assert!(c.told.gfc.iter().all(|g| *g > 0.5 && *g <= 1.0), "{c:?}");
     }
     // A family of one parameter is recovered far better once named.
     for kind in [LightKind::Daylight, LightKind::Incandescent] {
         let c = fit.checks.iter().find(|c| c.kind == kind).unwrap();
-        assert!(c.gfc[1] > c.gfc[0] && c.gfc[1] > 0.99, "{c:?}");
-        assert!(c.delta_uv[1] < c.delta_uv[0], "{c:?}");
+        assert!(
+            c.told.gfc[1] > c.told.gfc[0] && c.told.gfc[1] > 0.99,
+            "{c:?}"
+        );
+        assert!(c.told.delta_uv[1] < c.told.delta_uv[0], "{c:?}");
     }
     // The same seed gives the same priors; too few photos for the basis is refused.
     let again = KindFit::fit(&options, &data, &mut |_| {}).unwrap();
@@ -70,7 +63,7 @@ fn priors_fitted_on_a_few_photos_move_estimates_towards_their_kind() {
     assert_eq!(photos, [640, 800, 61]);
     assert_eq!(real[1].kind, LightKind::RgbLed);
     for c in &real {
-        assert!(c.gfc.iter().all(|g| *g > 0.5 && *g <= 1.0), "{c:?}");
-        assert!((0.0..=1.0).contains(&c.unlike), "{c:?}");
+        assert!(c.told.gfc.iter().all(|g| *g > 0.5 && *g <= 1.0), "{c:?}");
+        assert!((0.0..=1.0).contains(&c.told.unlike), "{c:?}");
     }
 }

@@ -49,7 +49,7 @@ struct FitArgs {
     photos: usize,
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Output JSON (the shipped models' priors live in models/<chart>.kinds.json).
+    /// Output JSON (the shipped models' priors live in `models/<chart>.kinds.json`).
     #[arg(short, long)]
     output: PathBuf,
 }

@@ -150,9 +150,14 @@ function setupInputs() {
     drop.classList.remove('over');
     addFiles([...e.dataTransfer.files]);
   });
-  // Another kind of light named: every photo already estimated is estimated again with it.
+  // Another kind of light named: every photo already estimated is estimated again with it,
+  // the chart found again where it was detected, else at the corners placed.
   $('light').addEventListener('change', () => {
-    for (const e of state.entries) if (e.result && !e.busy) run(e, e.corners);
+    for (const e of state.entries) {
+      if (!e.result || e.busy) continue;
+      const detected = e.result.photo && e.result.photo.method === 'detected';
+      run(e, detected ? null : e.corners);
+    }
   });
   $('example').addEventListener('click', async () => {
     const blob = await (await fetch('example.jpg')).blob();
