@@ -147,17 +147,8 @@ fn the_kind_of_light_can_be_named() {
         "{err}"
     );
     let list = ok(&["light-kinds", "list"]);
-    for kind in [
-        "unknown",
-        "daylight",
-        "incandescent",
-        "fluorescent",
-        "white-led",
-        "hid",
-        "rgb-led",
-        "luminaire",
-    ] {
-        assert!(list.contains(kind), "{list}");
+    for kind in spdcam_core::light_families::LightKind::ALL {
+        assert!(list.contains(kind.name()), "{list}");
     }
 }
 
