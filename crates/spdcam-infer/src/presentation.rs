@@ -18,6 +18,7 @@ pub use crate::rounding::{round_sig, round_with_uncertainty};
 use crate::rounding::{shown, NOT_DETERMINABLE};
 use crate::trust::Verdict;
 use serde::Serialize;
+use spdcam_core::light_families::LightKind;
 use spdcam_core::quality::CRI_MAX_DUV;
 
 /// Farther than this from the Planckian locus (|Duv|, CIE 1960 uv) a correlated colour
@@ -230,6 +231,12 @@ impl Presentation {
             None => summary.push_str(", too far from white for a colour temperature"),
         }
         summary.push('.');
+        if estimate.light != LightKind::Unknown {
+            summary.push_str(&format!(
+                " You said the light is {}: the estimate is kept among such lights.",
+                estimate.light.label()
+            ));
+        }
         match (spread, uncertainty) {
             (Some(spread), Some(u)) => summary.push_str(&format!(
                 " The estimate is good to about ±{} % of the spectrum's peak (95 % band, \
@@ -564,5 +571,23 @@ mod tests {
         assert_eq!(hue_name([0.2, 0.6]), "greenish");
         assert_eq!(hue_name([0.65, 0.3]), "reddish");
         assert_eq!(hue_name([0.16, 0.08]), "bluish");
+    }
+
+    #[test]
+    fn the_summary_says_which_kind_of_light_was_named() {
+        use spdcam_core::cie_illuminant::StandardIlluminant;
+        use spdcam_core::spectral::Grid;
+        let d65 = StandardIlluminant::D65.spd(&Grid::ESTIMATION).unwrap();
+        let mut e = crate::test_support::estimate_of(d65, &[]);
+        let plain = Presentation::of(&e).summary;
+        assert!(!plain.contains("You said"), "{plain}");
+        e.light = LightKind::Daylight;
+        let told = Presentation::of(&e).summary;
+        assert!(
+            told.contains(
+                "You said the light is daylight: the estimate is kept among such lights."
+            ),
+            "{told}"
+        );
     }
 }
