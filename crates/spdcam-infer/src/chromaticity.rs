@@ -109,7 +109,7 @@ fn planckian_locus() -> Vec<[f64; 2]> {
 /// The estimate's 95 % region in u′v′ (see the module's documentation), when its CCT is
 /// meaningful (near the Planckian locus) and its CCT and Δuv have calibrated intervals.
 pub fn region95(e: &Estimate) -> Option<Vec<[f64; 2]>> {
-    crate::presentation::cct_meaningful(e).ok()?;
+    crate::meaningful::cct_meaningful(e).ok()?;
     let (cct, duv) = (e.metrics.cct_k?, e.metrics.duv?);
     let u = e.trust.as_ref()?.uncertainty.as_ref()?;
     let (ht, hd) = (u.metrics.get("cct_k")?.half95, u.metrics.get("duv")?.half95);

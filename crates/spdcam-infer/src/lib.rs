@@ -24,7 +24,8 @@
 //!   an estimate is (SPD, colorimetry, lighting metrics, verdict, bands); [`stream`]: feature
 //!   rows read a block at a time, and the CSV layouts of many SPDs.
 //! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
-//!   verdict); [`presentation`]: what an estimate means in words and rounded numbers;
+//!   verdict); [`presentation`]: what an estimate means in words and rounded numbers
+//!   ([`meaningful`]: which metrics mean anything for the light);
 //!   [`rounding`]: the one rule every front end writes numbers by; [`meter`]: what a
 //!   colour meter's screen shows; [`plot`] and [`report`]: SVG plots (with the CIE 1976
 //!   u′v′ diagram of [`chromaticity`]) and the HTML report.
@@ -71,7 +72,9 @@ pub mod error;
 pub mod estimate;
 pub mod estimator;
 pub mod feature_rows;
+mod html;
 pub mod kind_prior;
+pub mod meaningful;
 pub mod meter;
 pub mod model;
 pub mod network;

@@ -7,7 +7,8 @@
 //! ([`spdcam_core::quality::film_tv`]). Every number is written by [`crate::rounding`].
 
 use crate::estimate::Estimate;
-use crate::presentation::{cct_meaningful, cri_meaningful, CCT_MAX_DUV};
+use crate::estimate::MAX_CCT_DUV;
+use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::rounding::{round_sig, shown, shown_with_unit, NOT_DETERMINABLE};
 use serde::Serialize;
 use spdcam_core::quality::dominant::{dominant_wavelength, peak_wavelength_nm, ILLUMINANT_E_XY};
@@ -62,7 +63,7 @@ impl Meter {
     pub fn of(e: &Estimate) -> Meter {
         let light = LightSpectrum::on_grid(e.spd.grid(), &e.spd).ok();
         let white =
-            cct_meaningful(e).is_ok() && e.metrics.duv.is_some_and(|d| d.abs() <= CCT_MAX_DUV);
+            cct_meaningful(e).is_ok() && e.metrics.duv.is_some_and(|d| d.abs() <= MAX_CCT_DUV);
         let mut headline = Vec::new();
         let (cct, duv) = (e.metrics.cct_k, e.metrics.duv);
         if let (true, Some(cct), Some(duv)) = (white, cct, duv) {

@@ -12,18 +12,14 @@
 //! - The light is described by simple rules on its chromaticity and its spectrum's shape
 //!   ([`describe_light`]).
 
-use crate::estimate::Estimate;
+use crate::estimate::{Estimate, MAX_CCT_DUV};
+use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::meter::Meter;
 pub use crate::rounding::{round_sig, round_with_uncertainty};
 use crate::rounding::{shown, NOT_DETERMINABLE};
 use crate::trust::Verdict;
 use serde::Serialize;
 use spdcam_core::light_families::LightKind;
-use spdcam_core::quality::CRI_MAX_DUV;
-
-/// Farther than this from the Planckian locus (|Duv|, CIE 1960 uv) a correlated colour
-/// temperature is not meaningful (CIE 015:2018 §9.5; Ohno 2014, LEUKOS 10:1).
-pub const CCT_MAX_DUV: f64 = 0.05;
 
 /// Within this |Duv| a light reads as white without a tint (ANSI C78.377-2017 puts its
 /// nominal white quadrangles about ±0.006 around the locus).
@@ -349,30 +345,6 @@ pub fn meaningful_value(estimate: &Estimate, key: &str) -> Result<f64, String> {
     Ok(value)
 }
 
-/// Whether the CCT (and what is built on it, TM-30's reference) is meaningful.
-pub fn cct_meaningful(estimate: &Estimate) -> Result<(), String> {
-    match estimate.metrics.duv {
-        Some(duv) if duv.abs() > CCT_MAX_DUV => Err(format!(
-            "not meaningful this far from white: |Duv| {:.3} is beyond {CCT_MAX_DUV}",
-            duv.abs()
-        )),
-        Some(_) => Ok(()),
-        None => Err("not meaningful: the light has no colour temperature".into()),
-    }
-}
-
-/// Whether CIE 13.3's Ra and R1–R14 are meaningful.
-pub fn cri_meaningful(estimate: &Estimate) -> Result<(), String> {
-    match estimate.metrics.duv {
-        Some(duv) if duv.abs() > CRI_MAX_DUV => Err(format!(
-            "not meaningful this far from white: |Duv| {:.3} is beyond CIE 13.3's {CRI_MAX_DUV}",
-            duv.abs()
-        )),
-        Some(_) => Ok(()),
-        None => Err("not meaningful: the light has no colour temperature".into()),
-    }
-}
-
 /// Why a metric has no number although it is meaningful: its 95 % interval is too wide.
 fn not_determinable_words(key: &str, half95: Option<f64>) -> String {
     match half95 {
@@ -418,7 +390,7 @@ fn band_spread(estimate: &Estimate) -> Option<f64> {
 ///   otherwise `smooth and broad (daylight-like)`, two `two-peaked`.
 pub fn describe_light(estimate: &Estimate) -> String {
     let colour = match (estimate.metrics.cct_k, estimate.metrics.duv) {
-        (Some(cct), Some(duv)) if duv.abs() <= CCT_MAX_DUV => {
+        (Some(cct), Some(duv)) if duv.abs() <= MAX_CCT_DUV => {
             let base = if cct < 3300.0 {
                 "warm white"
             } else if cct <= 5300.0 {

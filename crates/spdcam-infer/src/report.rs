@@ -10,7 +10,9 @@
 use crate::chromaticity::uv_diagram_svg;
 use crate::estimate::Colorimetry;
 use crate::estimate::Estimate;
-use crate::presentation::{cct_meaningful, Presentation};
+use crate::html::esc;
+use crate::meaningful::cct_meaningful;
+use crate::presentation::Presentation;
 use crate::report_meter::{film_tv_html, headline_html};
 use crate::trust::Band;
 use spdcam_core::quality::HueBin;
@@ -654,22 +656,6 @@ fn tm30_svg(bins: &[HueBin], rf: Option<f64>, rg: Option<f64>) -> String {
         label(rg)
     );
     s
-}
-
-/// Text escaped for HTML (element content and quoted attributes).
-pub(crate) fn esc(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for ch in s.chars() {
-        match ch {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
 }
 
 /// Standard base64 (RFC 4648, padded), for data URIs.

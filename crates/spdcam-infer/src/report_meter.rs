@@ -1,8 +1,8 @@
 //! The report's colour-meter parts ([`crate::meter`] as HTML): the headline readings, the
 //! R1–R15 bar chart and the film and TV numbers.
 
+use crate::html::esc;
 use crate::meter::Meter;
-use crate::report::esc;
 use std::fmt::Write as _;
 
 /// Approximate sRGB colours of CIE 13.3's test colour samples 1–14 and JIS Z 8726's No. 15,

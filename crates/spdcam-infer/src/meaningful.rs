@@ -1,0 +1,31 @@
+//! Whether a lighting metric means anything for a light: a correlated colour temperature
+//! (and TM-30, whose reference is built on it) only near the Planckian locus, CIE 13.3's
+//! colour rendering indices only nearer still. What the meter, the presentation and the
+//! chromaticity diagram all ask before they show such a number.
+
+use crate::estimate::{Estimate, MAX_CCT_DUV};
+use spdcam_core::quality::CRI_MAX_DUV;
+
+/// Whether the CCT (and what is built on it, TM-30's reference) is meaningful.
+pub fn cct_meaningful(estimate: &Estimate) -> Result<(), String> {
+    match estimate.metrics.duv {
+        Some(duv) if duv.abs() > MAX_CCT_DUV => Err(format!(
+            "not meaningful this far from white: |Duv| {:.3} is beyond {MAX_CCT_DUV}",
+            duv.abs()
+        )),
+        Some(_) => Ok(()),
+        None => Err("not meaningful: the light has no colour temperature".into()),
+    }
+}
+
+/// Whether CIE 13.3's Ra and R1–R14 are meaningful.
+pub fn cri_meaningful(estimate: &Estimate) -> Result<(), String> {
+    match estimate.metrics.duv {
+        Some(duv) if duv.abs() > CRI_MAX_DUV => Err(format!(
+            "not meaningful this far from white: |Duv| {:.3} is beyond CIE 13.3's {CRI_MAX_DUV}",
+            duv.abs()
+        )),
+        Some(_) => Ok(()),
+        None => Err("not meaningful: the light has no colour temperature".into()),
+    }
+}
