@@ -197,6 +197,8 @@ pub struct KindFit {
     pub checks: Vec<KindCheck>,
     /// Training cameras left out (unreadable curves).
     pub skipped: Vec<SkippedCamera>,
+    /// The model the priors are for.
+    pub model: Model,
 }
 
 /// The lights of one kind: particles and photographed lights, on the model's grid (peak 1)
@@ -278,11 +280,8 @@ impl KindFit {
                 .map(|s| Ok(normalise_by_max(s.resampled(&grid)?.values())))
                 .collect::<Result<_>>()?;
             let estimates: Vec<&[f64]> = estimates.chunks(grid.count).collect();
-            let in_basis = |spds: &mut dyn Iterator<Item = &[f64]>| -> Vec<Vec<f64>> {
-                spds.map(|s| basis.project(s)).collect()
-            };
-            let estimated = in_basis(&mut estimates.iter().copied());
-            let truth = in_basis(&mut truths.iter().map(Vec::as_slice));
+            let estimated: Vec<Vec<f64>> = estimates.iter().map(|e| basis.project(e)).collect();
+            let truth: Vec<Vec<f64>> = truths.iter().map(|t| basis.project(t)).collect();
             let even = |v: &[Vec<f64>]| -> Vec<Vec<f64>> { v.iter().step_by(2).cloned().collect() };
             let trial = KindPrior::from_photos(
                 kind,
@@ -333,6 +332,7 @@ impl KindFit {
             },
             checks,
             skipped: cameras.skipped,
+            model,
         })
     }
 

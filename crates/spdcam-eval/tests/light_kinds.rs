@@ -10,7 +10,6 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::light_families::LightKind;
 use spdcam_eval::light_kinds::{real_checks, KindFit, KindFitOptions};
 use spdcam_infer::kind_prior::KindPriors;
-use spdcam_infer::Model;
 use std::path::PathBuf;
 
 #[test]
@@ -57,8 +56,7 @@ fn priors_fitted_on_a_few_photos_move_estimates_towards_their_kind() {
     assert!(err.to_string().contains("residual photos"), "{err}");
 
     // The real sets, each estimated with and without its kind.
-    let model = Model::load(&options.model).unwrap();
-    let real = real_checks(&model, &fit.priors, &data).unwrap();
+    let real = real_checks(&fit.model, &fit.priors, &data).unwrap();
     let photos: Vec<usize> = real.iter().map(|c| c.photos).collect();
     assert_eq!(photos, [640, 800, 61]);
     assert_eq!(real[1].kind, LightKind::RgbLed);

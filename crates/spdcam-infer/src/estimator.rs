@@ -40,7 +40,7 @@ use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Grid, Spd};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// What judging one model's estimates needs, made once per model.
 struct ModelTrust {
@@ -101,8 +101,9 @@ pub struct Estimator {
     grid: Grid,
     /// Per model of the set, in order.
     on_grid: Vec<OnGrid>,
-    /// Per model of the set, in order: its light-kind priors, if it has any.
-    priors: Arc<Vec<Option<KindPriors>>>,
+    /// Per model of the set, in order: its light-kind priors, if it has any; read from the
+    /// built-in ones when a kind is first named (most estimates never name one).
+    priors: Arc<OnceLock<Vec<Option<KindPriors>>>>,
     /// The kind of light the estimates are told of.
     light: LightKind,
 }
@@ -134,11 +135,6 @@ impl Estimator {
                 Some(Arc::new(chart))
             })
             .collect();
-        let priors = models
-            .models()
-            .iter()
-            .map(|m| kind_prior::priors_for(&m.model))
-            .collect::<Result<Vec<_>>>()?;
         let prepared = Arc::new(Prepared {
             models,
             trust,
@@ -146,7 +142,7 @@ impl Estimator {
             charts,
             data_dir,
         });
-        Estimator::with(prepared, Arc::new(priors), LightKind::Unknown, grid)
+        Estimator::with(prepared, Arc::default(), LightKind::Unknown, grid)
     }
 
     /// The estimator of the shipped models (see [`ModelSet::shipped`]).
@@ -159,7 +155,7 @@ impl Estimator {
     /// no model says anything outside its own range).
     fn with(
         prepared: Arc<Prepared>,
-        priors: Arc<Vec<Option<KindPriors>>>,
+        priors: Arc<OnceLock<Vec<Option<KindPriors>>>>,
         light: LightKind,
         grid: Grid,
     ) -> Result<Estimator> {
@@ -227,14 +223,14 @@ impl Estimator {
     /// use spdcam_infer::Estimator;
     ///
     /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
-    /// assert!(estimator.light_kinds().contains(&LightKind::Daylight));
+    /// assert!(estimator.light_kinds()?.contains(&LightKind::Daylight));
     /// let daylight = estimator.for_light(LightKind::Daylight)?;
     /// assert_eq!(daylight.light(), LightKind::Daylight);
     /// # Ok::<(), spdcam_infer::InferError>(())
     /// ```
     pub fn for_light(&self, kind: LightKind) -> Result<Estimator> {
         if kind != LightKind::Unknown {
-            for (m, priors) in self.prepared.models.models().iter().zip(self.priors.iter()) {
+            for (m, priors) in self.prepared.models.models().iter().zip(self.priors()?) {
                 if priors.as_ref().and_then(|p| p.prior(kind)).is_none() {
                     return Err(InferError::invalid(format!(
                         "the model {} cannot be told the kind of light ('{}'): it carries no \
@@ -254,7 +250,7 @@ impl Estimator {
     /// The same models with light-kind priors of their own (`spdcam light-kinds fit`), each
     /// given to the model whose fingerprint it names, in place of any built in.
     pub fn with_priors(&self, given: Vec<KindPriors>) -> Result<Estimator> {
-        let mut priors: Vec<Option<KindPriors>> = self.priors.as_ref().clone();
+        let mut priors: Vec<Option<KindPriors>> = self.priors()?.to_vec();
         for p in given {
             let index = self
                 .prepared
@@ -271,7 +267,7 @@ impl Estimator {
             priors[index] = Some(p);
         }
         let mut out = self.clone();
-        out.priors = Arc::new(priors);
+        out.priors = Arc::new(OnceLock::from(priors));
         Ok(out)
     }
 
@@ -281,17 +277,32 @@ impl Estimator {
     }
 
     /// The kinds of light every model of the set can be told of, `Unknown` first.
-    pub fn light_kinds(&self) -> Vec<LightKind> {
-        LightKind::ALL
+    pub fn light_kinds(&self) -> Result<Vec<LightKind>> {
+        let priors = self.priors()?;
+        Ok(LightKind::ALL
             .into_iter()
             .filter(|&k| {
                 k == LightKind::Unknown
-                    || self
-                        .priors
+                    || priors
                         .iter()
                         .all(|p| p.as_ref().and_then(|p| p.prior(k)).is_some())
             })
-            .collect()
+            .collect())
+    }
+
+    /// Every model's light-kind priors, the built-in ones read at the first call.
+    fn priors(&self) -> Result<&[Option<KindPriors>]> {
+        if let Some(priors) = self.priors.get() {
+            return Ok(priors);
+        }
+        let built_in = self
+            .prepared
+            .models
+            .models()
+            .iter()
+            .map(|m| kind_prior::priors_for(&m.model))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(self.priors.get_or_init(|| built_in))
     }
 
     /// The model's SPDs `spds` (row-major on its grid) moved to the kind of light named.
@@ -299,7 +310,7 @@ impl Estimator {
         if self.light == LightKind::Unknown {
             return Ok(spds);
         }
-        let priors = self.priors[index]
+        let priors = self.priors()?[index]
             .as_ref()
             .ok_or_else(|| InferError::invalid("the model carries no light-kind priors"))?;
         let d = self.named(index).model.grid().count;
@@ -875,12 +886,12 @@ impl Estimator {
     /// With a kind of light named: whether the model's own estimate for `row` lies among the
     /// kind's lights; when it does not, `trust` says so and is at best doubtful.
     fn check_kind(&self, index: usize, row: &[f64], trust: &mut Trust) -> Result<()> {
-        let Some(priors) = self.priors[index].as_ref() else {
-            return Ok(());
-        };
         if self.light == LightKind::Unknown {
             return Ok(());
         }
+        let Some(priors) = self.priors()?[index].as_ref() else {
+            return Ok(());
+        };
         let own = self.named(index).model.estimate_rows(row)?;
         if priors.unlike(self.light, &own)? {
             let advice = Advice::UnlikeKind {
@@ -1234,7 +1245,7 @@ mod tests {
                 .light(),
             LightKind::Incandescent
         );
-        assert_eq!(estimator.light_kinds(), LightKind::ALL);
+        assert_eq!(estimator.light_kinds().unwrap(), LightKind::ALL);
     }
 
     #[test]
@@ -1256,13 +1267,13 @@ mod tests {
         let err = estimator.with_priors(vec![other]).err().unwrap();
         assert!(err.to_string().contains("no model of the set"), "{err}");
         let mut bare = estimator.clone();
-        bare.priors = Arc::new(vec![None]);
+        bare.priors = Arc::new(OnceLock::from(vec![None]));
         let err = bare.for_light(LightKind::Daylight).err().unwrap();
         assert!(
             err.to_string().contains("mine.spdm") && err.to_string().contains("none"),
             "{err}"
         );
-        assert_eq!(bare.light_kinds(), [LightKind::Unknown]);
+        assert_eq!(bare.light_kinds().unwrap(), [LightKind::Unknown]);
         assert!(bare.for_light(LightKind::Unknown).is_ok());
     }
 

@@ -8,21 +8,20 @@ use spdcam_core::quality::CRI_MAX_DUV;
 
 /// Whether the CCT (and what is built on it, TM-30's reference) is meaningful.
 pub fn cct_meaningful(estimate: &Estimate) -> Result<(), String> {
-    match estimate.metrics.duv {
-        Some(duv) if duv.abs() > MAX_CCT_DUV => Err(format!(
-            "not meaningful this far from white: |Duv| {:.3} is beyond {MAX_CCT_DUV}",
-            duv.abs()
-        )),
-        Some(_) => Ok(()),
-        None => Err("not meaningful: the light has no colour temperature".into()),
-    }
+    near_white(estimate, MAX_CCT_DUV, "")
 }
 
 /// Whether CIE 13.3's Ra and R1–R14 are meaningful.
 pub fn cri_meaningful(estimate: &Estimate) -> Result<(), String> {
+    near_white(estimate, CRI_MAX_DUV, "CIE 13.3's ")
+}
+
+/// Whether the estimate's light lies within `limit` (|Duv|) of the Planckian locus; the
+/// reason why not, naming the limit as `whose` it is.
+fn near_white(estimate: &Estimate, limit: f64, whose: &str) -> Result<(), String> {
     match estimate.metrics.duv {
-        Some(duv) if duv.abs() > CRI_MAX_DUV => Err(format!(
-            "not meaningful this far from white: |Duv| {:.3} is beyond CIE 13.3's {CRI_MAX_DUV}",
+        Some(duv) if duv.abs() > limit => Err(format!(
+            "not meaningful this far from white: |Duv| {:.3} is beyond {whose}{limit}",
             duv.abs()
         )),
         Some(_) => Ok(()),

@@ -9,7 +9,6 @@ use spdcam_core::chart::KnownChart;
 use spdcam_core::fsio;
 use spdcam_core::light_families::LightKind;
 use spdcam_eval::light_kinds::{real_checks, real_markdown, KindFit, KindFitOptions};
-use spdcam_infer::Model;
 use std::path::PathBuf;
 
 /// Options of `spdcam light-kinds`.
@@ -93,9 +92,8 @@ fn fit(args: FitArgs, data_dir: &DataDir) -> Result<()> {
          cameras, in distribution):\n\n{}",
         fit.markdown()
     );
-    let model = Model::load(&options.model)?;
-    if model.header().chart.as_deref() == Some(KnownChart::Sg96.name()) {
-        let checks = real_checks(&model, &fit.priors, data_dir)?;
+    if fit.model.header().chart.as_deref() == Some(KnownChart::Sg96.name()) {
+        let checks = real_checks(&fit.model, &fit.priors, data_dir)?;
         println!(
             "The real photo sets (outside their test photos):\n\n{}",
             real_markdown(&checks)

@@ -152,7 +152,7 @@ impl Shoot<'_> {
     /// (b): each light through a held-out camera with the randomised in-camera stage
     /// (exposure, white balance, tone, JPEG, gradient; `lamps validate`'s (a)), patch level
     /// on `chart`, estimated as feature rows by the estimator `estimator_for` gives for each
-    /// light (in parallel, a photo at a time).
+    /// light (in parallel, all the photos of a light at once).
     pub fn patches(
         &self,
         estimator_for: &EstimatorFor<'_>,
@@ -170,23 +170,41 @@ impl Shoot<'_> {
             camera.features_fast_with(ic.as_ref(), &light, &mut raw, &mut out);
             values.extend(out.iter().map(|&v| f64::from(v)));
         }
+        // The photos of a light are consecutive (see `jobs`): one block of rows per light.
         let width = names.len();
-        values
-            .par_chunks(width)
-            .zip(jobs)
-            .map(|(row, j)| {
+        let mut starts = Vec::with_capacity(self.lights.len());
+        let mut first = 0;
+        for (_, n) in self.lights {
+            starts.push((first, *n as usize));
+            first += *n as usize;
+        }
+        let scored = starts
+            .par_iter()
+            .enumerate()
+            .map(|(j, &(first, n))| {
                 let light = &self.lights[j].0;
-                let rows = FeatureRows::from_values(names.clone(), row.to_vec(), "a photo")?;
+                let block = values[first * width..(first + n) * width].to_vec();
+                let rows =
+                    FeatureRows::from_values(names.clone(), block, "the patch-level photos")?;
                 let estimates =
-                    estimator_for(light)?.estimate_rows(&rows, "a patch-level photo")?;
-                let e = estimates
-                    .first()
-                    .ok_or_else(|| EvalError::invalid("no estimate for a patch-level photo"))?;
-                Ok(PhotoScore {
-                    light: j,
-                    estimate: Some(Scored::of(e, light)?),
-                })
+                    estimator_for(light)?.estimate_rows(&rows, "the patch-level photos")?;
+                if estimates.len() != n {
+                    return Err(EvalError::invalid(format!(
+                        "{} estimates for {n} patch-level photos",
+                        estimates.len()
+                    )));
+                }
+                estimates
+                    .iter()
+                    .map(|e| {
+                        Ok(PhotoScore {
+                            light: j,
+                            estimate: Some(Scored::of(e, light)?),
+                        })
+                    })
+                    .collect::<Result<Vec<_>>>()
             })
-            .collect()
+            .collect::<Result<Vec<_>>>()?;
+        Ok(scored.concat())
     }
 }

@@ -1,4 +1,6 @@
-//! What the measured-data tests of the protocols share.
+//! What the measured-data tests of the protocols share: the second tier only
+//! (`--features measured-data`).
+#![cfg(feature = "measured-data")]
 
 use std::path::PathBuf;
 

@@ -89,7 +89,8 @@ pub fn s(p: &Path) -> String {
 }
 
 /// The measured data directory (second tier): `$SPDCAM_DATA`, else `../shared/data` beside
-/// the repository.
+/// the repository. Only the second tier (`--features spdcam/measured-data`) has it.
+#[cfg(feature = "measured-data")]
 pub fn data_dir() -> PathBuf {
     let root = std::env::var_os("SPDCAM_DATA")
         .map(PathBuf::from)
