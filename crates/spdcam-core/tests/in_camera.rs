@@ -4,7 +4,7 @@
 
 use spdcam_core::builtin::{self, DataDir};
 use spdcam_core::camera::colour::ColourTransform;
-use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, InCamera};
+use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, ChartGlow, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::tone::jpeg_quantise;
 use spdcam_core::camera::white_balance;
@@ -13,7 +13,8 @@ use spdcam_core::chart::Chart;
 use spdcam_core::cie_illuminant::StandardIlluminant;
 use spdcam_core::colorimetry;
 use spdcam_core::dataset::randomise::{
-    camera_pool, InCameraRanges, Randomisation, IN_CAMERA_AND_GRADIENT_GROUPS, IN_CAMERA_GROUPS,
+    camera_pool, GlowRange, InCameraRanges, Randomisation, GLOW_WIDTHS,
+    IN_CAMERA_AND_GRADIENT_GROUPS, IN_CAMERA_GROUPS,
 };
 use spdcam_core::dataset::{GenerateOptions, Generator, Pipeline};
 use spdcam_core::light_families::Lighting;
@@ -141,7 +142,7 @@ fn tone_stages_match_hand_computed_values() {
         ..InCamera::NEUTRAL
     };
     let mut raw = vec![[1.0, 2.0, 3.0], [3.0, 4.0, 5.0], [100.0, 100.0, 100.0]];
-    ic.glare().apply(&mut raw, 2);
+    ic.glare().apply(&mut raw, 2, &[[0.0, 0.0]; 3]);
     assert_eq!(raw[0], [2.0, 3.5, 5.0]);
     assert_eq!(raw[2], [101.0, 101.5, 102.0]);
     // Patch means were (2, 3, 4): patch 2 becomes (4, 5.5, 7), so the mean green is 4.5.
@@ -199,6 +200,7 @@ fn calibration_recovers_known_parameters() {
         jpeg_quality: None,
         gradient: [0.0, 0.0],
         floor: 0.0,
+        glow: ChartGlow::OFF,
     };
     let cam = camera(None);
     let lights = [
@@ -442,4 +444,129 @@ fn the_named_group_lists_differ_by_the_gradient_alone() {
         stage
     );
     assert_eq!(IN_CAMERA_AND_GRADIENT_GROUPS[..4], IN_CAMERA_GROUPS);
+}
+
+#[test]
+fn a_glow_lifts_the_dark_patches_near_it_and_is_refused_outside_its_ranges() {
+    // A glow on the black patch (p23, bottom right of the 4 × 6 chart, at x = 5/12,
+    // y = 3/8) lifts it far more than the patch at the opposite corner (p0, dark skin).
+    let spd = StandardIlluminant::D65.spd(&GRID).unwrap();
+    let cam = camera(None);
+    let ic = |level: f64| InCamera {
+        exposure_target: Some(0.3),
+        glow: ChartGlow {
+            level,
+            at: [5.0 / 12.0, 3.0 / 8.0],
+            width: 0.15,
+        },
+        ..InCamera::NEUTRAL
+    };
+    let clean = fast(&cam, Some(&ic(0.0)), &spd);
+    let glowing = fast(&cam, Some(&ic(0.5)), &spd);
+    let green = |f: &[f32], p: usize| f[3 * p + 1];
+    assert!(
+        green(&glowing, 23) > green(&clean, 23) + 40.0,
+        "black patch {} → {}",
+        green(&clean, 23),
+        green(&glowing, 23)
+    );
+    assert!(
+        (green(&glowing, 0) - green(&clean, 0)).abs() < 3.0,
+        "far patch {} → {}",
+        green(&clean, 0),
+        green(&glowing, 0)
+    );
+    // Level 0 is the stage without a glow, whatever its place and width.
+    let plain = InCamera {
+        exposure_target: Some(0.3),
+        ..InCamera::NEUTRAL
+    };
+    assert_eq!(clean, fast(&cam, Some(&plain), &spd));
+    for bad in [
+        ChartGlow {
+            level: 1.5,
+            at: [0.0, 0.0],
+            width: 0.3,
+        },
+        ChartGlow {
+            level: 0.3,
+            at: [0.0, 0.0],
+            width: 0.0,
+        },
+        ChartGlow {
+            level: 0.3,
+            at: [2.0, 0.0],
+            width: 0.3,
+        },
+        ChartGlow {
+            level: f64::NAN,
+            at: [0.0, 0.0],
+            width: 0.3,
+        },
+    ] {
+        let err = InCamera {
+            glow: bad,
+            ..InCamera::NEUTRAL
+        }
+        .validate()
+        .unwrap_err();
+        assert!(err.to_string().contains("glow"), "{err}");
+    }
+}
+
+#[test]
+fn randomised_glows_cover_their_ranges_and_are_recorded_only_when_drawn() {
+    let chart = Chart::colorchecker24(&GRID).unwrap();
+    let config = CameraConfig {
+        noise: None,
+        ..CameraConfig::default()
+    };
+    let pool = vec![Camera::new(&nikon(), chart, config, &GRID).unwrap()];
+    let ranges = InCameraRanges::for_groups(&["glow"]).unwrap();
+    let GlowRange {
+        share,
+        level: [lo, hi],
+    } = ranges.glow.unwrap();
+    let randomisation = Randomisation::new(pool.clone(), ranges).unwrap();
+    let all: Vec<ChartGlow> = (0..400)
+        .map(|i| randomisation.draw(4, i).1.unwrap().glow)
+        .collect();
+    let glows: Vec<ChartGlow> = all.iter().copied().filter(|g| !g.is_off()).collect();
+    let drawn = glows.len() as f64 / all.len() as f64;
+    assert!(
+        (drawn - share).abs() < 0.08,
+        "{drawn} of the photos with a glow"
+    );
+    for g in &glows {
+        assert!((lo..=hi).contains(&g.level), "{g:?}");
+        assert!(
+            (GLOW_WIDTHS[0]..=GLOW_WIDTHS[1]).contains(&g.width),
+            "{g:?}"
+        );
+        assert!(g.at.iter().all(|a| a.abs() <= 0.5), "{g:?}");
+    }
+    let largest = glows.iter().map(|g| g.level).fold(0.0, f64::max);
+    assert!(
+        largest > 0.9 * hi,
+        "the draws reach the top of the range: {largest}"
+    );
+    let corners = [[-1.0, -1.0], [1.0, -1.0], [-1.0, 1.0], [1.0, 1.0]];
+    for [sx, sy] in corners {
+        assert!(
+            glows
+                .iter()
+                .any(|g| g.at[0] * sx > 0.3 && g.at[1] * sy > 0.3),
+            "some glow near the corner ({sx}, {sy})"
+        );
+    }
+    // Without the group the glow is off and the record does not name it.
+    let without = InCameraRanges::for_groups(&IN_CAMERA_AND_GRADIENT_GROUPS).unwrap();
+    assert!(!serde_json::to_string(&without).unwrap().contains("glow"));
+    let plain = Randomisation::new(pool, without).unwrap();
+    assert!((0..50).all(|i| plain.draw(4, i).1.unwrap().glow.is_off()));
+    let json = serde_json::to_string(&InCamera::NEUTRAL).unwrap();
+    assert!(!json.contains("glow"), "{json}");
+    let with = InCameraRanges::for_groups(&["glow"]).unwrap();
+    let json = serde_json::to_string(&with).unwrap();
+    assert_eq!(serde_json::from_str::<InCameraRanges>(&json).unwrap(), with);
 }

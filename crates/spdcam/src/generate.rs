@@ -56,7 +56,8 @@ pub struct GenerateArgs {
     /// Domain randomisation per sample, comma-separated: camera (draw the camera from
     /// --cameras), exposure, wb (or wb-wide), tone, jpeg, floor (draw those in-camera
     /// parameters; floor: a black floor under the rendered values), gradient (uneven
-    /// lighting across the chart).
+    /// lighting across the chart), glow (a glow of random place, size and strength on the
+    /// chart in half the photos, as a lamp beside it gives).
     #[arg(long, value_delimiter = ',', value_name = "GROUPS")]
     randomise: Vec<String>,
     /// Cameras to draw from with --randomise camera, comma-separated: directories of

@@ -1,5 +1,5 @@
 //! The per-shot settings of a JPEG camera, beyond the thesis's pipeline, in one record:
-//! uneven lighting across the chart, veiling glare, automatic exposure with sensor
+//! uneven lighting across the chart, veiling glare and a glow on part of it, automatic exposure with sensor
 //! saturation, auto white balance with incomplete adaptation, colour saturation, a
 //! highlight shoulder, a tone curve beyond the sRGB gamma, and JPEG-like quantisation.
 //! Each setting belongs to one stage of the chain and is carried out there:
@@ -7,7 +7,7 @@
 //! | settings | stage | module |
 //! |---|---|---|
 //! | `gradient` | scene: uneven lighting | [`super::scene`] |
-//! | `flare` | optics: veiling glare | [`super::optics`] |
+//! | `flare`, `glow` | optics: veiling glare | [`super::optics`] |
 //! | `exposure_target` (+ clipping at full scale) | sensor: auto exposure | [`super::sensor`] |
 //! | `adaptation` | ISP: white balance | [`super::white_balance`] |
 //! | `saturation`, `shoulder`, `gamma`, `contrast`, `jpeg_quality` | ISP: rendering | [`super::tone`] |
@@ -17,7 +17,7 @@
 //! unchanged; the whole record is off unless [`crate::camera::CameraConfig::in_camera`] is
 //! set.
 
-use super::optics::VeilingGlare;
+use super::optics::{Glow, VeilingGlare};
 use super::scene::UnevenLighting;
 use super::sensor::AutoExposure;
 use super::tone::ToneRendering;
@@ -65,7 +65,49 @@ pub struct InCamera {
     /// saturated patch's channel below black (`docs/real-cameras.md`).
     #[serde(default)]
     pub floor: f64,
+    /// A glow on part of the chart (a bright light beside it, scattered by the lens onto the
+    /// patches near it); off when its level is 0, and then left unwritten, so that records
+    /// made before it existed read the same.
+    #[serde(default, skip_serializing_if = "ChartGlow::is_off")]
+    pub glow: ChartGlow,
 }
+
+/// A glow on part of the chart: at `at` it adds `level` × the mean raw value of the chart's
+/// patches, falling off as a Gaussian whose standard deviation is `width` (a share of the
+/// chart's extent along each axis) — the local form of veiling glare (ISO 18844's glare
+/// spread function in its simplest shape) that real photos of a semi-gloss chart under a
+/// lamp beside it show as a bright region.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub struct ChartGlow {
+    /// Share of the patches' mean raw value added at the centre (0 = off; sensible 0–0.6).
+    pub level: f64,
+    /// The centre in the chart's coordinates (−½ to ½ across and down the patch grid, as
+    /// the lighting gradient's).
+    pub at: [f64; 2],
+    /// The fall-off's standard deviation, as a share of the chart's extent (sensible 0.1–1).
+    pub width: f64,
+}
+
+impl ChartGlow {
+    /// No glow.
+    pub const OFF: ChartGlow = ChartGlow {
+        level: 0.0,
+        at: [0.0, 0.0],
+        width: 0.0,
+    };
+
+    /// Whether it adds nothing.
+    pub fn is_off(&self) -> bool {
+        self.level == 0.0
+    }
+}
+
+/// Largest glow level: the patches' mean raw value at the glow's centre.
+const MAX_GLOW_LEVEL: f64 = 1.0;
+/// Largest glow width: twice the chart's extent (wider is a veiling glare).
+const MAX_GLOW_WIDTH: f64 = 2.0;
+/// Farthest glow centre from the chart's centre, along each axis, in chart extents.
+const MAX_GLOW_OFFSET: f64 = 1.5;
 
 /// Largest black floor: half of full scale.
 const MAX_FLOOR: f64 = 0.5;
@@ -104,6 +146,7 @@ impl InCamera {
         jpeg_quality: None,
         gradient: [0.0, 0.0],
         floor: 0.0,
+        glow: ChartGlow::OFF,
     };
 
     /// The fitted parameters as a vector in [`RANGES`] order (exposure target 0 when off).
@@ -164,6 +207,21 @@ impl InCamera {
                 self.floor
             )));
         }
+        let g = self.glow;
+        let glow_in_range = (0.0..=MAX_GLOW_LEVEL).contains(&g.level)
+            && g.width > 0.0
+            && g.width <= MAX_GLOW_WIDTH
+            && g.at.iter().all(|a| a.abs() <= MAX_GLOW_OFFSET);
+        if !g.is_off() && !glow_in_range {
+            return Err(Error::invalid(format!(
+                "in-camera glow (level {}, width {}, at {:?}) is outside level [0, \
+                 {MAX_GLOW_LEVEL}], width (0, {MAX_GLOW_WIDTH}], centre within \
+                 ±{MAX_GLOW_OFFSET} chart extents",
+                short_number(g.level),
+                short_number(g.width),
+                g.at
+            )));
+        }
         if let Some(q) = self.jpeg_quality {
             if !(1..=100).contains(&q) {
                 return Err(Error::invalid(format!(
@@ -181,9 +239,16 @@ impl InCamera {
         }
     }
 
-    /// The optics stage's setting: the veiling glare.
+    /// The optics stage's setting: the veiling glare and the glow.
     pub fn glare(&self) -> VeilingGlare {
-        VeilingGlare { share: self.flare }
+        VeilingGlare {
+            share: self.flare,
+            glow: Glow {
+                level: self.glow.level,
+                width: self.glow.width,
+            },
+            at: self.glow.at,
+        }
     }
 
     /// The sensor stage's automatic exposure, when it is on.

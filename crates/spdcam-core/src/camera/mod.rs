@@ -394,7 +394,7 @@ impl Camera {
         self.response.raw_into(light, raw);
         let patches = self.chart.reflectances.len();
         shot.lighting.apply(raw, &self.region_centres);
-        shot.glare.apply(raw, patches);
+        shot.glare.apply(raw, patches, &self.region_centres);
     }
 
     /// The exposure's scale for lit region values: the shot's metering, or the camera's
@@ -843,7 +843,7 @@ impl Shot {
                 lighting: UnevenLighting {
                     gradient: [0.0, 0.0],
                 },
-                glare: VeilingGlare { share: 0.0 },
+                glare: VeilingGlare::uniform(0.0),
                 auto_exposure: None,
                 full_scale: f32::INFINITY,
                 adaptation: 1.0,

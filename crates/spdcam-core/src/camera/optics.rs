@@ -7,23 +7,45 @@ use super::patch_mean;
 use crate::raster::{gaussian_blur, RgbImage};
 
 /// Veiling glare (ISO 18844): stray light scattered inside the lens adds a share of the
-/// scene's mean level to every region, lifting dark patches most.
+/// scene's mean level to every region, lifting dark patches most; and a glow on part of the
+/// chart, where a bright light beside it scatters more onto the regions near it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VeilingGlare {
     /// Each region's raw value gains this share of the mean raw value of the chart's
     /// patches (0 = none).
     pub share: f64,
+    /// The local glow: its level is a share of the patches' mean raw value, its width a
+    /// share of the chart's extent along each axis.
+    pub glow: Glow,
+    /// The glow's centre in the chart's coordinates (−½ to ½ across and down the patch
+    /// grid, as the regions' centres).
+    pub at: [f64; 2],
 }
 
 impl VeilingGlare {
+    /// The same share everywhere, no glow.
+    pub fn uniform(share: f64) -> VeilingGlare {
+        VeilingGlare {
+            share,
+            glow: Glow {
+                level: 0.0,
+                width: 0.0,
+            },
+            at: [0.0, 0.0],
+        }
+    }
+
     /// Adds the glare to the raw region values in place; `patches` is the number of chart
-    /// patches (the regions before the background).
-    pub fn apply(&self, raw: &mut [[f32; 3]], patches: usize) {
-        if self.share > 0.0 {
-            let mean = patch_mean(raw, patches);
-            let f = self.share as f32;
-            raw.iter_mut()
-                .for_each(|v| *v = std::array::from_fn(|c| v[c] + f * mean[c]));
+    /// patches (the regions before the background) and `centres` each region's position.
+    pub fn apply(&self, raw: &mut [[f32; 3]], patches: usize, centres: &[[f32; 2]]) {
+        if self.share <= 0.0 && self.glow.level <= 0.0 {
+            return;
+        }
+        let mean = patch_mean(raw, patches);
+        for (v, &[x, y]) in raw.iter_mut().zip(centres) {
+            let local = self.glow.share_at([x as f64, y as f64], self.at, 1.0);
+            let f = (self.share + local) as f32;
+            *v = std::array::from_fn(|c| v[c] + f * mean[c]);
         }
     }
 }
@@ -132,11 +154,32 @@ mod tests {
     fn glare_adds_a_share_of_the_patch_mean_to_every_region() {
         // Two patches (mean 0.5, 1, 0.25) and the background.
         let mut raw = [[0.0f32, 1.0, 0.5], [1.0, 1.0, 0.0], [0.2, 0.2, 0.2]];
-        VeilingGlare { share: 0.5 }.apply(&mut raw, 2);
+        let centres = [[-0.5, 0.0], [0.5, 0.0], [0.0, 0.0]];
+        VeilingGlare::uniform(0.5).apply(&mut raw, 2, &centres);
         assert_eq!(
             raw,
             [[0.25, 1.5, 0.625], [1.25, 1.5, 0.125], [0.45, 0.7, 0.325]]
         );
+    }
+
+    #[test]
+    fn a_glow_on_the_chart_lifts_the_regions_near_its_centre_most() {
+        // Two patches of the same value left and right, the glow on the left one.
+        let mut raw = [[0.4f32; 3], [0.4; 3]];
+        let centres = [[-0.5, 0.0], [0.5, 0.0]];
+        let glare = VeilingGlare {
+            share: 0.1,
+            glow: Glow {
+                level: 0.5,
+                width: 0.5,
+            },
+            at: [-0.5, 0.0],
+        };
+        glare.apply(&mut raw, 2, &centres);
+        // Left: 0.4 + (0.1 + 0.5) × 0.4; right, one chart width (2σ) away: e^(−2) of it.
+        assert!((raw[0][1] - 0.64).abs() < 1e-6, "{raw:?}");
+        let right = 0.4 + (0.1 + 0.5 * (-2.0f64).exp()) * 0.4;
+        assert!((raw[1][1] as f64 - right).abs() < 1e-6, "{raw:?}");
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //! depends only on (seed, i).
 
 use crate::builtin::DataDir;
-use crate::camera::in_camera::InCamera;
+use crate::camera::in_camera::{ChartGlow, InCamera};
 use crate::camera::sensor::{Sensitivities, SkippedFiles};
 use crate::camera::{Camera, CameraConfig};
 use crate::chart::Chart;
@@ -60,13 +60,34 @@ pub struct InCameraRanges {
     /// so that the records of runs without it read as before it existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub floor: Option<[f64; 2]>,
+    /// How often [`InCamera::glow`] is drawn and the range of its level; its centre is
+    /// drawn anywhere on the chart and its width from [`GLOW_WIDTHS`]. Left unwritten when
+    /// not drawn.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub glow: Option<GlowRange>,
 }
+
+/// The glows a randomised run draws: a share of the photos has one, of a level drawn
+/// uniformly from `level`; the others have none (real photos either catch a lamp's glare
+/// or do not).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GlowRange {
+    /// Share of the photos with a glow (0–1).
+    pub share: f64,
+    /// Range of its level (share of the patches' mean raw value at its centre).
+    pub level: [f64; 2],
+}
+
+/// The range of a drawn glow's width (share of the chart's extent): from a spot over a few
+/// patches to a glow over half the chart.
+pub const GLOW_WIDTHS: [f64; 2] = [0.1, 0.5];
 
 impl InCameraRanges {
     /// Ranges for the named groups (`exposure`: exposure target and flare; `wb`:
     /// adaptation from half to full; `wb-wide`: adaptation from none to full; `tone`: saturation, shoulder, gamma, contrast; `jpeg`: JPEG quality;
     /// `gradient`: uneven lighting across the chart; `floor`: a black floor under the
-    /// rendered values), wide enough to cover the JPEG cameras
+    /// rendered values; `glow`: a glow of random place, size and strength on the chart),
+    /// wide enough to cover the JPEG cameras
     /// and photo set-ups we know of.
     pub fn for_groups(groups: &[&str]) -> Result<InCameraRanges> {
         let mut r = InCameraRanges::default();
@@ -91,11 +112,22 @@ impl InCameraRanges {
                 // A black floor up to the Telelumen photos' darkest patch (about 0.15 of
                 // full scale; the Hue photos' about 0.02).
                 "floor" => r.floor = Some([0.0, 0.15]),
+                // Up to the real Telelumen photos' glare: their blackest patch gains 0.52–0.66
+                // of the chart's mean linear level (10th–90th percentile, at most 0.79) more
+                // than the other dark patches (`docs/glow.md`, `tools/real_glare.py`).
+                // Half the photos: the Hue photos show none.
+                "glow" => {
+                    r.glow = Some(GlowRange {
+                        share: 0.5,
+                        level: [0.0, 0.8],
+                    })
+                }
                 other => {
                     return Err(Error::UnknownName {
                         kind: "randomisation group",
                         name: other.to_string(),
-                        valid: "camera, exposure, wb, wb-wide, tone, jpeg, gradient, floor".into(),
+                        valid: "camera, exposure, wb, wb-wide, tone, jpeg, gradient, floor, glow"
+                            .into(),
                     })
                 }
             }
@@ -129,6 +161,7 @@ impl InCameraRanges {
             jpeg_quality: base.jpeg_quality,
             gradient: base.gradient,
             floor: u(self.floor, base.floor),
+            glow: base.glow,
         };
         let drawn = match self.jpeg_quality {
             Some([lo, hi]) => InCamera {
@@ -137,11 +170,31 @@ impl InCameraRanges {
             },
             None => drawn,
         };
-        match self.gradient {
+        let drawn = match self.gradient {
             Some(g) => InCamera {
                 gradient: [0, 1].map(|_| g * (2.0 * rng.random::<f64>() - 1.0)),
                 ..drawn
             },
+            None => drawn,
+        };
+        match self.glow {
+            Some(GlowRange {
+                share,
+                level: [lo, hi],
+            }) => {
+                let on = rng.random::<f64>() < share;
+                let level = lo + (hi - lo) * rng.random::<f64>();
+                let at = [0, 1].map(|_| rng.random::<f64>() - 0.5);
+                let [w0, w1] = GLOW_WIDTHS;
+                let width = w0 + (w1 - w0) * rng.random::<f64>();
+                match on {
+                    true => InCamera {
+                        glow: ChartGlow { level, at, width },
+                        ..drawn
+                    },
+                    false => drawn,
+                }
+            }
             None => drawn,
         }
     }
@@ -216,6 +269,33 @@ impl Randomisation {
                 }
                 probe(lo)?;
                 probe(hi)?;
+            }
+        }
+        if let Some(GlowRange {
+            share,
+            level: [lo, hi],
+        }) = ranges.glow
+        {
+            if !(0.0..=1.0).contains(&share) {
+                return Err(Error::invalid(format!(
+                    "randomisation share of photos with a glow {share} is outside [0, 1]"
+                )));
+            }
+            if lo.is_nan() || hi.is_nan() || lo > hi {
+                return Err(Error::invalid(format!(
+                    "randomisation range of the glow's level [{lo}, {hi}] is empty"
+                )));
+            }
+            for level in [lo, hi] {
+                InCamera {
+                    glow: ChartGlow {
+                        level,
+                        at: [0.5, 0.5],
+                        width: GLOW_WIDTHS[1],
+                    },
+                    ..InCamera::NEUTRAL
+                }
+                .validate()?;
             }
         }
         if let Some(g) = ranges.gradient {
