@@ -357,12 +357,8 @@ fn lighting_gradient_scales_patches_by_their_position() {
 
 #[test]
 fn randomised_gradient_stays_in_its_range() {
-    let chart = Chart::colorchecker24(&GRID).unwrap();
-    let config = CameraConfig {
-        noise: None,
-        ..CameraConfig::default()
-    };
-    let pool = vec![Camera::new(&nikon(), chart, config, &GRID).unwrap()];
+    // One camera: the Nikon, noise-free, photographing the ColorChecker 24.
+    let pool = vec![camera(None)];
     let ranges = InCameraRanges::for_groups(&["gradient"]).unwrap();
     let max = ranges.gradient.unwrap();
     let randomisation = Randomisation::new(pool, ranges).unwrap();
@@ -516,12 +512,8 @@ fn a_glow_lifts_the_dark_patches_near_it_and_is_refused_outside_its_ranges() {
 
 #[test]
 fn randomised_glows_cover_their_ranges_and_are_recorded_only_when_drawn() {
-    let chart = Chart::colorchecker24(&GRID).unwrap();
-    let config = CameraConfig {
-        noise: None,
-        ..CameraConfig::default()
-    };
-    let pool = vec![Camera::new(&nikon(), chart, config, &GRID).unwrap()];
+    // One camera: the Nikon, noise-free, photographing the ColorChecker 24.
+    let pool = vec![camera(None)];
     let ranges = InCameraRanges::for_groups(&["glow"]).unwrap();
     let GlowRange {
         share,
