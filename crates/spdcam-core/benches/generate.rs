@@ -35,11 +35,7 @@ struct SetUp {
 }
 
 fn set_up(grid: &Grid) -> SetUp {
-    let root = std::env::var_os("SPDCAM_DATA")
-        .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| {
-            std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
-        });
+    let root = builtin::measured_data_dir();
     let data_dir = DataDir::new(Some(root.clone()));
     let thesis = root.join("thesis").is_dir();
     let (camera_name, chart_name, lighting_spec) = if thesis {

@@ -4,7 +4,8 @@
 
 use spdcam_core::builtin::{self, DataDir};
 use spdcam_core::camera::colour::ColourTransform;
-use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, ChartGlow, InCamera};
+use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, InCamera};
+use spdcam_core::camera::optics::ChartGlow;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::tone::jpeg_quantise;
 use spdcam_core::camera::white_balance;

@@ -15,7 +15,7 @@ use spdcam_core::photo::decode_photo;
 use spdcam_core::spectral::Grid;
 use spdcam_infer::{Estimator, PhotoOptions};
 use std::hint::black_box;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 use support::median;
 
@@ -26,9 +26,7 @@ fn main() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let example = image::open(repo.join("examples/sg-telelumen.jpg")).expect("the example photo");
     let jpeg = support::enlarged_jpeg(&example);
-    let data = std::env::var_os("SPDCAM_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo.join("../shared/data"));
+    let data = spdcam_core::builtin::measured_data_dir();
     let data_dir = DataDir::new(data.is_dir().then_some(data));
     let estimator = Estimator::shipped(data_dir, Grid::ESTIMATION).expect("the estimator");
     let options = PhotoOptions::default();

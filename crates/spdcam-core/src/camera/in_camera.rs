@@ -1,6 +1,6 @@
 //! The per-shot settings of a JPEG camera, beyond the thesis's pipeline, in one record:
-//! uneven lighting across the chart, veiling glare and a glow on part of it, automatic exposure with sensor
-//! saturation, auto white balance with incomplete adaptation, colour saturation, a
+//! uneven lighting across the chart, veiling glare and a glow on part of it, automatic
+//! exposure with sensor saturation, auto white balance with incomplete adaptation, colour saturation, a
 //! highlight shoulder, a tone curve beyond the sRGB gamma, and JPEG-like quantisation.
 //! Each setting belongs to one stage of the chain and is carried out there:
 //!
@@ -17,7 +17,7 @@
 //! unchanged; the whole record is off unless [`crate::camera::CameraConfig::in_camera`] is
 //! set.
 
-use super::optics::{Glow, VeilingGlare};
+use super::optics::{ChartGlow, VeilingGlare};
 use super::scene::UnevenLighting;
 use super::sensor::AutoExposure;
 use super::tone::ToneRendering;
@@ -70,36 +70,6 @@ pub struct InCamera {
     /// made before it existed read the same.
     #[serde(default, skip_serializing_if = "ChartGlow::is_off")]
     pub glow: ChartGlow,
-}
-
-/// A glow on part of the chart: at `at` it adds `level` × the mean raw value of the chart's
-/// patches, falling off as a Gaussian whose standard deviation is `width` (a share of the
-/// chart's extent along each axis) — the local form of veiling glare (ISO 18844's glare
-/// spread function in its simplest shape) that real photos of a semi-gloss chart under a
-/// lamp beside it show as a bright region.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
-pub struct ChartGlow {
-    /// Share of the patches' mean raw value added at the centre (0 = off; sensible 0–0.6).
-    pub level: f64,
-    /// The centre in the chart's coordinates (−½ to ½ across and down the patch grid, as
-    /// the lighting gradient's).
-    pub at: [f64; 2],
-    /// The fall-off's standard deviation, as a share of the chart's extent (sensible 0.1–1).
-    pub width: f64,
-}
-
-impl ChartGlow {
-    /// No glow.
-    pub const OFF: ChartGlow = ChartGlow {
-        level: 0.0,
-        at: [0.0, 0.0],
-        width: 0.0,
-    };
-
-    /// Whether it adds nothing.
-    pub fn is_off(&self) -> bool {
-        self.level == 0.0
-    }
 }
 
 /// Largest glow level: the patches' mean raw value at the glow's centre.
@@ -243,11 +213,7 @@ impl InCamera {
     pub fn glare(&self) -> VeilingGlare {
         VeilingGlare {
             share: self.flare,
-            glow: Glow {
-                level: self.glow.level,
-                width: self.glow.width,
-            },
-            at: self.glow.at,
+            glow: self.glow,
         }
     }
 

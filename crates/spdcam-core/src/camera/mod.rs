@@ -43,7 +43,7 @@ use colour::{ColourConfig, ColourTransform};
 use demosaic::DemosaicMethod;
 use in_camera::InCamera;
 use noise::NoiseParams;
-use optics::VeilingGlare;
+use optics::{ChartGlow, VeilingGlare};
 use scene::UnevenLighting;
 use sensor::{AutoExposure, Sensitivities, SensorConfig, SensorMode, SpectralResponse};
 use serde::{Deserialize, Serialize};
@@ -843,7 +843,10 @@ impl Shot {
                 lighting: UnevenLighting {
                     gradient: [0.0, 0.0],
                 },
-                glare: VeilingGlare::uniform(0.0),
+                glare: VeilingGlare {
+                    share: 0.0,
+                    glow: ChartGlow::OFF,
+                },
                 auto_exposure: None,
                 full_scale: f32::INFINITY,
                 adaptation: 1.0,

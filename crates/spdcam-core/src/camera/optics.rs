@@ -5,6 +5,7 @@
 
 use super::patch_mean;
 use crate::raster::{gaussian_blur, RgbImage};
+use serde::{Deserialize, Serialize};
 
 /// Veiling glare (ISO 18844): stray light scattered inside the lens adds a share of the
 /// scene's mean level to every region, lifting dark patches most; and a glow on part of the
@@ -14,27 +15,11 @@ pub struct VeilingGlare {
     /// Each region's raw value gains this share of the mean raw value of the chart's
     /// patches (0 = none).
     pub share: f64,
-    /// The local glow: its level is a share of the patches' mean raw value, its width a
-    /// share of the chart's extent along each axis.
-    pub glow: Glow,
-    /// The glow's centre in the chart's coordinates (−½ to ½ across and down the patch
-    /// grid, as the regions' centres).
-    pub at: [f64; 2],
+    /// The glow on part of the chart.
+    pub glow: ChartGlow,
 }
 
 impl VeilingGlare {
-    /// The same share everywhere, no glow.
-    pub fn uniform(share: f64) -> VeilingGlare {
-        VeilingGlare {
-            share,
-            glow: Glow {
-                level: 0.0,
-                width: 0.0,
-            },
-            at: [0.0, 0.0],
-        }
-    }
-
     /// Adds the glare to the raw region values in place; `patches` is the number of chart
     /// patches (the regions before the background) and `centres` each region's position.
     pub fn apply(&self, raw: &mut [[f32; 3]], patches: usize, centres: &[[f32; 2]]) {
@@ -43,10 +28,48 @@ impl VeilingGlare {
         }
         let mean = patch_mean(raw, patches);
         for (v, &[x, y]) in raw.iter_mut().zip(centres) {
-            let local = self.glow.share_at([x as f64, y as f64], self.at, 1.0);
-            let f = (self.share + local) as f32;
+            let f = (self.share + self.glow.share_at([x as f64, y as f64])) as f32;
             *v = std::array::from_fn(|c| v[c] + f * mean[c]);
         }
+    }
+}
+
+/// A glow on part of the chart: at `at` it adds `level` × the mean raw value of the chart's
+/// patches, falling off as a Gaussian whose standard deviation is `width` (a share of the
+/// chart's extent along each axis) — the local form of veiling glare (ISO 18844's glare
+/// spread function in its simplest shape) that real photos of a semi-gloss chart under a
+/// lamp beside it show as a bright region.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub struct ChartGlow {
+    /// Share of the patches' mean raw value added at the centre (0 = off; sensible 0–0.8).
+    pub level: f64,
+    /// The centre in the chart's coordinates (−½ to ½ across and down the patch grid, as
+    /// the lighting gradient's).
+    pub at: [f64; 2],
+    /// The fall-off's standard deviation, as a share of the chart's extent (sensible 0.1–1).
+    pub width: f64,
+}
+
+impl ChartGlow {
+    /// No glow.
+    pub const OFF: ChartGlow = ChartGlow {
+        level: 0.0,
+        at: [0.0, 0.0],
+        width: 0.0,
+    };
+
+    /// Whether it adds nothing.
+    pub fn is_off(&self) -> bool {
+        self.level == 0.0
+    }
+
+    /// The share of the patches' mean it adds at `point` (chart coordinates).
+    pub fn share_at(&self, point: [f64; 2]) -> f64 {
+        let glow = Glow {
+            level: self.level,
+            width: self.width,
+        };
+        glow.share_at(point, self.at, 1.0)
     }
 }
 
@@ -155,7 +178,11 @@ mod tests {
         // Two patches (mean 0.5, 1, 0.25) and the background.
         let mut raw = [[0.0f32, 1.0, 0.5], [1.0, 1.0, 0.0], [0.2, 0.2, 0.2]];
         let centres = [[-0.5, 0.0], [0.5, 0.0], [0.0, 0.0]];
-        VeilingGlare::uniform(0.5).apply(&mut raw, 2, &centres);
+        let glare = VeilingGlare {
+            share: 0.5,
+            glow: ChartGlow::OFF,
+        };
+        glare.apply(&mut raw, 2, &centres);
         assert_eq!(
             raw,
             [[0.25, 1.5, 0.625], [1.25, 1.5, 0.125], [0.45, 0.7, 0.325]]
@@ -169,11 +196,11 @@ mod tests {
         let centres = [[-0.5, 0.0], [0.5, 0.0]];
         let glare = VeilingGlare {
             share: 0.1,
-            glow: Glow {
+            glow: ChartGlow {
                 level: 0.5,
+                at: [-0.5, 0.0],
                 width: 0.5,
             },
-            at: [-0.5, 0.0],
         };
         glare.apply(&mut raw, 2, &centres);
         // Left: 0.4 + (0.1 + 0.5) × 0.4; right, one chart width (2σ) away: e^(−2) of it.

@@ -6,7 +6,8 @@
 //! depends only on (seed, i).
 
 use crate::builtin::DataDir;
-use crate::camera::in_camera::{ChartGlow, InCamera};
+use crate::camera::in_camera::InCamera;
+use crate::camera::optics::ChartGlow;
 use crate::camera::sensor::{Sensitivities, SkippedFiles};
 use crate::camera::{Camera, CameraConfig};
 use crate::chart::Chart;
@@ -187,12 +188,13 @@ impl InCameraRanges {
                 let at = [0, 1].map(|_| rng.random::<f64>() - 0.5);
                 let [w0, w1] = GLOW_WIDTHS;
                 let width = w0 + (w1 - w0) * rng.random::<f64>();
-                match on {
-                    true => InCamera {
+                if on {
+                    InCamera {
                         glow: ChartGlow { level, at, width },
                         ..drawn
-                    },
-                    false => drawn,
+                    }
+                } else {
+                    drawn
                 }
             }
             None => drawn,

@@ -8,9 +8,7 @@ use std::path::PathBuf;
 /// The measured-data directory; panics with instructions when it is missing, so a test
 /// that needs it fails loudly instead of passing without checking anything.
 pub fn data_dir() -> PathBuf {
-    let dir = std::env::var_os("SPDCAM_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    let dir = spdcam_core::builtin::measured_data_dir();
     assert!(
         dir.join("thesis").is_dir(),
         "measured data not found at {}: put the shared data beside the repository or set SPDCAM_DATA",

@@ -92,9 +92,7 @@ pub fn s(p: &Path) -> String {
 /// the repository. Only the second tier (`--features spdcam/measured-data`) has it.
 #[cfg(feature = "measured-data")]
 pub fn data_dir() -> PathBuf {
-    let root = std::env::var_os("SPDCAM_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
+    let root = spdcam_core::builtin::measured_data_dir();
     assert!(root.is_dir(), "shared data not found at {}", root.display());
     root
 }
