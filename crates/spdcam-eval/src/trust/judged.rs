@@ -24,6 +24,8 @@ pub struct Judged {
     pub metric_spread: BTreeMap<String, f64>,
     /// Per single-number metric, its absolute error against the truth.
     pub metric_error: BTreeMap<String, f64>,
+    /// Per single-number metric, the estimate's value (with a truth only).
+    pub metric_value: BTreeMap<String, f64>,
 }
 
 /// `features` estimated and judged by `model` (with the chart check `check`, when the
@@ -52,7 +54,7 @@ pub fn judge_rows(
             let perturbed = Perturbed::of(model, row)?;
             let wavelengths = model.grid().wavelengths();
             let truth = truths.map(|t| t[r].clone());
-            let metric_error = match &truth {
+            let (metric_error, metric_value) = match &truth {
                 Some(t) => {
                     let (e, t) = (
                         LightingMetrics::from_samples(&wavelengths, &spd),
@@ -60,10 +62,14 @@ pub fn judge_rows(
                     );
                     SCALAR_KEYS
                         .iter()
-                        .filter_map(|&k| Some((k.to_string(), (e.scalar(k)? - t.scalar(k)?).abs())))
-                        .collect()
+                        .filter_map(|&k| {
+                            let value = e.scalar(k)?;
+                            let error = (value - t.scalar(k)?).abs();
+                            Some(((k.to_string(), error), (k.to_string(), value)))
+                        })
+                        .unzip()
                 }
-                None => BTreeMap::new(),
+                None => (BTreeMap::new(), BTreeMap::new()),
             };
             Ok(Judged {
                 spread: perturbed.spread(),
@@ -74,6 +80,7 @@ pub fn judge_rows(
                     BTreeMap::new()
                 },
                 metric_error,
+                metric_value,
                 truth,
                 spd,
                 self_check,
@@ -208,6 +215,7 @@ pub(crate) mod fixtures {
             self_check: None,
             metric_spread: BTreeMap::new(),
             metric_error: BTreeMap::new(),
+            metric_value: BTreeMap::new(),
         }
     }
 }

@@ -59,9 +59,17 @@ calibration's 50th, 75th or 90th percentile (95 % band on dev: 80.4 %, 94.5 %, a
 and 88 %); the Hue and tablet sets were looked at alongside.\n\
 - **Metric intervals.** The same rule for each single-number metric (CCT, Duv, Ra, R9, Rf, Rg, \
 M-EDER, S/P, PPF per lux, blue-light hazard efficacy): its standard deviation over the 16 \
-copies' metrics (Monte Carlo propagation, JCGM 101:2008) plus a floor (its median absolute \
-error on the calibration photos), times the widening, scaled by the conformal quantiles of \
-|error|/((floor + spread)·w). Estimates print the 95 % half-width: \"Ra 82 ± 4\".\n\
+copies' metrics (Monte Carlo propagation, JCGM 101:2008) plus a floor, times the widening, \
+scaled by the conformal quantiles of |error|/((floor·g + spread)·w). The floor follows the \
+expected GFC: g = ((1 − expected GFC) / its median on the calibration photos)^p, so that an \
+estimate the calibration expects to be good gets a narrower interval and a poor one a wider \
+(a locally weighted conformal interval, Lei et al. 2018, section 5.2); the floor itself is \
+the median of |error|/(g·w). CCT may instead be measured in shares of the estimated CCT \
+(its errors grow with it, as a step in mireds is alike across the scale). Per metric, the \
+power p (0, ¼, ½, ¾ or 1; 0 is one floor for every photo) and, for CCT, kelvin or shares \
+are chosen as the candidate whose 95 % intervals are narrowest in the median over the \
+calibration photos (CCT's in per cent of the estimate); the calibration file records the \
+choice. Estimates print the 95 % half-width: \"Ra 82 ± 4\".\n\
 - **Expected GFC.** A ridge regression of ln(1 − GFC) on ln(difficulty) and the estimate's \
 coordinates on the first principal components of the calibration photos' estimates \
 (`spdcam_infer::trust::GfcModel`; the number of components, 0–12, and the penalty by \
@@ -118,14 +126,20 @@ glare: dev 0.8318, Hue 0.9012, tablet 0.8002, held-out virtual 0.9347 (SG) and 0
 and costs another, so none is switched on.\n";
 
 /// Per metric, on one photo set: estimates whose true value lay within the 68 % and 95 %
-/// intervals, estimates with an interval, and the 95 % half-widths.
+/// intervals, estimates with an interval, the 95 % half-widths and the same as shares of the
+/// estimate's value.
 #[derive(Default)]
 struct MetricCoverage {
     in68: usize,
     in95: usize,
     total: usize,
     half95: Vec<f64>,
+    share95: Vec<f64>,
 }
+
+/// Metrics whose median 95 % half-width the report also gives as a share of the estimate
+/// (the issue's goal for CCT is one in per cent).
+const SHARE_SHOWN: [&str; 1] = ["cct_k"];
 
 /// Scene photos of each test lamp the report measures (the whole camera chain).
 pub const REPORT_SCENES_PER_LAMP: usize = 2;
@@ -180,6 +194,9 @@ fn measure_row(
                 c.in95 += usize::from(err <= interval.half95);
                 c.total += 1;
                 c.half95.push(interval.half95);
+                if let Some(value) = j.metric_value.get(key).filter(|v| **v != 0.0) {
+                    c.share95.push(interval.half95 / value.abs());
+                }
             }
         }
         let truth = j.truth.as_deref().unwrap_or_default();
@@ -284,7 +301,8 @@ fn corrections_row(
 }
 
 /// The metrics' table of one model: per metric and photo set, the share of true values
-/// within the 68 % and 95 % intervals and the median 95 % half-width.
+/// within the 68 % and 95 % intervals and the median 95 % half-width (for CCT also as a share
+/// of the estimate).
 fn metric_table(name: &str, sets: &[(String, BTreeMap<String, MetricCoverage>)]) -> String {
     let mut t = format!(
         "### `{name}`\n\n| metric |{}\n|---|{}\n",
@@ -298,10 +316,15 @@ fn metric_table(name: &str, sets: &[(String, BTreeMap<String, MetricCoverage>)])
         for (_, coverage) in sets {
             t += &match coverage.get(key) {
                 Some(c) if c.total > 0 => format!(
-                    " {:.0} / {:.0} % (± {}) |",
+                    " {:.0} / {:.0} % (± {}{}) |",
                     100.0 * c.in68 as f64 / c.total as f64,
                     100.0 * c.in95 as f64 / c.total as f64,
-                    significant(median(&mut c.half95.clone()))
+                    significant(median(&mut c.half95.clone())),
+                    if SHARE_SHOWN.contains(&key) && !c.share95.is_empty() {
+                        format!(", ± {:.1} %", 100.0 * median(&mut c.share95.clone()))
+                    } else {
+                        String::new()
+                    }
                 ),
                 _ => " – |".into(),
             };
@@ -431,9 +454,12 @@ impl TrustReport {
             "## Metric intervals\n\n\
              Per single-number metric (computed on the model's wavelengths for the estimate and the \
              truth alike): the share of photos whose true value lies within the estimate's 68 % and \
-             95 % intervals, and in brackets the median 95 % half-width (\"Ra 82 ± 4\"). Each \
-             interval is the metric's spread over the perturbed copies plus a floor, times the \
-             photo's widening, scaled by the calibration's conformal quantiles.\n\n",
+             95 % intervals, and in brackets the median 95 % half-width (\"Ra 82 ± 4\"; for CCT \
+             also as a share of the estimated CCT). Each interval is the metric's spread over the \
+             perturbed copies plus a floor that follows the expected GFC (its power chosen per \
+             metric on the calibration photos: the narrowest intervals), times the photo's \
+             widening, scaled by the calibration's conformal quantiles; CCT's in shares of the \
+             estimated CCT, as its errors grow with it.\n\n",
         );
         let mut corrections_md = String::from(
             "## The photo's own corrections\n\n\

@@ -6,6 +6,7 @@ use super::self_check::SelfCheck;
 use crate::error::{InferError, Result};
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
+use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Grid, Spd};
 use std::collections::BTreeMap;
 
@@ -59,19 +60,57 @@ pub struct MetricInterval {
 }
 
 /// One metric's calibration: the same scaled-residual conformal rule as the bands (see
-/// [`TrustCalibration`]) with the metric's spread over the perturbed copies as the scale.
+/// [`TrustCalibration`]) with the metric's spread over the perturbed copies, plus a floor that
+/// follows the expected GFC, as the scale ([`MetricCalibration::unit`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MetricCalibration {
     /// The metric's key ([`SCALAR_KEYS`](spdcam_core::quality::SCALAR_KEYS)).
     pub key: String,
-    /// The median absolute error of the metric on the calibration photos.
+    /// The median of |error| / (widening · gap factor) on the calibration photos
+    /// ([`MetricCalibration::gap_factor`]; the median absolute error where the factor is 1).
     pub floor: f64,
-    /// The 68 % quantile of |error| / ((floor + spread)·widening).
+    /// The 68 % quantile of |error| / [`MetricCalibration::unit`].
     pub scale68: f64,
     /// The 95 % quantile of the same.
     pub scale95: f64,
     /// How many calibration photos defined the metric (for the estimate and the truth).
     pub photos: usize,
+    /// The power of the expected 1 − GFC in the floor: 0 keeps one floor for every photo;
+    /// larger, the floor shrinks for estimates the calibration expects to be good and grows
+    /// for the others. 0 in calibrations made before it existed.
+    #[serde(default)]
+    pub gap_power: f64,
+    /// The calibration photos' median expected 1 − GFC, where the gap factor is 1.
+    #[serde(default)]
+    pub gap_reference: f64,
+    /// Whether error, spread and floor are shares of the estimate's value rather than in the
+    /// metric's unit (CCT: an error of a few per cent is hundreds of kelvin at 6500 K and
+    /// tens at 2700 K, as a step in mireds is alike across the scale).
+    #[serde(default)]
+    pub relative: bool,
+}
+
+/// The smallest expected 1 − GFC the floor's gap factor uses.
+const GAP_FACTOR_FLOOR: f64 = 1e-5;
+
+impl MetricCalibration {
+    /// How much the floor is scaled for an estimate whose expected GFC is 1 − `expected_gap`:
+    /// (expected_gap / [`gap_reference`](Self::gap_reference))^[`gap_power`](Self::gap_power),
+    /// 1 with no power. A locally weighted conformal scale (Lei et al. 2018, JASA 113:
+    /// 1094–1111, section 5.2) whose weight is the expected error of the shape.
+    pub fn gap_factor(&self, expected_gap: f64) -> f64 {
+        if self.gap_power == 0.0 || self.gap_reference <= 0.0 {
+            return 1.0;
+        }
+        (expected_gap.max(GAP_FACTOR_FLOOR) / self.gap_reference).powf(self.gap_power)
+    }
+
+    /// The unit of the conformal scaling of one photo: (floor · gap factor + spread) ·
+    /// widening, with `spread` in the calibration's units (a share of the estimate's value
+    /// where it is [`relative`](Self::relative)).
+    pub fn unit(&self, spread: f64, expected_gap: f64, widening: f64) -> f64 {
+        (self.floor * self.gap_factor(expected_gap) + spread) * widening
+    }
 }
 
 impl Band {
@@ -353,10 +392,16 @@ impl TrustCalibration {
             })
         };
         let difficulty = spread.iter().sum::<f64>() / d as f64;
+        let expected_gfc = self.gfc_model.expected(spd, difficulty);
+        let values = self
+            .metrics
+            .iter()
+            .any(|m| m.relative)
+            .then(|| LightingMetrics::from_samples(&grid.wavelengths(), spd));
         Ok(Uncertainty {
             band68: band(&self.scale68)?,
             band95: band(&self.scale95)?,
-            expected_gfc: self.gfc_model.expected(spd, difficulty),
+            expected_gfc,
             gfc_at_least95: self.gfc_model.at_least95(spd, difficulty),
             difficulty,
             widening,
@@ -364,12 +409,21 @@ impl TrustCalibration {
                 .metrics
                 .iter()
                 .filter_map(|m| {
-                    let s = metric_spread.get(&m.key)?;
+                    let s = *metric_spread.get(&m.key)?;
+                    // A relative metric's interval is a share of the estimate's value.
+                    let size = match (&values, m.relative) {
+                        (Some(v), true) => v.scalar(&m.key)?.abs(),
+                        _ => 1.0,
+                    };
+                    if size <= 0.0 || !size.is_finite() {
+                        return None;
+                    }
+                    let unit = m.unit(s / size, 1.0 - expected_gfc, widening) * size;
                     Some((
                         m.key.clone(),
                         MetricInterval {
-                            half68: m.scale68 * (m.floor + s) * widening,
-                            half95: m.scale95 * (m.floor + s) * widening,
+                            half68: m.scale68 * unit,
+                            half95: m.scale95 * unit,
                         },
                     ))
                 })
@@ -511,6 +565,91 @@ mod tests {
         assert_eq!(wide.band95.lower[1], 0.0);
         assert_eq!(plain.expected_gfc, wide.expected_gfc);
         assert!((plain.expected_gfc - (1.0 - (-3.0f64).exp())).abs() < 1e-12);
+    }
+
+    #[test]
+    fn metric_intervals_follow_the_expected_gfc_and_a_relative_one_the_value() {
+        let grid = Grid::from_parts(400.0, 10.0, 31).unwrap();
+        let d = grid.count;
+        let spd = spdcam_core::spectral::normalise_by_max(
+            spdcam_core::cie_illuminant::planck(3000.0, &grid)
+                .unwrap()
+                .values(),
+        );
+        let cct = LightingMetrics::from_samples(&grid.wavelengths(), &spd)
+            .cct_k
+            .unwrap();
+        let metric = |key: &str, gap_power: f64, relative: bool| MetricCalibration {
+            key: key.into(),
+            floor: 0.02,
+            scale68: 1.0,
+            scale95: 2.0,
+            photos: 100,
+            gap_power,
+            gap_reference: 0.01,
+            relative,
+        };
+        // Expected GFC 1 − e⁻³ (constant regression): 1 − GFC = 0.0498, five times the
+        // reference 0.01 (to 0.4 %).
+        let gap = (-3.0f64).exp();
+        let cal = TrustCalibration {
+            model: "0".into(),
+            chart: "c".into(),
+            method: "m".into(),
+            wavelength_nm: grid.wavelengths(),
+            floor: vec![0.1; d],
+            scale68: vec![1.0; d],
+            scale95: vec![2.0; d],
+            gfc_model: GfcModel {
+                mean: vec![0.5; d],
+                components: Vec::new(),
+                weights: vec![0.0, -3.0],
+                low: vec![-10.0, 1.0],
+                high: vec![0.0, 1.0],
+                gap_range: [-10.0, 0.0],
+                gap_margin95: 0.0,
+            },
+            residual_reference: Some(0.05),
+            difficulty_doubtful: 1.0,
+            self_check_doubtful: None,
+            metrics: vec![
+                metric("cct_k", 0.0, true),
+                metric("cri_ra", 1.0, false),
+                metric("duv", 0.0, false),
+            ],
+            split_doubtful: None,
+            colour_gradient_doubtful: None,
+            glare_doubtful: None,
+            two_lights_doubtful: None,
+            clipped_doubtful: 0,
+            real_photos: 0,
+            scenes_per_lamp: 0,
+        };
+        let spreads: BTreeMap<String, f64> = [("cct_k", 30.0), ("cri_ra", 0.5), ("duv", 0.001)]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        // Widening 2 (residual 0.1 over 0.05).
+        let u = cal
+            .uncertainty(&spd, &vec![0.0; d], &spreads, Some(0.1))
+            .unwrap();
+        // CCT: a share of the estimate's value, 2 × (0.02 + 30 / CCT) × 2 × CCT.
+        let want = 2.0 * (0.02 * cct + 30.0) * 2.0;
+        assert!((u.metrics["cct_k"].half95 - want).abs() < 1e-9 * want);
+        assert!((u.metrics["cct_k"].half68 - want / 2.0).abs() < 1e-9 * want);
+        // Ra: its floor scaled by (gap / reference)¹.
+        let want = 2.0 * (0.02 * gap / 0.01 + 0.5) * 2.0;
+        assert!((u.metrics["cri_ra"].half95 - want).abs() < 1e-12);
+        // Duv: one floor, in its own unit, as calibrations made before the power read.
+        assert!((u.metrics["duv"].half95 - 2.0 * 0.021 * 2.0).abs() < 1e-12);
+        let old = r#"{"key":"duv","floor":0.02,"scale68":1.0,"scale95":2.0,"photos":9}"#;
+        let read: MetricCalibration = serde_json::from_str(old).unwrap();
+        let want = MetricCalibration {
+            gap_reference: 0.0,
+            photos: 9,
+            ..metric("duv", 0.0, false)
+        };
+        assert_eq!(read, want);
     }
 
     #[test]
