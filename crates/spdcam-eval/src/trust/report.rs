@@ -458,8 +458,8 @@ impl TrustReport {
              also as a share of the estimated CCT). Each interval is the metric's spread over the \
              perturbed copies plus a floor that follows the expected GFC (its power chosen per \
              metric on the calibration photos: the narrowest intervals), times the photo's \
-             widening, scaled by the calibration's conformal quantiles; CCT's in shares of the \
-             estimated CCT, as its errors grow with it.\n\n",
+             widening, scaled by the calibration's conformal quantiles; CCT's in kelvin or in shares \
+             of the estimated CCT, as the calibration chose.\n\n",
         );
         let mut corrections_md = String::from(
             "## The photo's own corrections\n\n\

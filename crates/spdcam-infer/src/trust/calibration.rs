@@ -519,14 +519,18 @@ mod tests {
         assert!((wild.expected(&spd, difficulty) - (1.0 - (-3.0f64).exp())).abs() < 1e-12);
     }
 
-    #[test]
-    fn bands_widen_with_the_residual_and_the_expected_gfc_does_not_move() {
-        let d = 2;
-        let cal = TrustCalibration {
+    /// A calibration on `wavelength_nm` with bands of floor 0.1 and scales 1 and 2, an
+    /// expected GFC of 1 − e⁻³ for every estimate, a typical residual of 0.05 and `metrics`.
+    fn test_calibration(
+        wavelength_nm: Vec<f64>,
+        metrics: Vec<MetricCalibration>,
+    ) -> TrustCalibration {
+        let d = wavelength_nm.len();
+        TrustCalibration {
             model: "0".into(),
             chart: "c".into(),
             method: "m".into(),
-            wavelength_nm: vec![400.0, 410.0],
+            wavelength_nm,
             floor: vec![0.1; d],
             scale68: vec![1.0; d],
             scale95: vec![2.0; d],
@@ -542,7 +546,7 @@ mod tests {
             residual_reference: Some(0.05),
             difficulty_doubtful: 1.0,
             self_check_doubtful: None,
-            metrics: Vec::new(),
+            metrics,
             split_doubtful: None,
             colour_gradient_doubtful: None,
             glare_doubtful: None,
@@ -550,7 +554,12 @@ mod tests {
             clipped_doubtful: 0,
             real_photos: 0,
             scenes_per_lamp: 0,
-        };
+        }
+    }
+
+    #[test]
+    fn bands_widen_with_the_residual_and_the_expected_gfc_does_not_move() {
+        let cal = test_calibration(vec![400.0, 410.0], Vec::new());
         let (spd, spread) = ([1.0, 0.5], [0.05, 0.05]);
         let plain = cal
             .uncertainty(&spd, &spread, &BTreeMap::new(), Some(0.04))
@@ -592,39 +601,14 @@ mod tests {
         // Expected GFC 1 − e⁻³ (constant regression): 1 − GFC = 0.0498, five times the
         // reference 0.01 (to 0.4 %).
         let gap = (-3.0f64).exp();
-        let cal = TrustCalibration {
-            model: "0".into(),
-            chart: "c".into(),
-            method: "m".into(),
-            wavelength_nm: grid.wavelengths(),
-            floor: vec![0.1; d],
-            scale68: vec![1.0; d],
-            scale95: vec![2.0; d],
-            gfc_model: GfcModel {
-                mean: vec![0.5; d],
-                components: Vec::new(),
-                weights: vec![0.0, -3.0],
-                low: vec![-10.0, 1.0],
-                high: vec![0.0, 1.0],
-                gap_range: [-10.0, 0.0],
-                gap_margin95: 0.0,
-            },
-            residual_reference: Some(0.05),
-            difficulty_doubtful: 1.0,
-            self_check_doubtful: None,
-            metrics: vec![
+        let cal = test_calibration(
+            grid.wavelengths(),
+            vec![
                 metric("cct_k", 0.0, true),
                 metric("cri_ra", 1.0, false),
                 metric("duv", 0.0, false),
             ],
-            split_doubtful: None,
-            colour_gradient_doubtful: None,
-            glare_doubtful: None,
-            two_lights_doubtful: None,
-            clipped_doubtful: 0,
-            real_photos: 0,
-            scenes_per_lamp: 0,
-        };
+        );
         let spreads: BTreeMap<String, f64> = [("cct_k", 30.0), ("cri_ra", 0.5), ("duv", 0.001)]
             .into_iter()
             .map(|(k, v)| (k.to_string(), v))
