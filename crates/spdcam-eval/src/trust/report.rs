@@ -78,7 +78,14 @@ median GFC of estimates of this shape. Spiky, narrow-band estimates come from li
 broadband patches resolve poorly. It replaced the median GFC of five difficulty bins \
 (ρ 0.49 / 0.43 on held-out virtual photos, now 0.76 / 0.76). Scaling its 1 − GFC by the \
 widening (w or w², as 1 − GFC ≈ θ²/2 for an error angle θ) made the Telelumen dev photos' \
-median expected 1 − GFC 0.29 or 0.63 against an actual 0.15; without it, 0.13: not done.\n- **Verdict** (constants in `spdcam_infer::trust`, levels in the calibration file): `doubtful` \
+median expected 1 − GFC 0.29 or 0.63 against an actual 0.15; without it, 0.13: not done. \
+Also tried, not kept: the 95 % margin taken among photos predicted alike (three ranges of \
+the prediction, each its own group-conditional quantile; Vovk et al. 2005, section 4.5). \
+Photos expected to be good turned out to need a wider margin in ln(1 − GFC) than the \
+pooled one (SG ×5.5 and ×6.3 against ×4.4 for expected GFC above 0.98 and 0.95), so fewer \
+came out `ok`: ok with GFC below 0.90 fell (SG held-out virtual 17 → 6, scene 5 → 4; \
+ColorChecker 24 16 → 5, 6 → 2) but so did the ok share (SG scene 58 → 48 %, ColorChecker \
+24 scene 53 → 41 %) and every Hue test photo lost its `ok` (13 → 0 %, mean GFC 0.97).\n- **Verdict** (constants in `spdcam_infer::trust`, levels in the calibration file): `doubtful` \
 when the detection confidence is below 0.8, more feature patches are clipped than in 99 % of \
 the calibration photos, more than a quarter are nearly black, the self-check's mean or split \
 residual, colour gradient, glare or two-lights ratio exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
