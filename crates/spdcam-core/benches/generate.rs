@@ -35,7 +35,7 @@ struct SetUp {
 }
 
 fn set_up(grid: &Grid) -> SetUp {
-    let root = builtin::measured_data_dir();
+    let root = spdcam_test_data::measured_data_dir();
     let data_dir = DataDir::new(Some(root.clone()));
     let thesis = root.join("thesis").is_dir();
     let (camera_name, chart_name, lighting_spec) = if thesis {

@@ -11,15 +11,6 @@ use std::path::{Path, PathBuf};
 /// Environment variable naming the data directory.
 pub const DATA_DIR_ENV: &str = "SPDCAM_DATA";
 
-/// Where the project's own tests and benchmarks find the measured data: [`DATA_DIR_ENV`],
-/// else `shared/data` beside the repository's checkout. Whether it exists is the caller's
-/// question (the second test tier requires it; benchmarks fall back to built-in data).
-pub fn measured_data_dir() -> PathBuf {
-    std::env::var_os(DATA_DIR_ENV)
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"))
-}
-
 /// A built-in spectral table: its name, what it is, and its CSV text.
 #[derive(Debug, Clone, Copy)]
 pub struct BuiltinTable {

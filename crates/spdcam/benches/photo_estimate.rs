@@ -26,7 +26,7 @@ fn main() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let example = image::open(repo.join("examples/sg-telelumen.jpg")).expect("the example photo");
     let jpeg = support::enlarged_jpeg(&example);
-    let data = spdcam_core::builtin::measured_data_dir();
+    let data = spdcam_test_data::measured_data_dir();
     let data_dir = DataDir::new(data.is_dir().then_some(data));
     let estimator = Estimator::shipped(data_dir, Grid::ESTIMATION).expect("the estimator");
     let options = PhotoOptions::default();

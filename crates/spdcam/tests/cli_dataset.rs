@@ -226,7 +226,7 @@ fn generated_features_equal_spdcam_render_of_their_spd() {
 #[cfg(feature = "measured-data")]
 #[test]
 fn thesis_dev_set_imports_without_losing_a_number() {
-    let root = spdcam_core::builtin::measured_data_dir();
+    let root = spdcam_test_data::measured_data_dir();
     let src = root.join("thesis/measured/telelumen_canon5d4_dev");
     assert!(src.is_dir(), "shared data not found at {}", root.display());
     let dir = scratch("import");

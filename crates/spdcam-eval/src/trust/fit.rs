@@ -194,9 +194,9 @@ pub fn fit_calibration(
     })
 }
 
-/// Metrics whose intervals may be shares of the estimate's value
-/// ([`MetricCalibration::relative`]): CCT, whose errors grow with it.
-const MAY_BE_RELATIVE: [&str; 1] = ["cct_k"];
+/// Metrics whose intervals are judged by their width as a share of the estimate when the
+/// calibration chooses among them ([`fit_metric`]): CCT, whose goal is one in per cent.
+const WIDTH_AS_SHARE: [&str; 1] = ["cct_k"];
 /// Powers of the expected 1 − GFC in a metric's floor that the calibration chooses among
 /// ([`MetricCalibration::gap_power`]); 0 is one floor for every photo.
 const GAP_POWERS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
@@ -218,27 +218,25 @@ struct MetricPhoto {
 }
 
 /// The calibration of metric `key` on `photos` (none below [`MIN_METRIC_PHOTOS`]): for each
-/// power of the expected 1 − GFC in the floor ([`GAP_POWERS`]), and for CCT in kelvin and in
-/// shares of the estimate ([`MAY_BE_RELATIVE`]), the floor (median of |error| / (widening ·
-/// gap factor)) and the group-conditional conformal scales; the candidate whose 95 %
-/// intervals are narrowest in the median over the photos is kept, measured in the metric's
-/// unit, or as a share of the estimate where a candidate may be relative. The conformal
-/// quantile holds for any candidate fixed beforehand; choosing among ten on the same photos
-/// costs little coverage, which the report measures on held-out photos.
+/// power of the expected 1 − GFC in the floor ([`GAP_POWERS`]), the floor (median of |error|
+/// / (widening · gap factor)) and the group-conditional conformal scales; the power whose 95 %
+/// intervals are narrowest in the median over the photos is kept (for CCT as a share of the
+/// estimate, [`WIDTH_AS_SHARE`]). The conformal quantile holds for any power fixed
+/// beforehand; choosing among five on the same photos costs little coverage, which the
+/// report measures on held-out photos.
 fn fit_metric(key: &str, photos: &[MetricPhoto]) -> Option<MetricCalibration> {
-    let may_be_relative = MAY_BE_RELATIVE.contains(&key);
-    // A relative candidate needs the estimate's value; photos without one are left out.
+    let as_share = WIDTH_AS_SHARE.contains(&key);
+    // A width as a share needs the estimate's value; photos without one are left out.
     let photos: Vec<&MetricPhoto> = photos
         .iter()
-        .filter(|p| !may_be_relative || (p.value > 0.0 && p.value.is_finite()))
+        .filter(|p| !as_share || (p.value > 0.0 && p.value.is_finite()))
         .collect();
     if photos.len() < MIN_METRIC_PHOTOS {
         return None;
     }
     let mut gaps: Vec<f64> = photos.iter().map(|p| p.expected_gap).collect();
     let gap_reference = median(&mut gaps).max(f64::EPSILON);
-    let candidate = |gap_power: f64, relative: bool| -> (f64, MetricCalibration) {
-        let size = |p: &MetricPhoto| if relative { p.value } else { 1.0 };
+    let candidate = |gap_power: f64| -> (f64, MetricCalibration) {
         let mut m = MetricCalibration {
             key: key.to_string(),
             floor: 1.0,
@@ -247,19 +245,17 @@ fn fit_metric(key: &str, photos: &[MetricPhoto]) -> Option<MetricCalibration> {
             photos: photos.len(),
             gap_power,
             gap_reference,
-            relative,
         };
         m.floor = median(
             &mut photos
                 .iter()
-                .map(|p| p.error / size(p) / (p.widening * m.gap_factor(p.expected_gap)))
+                .map(|p| p.error / (p.widening * m.gap_factor(p.expected_gap)))
                 .collect::<Vec<_>>(),
         )
         .max(f64::EPSILON);
-        // Each photo's unit in the metric's own unit.
         let units: Vec<f64> = photos
             .iter()
-            .map(|p| m.unit(p.spread / size(p), p.expected_gap, p.widening) * size(p))
+            .map(|p| m.unit(p.spread, p.expected_gap, p.widening))
             .collect();
         let ratios: Vec<(f64, PhotoKind)> = photos
             .iter()
@@ -272,24 +268,15 @@ fn fit_metric(key: &str, photos: &[MetricPhoto]) -> Option<MetricCalibration> {
             &mut photos
                 .iter()
                 .zip(&units)
-                .map(|(p, u)| {
-                    let shown = if may_be_relative { p.value } else { 1.0 };
-                    u * m.scale95 / shown
-                })
+                .map(|(p, u)| u * m.scale95 / if as_share { p.value } else { 1.0 })
                 .collect::<Vec<_>>(),
         );
         (width, m)
     };
-    let relative_choices: &[bool] = if may_be_relative {
-        &[false, true]
-    } else {
-        &[false]
-    };
-    // The narrowest; a tie keeps the one tried first (in kelvin, the smaller power).
-    relative_choices
+    // The narrowest; a tie keeps the smaller power (tried first).
+    GAP_POWERS
         .iter()
-        .flat_map(|&relative| GAP_POWERS.iter().map(move |&power| (power, relative)))
-        .map(|(power, relative)| candidate(power, relative))
+        .map(|&power| candidate(power))
         .fold(
             None,
             |best: Option<(f64, MetricCalibration)>, c| match best {
@@ -633,7 +620,6 @@ mod tests {
         let photos = metric_photos(|gap, i| 50.0 * gap * cycle(i));
         let m = fit_metric("cri_ra", &photos).expect("enough photos");
         assert_eq!(m.gap_power, 1.0);
-        assert!(!m.relative);
         let mut gaps: Vec<f64> = photos.iter().map(|p| p.expected_gap).collect();
         assert!((m.gap_reference - median(&mut gaps)).abs() < 1e-15);
         let held = photos
@@ -651,30 +637,6 @@ mod tests {
         assert_eq!(flat.gap_factor(0.5), 1.0);
         // Too few photos: no interval.
         assert!(fit_metric("cri_ra", &photos[..MIN_METRIC_PHOTOS - 1]).is_none());
-    }
-
-    #[test]
-    fn a_cct_interval_is_a_share_of_the_estimate_where_its_errors_grow_with_it() {
-        // Errors of 2–5 % of the value: in shares of it they are narrow.
-        let cycle = |i: usize| 0.02 + 0.03 * ((i * 37) % 100) as f64 / 99.0;
-        let mut photos = metric_photos(|_, _| 0.0);
-        for (i, p) in photos.iter_mut().enumerate() {
-            p.value = 1000.0 * 1.02f64.powi((i % 100) as i32);
-            p.error = p.value * cycle(i);
-        }
-        let m = fit_metric("cct_k", &photos).expect("enough photos");
-        assert!(m.relative && m.gap_power == 0.0, "{m:?}");
-        assert!((0.02..0.05).contains(&m.floor), "{}", m.floor);
-        // Errors of the same size in kelvin whatever the value: kelvin.
-        for (i, p) in photos.iter_mut().enumerate() {
-            p.error = 100.0 * cycle(i);
-        }
-        assert!(!fit_metric("cct_k", &photos).unwrap().relative);
-        // Any other metric stays in its own unit.
-        for (i, p) in photos.iter_mut().enumerate() {
-            p.error = p.value * cycle(i);
-        }
-        assert!(!fit_metric("cri_ra", &photos).unwrap().relative);
     }
 
     #[test]

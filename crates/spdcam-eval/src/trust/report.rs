@@ -64,12 +64,13 @@ scaled by the conformal quantiles of |error|/((floor·g + spread)·w). The floor
 expected GFC: g = ((1 − expected GFC) / its median on the calibration photos)^p, so that an \
 estimate the calibration expects to be good gets a narrower interval and a poor one a wider \
 (a locally weighted conformal interval, Lei et al. 2018, section 5.2); the floor itself is \
-the median of |error|/(g·w). CCT may instead be measured in shares of the estimated CCT \
-(its errors grow with it, as a step in mireds is alike across the scale). Per metric, the \
-power p (0, ¼, ½, ¾ or 1; 0 is one floor for every photo) and, for CCT, kelvin or shares \
-are chosen as the candidate whose 95 % intervals are narrowest in the median over the \
-calibration photos (CCT's in per cent of the estimate); the calibration file records the \
-choice. Estimates print the 95 % half-width: \"Ra 82 ± 4\".\n\
+the median of |error|/(g·w). Per metric, the power p (0, ¼, ½, ¾ or 1; 0 is one floor for \
+every photo) is chosen as the one whose 95 % intervals are narrowest in the median over the \
+calibration photos (CCT's in per cent of the estimate); the calibration file records it. \
+Measuring CCT's error in shares of the estimated CCT instead was tried: fixed beforehand it \
+widened the SG's intervals (scene photos ± 1,223 K, Telelumen/Canon ± 22,500 K), and offered \
+to the same choice it was never taken, so it is gone. Estimates print the 95 % half-width: \
+\"Ra 82 ± 4\".\n\
 - **Expected GFC.** A ridge regression of ln(1 − GFC) on ln(difficulty) and the estimate's \
 coordinates on the first principal components of the calibration photos' estimates \
 (`spdcam_infer::trust::GfcModel`; the number of components, 0–12, and the penalty by \
@@ -201,7 +202,11 @@ fn measure_row(
                 c.in95 += usize::from(err <= interval.half95);
                 c.total += 1;
                 c.half95.push(interval.half95);
-                if let Some(value) = j.metric_value.get(key).filter(|v| **v != 0.0) {
+                if let Some(value) = j
+                    .metric_value
+                    .get(key)
+                    .filter(|v| SHARE_SHOWN.contains(&key.as_str()) && **v != 0.0)
+                {
                     c.share95.push(interval.half95 / value.abs());
                 }
             }
@@ -465,8 +470,7 @@ impl TrustReport {
              also as a share of the estimated CCT). Each interval is the metric's spread over the \
              perturbed copies plus a floor that follows the expected GFC (its power chosen per \
              metric on the calibration photos: the narrowest intervals), times the photo's \
-             widening, scaled by the calibration's conformal quantiles; CCT's in kelvin or in shares \
-             of the estimated CCT, as the calibration chose.\n\n",
+             widening, scaled by the calibration's conformal quantiles.\n\n",
         );
         let mut corrections_md = String::from(
             "## The photo's own corrections\n\n\

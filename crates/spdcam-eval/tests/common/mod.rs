@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 /// The measured data: `$SPDCAM_DATA`, else `../shared/data` beside the repository.
 pub fn data_dir() -> PathBuf {
-    let dir = spdcam_core::builtin::measured_data_dir();
+    let dir = spdcam_test_data::measured_data_dir();
     assert!(
         dir.join("lamps").is_dir() && dir.join("cameras").is_dir(),
         "measured data not found at {}: set SPDCAM_DATA",

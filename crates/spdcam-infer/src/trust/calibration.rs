@@ -6,7 +6,6 @@ use super::self_check::SelfCheck;
 use crate::error::{InferError, Result};
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
-use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Grid, Spd};
 use std::collections::BTreeMap;
 
@@ -83,11 +82,6 @@ pub struct MetricCalibration {
     /// The calibration photos' median expected 1 − GFC, where the gap factor is 1.
     #[serde(default)]
     pub gap_reference: f64,
-    /// Whether error, spread and floor are shares of the estimate's value rather than in the
-    /// metric's unit (CCT: an error of a few per cent is hundreds of kelvin at 6500 K and
-    /// tens at 2700 K, as a step in mireds is alike across the scale).
-    #[serde(default)]
-    pub relative: bool,
 }
 
 /// The smallest expected 1 − GFC the floor's gap factor uses.
@@ -106,8 +100,7 @@ impl MetricCalibration {
     }
 
     /// The unit of the conformal scaling of one photo: (floor · gap factor + spread) ·
-    /// widening, with `spread` in the calibration's units (a share of the estimate's value
-    /// where it is [`relative`](Self::relative)).
+    /// widening.
     pub fn unit(&self, spread: f64, expected_gap: f64, widening: f64) -> f64 {
         (self.floor * self.gap_factor(expected_gap) + spread) * widening
     }
@@ -393,11 +386,6 @@ impl TrustCalibration {
         };
         let difficulty = spread.iter().sum::<f64>() / d as f64;
         let expected_gfc = self.gfc_model.expected(spd, difficulty);
-        let values = self
-            .metrics
-            .iter()
-            .any(|m| m.relative)
-            .then(|| LightingMetrics::from_samples(&grid.wavelengths(), spd));
         Ok(Uncertainty {
             band68: band(&self.scale68)?,
             band95: band(&self.scale95)?,
@@ -410,15 +398,7 @@ impl TrustCalibration {
                 .iter()
                 .filter_map(|m| {
                     let s = *metric_spread.get(&m.key)?;
-                    // A relative metric's interval is a share of the estimate's value.
-                    let size = match (&values, m.relative) {
-                        (Some(v), true) => v.scalar(&m.key)?.abs(),
-                        _ => 1.0,
-                    };
-                    if size <= 0.0 || !size.is_finite() {
-                        return None;
-                    }
-                    let unit = m.unit(s / size, 1.0 - expected_gfc, widening) * size;
+                    let unit = m.unit(s, 1.0 - expected_gfc, widening);
                     Some((
                         m.key.clone(),
                         MetricInterval {
@@ -577,18 +557,8 @@ mod tests {
     }
 
     #[test]
-    fn metric_intervals_follow_the_expected_gfc_and_a_relative_one_the_value() {
-        let grid = Grid::from_parts(400.0, 10.0, 31).unwrap();
-        let d = grid.count;
-        let spd = spdcam_core::spectral::normalise_by_max(
-            spdcam_core::cie_illuminant::planck(3000.0, &grid)
-                .unwrap()
-                .values(),
-        );
-        let cct = LightingMetrics::from_samples(&grid.wavelengths(), &spd)
-            .cct_k
-            .unwrap();
-        let metric = |key: &str, gap_power: f64, relative: bool| MetricCalibration {
+    fn metric_intervals_follow_the_expected_gfc() {
+        let metric = |key: &str, gap_power: f64| MetricCalibration {
             key: key.into(),
             floor: 0.02,
             scale68: 1.0,
@@ -596,42 +566,34 @@ mod tests {
             photos: 100,
             gap_power,
             gap_reference: 0.01,
-            relative,
         };
         // Expected GFC 1 − e⁻³ (constant regression): 1 − GFC = 0.0498, five times the
-        // reference 0.01 (to 0.4 %).
+        // reference 0.01.
         let gap = (-3.0f64).exp();
         let cal = test_calibration(
-            grid.wavelengths(),
-            vec![
-                metric("cct_k", 0.0, true),
-                metric("cri_ra", 1.0, false),
-                metric("duv", 0.0, false),
-            ],
+            vec![400.0, 410.0],
+            vec![metric("cri_ra", 1.0), metric("duv", 0.0)],
         );
-        let spreads: BTreeMap<String, f64> = [("cct_k", 30.0), ("cri_ra", 0.5), ("duv", 0.001)]
+        let spreads: BTreeMap<String, f64> = [("cri_ra", 0.5), ("duv", 0.001)]
             .into_iter()
             .map(|(k, v)| (k.to_string(), v))
             .collect();
         // Widening 2 (residual 0.1 over 0.05).
         let u = cal
-            .uncertainty(&spd, &vec![0.0; d], &spreads, Some(0.1))
+            .uncertainty(&[1.0, 0.5], &[0.0; 2], &spreads, Some(0.1))
             .unwrap();
-        // CCT: a share of the estimate's value, 2 × (0.02 + 30 / CCT) × 2 × CCT.
-        let want = 2.0 * (0.02 * cct + 30.0) * 2.0;
-        assert!((u.metrics["cct_k"].half95 - want).abs() < 1e-9 * want);
-        assert!((u.metrics["cct_k"].half68 - want / 2.0).abs() < 1e-9 * want);
         // Ra: its floor scaled by (gap / reference)¹.
         let want = 2.0 * (0.02 * gap / 0.01 + 0.5) * 2.0;
         assert!((u.metrics["cri_ra"].half95 - want).abs() < 1e-12);
-        // Duv: one floor, in its own unit, as calibrations made before the power read.
+        assert!((u.metrics["cri_ra"].half68 - want / 2.0).abs() < 1e-12);
+        // Duv: one floor, as calibrations made before the power read.
         assert!((u.metrics["duv"].half95 - 2.0 * 0.021 * 2.0).abs() < 1e-12);
         let old = r#"{"key":"duv","floor":0.02,"scale68":1.0,"scale95":2.0,"photos":9}"#;
         let read: MetricCalibration = serde_json::from_str(old).unwrap();
         let want = MetricCalibration {
             gap_reference: 0.0,
             photos: 9,
-            ..metric("duv", 0.0, false)
+            ..metric("duv", 0.0)
         };
         assert_eq!(read, want);
     }

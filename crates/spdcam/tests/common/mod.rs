@@ -92,7 +92,7 @@ pub fn s(p: &Path) -> String {
 /// the repository. Only the second tier (`--features spdcam/measured-data`) has it.
 #[cfg(feature = "measured-data")]
 pub fn data_dir() -> PathBuf {
-    let root = spdcam_core::builtin::measured_data_dir();
+    let root = spdcam_test_data::measured_data_dir();
     assert!(root.is_dir(), "shared data not found at {}", root.display());
     root
 }
