@@ -68,6 +68,7 @@
 pub mod absolute;
 pub mod chromaticity;
 pub mod colour_head;
+pub mod colour_map;
 pub mod error;
 pub mod estimate;
 pub mod estimator;

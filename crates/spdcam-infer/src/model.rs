@@ -13,6 +13,7 @@
 //! Reading checks all of it, so a wrong, damaged or incompatible file is an error naming what
 //! is wrong, never a panic.
 
+use crate::colour_map::ColourMap;
 use crate::error::{InferError, Result};
 use crate::network::{Architecture, Network, Parameter};
 use crate::record::TrainingRecord;
@@ -67,6 +68,10 @@ pub struct ModelHeader {
     pub target: Target,
     /// Target scaling.
     pub target_scaler: TargetScaler,
+    /// A correction of the light's colour fitted on validation photos after training
+    /// (`spdcam colour-map fit`); `None`: the spectrum as the network gives it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour_map: Option<ColourMap>,
     /// The grid of the estimated SPDs.
     pub grid: Grid,
     /// How it was trained.
@@ -138,6 +143,7 @@ impl Model {
             feature_scaler,
             target,
             target_scaler,
+            colour_map: None,
             grid,
             training,
             tensors: network
@@ -185,6 +191,13 @@ impl Model {
             if b.grid != a.grid || b.chart != a.chart || b.camera != a.camera {
                 return differs("grid, chart or camera");
             }
+            if b.colour_map.is_some() {
+                return Err(InferError::invalid(format!(
+                    "member {} carries a colour map; average the models without one, then \
+                     fit a map to the average (`spdcam colour-map fit`)",
+                    i + 1
+                )));
+            }
             network_list.push(m.network.clone());
         }
         let network = Network::average(&network_list)?;
@@ -230,6 +243,14 @@ impl Model {
                 h.target_scaler.width()
             )));
         }
+        if let Some(map) = &h.colour_map {
+            if h.target.pca().is_none() {
+                return Err(InferError::invalid(
+                    "the model's colour map needs a PCA target; its target is channel weights",
+                ));
+            }
+            map.validate(h.grid.count)?;
+        }
         if h.target.spd_len() != h.grid.count {
             return Err(InferError::invalid(format!(
                 "the model's SPDs have {} values for a grid of {} ({})",
@@ -256,21 +277,42 @@ impl Model {
         }
     }
 
+    /// Sets (or, with `None`, removes) the correction of the light's colour
+    /// ([`ColourMap`]); an error for a model without a PCA target or a map for another grid.
+    pub fn set_colour_map(&mut self, map: Option<ColourMap>) -> Result<()> {
+        let before = std::mem::replace(&mut self.header.colour_map, map);
+        if let Err(e) = self.validate() {
+            self.header.colour_map = before;
+            return Err(e);
+        }
+        Ok(())
+    }
+
     /// The header (everything but the weights).
     pub fn header(&self) -> &ModelHeader {
         &self.header
     }
 
-    /// FNV-1a 64 of the network's parameter values (f32 LE, in order), as 16 hex digits:
-    /// tells this model's weights from another's, so a calibration is used only for the
-    /// model it was measured on.
+    /// FNV-1a 64 of the network's parameter values (f32 LE, in order) and, where the model
+    /// has one, of its colour map's numbers (f64 LE), as 16 hex digits: tells this model's
+    /// estimates from another's, so a calibration is used only for the model it was
+    /// measured on.
     pub fn fingerprint(&self) -> String {
-        let bytes: Vec<u8> = self
+        let mut bytes: Vec<u8> = self
             .network
             .parameters()
             .iter()
             .flat_map(|p| p.data.iter().flat_map(|v| v.to_le_bytes()))
             .collect();
+        if let Some(map) = &self.header.colour_map {
+            let numbers = [
+                map.mired.slope,
+                map.mired.offset,
+                map.duv.slope,
+                map.duv.offset,
+            ];
+            bytes.extend(numbers.iter().flat_map(|v| v.to_le_bytes()));
+        }
         format!("{:016x}", fnv1a(&bytes))
     }
 
@@ -385,7 +427,9 @@ impl Model {
         let decode = |(out, spd): (&[f32], &mut [f64])| {
             let mut t = vec![0.0; k];
             self.header.target_scaler.unscale_into(out, &mut t);
-            self.header.target.decode_into(&t, spd);
+            self.header
+                .target
+                .decode_into(&t, spd, self.header.colour_map.as_ref());
         };
         if rows > 512 {
             outputs

@@ -5,6 +5,7 @@
 //! training data.
 
 use crate::colour_head::ColourHead;
+use crate::colour_map::ColourMap;
 use crate::error::{InferError, Result};
 use crate::pca::{Components, Pca};
 use faer::{linalg::solvers::Solve, Mat, Side};
@@ -86,15 +87,26 @@ impl Target {
         }
     }
 
-    /// The (relative, max-normalised, non-negative) SPD for one row of targets.
-    pub fn decode_into(&self, targets: &[f64], spd: &mut [f64]) {
+    /// The (relative, max-normalised, non-negative) SPD for one row of targets, its colour
+    /// corrected by `map` where given (a PCA target only: [`ColourMap::correct`]).
+    pub fn decode_into(&self, targets: &[f64], spd: &mut [f64], map: Option<&ColourMap>) {
         match self {
-            Target::Pca(p) => spd.copy_from_slice(&p.reconstruct(targets)),
+            Target::Pca(p) => match map {
+                Some(map) => {
+                    let mut coefficients = targets.to_vec();
+                    map.correct(p, &mut coefficients);
+                    spd.copy_from_slice(&p.reconstruct(&coefficients));
+                }
+                None => spd.copy_from_slice(&p.reconstruct(targets)),
+            },
             Target::PcaColour(p) => {
                 let k = p.pca.len();
                 let mut coefficients = targets[..k].to_vec();
                 p.colour
                     .conform(&p.pca, &mut coefficients, [targets[k], targets[k + 1]]);
+                if let Some(map) = map {
+                    map.correct(&p.pca, &mut coefficients);
+                }
                 spd.copy_from_slice(&p.pca.reconstruct(&coefficients));
             }
             Target::Weights(c) => {
@@ -229,7 +241,7 @@ impl Channels {
         let mut sq = 0.0;
         let mut spd = vec![0.0; d];
         for i in 0..n {
-            target.decode_into(&weights[i * k..(i + 1) * k], &mut spd);
+            target.decode_into(&weights[i * k..(i + 1) * k], &mut spd, None);
             sq += spd
                 .iter()
                 .zip(&spds[i * d..(i + 1) * d])

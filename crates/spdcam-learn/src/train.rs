@@ -231,7 +231,7 @@ fn score(fitted: &Fitted, outputs: &[f32], y: &[f32], spds: &[f64]) -> Result<(f
         fitted
             .targets
             .unscale_into(&outputs[r * k..(r + 1) * k], &mut t);
-        fitted.target.decode_into(&t, &mut spd);
+        fitted.target.decode_into(&t, &mut spd, None);
         gfc += spectral_error::gfc(&spds[r * d..(r + 1) * d], &spd)?;
     }
     Ok((mse, gfc / rows.max(1) as f64))

@@ -57,6 +57,7 @@ const OUTPUTS: &[(&str, &str, Output)] = &[
     ("experiment thesis", "output", Output::Directory),
     ("experiment real-cameras", "output", Output::File),
     ("experiment colour", "output", Output::File),
+    ("experiment colour", "photos_csv", Output::File),
     ("calibrate", "output", Output::File),
     ("sim2real", "output", Output::File),
     ("coverage", "output", Output::File),
@@ -64,6 +65,7 @@ const OUTPUTS: &[(&str, &str, Output)] = &[
     ("lamps split", "output", Output::File),
     ("lamps fit", "output", Output::File),
     ("light-kinds fit", "output", Output::File),
+    ("colour-map fit", "output", Output::File),
     ("lamps validate", "output", Output::File),
     ("trust calibrate", "output", Output::AddsFilesTo),
     ("trust report", "output", Output::File),
@@ -237,7 +239,7 @@ mod tests {
     fn the_output_table_names_every_output_argument_and_only_those() {
         // Argument ids that write wherever they appear; `features` writes in `render`
         // only (elsewhere it is an input), so the table is checked for it by hand below.
-        const WRITES: [&str; 11] = [
+        const WRITES: [&str; 12] = [
             "output",
             "log",
             "plot",
@@ -249,6 +251,7 @@ mod tests {
             "misses",
             "reliability",
             "per_lamp",
+            "photos_csv",
         ];
         let mut all = Vec::new();
         leaves(&crate::Cli::command(), String::new(), &mut all);

@@ -8,6 +8,7 @@ mod args;
 #[cfg(feature = "train")]
 mod average;
 mod calibrate;
+mod colour_map;
 mod command_paths;
 mod coverage;
 mod dataset;
@@ -95,6 +96,8 @@ enum Command {
     Lamps(lamps::LampsArgs),
     /// The kinds of light `estimate --light` takes, and each model's priors for them.
     LightKinds(light_kinds::LightKindsArgs),
+    /// A model's correction of the light's colour, fitted on validation photos.
+    ColourMap(colour_map::ColourMapArgs),
     /// Calibrate and measure how far estimates can be trusted (bands, verdicts).
     Trust(trust::TrustArgs),
 }
@@ -158,6 +161,7 @@ fn main() -> ExitCode {
         Command::Coverage(args) => coverage::run(*args, &data_dir),
         Command::Lamps(args) => lamps::run(args, &data_dir),
         Command::LightKinds(args) => light_kinds::run(args, &data_dir),
+        Command::ColourMap(args) => colour_map::run(args, &data_dir),
         Command::Trust(args) => trust::run(args, &data_dir),
     };
     match result {

@@ -157,6 +157,36 @@ fn render_outputs_onto_inputs_or_each_other_are_refused() {
 }
 
 #[test]
+fn a_colour_map_written_onto_its_model_is_refused() {
+    let dir = scratch("colour-map");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let model = dir.join("m.spdm");
+    let split = dir.join("split.json");
+    std::fs::copy(repo.join("models/colorchecker24.spdm"), &model).unwrap();
+    std::fs::copy(repo.join("docs/validation-split.json"), &split).unwrap();
+    let (m, sp) = (s(&model), s(&split));
+    refused_and_nothing_touched(
+        &dir,
+        &["colour-map", "fit", "--model", &m, "--split", &sp, "-o", &m],
+        &["--model"],
+    );
+    refused_and_nothing_touched(
+        &dir,
+        &[
+            "colour-map",
+            "fit",
+            "--model",
+            &m,
+            "--split",
+            &sp,
+            "-o",
+            &sp,
+        ],
+        &["--split"],
+    );
+}
+
+#[test]
 fn spd_out_dash_is_standard_output_and_outputs_that_cannot_be_are_refused() {
     let dir = scratch("dash");
     let png = s(&dir.join("a.png"));

@@ -17,6 +17,7 @@
 //! writes them.
 
 pub mod lights;
+pub mod map_fit;
 pub mod photos;
 mod report;
 pub mod score;
@@ -110,6 +111,8 @@ pub struct ModelColour {
     pub calibrated: bool,
     /// Per group of lights.
     pub rows: Vec<ModelRow>,
+    /// Every photo scored: (a) scene photos, (b) patch-level photos.
+    pub photos: [Vec<PhotoScore>; 2],
 }
 
 /// The colour protocol's results.
@@ -119,6 +122,10 @@ pub struct ColourReport {
     pub models: Vec<ModelColour>,
     /// The constant and the truncated truth, per group, on [`Grid::ESTIMATION`].
     pub baselines: Vec<BaselineRow>,
+    /// The lights photographed, as [`PhotoScore::light`] counts them.
+    pub lights: Vec<Light>,
+    /// The held-out cameras' names, as [`PhotoScore::camera`] counts them.
+    pub camera_names: Vec<String>,
     /// Scene photos of each lamp, of each reference, and patch-level photos of each light.
     pub photos: [u64; 3],
     /// How many held-out cameras took them.
@@ -272,6 +279,7 @@ impl ColourReport {
                     light_named,
                     calibrated,
                     rows: rows(&groups, &lights, [&a, &b])?,
+                    photos: [a, b],
                 });
             }
         }
@@ -282,6 +290,8 @@ impl ColourReport {
         Ok(ColourReport {
             models,
             baselines: rows(&groups, &lights, [&baselines[0], &baselines[1]])?,
+            camera_names: setup.cameras.iter().map(|c| c.name.clone()).collect(),
+            lights,
             photos: [
                 held_out.shots,
                 options.reference_photos,
@@ -309,6 +319,7 @@ fn baselines(spds: &[Spd], fit: &[usize], lights: &[Light]) -> Result<[Vec<Photo
         for (k, spd) in [&constant, &truncated].into_iter().enumerate() {
             out[k].push(PhotoScore {
                 light: j,
+                camera: None,
                 estimate: Some(Scored::spd(spd, light)?),
             });
         }

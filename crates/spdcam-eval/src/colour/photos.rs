@@ -30,6 +30,8 @@ pub const SCENE_SIZE: (usize, usize) = (1200, 900);
 pub struct PhotoScore {
     /// Which of the protocol's lights it shows.
     pub light: usize,
+    /// Which of the held-out cameras took it (`None` for a baseline, which no camera takes).
+    pub camera: Option<usize>,
     /// The scoring of the estimate; `None`: refused (no chart found).
     pub estimate: Option<Scored>,
 }
@@ -131,6 +133,7 @@ impl Shoot<'_> {
             .map(|(g, j)| {
                 let light = &self.lights[j].0;
                 let camera = &pool[g % pool.len()];
+                let camera_index = g % pool.len();
                 let shot_seed = seed::derive(self.seed, g as u64);
                 let shot = scene::photograph(
                     camera,
@@ -144,7 +147,11 @@ impl Shoot<'_> {
                         Ok(e) => Some(Scored::of(&e, light)?),
                         Err(_) => None,
                     };
-                Ok(PhotoScore { light: j, estimate })
+                Ok(PhotoScore {
+                    light: j,
+                    camera: Some(camera_index),
+                    estimate,
+                })
             })
             .collect()
     }
@@ -163,8 +170,14 @@ impl Shoot<'_> {
         let jobs = self.jobs();
         let mut values = Vec::with_capacity(jobs.len() * names.len());
         let (mut raw, mut out) = (Vec::new(), Vec::new());
+        let mut taken_by = Vec::with_capacity(jobs.len());
         for (g, &j) in jobs.iter().enumerate() {
             let (camera, ic) = randomisation.draw(self.seed, g as u64);
+            taken_by.push(
+                self.cameras
+                    .iter()
+                    .position(|c| c.name == camera.camera_name()),
+            );
             let light = camera.light(&self.lights[j].0.spd)?;
             out.clear();
             camera.features_fast_with(ic.as_ref(), &light, &mut raw, &mut out);
@@ -196,9 +209,11 @@ impl Shoot<'_> {
                 }
                 estimates
                     .iter()
-                    .map(|e| {
+                    .zip(&taken_by[first..first + n])
+                    .map(|(e, &camera)| {
                         Ok(PhotoScore {
                             light: j,
+                            camera,
                             estimate: Some(Scored::of(e, light)?),
                         })
                     })

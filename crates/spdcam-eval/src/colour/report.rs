@@ -3,6 +3,7 @@
 
 use super::lights::LightSet;
 use super::{ColourReport, Group, ModelColour, Row, Summary, CCT_MAX_DUV};
+use crate::error::EvalError;
 use crate::held_out::file_name;
 use spdcam_core::light_families::LampType;
 use spdcam_core::spectral::Grid;
@@ -84,7 +85,74 @@ impl ModelColour {
     }
 }
 
+/// The columns of [`ColourReport::photos_csv`].
+const PHOTO_COLUMNS: [&str; 17] = [
+    "model",
+    "light_named",
+    "photo",
+    "set",
+    "light",
+    "lamp_type",
+    "camera",
+    "refused",
+    "gfc",
+    "true_u_prime",
+    "true_v_prime",
+    "estimate_u_prime",
+    "estimate_v_prime",
+    "delta_uv_prime",
+    "true_cct_k",
+    "estimate_cct_k",
+    "ok",
+];
+
 impl ColourReport {
+    /// Every photo of every model as CSV, a row each (the columns of [`PHOTO_COLUMNS`]):
+    /// what the tables summarise, for a study of its own (empty cells where a photo was
+    /// refused or a CCT is not scored).
+    pub fn photos_csv(&self) -> crate::error::Result<String> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let fail = |e: csv::Error| EvalError::invalid(format!("the photos' CSV: {e}"));
+        w.write_record(PHOTO_COLUMNS).map_err(fail)?;
+        let number = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v}"));
+        for m in &self.models {
+            for (k, photos) in m.photos.iter().enumerate() {
+                for p in photos {
+                    let light = &self.lights[p.light];
+                    let e = p.estimate.as_ref();
+                    let c = e.map(|e| &e.colour);
+                    let record = [
+                        file_name(&m.model),
+                        m.light_named.to_string(),
+                        ["scene", "patch"][k].to_string(),
+                        light.set.label().to_string(),
+                        light.name.clone(),
+                        light.kind.map_or(String::new(), |t| t.label().to_string()),
+                        p.camera
+                            .and_then(|i| self.camera_names.get(i))
+                            .cloned()
+                            .unwrap_or_default(),
+                        e.is_none().to_string(),
+                        number(e.map(|e| e.gfc)),
+                        number(c.map(|c| c.true_uv_prime[0])),
+                        number(c.map(|c| c.true_uv_prime[1])),
+                        number(c.map(|c| c.estimate_uv_prime[0])),
+                        number(c.map(|c| c.estimate_uv_prime[1])),
+                        number(c.map(|c| c.delta_uv_prime)),
+                        number(c.and_then(|c| c.true_cct)),
+                        number(c.and_then(|c| c.estimate_cct)),
+                        e.is_some_and(|e| e.ok).to_string(),
+                    ];
+                    w.write_record(&record).map_err(fail)?;
+                }
+            }
+        }
+        let bytes = w
+            .into_inner()
+            .map_err(|e| EvalError::invalid(format!("the photos' CSV: {e}")))?;
+        String::from_utf8(bytes).map_err(|e| EvalError::invalid(format!("the photos' CSV: {e}")))
+    }
+
     /// The results as the Markdown `spdcam experiment colour` writes.
     pub fn markdown(&self) -> String {
         let mut md = String::from("## Summary: every light of each set\n\n");
@@ -243,8 +311,11 @@ mod tests {
                 light_named: false,
                 calibrated: false,
                 rows: vec![row([summary(Some((0.04, 0.9))), summary(None)])],
+                photos: [Vec::new(), Vec::new()],
             }],
             baselines: vec![row([summary(None), summary(None)])],
+            lights: Vec::new(),
+            camera_names: Vec::new(),
             photos: [2, 4, 8],
             cameras: 13,
             seed: 1,
@@ -260,5 +331,77 @@ mod tests {
         assert!(md.contains("carry no CCT interval"));
         assert!(md.contains("the split's 13 held-out cameras"));
         assert!(md.contains("Baselines, over 400–700 nm"));
+    }
+
+    #[test]
+    fn every_photo_is_a_csv_row_with_empty_cells_where_nothing_was_scored() {
+        use crate::colour::lights::Light;
+        use crate::colour::photos::{PhotoScore, Scored};
+        use crate::colour::score::ColourScore;
+        use spdcam_core::cie_illuminant::planck;
+        use spdcam_core::light_families::LightKind;
+        let light = Light {
+            name: "Lamp, \"warm\"".into(),
+            set: LightSet::Test,
+            kind: Some(LampType::ALL[0]),
+            light_kind: LightKind::Incandescent,
+            spd: planck(3000.0, &Grid::ESTIMATION).unwrap(),
+        };
+        let scored = Scored {
+            gfc: 0.97,
+            colour: ColourScore {
+                delta_uv_prime: 0.005,
+                true_uv_prime: [0.25, 0.52],
+                estimate_uv_prime: [0.245, 0.52],
+                true_cct: Some(3000.0),
+                estimate_cct: None,
+            },
+            ok: true,
+            cct_interval: None,
+        };
+        let report = ColourReport {
+            models: vec![ModelColour {
+                model: PathBuf::from("models/cc24.spdm"),
+                chart: "colorchecker24".into(),
+                light_named: false,
+                calibrated: false,
+                rows: Vec::new(),
+                photos: [
+                    vec![PhotoScore {
+                        light: 0,
+                        camera: Some(1),
+                        estimate: Some(scored),
+                    }],
+                    vec![PhotoScore {
+                        light: 0,
+                        camera: None,
+                        estimate: None,
+                    }],
+                ],
+            }],
+            baselines: Vec::new(),
+            lights: vec![light],
+            camera_names: vec!["cam_a".into(), "cam_b".into()],
+            photos: [1, 1, 1],
+            cameras: 2,
+            seed: 1,
+            skipped: Vec::new(),
+        };
+        let csv = report.photos_csv().unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 3, "{csv}");
+        assert_eq!(lines[0], PHOTO_COLUMNS.join(","));
+        let kind = LampType::ALL[0].label();
+        assert_eq!(
+            lines[1],
+            format!(
+                "cc24.spdm,false,scene,test lamps,\"Lamp, \"\"warm\"\"\",{kind},cam_b,false,\
+                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,true"
+            )
+        );
+        assert_eq!(
+            lines[2],
+            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,false")
+        );
     }
 }

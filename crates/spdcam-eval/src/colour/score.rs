@@ -43,6 +43,10 @@ impl LightColour {
 pub struct ColourScore {
     /// Δu′v′: the Euclidean distance of the two (u′, v′) (CIE 015:2018 §8.1).
     pub delta_uv_prime: f64,
+    /// The true light's (u′, v′).
+    pub true_uv_prime: [f64; 2],
+    /// The estimate's (u′, v′).
+    pub estimate_uv_prime: [f64; 2],
     /// The true light's CCT (K), where it lies within [`CCT_MAX_DUV`] of the locus.
     pub true_cct: Option<f64>,
     /// The estimate's CCT (K), where the truth's is scored and the estimate has one.
@@ -83,6 +87,8 @@ impl ColourScore {
             .map(|(cct, _)| cct);
         ColourScore {
             delta_uv_prime: (a - c).hypot(b - d),
+            true_uv_prime: truth.uv_prime,
+            estimate_uv_prime: estimate.uv_prime,
             true_cct,
             estimate_cct: true_cct.and(estimate.cct_duv.map(|(cct, _)| cct)),
         }

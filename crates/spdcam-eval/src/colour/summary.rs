@@ -137,6 +137,8 @@ mod tests {
             gfc: 0.9,
             colour: ColourScore {
                 delta_uv_prime: 0.01,
+                true_uv_prime: [0.2, 0.5],
+                estimate_uv_prime: [0.21, 0.5],
                 true_cct: Some(truth),
                 estimate_cct: Some(estimate),
             },
@@ -150,18 +152,22 @@ mod tests {
         let scores = [
             PhotoScore {
                 light: 0,
+                camera: None,
                 estimate: Some(scored(3000.0, 3300.0, Some(330.0))),
             },
             PhotoScore {
                 light: 0,
+                camera: None,
                 estimate: Some(scored(4000.0, 3800.0, Some(100.0))),
             },
             PhotoScore {
                 light: 0,
+                camera: None,
                 estimate: None,
             },
             PhotoScore {
                 light: 1,
+                camera: None,
                 estimate: Some(scored(5000.0, 9000.0, None)),
             },
         ];

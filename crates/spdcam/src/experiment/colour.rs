@@ -49,6 +49,10 @@ pub(super) struct ColourArgs {
     /// (repeatable; each used for the model it was fitted to).
     #[arg(long, value_name = "PRIORS.json")]
     light_priors: Vec<PathBuf>,
+    /// Also write every photo's scores as CSV (model, light, camera, GFC, the true and
+    /// estimated u′v′ and CCT, verdict): a row each.
+    #[arg(long, value_name = "FILE.csv")]
+    photos_csv: Option<PathBuf>,
     /// Output Markdown report.
     #[arg(short, long)]
     output: PathBuf,
@@ -116,6 +120,9 @@ pub(super) fn run(args: ColourArgs, data_dir: &DataDir) -> Result<()> {
         report.markdown(),
         args.command_line(reference_photos)
     );
+    if let Some(path) = &args.photos_csv {
+        write_atomic(path, report.photos_csv()?.as_bytes())?;
+    }
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");
     Ok(())
