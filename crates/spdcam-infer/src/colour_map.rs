@@ -140,7 +140,7 @@ impl ColourMap {
         };
         let w = Self::weight(duv);
         let corrected_mired = self.mired.at(mired);
-        if w == 0.0 || !(corrected_mired > 0.0) {
+        if w == 0.0 || corrected_mired <= 0.0 || !corrected_mired.is_finite() {
             return uv_prime;
         }
         let Ok(uv) = cct_duv_to_uv(1e6 / corrected_mired, self.duv.at(duv)) else {
