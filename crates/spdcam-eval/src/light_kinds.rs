@@ -19,6 +19,7 @@ use spdcam_core::dataset::REAL_PHOTO_SETS;
 use spdcam_core::light_families::{LightKind, Lighting, ValidationSplit};
 use spdcam_core::spectral::{normalise_by_max, Grid, Spd};
 use spdcam_core::{seed, spectral_error};
+use spdcam_infer::colour_map::ColourMap;
 use spdcam_infer::kind_prior::{KindPrior, KindPriors, FORMAT, VERSION};
 use spdcam_infer::pca::{Components, Pca};
 use spdcam_infer::Model;
@@ -69,10 +70,12 @@ pub struct Told {
 
 impl Told {
     /// The scores of the model's estimates `estimates` (on `grid`, peak 1) of lights
-    /// `truths` (on `grid`), without and with `kind` named through `priors`.
+    /// `truths` (on `grid`), without and with `kind` named through `priors` (and the model's
+    /// colour `map`, as `estimate --light` names it).
     fn of<'a>(
         kind: LightKind,
         priors: &KindPriors,
+        map: Option<&ColourMap>,
         pairs: impl Iterator<Item = (&'a [f64], &'a [f64])>,
         grid: &Grid,
     ) -> Result<Told> {
@@ -82,7 +85,7 @@ impl Told {
         for (truth, estimate) in pairs {
             unlike.push(f64::from(u8::from(priors.unlike(kind, estimate)?)));
             let truth_spd = Spd::new(*grid, truth.to_vec())?;
-            let told = priors.apply(kind, estimate)?;
+            let told = priors.told(kind, estimate, map)?;
             for (k, spd) in [estimate.to_vec(), told].into_iter().enumerate() {
                 gfc[k].push(spectral_error::gfc(truth, &spd)?);
                 let score = ColourScore::of(&truth_spd, &Spd::new(*grid, spd)?)?;
@@ -163,7 +166,13 @@ pub fn real_checks(
                 set: set.label,
                 kind,
                 photos: photos.spds.len(),
-                told: Told::of(kind, priors, pairs, &grid)?,
+                told: Told::of(
+                    kind,
+                    priors,
+                    model.header().colour_map.as_ref(),
+                    pairs,
+                    &grid,
+                )?,
             })
         })
         .collect()
@@ -301,6 +310,7 @@ impl KindFit {
             checks.push(check(
                 kind,
                 &trial,
+                model.header().colour_map.as_ref(),
                 &truths,
                 &estimates,
                 &grid,
@@ -382,10 +392,12 @@ fn kind_lights(
     })
 }
 
-/// The trial of `priors` (one kind's) on the odd-numbered photos.
+/// The trial of `priors` (one kind's) on the odd-numbered photos, with the model's colour
+/// `map` as `estimate --light` uses it.
 fn check(
     kind: LightKind,
     priors: &KindPriors,
+    map: Option<&ColourMap>,
     truths: &[Vec<f64>],
     estimates: &[&[f64]],
     grid: &Grid,
@@ -400,7 +412,7 @@ fn check(
     Ok(KindCheck {
         kind,
         worst_particle_gfc,
-        told: Told::of(kind, priors, odd, grid)?,
+        told: Told::of(kind, priors, map, odd, grid)?,
     })
 }
 

@@ -163,6 +163,30 @@ impl ColourMap {
         }
     }
 
+    /// `moved` — the model's estimate `estimate` moved by a light-kind prior of PCA `basis`
+    /// ([`crate::kind_prior`]) — given back the estimate's corrected colour as far as the map
+    /// applies to it, its shape the prior's: the prior keeps a daylight a daylight, the map
+    /// says which (the prior's colour comes from lights like the training ones, the map's
+    /// from photos like a user's). Peak 1, nothing below 0.
+    pub fn keep_colour(&self, basis: &Pca, estimate: &[f64], moved: &[f64]) -> Vec<f64> {
+        let (Some(own), Some(now)) = (self.head.uv(estimate), self.head.uv(moved)) else {
+            return moved.to_vec();
+        };
+        let Some((_, duv)) = mired_duv(own) else {
+            return moved.to_vec();
+        };
+        let w = Self::weight(duv);
+        if w == 0.0 {
+            return moved.to_vec();
+        }
+        let mut coefficients = basis.project(moved);
+        let target = [0, 1].map(|i| now[i] + w * (own[i] - now[i]));
+        self.head.conform(basis, &mut coefficients, target);
+        let mut out = basis.reconstruct(&coefficients);
+        spdcam_core::spectral::clip_normalise(&mut out);
+        out
+    }
+
     /// Checks the stored numbers (for a map read from a file) against the model's SPD length.
     pub fn validate(&self, spd_len: usize) -> Result<()> {
         let numbers = [
@@ -303,5 +327,36 @@ mod tests {
             "{before:?} → {after:?}, want {want:?}"
         );
         assert!((after[0] - before[0]).hypot(after[1] - before[1]) > 1e-3);
+    }
+
+    #[test]
+    fn a_prior_keeps_its_shape_and_white_light_the_estimate_colour() {
+        let g = grid();
+        let data: Vec<f64> = (0..40)
+            .flat_map(|i| {
+                let s = planck(2500.0 + 140.0 * i as f64, &g).unwrap();
+                let m = s.values().iter().cloned().fold(0.0, f64::max);
+                s.values().iter().map(|v| v / m).collect::<Vec<_>>()
+            })
+            .collect();
+        let basis = Pca::fit(&data, 61, Components::Count(4)).unwrap();
+        let map = ColourMap::fit(&lattice(), &g, "lattice".into()).unwrap();
+        // The estimate a 3,900 K spectrum, the prior's a 4,460 K one: the result has the
+        // estimate's colour.
+        let (estimate, moved) = (&data[61 * 10..61 * 11], &data[61 * 14..61 * 15]);
+        let kept = map.keep_colour(&basis, estimate, moved);
+        let (want, got) = (map.head.uv(estimate).unwrap(), map.head.uv(&kept).unwrap());
+        assert!(
+            (want[0] - got[0]).hypot(want[1] - got[1]) < 1e-5,
+            "{want:?} {got:?}"
+        );
+        assert_eq!(kept.iter().cloned().fold(0.0, f64::max), 1.0);
+        // A coloured estimate (a green band far above the locus) leaves the prior's as it is.
+        let green: Vec<f64> = g
+            .wavelengths()
+            .iter()
+            .map(|&w| (-((w - 530.0) / 20.0).powi(2)).exp())
+            .collect();
+        assert_eq!(map.keep_colour(&basis, &green, moved), moved.to_vec());
     }
 }

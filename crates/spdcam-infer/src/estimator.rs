@@ -313,10 +313,12 @@ impl Estimator {
         let priors = self.priors()?[index]
             .as_ref()
             .ok_or_else(|| InferError::invalid("the model carries no light-kind priors"))?;
-        let d = self.named(index).model.grid().count;
+        let model = &self.named(index).model;
+        let d = model.grid().count;
+        let map = model.header().colour_map.as_ref();
         let moved = spds
             .par_chunks(d)
-            .map(|spd| priors.apply(self.light, spd))
+            .map(|spd| priors.told(self.light, spd, map))
             .collect::<Result<Vec<_>>>()?;
         Ok(moved.concat())
     }

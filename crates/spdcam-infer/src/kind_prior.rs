@@ -13,6 +13,7 @@
 //!
 //! `spdcam light-kinds fit` makes a model's priors; the shipped models' are built in.
 
+use crate::colour_map::ColourMap;
 use crate::error::{InferError, Result};
 use crate::model::Model;
 use crate::pca::Pca;
@@ -313,6 +314,16 @@ impl KindPriors {
             )));
         }
         Ok(normalise_by_max(&moved))
+    }
+
+    /// [`KindPriors::apply`], then, for a model with a colour map, the estimate's corrected
+    /// colour given back ([`ColourMap::keep_colour`]): what `estimate --light` gives.
+    pub fn told(&self, kind: LightKind, spd: &[f64], map: Option<&ColourMap>) -> Result<Vec<f64>> {
+        let moved = self.apply(kind, spd)?;
+        Ok(match map {
+            Some(map) if kind != LightKind::Unknown => map.keep_colour(&self.basis, spd, &moved),
+            _ => moved,
+        })
     }
 
     /// Whether the model's estimate `spd` lies farther from every light of `kind` than 99 %
