@@ -219,6 +219,20 @@ mod tests {
         Grid::new(400.0, 700.0, 5.0).unwrap()
     }
 
+    /// Planckian spectra of 2,500–8,000 K (peak 1, rows of 61 on [`grid`]) and a PCA of them.
+    fn planckians() -> (Vec<f64>, Pca) {
+        let g = grid();
+        let data: Vec<f64> = (0..40)
+            .flat_map(|i| {
+                let s = planck(2500.0 + 140.0 * i as f64, &g).unwrap();
+                let m = s.values().iter().cloned().fold(0.0, f64::max);
+                s.values().iter().map(|v| v / m).collect::<Vec<_>>()
+            })
+            .collect();
+        let pca = Pca::fit(&data, 61, Components::Count(4)).unwrap();
+        (data, pca)
+    }
+
     /// u′v′ of a CCT and Duv.
     fn uv_prime(cct: f64, duv: f64) -> [f64; 2] {
         let [u, v] = cct_duv_to_uv(cct, duv).unwrap();
@@ -302,17 +316,8 @@ mod tests {
 
     #[test]
     fn a_corrected_spectrum_has_the_mapped_colour() {
-        // A PCA of Planckian spectra 2,500–8,000 K and the lattice's map.
-        let g = grid();
-        let data: Vec<f64> = (0..40)
-            .flat_map(|i| {
-                let s = planck(2500.0 + 140.0 * i as f64, &g).unwrap();
-                let m = s.values().iter().cloned().fold(0.0, f64::max);
-                s.values().iter().map(|v| v / m).collect::<Vec<_>>()
-            })
-            .collect();
-        let pca = Pca::fit(&data, 61, Components::Count(4)).unwrap();
-        let map = ColourMap::fit(&lattice(), &g, "lattice".into()).unwrap();
+        let (data, pca) = planckians();
+        let map = ColourMap::fit(&lattice(), &grid(), "lattice".into()).unwrap();
         map.validate(61).unwrap();
         let start = &data[61 * 10..61 * 11];
         let before = map.head.uv(start).unwrap();
@@ -332,14 +337,7 @@ mod tests {
     #[test]
     fn a_prior_keeps_its_shape_and_white_light_the_estimate_colour() {
         let g = grid();
-        let data: Vec<f64> = (0..40)
-            .flat_map(|i| {
-                let s = planck(2500.0 + 140.0 * i as f64, &g).unwrap();
-                let m = s.values().iter().cloned().fold(0.0, f64::max);
-                s.values().iter().map(|v| v / m).collect::<Vec<_>>()
-            })
-            .collect();
-        let basis = Pca::fit(&data, 61, Components::Count(4)).unwrap();
+        let (data, basis) = planckians();
         let map = ColourMap::fit(&lattice(), &g, "lattice".into()).unwrap();
         // The estimate a 3,900 K spectrum, the prior's a 4,460 K one: the result has the
         // estimate's colour.

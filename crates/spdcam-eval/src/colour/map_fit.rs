@@ -85,32 +85,26 @@ impl MapFit {
             model.grid(),
         )?;
         let same = |_: &lights::Light| Ok(estimator.clone());
+        // The shoot of `per_lamp` photos of each lamp, its draws from stream `stream`.
+        let lights_of =
+            |per_lamp: u64| -> Vec<_> { lamps.iter().map(|l| (l.clone(), per_lamp)).collect() };
+        let (scene_lights, patch_lights) = (
+            lights_of(options.scene_photos),
+            lights_of(options.patch_photos),
+        );
+        let shoot = |lights, stream| Shoot {
+            cameras: &cameras.cameras,
+            lights,
+            seed: seed::derive(options.seed, stream),
+        };
         let mut scores: Vec<PhotoScore> = Vec::new();
         if options.scene_photos > 0 {
             progress("scene photos");
-            let lights: Vec<_> = lamps
-                .iter()
-                .map(|l| (l.clone(), options.scene_photos))
-                .collect();
-            let shoot = Shoot {
-                cameras: &cameras.cameras,
-                lights: &lights,
-                seed: seed::derive(options.seed, 1),
-            };
-            scores.extend(shoot.scenes(&same, &chart_name, data_dir)?);
+            scores.extend(shoot(&scene_lights, 1).scenes(&same, &chart_name, data_dir)?);
         }
         if options.patch_photos > 0 {
             progress("patch-level photos");
-            let lights: Vec<_> = lamps
-                .iter()
-                .map(|l| (l.clone(), options.patch_photos))
-                .collect();
-            let shoot = Shoot {
-                cameras: &cameras.cameras,
-                lights: &lights,
-                seed: seed::derive(options.seed, 2),
-            };
-            scores.extend(shoot.patches(&same, &chart)?);
+            scores.extend(shoot(&patch_lights, 2).patches(&same, &chart)?);
         }
         let pairs: Vec<([f64; 2], [f64; 2])> = scores
             .iter()
