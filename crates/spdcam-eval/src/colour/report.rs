@@ -107,9 +107,9 @@ const PHOTO_COLUMNS: [&str; 17] = [
 ];
 
 impl ColourReport {
-    /// Every photo of every model as CSV, a row each (the columns of [`PHOTO_COLUMNS`]):
-    /// what the tables summarise, for a study of its own (empty cells where a photo was
-    /// refused or a CCT is not scored).
+    /// Every photo of every model as CSV, a row each (model, light, camera, GFC, the true and
+    /// estimated u′v′ and CCT, verdict): what the tables summarise, for a study of its own
+    /// (empty cells where a photo was refused or a CCT is not scored).
     pub fn photos_csv(&self) -> crate::error::Result<String> {
         let mut w = csv::Writer::from_writer(Vec::new());
         let fail = |e: csv::Error| EvalError::invalid(format!("the photos' CSV: {e}"));
