@@ -363,7 +363,8 @@ impl Model {
         Ok(())
     }
 
-    /// A one-line description: architecture, inputs, targets, grid, chart and camera.
+    /// A one-line description: architecture, inputs, targets, grid, chart and camera, and
+    /// the colour map where the model has one.
     pub fn describe(&self) -> String {
         let h = &self.header;
         let target = match &h.target {
@@ -386,7 +387,11 @@ impl Model {
             h.grid.label(),
             h.chart.as_deref().unwrap_or("unknown"),
             h.camera.as_deref().unwrap_or("unknown")
-        )
+        ) + if h.colour_map.is_some() {
+            "; white light's colour mapped (`spdcam colour-map fit`)"
+        } else {
+            ""
+        }
     }
 
     /// Checks that features with these column names (from `source`) fit the model.

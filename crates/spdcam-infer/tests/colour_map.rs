@@ -39,6 +39,10 @@ fn the_map_moves_the_estimate_to_the_colour_it_gives() {
         "{before:?} → {after:?}, the map gives {want:?}"
     );
     assert_ne!(mapped.fingerprint(), plain.fingerprint());
+    assert!(mapped
+        .describe()
+        .ends_with("white light's colour mapped (`spdcam colour-map fit`)"));
+    assert!(!plain.describe().contains("colour mapped"));
 }
 
 #[test]
