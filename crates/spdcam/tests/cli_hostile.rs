@@ -128,6 +128,24 @@ fn dash_writes_to_standard_output() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[test]
+fn a_colour_map_without_photos_or_a_place_to_go_is_refused_before_any_work() {
+    let dir = scratch("colour-map");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let model = s(&repo.join("models/colorchecker24.spdm"));
+    let split = s(&repo.join("docs/validation-split.json"));
+    let base = ["colour-map", "fit", "--model", &model, "--split", &split];
+    let out = s(&dir.join("m.spdm"));
+    let none = [&base[..], &["--photos", "0", "-o", &out]].concat();
+    let e = fails_fast(&none);
+    assert!(e.contains("a colour map needs photos"), "{e}");
+    let nowhere = s(&dir.join("missing/m.spdm"));
+    let e = fails_fast(&[&base[..], &["-o", &nowhere]].concat());
+    assert!(e.contains("does not exist"), "{e}");
+    assert!(!dir.join("m.spdm").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[cfg(feature = "train")]
 #[test]
 fn train_refuses_an_unwritable_model_path_before_training() {
