@@ -16,6 +16,7 @@
 
 use crate::estimate::Estimate;
 use spdcam_core::colorimetry::{cct_duv_to_uv, cct_to_uv_planck, Observer};
+use spdcam_core::quality::uv::uv1960_to_uv1976;
 use spdcam_core::spectral::Grid;
 use std::fmt::Write as _;
 
@@ -69,11 +70,6 @@ pub fn xy_to_uv_prime(xy: [f64; 2]) -> [f64; 2] {
     [4.0 * xy[0] / d, 9.0 * xy[1] / d]
 }
 
-/// CIE 1960 uv → CIE 1976 u′v′.
-fn uv1960_to_prime(uv: [f64; 2]) -> [f64; 2] {
-    [uv[0], 1.5 * uv[1]]
-}
-
 /// The spectral locus in u′v′ with its wavelengths, 360–700 nm every 5 nm.
 fn spectral_locus() -> Vec<(f64, [f64; 2])> {
     let Ok(grid) = Grid::new(360.0, 700.0, 5.0) else {
@@ -99,7 +95,7 @@ fn planckian_locus() -> Vec<[f64; 2]> {
     let mut t = 1000.0_f64;
     while t <= 20000.0 {
         if let Ok(uv) = cct_to_uv_planck(t) {
-            out.push(uv1960_to_prime(uv));
+            out.push(uv1960_to_uv1976(uv));
         }
         t *= 1.02;
     }
@@ -119,7 +115,7 @@ pub fn region95(e: &Estimate) -> Option<Vec<[f64; 2]>> {
             let t = (cct + ht * a.cos()).max(1000.0);
             cct_duv_to_uv(t, duv + hd * a.sin())
                 .ok()
-                .map(uv1960_to_prime)
+                .map(uv1960_to_uv1976)
         })
         .collect()
 }
@@ -245,7 +241,7 @@ fn draw_view(
         let (Ok(a), Ok(c)) = (cct_duv_to_uv(k, -0.05), cct_duv_to_uv(k, 0.05)) else {
             continue;
         };
-        let (a, c) = (view.at(uv1960_to_prime(a)), view.at(uv1960_to_prime(c)));
+        let (a, c) = (view.at(uv1960_to_uv1976(a)), view.at(uv1960_to_uv1976(c)));
         let _ = write!(
             s,
             "<line class=\"isotemperature\" data-k=\"{k:.0}\" x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\" stroke=\"#c9a34a\" stroke-width=\"0.8\"/>",

@@ -25,6 +25,7 @@ use crate::error::{InferError, Result};
 use crate::pca::Pca;
 use serde::{Deserialize, Serialize};
 use spdcam_core::colorimetry::{cct_duv_to_uv, uv_to_cct_duv};
+use spdcam_core::quality::uv::{uv1960_to_uv1976, uv1976_to_uv1960};
 use spdcam_core::spectral::Grid;
 
 /// The fewest white photos a map is fitted on: four parameters need many more pairs than
@@ -83,14 +84,9 @@ pub struct ColourMap {
     pub fitted_on: String,
 }
 
-/// CIE 1976 u′v′ → CIE 1960 uv.
-fn uv1960(uv_prime: [f64; 2]) -> [f64; 2] {
-    [uv_prime[0], uv_prime[1] / 1.5]
-}
-
 /// The estimate's mired and Duv where it has a CCT.
 fn mired_duv(uv_prime: [f64; 2]) -> Option<(f64, f64)> {
-    uv_to_cct_duv(uv1960(uv_prime))
+    uv_to_cct_duv(uv1976_to_uv1960(uv_prime))
         .ok()
         .map(|(cct, duv)| (1e6 / cct, duv))
 }
@@ -146,7 +142,7 @@ impl ColourMap {
         let Ok(uv) = cct_duv_to_uv(1e6 / corrected_mired, self.duv.at(duv)) else {
             return uv_prime;
         };
-        let mapped = [uv[0], 1.5 * uv[1]];
+        let mapped = uv1960_to_uv1976(uv);
         [0, 1].map(|i| uv_prime[i] + w * (mapped[i] - uv_prime[i]))
     }
 
@@ -235,8 +231,7 @@ mod tests {
 
     /// u′v′ of a CCT and Duv.
     fn uv_prime(cct: f64, duv: f64) -> [f64; 2] {
-        let [u, v] = cct_duv_to_uv(cct, duv).unwrap();
-        [u, 1.5 * v]
+        uv1960_to_uv1976(cct_duv_to_uv(cct, duv).unwrap())
     }
 
     /// Estimates on a lattice of 2,500–7,000 K and Duv −0.012…0.012, truths by the lines
@@ -265,8 +260,7 @@ mod tests {
         assert!((map.duv.slope - 0.5).abs() < 2e-3, "{:?}", map.duv);
         assert!((map.duv.offset - 0.001).abs() < 2e-5, "{:?}", map.duv);
         // 4,000 K (250 mired) on the locus → 1.1·250 − 20 = 255 mired (3,922 K), Duv 0.001.
-        let [u, v] = map.apply(uv_prime(4000.0, 0.0));
-        let (cct, duv) = uv_to_cct_duv([u, v / 1.5]).unwrap();
+        let (cct, duv) = uv_to_cct_duv(uv1976_to_uv1960(map.apply(uv_prime(4000.0, 0.0)))).unwrap();
         assert!((cct - 1e6 / 255.0).abs() < 3.0, "{cct}");
         assert!((duv - 0.001).abs() < 2e-5, "{duv}");
     }

@@ -14,6 +14,16 @@ pub fn xyz_to_uv1976(xyz: [f64; 3]) -> [f64; 2] {
     [4.0 * xyz[0] / d, 9.0 * xyz[1] / d]
 }
 
+/// CIE 1960 (u, v) → CIE 1976 (u′, v′): u′ = u, v′ = 1.5 v (CIE 015:2018 §8.1).
+pub fn uv1960_to_uv1976(uv: [f64; 2]) -> [f64; 2] {
+    [uv[0], 1.5 * uv[1]]
+}
+
+/// CIE 1976 (u′, v′) → CIE 1960 (u, v), the inverse of [`uv1960_to_uv1976`].
+pub fn uv1976_to_uv1960(uv_prime: [f64; 2]) -> [f64; 2] {
+    [uv_prime[0], uv_prime[1] / 1.5]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -33,5 +43,9 @@ mod tests {
         let via_xy = xy_to_uv1960([0.31271, 0.32902]);
         let direct = xyz_to_uv1960(xyz);
         assert!((via_xy[0] - direct[0]).abs() < 1e-15 && (via_xy[1] - direct[1]).abs() < 1e-15);
+        // The two scales of one light convert into each other.
+        assert_eq!(uv1960_to_uv1976(e), e76);
+        let back = uv1976_to_uv1960(d65);
+        assert!((back[0] - direct[0]).abs() < 1e-15 && (back[1] - direct[1]).abs() < 1e-15);
     }
 }

@@ -276,6 +276,7 @@ impl ColourReport {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::colour::photos::PhotoScore;
     use crate::colour::{CctSummary, ModelColour};
     use std::path::PathBuf;
 
@@ -296,6 +297,18 @@ mod tests {
         }
     }
 
+    /// The ColorChecker 24 model's measurement with `rows` and `photos`, uncalibrated.
+    fn cc24(rows: Vec<Row<[Summary; 2]>>, photos: [Vec<PhotoScore>; 2]) -> ModelColour {
+        ModelColour {
+            model: PathBuf::from("models/cc24.spdm"),
+            chart: "colorchecker24".into(),
+            light_named: false,
+            calibrated: false,
+            rows,
+            photos,
+        }
+    }
+
     #[test]
     fn rows_show_shares_signed_errors_and_dashes_where_nothing_was_measured() {
         let row = |scores| Row {
@@ -305,14 +318,10 @@ mod tests {
             scores,
         };
         let report = ColourReport {
-            models: vec![ModelColour {
-                model: PathBuf::from("models/cc24.spdm"),
-                chart: "colorchecker24".into(),
-                light_named: false,
-                calibrated: false,
-                rows: vec![row([summary(Some((0.04, 0.9))), summary(None)])],
-                photos: [Vec::new(), Vec::new()],
-            }],
+            models: vec![cc24(
+                vec![row([summary(Some((0.04, 0.9))), summary(None)])],
+                [Vec::new(), Vec::new()],
+            )],
             baselines: vec![row([summary(None), summary(None)])],
             lights: Vec::new(),
             camera_names: Vec::new(),
@@ -336,7 +345,7 @@ mod tests {
     #[test]
     fn every_photo_is_a_csv_row_with_empty_cells_where_nothing_was_scored() {
         use crate::colour::lights::Light;
-        use crate::colour::photos::{PhotoScore, Scored};
+        use crate::colour::photos::Scored;
         use crate::colour::score::ColourScore;
         use spdcam_core::cie_illuminant::planck;
         use spdcam_core::light_families::LightKind;
@@ -360,13 +369,9 @@ mod tests {
             cct_interval: None,
         };
         let report = ColourReport {
-            models: vec![ModelColour {
-                model: PathBuf::from("models/cc24.spdm"),
-                chart: "colorchecker24".into(),
-                light_named: false,
-                calibrated: false,
-                rows: Vec::new(),
-                photos: [
+            models: vec![cc24(
+                Vec::new(),
+                [
                     vec![PhotoScore {
                         light: 0,
                         camera: Some(1),
@@ -378,7 +383,7 @@ mod tests {
                         estimate: None,
                     }],
                 ],
-            }],
+            )],
             baselines: Vec::new(),
             lights: vec![light],
             camera_names: vec!["cam_a".into(), "cam_b".into()],
