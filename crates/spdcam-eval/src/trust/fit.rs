@@ -22,6 +22,7 @@ use spdcam_infer::trust::{
     JITTER_SIGMA,
 };
 use spdcam_infer::Model;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Fewer calibration photos defining a metric than this leave it without an interval.
@@ -61,6 +62,15 @@ pub enum PhotoKind {
 impl PhotoKind {
     /// Every kind.
     pub const ALL: [PhotoKind; 3] = [PhotoKind::Virtual, PhotoKind::Scene, PhotoKind::Real];
+
+    /// The kind's name in a calibration file: `virtual`, `scene` or `real`.
+    pub fn label(self) -> &'static str {
+        match self {
+            PhotoKind::Virtual => "virtual",
+            PhotoKind::Scene => "scene",
+            PhotoKind::Real => "real",
+        }
+    }
 }
 
 impl CalibrationPhotos {
@@ -293,6 +303,15 @@ fn fit_metric(key: &str, photos: &[MetricPhoto]) -> Option<MetricCalibration> {
 /// only on all of them pooled (Vovk, Gammerman & Shafer 2005, "Algorithmic Learning in a
 /// Random World", section 4.5).
 fn group_conditional_quantile(values: &[(f64, PhotoKind)], q: f64, min: usize) -> f64 {
+    group_quantiles(values, q, min)
+        .into_values()
+        .fold(0.0, f64::max)
+}
+
+/// The conformal `q` quantile of `values` for each kind of photo with at least `min` of them
+/// (keyed by [`PhotoKind::label`]) and for all of them (`pooled`): the quantiles
+/// [`group_conditional_quantile`] takes the largest of.
+fn group_quantiles(values: &[(f64, PhotoKind)], q: f64, min: usize) -> BTreeMap<String, f64> {
     let of = |kind: Option<PhotoKind>| -> Vec<f64> {
         values
             .iter()
@@ -302,11 +321,11 @@ fn group_conditional_quantile(values: &[(f64, PhotoKind)], q: f64, min: usize) -
     };
     PhotoKind::ALL
         .iter()
-        .map(|&k| of(Some(k)))
-        .filter(|v| v.len() >= min)
-        .chain(std::iter::once(of(None)))
-        .map(|mut v| conformal_quantile(&mut v, q))
-        .fold(0.0, f64::max)
+        .map(|&k| (k.label(), of(Some(k))))
+        .filter(|(_, v)| v.len() >= min)
+        .chain(std::iter::once(("pooled", of(None))))
+        .map(|(label, mut v)| (label.to_string(), conformal_quantile(&mut v, q)))
+        .collect()
 }
 
 /// Numbers of principal components the expected-GFC regression chooses among.
@@ -353,6 +372,7 @@ pub fn fit_gfc_model(judged: &[Judged], groups: &[usize], kinds: &[PhotoKind]) -
         high: Vec::new(),
         gap_range: [0.0; 2],
         gap_margin95: 0.0,
+        gap_quantiles95: BTreeMap::new(),
     };
     let inputs = |m: &GfcModel| -> Vec<Vec<f64>> {
         judged
@@ -425,6 +445,7 @@ pub fn fit_gfc_model(judged: &[Judged], groups: &[usize], kinds: &[PhotoKind]) -
                 .map(|&i| (target[i][0] - ridge.predict(&x[i])[0], kinds[i])),
         );
     }
+    model.gap_quantiles95 = group_quantiles(&residuals, 0.95, MIN_METRIC_PHOTOS);
     model.gap_margin95 = group_conditional_quantile(&residuals, 0.95, MIN_METRIC_PHOTOS);
     let ridge = solve(&gram(&x, &(0..n).collect::<Vec<_>>())?, penalty)?;
     model.weights = (0..ridge.inputs()).map(|j| ridge.weight(0, j)).collect();
@@ -584,6 +605,14 @@ mod tests {
         // would be the 286th of 300, 2.58.
         let q = group_conditional_quantile(&values, 0.95, 40);
         assert!((q - 2.88).abs() < 1e-9, "{q}");
+        // Each kind's own quantile is kept (the patch-level photos' the 191st of 200), with
+        // the pool's: the calibration file says which kind set the margin.
+        let each = group_quantiles(&values, 0.95, 40);
+        let keys: Vec<&str> = each.keys().map(String::as_str).collect();
+        assert_eq!(keys, ["pooled", "scene", "virtual"]);
+        for (key, want) in [("virtual", 0.955), ("scene", 2.88), ("pooled", 2.58)] {
+            assert!((each[key] - want).abs() < 1e-9, "{key}: {}", each[key]);
+        }
         let mut pooled: Vec<f64> = values.iter().map(|v| v.0).collect();
         assert!((conformal_quantile(&mut pooled, 0.95) - 2.58).abs() < 1e-9);
         // Too few scene photos (30) to stand on their own: the patch-level photos' quantile

@@ -18,7 +18,7 @@ use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::quality::SCALAR_KEYS;
 use spdcam_core::spectral_error;
 use spdcam_infer::trust::{
-    self, assess, ChartCheck, PhotoFlags, TrustCalibration, Verdict, POOR_GFC,
+    self, assess, weigh, ChartCheck, PhotoFlags, TrustCalibration, Verdict, DOUBTFUL_GFC, POOR_GFC,
 };
 use spdcam_infer::Model;
 use std::collections::BTreeMap;
@@ -170,6 +170,46 @@ struct Measured {
     metrics: BTreeMap<String, MetricCoverage>,
     /// The set's points in the reliability diagram.
     reliability: SetReliability,
+    /// The row of the reasons table ([`REASON_KINDS`]).
+    reasons: String,
+}
+
+/// The kinds of advice ([`Advice::kind`]) a feature row's verdict can carry, in the order of
+/// the reasons table.
+const REASON_KINDS: [&str; 12] = [
+    "clipped",
+    "dark",
+    "too_few_to_check",
+    "check_failed",
+    "residual",
+    "halves",
+    "colour_gradient",
+    "two_lights",
+    "glare",
+    "ambiguous",
+    "low_gfc",
+    "may_be_poor",
+];
+
+/// The row of `model`'s calibration in the margins table: each kind of calibration photo's
+/// 95 % quantile of ln(1 − GFC) above the expected, as a factor on 1 − GFC; the margin used;
+/// and the expected GFC at which an estimate's 95 % floor reaches [`POOR_GFC`].
+fn margin_row(model: &str, cal: &TrustCalibration) -> String {
+    let g = &cal.gfc_model;
+    let factor = |key: &str| {
+        g.gap_quantiles95
+            .get(key)
+            .map_or("–".to_string(), |m| format!("× {:.1}", m.exp()))
+    };
+    let needed = (1.0 - (1.0 - POOR_GFC) * (-g.gap_margin95.max(0.0)).exp()).max(DOUBTFUL_GFC);
+    format!(
+        "| `{model}` | {} | {} | {} | {} | × {:.1} | {needed:.3} |\n",
+        factor("virtual"),
+        factor("scene"),
+        factor("real"),
+        factor("pooled"),
+        g.gap_margin95.max(0.0).exp()
+    )
 }
 
 /// One row of the report's first table (coverage, rank correlation, verdicts and the mean
@@ -192,6 +232,8 @@ fn measure_row(
     let mut verdicts = [0usize; 3];
     let mut gfc_by_verdict = [0.0f64; 3];
     let mut poor_ok = 0usize;
+    let mut with_reason = [0usize; REASON_KINDS.len()];
+    let mut only_reason = [0usize; REASON_KINDS.len()];
     let mut coverage: BTreeMap<String, MetricCoverage> = BTreeMap::new();
     for (j, row) in judged.iter().zip(features) {
         let u = cal.uncertainty(&j.spd, &j.spread, &j.metric_spread, residual(j))?;
@@ -223,10 +265,17 @@ fn measure_row(
         }
         expected.push(u.expected_gfc);
         actual.push(gfc(j));
-        let t = assess(model, Some(cal), check, row, &j.spd, &PhotoFlags::default())?;
-        verdicts[t.verdict as usize] += 1;
-        gfc_by_verdict[t.verdict as usize] += gfc(j);
-        poor_ok += usize::from(t.verdict == Verdict::Ok && gfc(j) < POOR_GFC);
+        let (verdict, advice, ..) =
+            weigh(model, Some(cal), check, row, &j.spd, &PhotoFlags::default())?;
+        for a in &advice {
+            if let Some(k) = REASON_KINDS.iter().position(|&k| k == a.kind()) {
+                with_reason[k] += 1;
+                only_reason[k] += usize::from(advice.len() == 1);
+            }
+        }
+        verdicts[verdict as usize] += 1;
+        gfc_by_verdict[verdict as usize] += gfc(j);
+        poor_ok += usize::from(verdict == Verdict::Ok && gfc(j) < POOR_GFC);
     }
     let n = judged.len() as f64;
     let difficulty: Vec<f64> = judged.iter().map(|j| -difficulty(j)).collect();
@@ -248,8 +297,18 @@ fn measure_row(
         mean_gfc(Verdict::Ok),
         mean_gfc(Verdict::Doubtful),
     );
+    let mut reasons = format!("| {label} |");
+    for (with, only) in with_reason.iter().zip(&only_reason) {
+        reasons += &format!(
+            " {:.0} ({:.0}) |",
+            100.0 * *with as f64 / n,
+            100.0 * *only as f64 / n
+        );
+    }
+    reasons.push('\n');
     let pairs: Vec<(f64, f64)> = expected.into_iter().zip(actual).collect();
     Ok(Measured {
+        reasons,
         row,
         metrics: coverage,
         reliability: SetReliability::new(
@@ -487,6 +546,26 @@ impl TrustReport {
              |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         );
         md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable | mean GFC: ok / doubtful | ok with GFC below 0.90 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        let mut reasons_md = format!(
+            "## What keeps estimates from `ok`\n\n\
+             Per set, the share of photos (%) whose verdict carries each reason, and in brackets \
+             the share for which it is the only one (patch-level flags as above: no detection, \
+             so no confidence). The reasons: {}.\n\n| model · photos |{}\n|---|{}\n",
+            REASON_KINDS.map(|k| format!("`{k}`")).join(", "),
+            REASON_KINDS.map(|k| format!(" {k} |")).concat(),
+            "---:|".repeat(REASON_KINDS.len())
+        );
+        let mut margins_md = String::from(
+            "\nWhat sets the bar of `may_be_poor`: an estimate is `ok` only where 95 % of the \
+             calibration's estimates like it reach GFC 0.90, i.e. where its expected 1 − GFC \
+             times the calibration's 95 % margin stays below 0.10. The margin is each kind of \
+             calibration photo's 95 % quantile of how far its 1 − GFC lay above the expected \
+             one (predicted without its own lamp), the largest of the kinds and of all of them \
+             pooled, so that it holds on each kind. Per model: each kind's factor, the one \
+             used, and the expected GFC an `ok` needs.\n\n\
+             | model | patch-level virtual | scene photos | real photos | pooled | used | expected GFC needed |\n\
+             |---|---:|---:|---:|---:|---:|---:|\n",
+        );
         let mut diagram = Vec::new();
         let mut scenes_per_lamp = 0;
         for ((path, model, chart_name), cal_path) in models.iter().zip(calibrations) {
@@ -500,6 +579,7 @@ impl TrustReport {
                     path.display()
                 )));
             }
+            margins_md += &margin_row(&file_name(path), &cal);
             let chart = Chart::resolve(chart_name, None, data_dir, &GRID)?;
             let check = ChartCheck::for_model(model, data_dir)?;
             let truth = on_grid(&setup.library, &model.grid())?;
@@ -556,6 +636,7 @@ impl TrustReport {
                 &shots.clean.truths,
             )?;
             md += &measured.row;
+            reasons_md += &measured.reasons;
             metric_sets.push(("held-out virtual".to_string(), measured.metrics));
             diagram.push(measured.reliability);
             let test_scenes = scene_rows(
@@ -586,6 +667,7 @@ impl TrustReport {
                 &scene_truths,
             )?;
             md += &measured.row;
+            reasons_md += &measured.reasons;
             metric_sets.push(("scene photos".to_string(), measured.metrics));
             diagram.push(measured.reliability);
             corrections_md += &corrections_row(
@@ -609,6 +691,7 @@ impl TrustReport {
                     &rows.truths,
                 )?;
                 md += &measured.row;
+                reasons_md += &measured.reasons;
                 metric_sets.push((format!("real: {label} (test)"), measured.metrics));
                 diagram.push(measured.reliability);
                 corrections_md += &corrections_row(
@@ -700,7 +783,10 @@ impl TrustReport {
             );
             progress(path);
         }
-        let mut sections = metrics_md;
+        let mut sections = reasons_md;
+        sections += &margins_md;
+        sections.push('\n');
+        sections += &metrics_md;
         sections += &corrections_md;
         sections += CORRECTIONS_TRIED;
         sections.push('\n');
@@ -772,14 +858,37 @@ mod tests {
     use super::*;
     use crate::trust::judged::fixtures::judged;
 
-    #[test]
-    fn band_scales_grow_with_the_level_and_hold_that_share_of_the_calibration() {
+    /// The ColorChecker 24's shipped calibration.
+    fn cc24_calibration() -> TrustCalibration {
         let cal_json = std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../models/colorchecker24.trust.json"
         ))
         .unwrap();
-        let cal = TrustCalibration::from_json(&cal_json, "cc24").unwrap();
+        TrustCalibration::from_json(&cal_json, "cc24").unwrap()
+    }
+
+    #[test]
+    fn the_margin_row_names_the_kind_that_set_it_and_the_expected_gfc_ok_needs() {
+        let mut cal = cc24_calibration();
+        let g = &mut cal.gfc_model;
+        g.gap_margin95 = 4.0f64.ln();
+        g.gap_quantiles95 = [("virtual", 4.0f64), ("scene", 2.0), ("pooled", 3.0)]
+            .map(|(k, f)| (k.to_string(), f.ln()))
+            .into();
+        // ok needs 4 × (1 − expected) ≤ 0.10: expected GFC at least 0.975; no real photos.
+        assert_eq!(
+            margin_row("m.spdm", &cal),
+            "| `m.spdm` | × 4.0 | × 2.0 | – | × 3.0 | × 4.0 | 0.975 |\n"
+        );
+        // A small margin cannot make ok easier than the expected GFC's own level.
+        cal.gfc_model.gap_margin95 = 0.0;
+        assert!(margin_row("m.spdm", &cal).ends_with("| × 1.0 | 0.950 |\n"));
+    }
+
+    #[test]
+    fn band_scales_grow_with_the_level_and_hold_that_share_of_the_calibration() {
+        let cal = cc24_calibration();
         let d = cal.floor.len();
         let photos: Vec<Judged> = (0..200)
             .map(|i| {

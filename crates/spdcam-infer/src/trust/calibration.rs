@@ -224,6 +224,12 @@ pub struct GfcModel {
     /// own, as the metric intervals). 0 in calibrations made before it existed.
     #[serde(default)]
     pub gap_margin95: f64,
+    /// The same quantile for each kind of calibration photo on its own (`virtual`, `scene`,
+    /// `real`) and for all of them pooled (`pooled`): [`GfcModel::gap_margin95`] is the
+    /// largest, and this says which kind set it. Empty in calibrations made before it
+    /// existed.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub gap_quantiles95: BTreeMap<String, f64>,
 }
 
 impl GfcModel {
@@ -463,6 +469,7 @@ mod tests {
             high: vec![0.0, 1.0, 1.0],
             gap_range: [-20.0, 0.0],
             gap_margin95: 0.0,
+            gap_quantiles95: BTreeMap::new(),
         };
         let (spd, difficulty) = ([1.0, 0.25], 0.04);
         let coordinate = 0.6 * 0.5 + 0.8 * -0.25;
@@ -522,6 +529,7 @@ mod tests {
                 high: vec![0.0, 1.0],
                 gap_range: [-10.0, 0.0],
                 gap_margin95: 0.0,
+                gap_quantiles95: BTreeMap::new(),
             },
             residual_reference: Some(0.05),
             difficulty_doubtful: 1.0,

@@ -135,10 +135,11 @@ pub fn assess(
 }
 
 /// What [`weigh`] finds: the verdict, the advice behind it, the self-check and the bands.
-type Weighed = (Verdict, Vec<Advice>, Option<SelfCheck>, Option<Uncertainty>);
+pub type Weighed = (Verdict, Vec<Advice>, Option<SelfCheck>, Option<Uncertainty>);
 
-/// [`assess`] with its reasons as [`Advice`] (their words are the advice's).
-fn weigh(
+/// [`assess`] with its reasons as [`Advice`] (their words are the advice's): what a
+/// measurement of the verdict counts by kind.
+pub fn weigh(
     model: &Model,
     calibration: Option<&TrustCalibration>,
     check: Option<&ChartCheck>,
