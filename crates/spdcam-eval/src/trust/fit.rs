@@ -446,7 +446,7 @@ pub fn fit_gfc_model(judged: &[Judged], groups: &[usize], kinds: &[PhotoKind]) -
         );
     }
     model.gap_quantiles95 = group_quantiles(&residuals, 0.95, MIN_METRIC_PHOTOS);
-    model.gap_margin95 = group_conditional_quantile(&residuals, 0.95, MIN_METRIC_PHOTOS);
+    model.gap_margin95 = model.gap_quantiles95.values().copied().fold(0.0, f64::max);
     let ridge = solve(&gram(&x, &(0..n).collect::<Vec<_>>())?, penalty)?;
     model.weights = (0..ridge.inputs()).map(|j| ridge.weight(0, j)).collect();
     let range = |values: &mut dyn Iterator<Item = f64>| {

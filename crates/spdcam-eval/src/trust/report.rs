@@ -170,26 +170,46 @@ struct Measured {
     metrics: BTreeMap<String, MetricCoverage>,
     /// The set's points in the reliability diagram.
     reliability: SetReliability,
-    /// The row of the reasons table ([`REASON_KINDS`]).
-    reasons: String,
+    /// The set's verdict reasons, counted.
+    reasons: ReasonCounts,
 }
 
-/// The kinds of advice ([`Advice::kind`]) a feature row's verdict can carry, in the order of
-/// the reasons table.
-const REASON_KINDS: [&str; 12] = [
-    "clipped",
-    "dark",
-    "too_few_to_check",
-    "check_failed",
-    "residual",
-    "halves",
-    "colour_gradient",
-    "two_lights",
-    "glare",
-    "ambiguous",
-    "low_gfc",
-    "may_be_poor",
-];
+/// How many of a set's photos carry each kind of reason in their verdict
+/// (`spdcam_core::advice::Advice::kind`): a row of the reasons table.
+struct ReasonCounts {
+    /// The set's label.
+    label: String,
+    /// Its photos.
+    photos: usize,
+    /// Per kind of reason, the photos carrying it and those carrying it alone.
+    counts: BTreeMap<&'static str, (usize, usize)>,
+}
+
+/// The reasons table: a column per kind of reason some photo carries, a row per set, each
+/// cell the share of the set's photos carrying the reason and, in brackets, carrying it
+/// alone.
+fn reasons_table(rows: &[ReasonCounts]) -> String {
+    let kinds: std::collections::BTreeSet<&str> =
+        rows.iter().flat_map(|r| r.counts.keys().copied()).collect();
+    let mut md = format!(
+        "| model · photos |{}\n|---|{}\n",
+        kinds
+            .iter()
+            .map(|k| format!(" `{k}` |"))
+            .collect::<String>(),
+        "---:|".repeat(kinds.len())
+    );
+    for r in rows {
+        md += &format!("| {} |", r.label);
+        let share = |count: usize| 100.0 * count as f64 / r.photos.max(1) as f64;
+        for k in &kinds {
+            let (with, alone) = r.counts.get(k).copied().unwrap_or_default();
+            md += &format!(" {:.0} ({:.0}) |", share(with), share(alone));
+        }
+        md.push('\n');
+    }
+    md
+}
 
 /// The row of `model`'s calibration in the margins table: each kind of calibration photo's
 /// 95 % quantile of ln(1 − GFC) above the expected, as a factor on 1 − GFC; the margin used;
@@ -232,8 +252,11 @@ fn measure_row(
     let mut verdicts = [0usize; 3];
     let mut gfc_by_verdict = [0.0f64; 3];
     let mut poor_ok = 0usize;
-    let mut with_reason = [0usize; REASON_KINDS.len()];
-    let mut only_reason = [0usize; REASON_KINDS.len()];
+    let mut reasons = ReasonCounts {
+        label: label.to_string(),
+        photos: judged.len(),
+        counts: BTreeMap::new(),
+    };
     let mut coverage: BTreeMap<String, MetricCoverage> = BTreeMap::new();
     for (j, row) in judged.iter().zip(features) {
         let u = cal.uncertainty(&j.spd, &j.spread, &j.metric_spread, residual(j))?;
@@ -268,10 +291,9 @@ fn measure_row(
         let (verdict, advice, ..) =
             weigh(model, Some(cal), check, row, &j.spd, &PhotoFlags::default())?;
         for a in &advice {
-            if let Some(k) = REASON_KINDS.iter().position(|&k| k == a.kind()) {
-                with_reason[k] += 1;
-                only_reason[k] += usize::from(advice.len() == 1);
-            }
+            let (with, alone) = reasons.counts.entry(a.kind()).or_default();
+            *with += 1;
+            *alone += usize::from(advice.len() == 1);
         }
         verdicts[verdict as usize] += 1;
         gfc_by_verdict[verdict as usize] += gfc(j);
@@ -297,15 +319,6 @@ fn measure_row(
         mean_gfc(Verdict::Ok),
         mean_gfc(Verdict::Doubtful),
     );
-    let mut reasons = format!("| {label} |");
-    for (with, only) in with_reason.iter().zip(&only_reason) {
-        reasons += &format!(
-            " {:.0} ({:.0}) |",
-            100.0 * *with as f64 / n,
-            100.0 * *only as f64 / n
-        );
-    }
-    reasons.push('\n');
     let pairs: Vec<(f64, f64)> = expected.into_iter().zip(actual).collect();
     Ok(Measured {
         reasons,
@@ -546,15 +559,7 @@ impl TrustReport {
              |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         );
         md += "## Coverage and rank correlation\n\n| model · photos | n | mean GFC | in 68 % band | in 95 % band | ρ(expected GFC, GFC) | ρ(−difficulty, GFC) | ok / doubtful / unusable | mean GFC: ok / doubtful | ok with GFC below 0.90 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-        let mut reasons_md = format!(
-            "## What keeps estimates from `ok`\n\n\
-             Per set, the share of photos (%) whose verdict carries each reason, and in brackets \
-             the share for which it is the only one (patch-level flags as above: no detection, \
-             so no confidence). The reasons: {}.\n\n| model · photos |{}\n|---|{}\n",
-            REASON_KINDS.map(|k| format!("`{k}`")).join(", "),
-            REASON_KINDS.map(|k| format!(" {k} |")).concat(),
-            "---:|".repeat(REASON_KINDS.len())
-        );
+        let mut reason_rows = Vec::new();
         let mut margins_md = String::from(
             "\nWhat sets the bar of `may_be_poor`: an estimate is `ok` only where 95 % of the \
              calibration's estimates like it reach GFC 0.90, i.e. where its expected 1 − GFC \
@@ -636,7 +641,7 @@ impl TrustReport {
                 &shots.clean.truths,
             )?;
             md += &measured.row;
-            reasons_md += &measured.reasons;
+            reason_rows.push(measured.reasons);
             metric_sets.push(("held-out virtual".to_string(), measured.metrics));
             diagram.push(measured.reliability);
             let test_scenes = scene_rows(
@@ -667,7 +672,7 @@ impl TrustReport {
                 &scene_truths,
             )?;
             md += &measured.row;
-            reasons_md += &measured.reasons;
+            reason_rows.push(measured.reasons);
             metric_sets.push(("scene photos".to_string(), measured.metrics));
             diagram.push(measured.reliability);
             corrections_md += &corrections_row(
@@ -691,7 +696,7 @@ impl TrustReport {
                     &rows.truths,
                 )?;
                 md += &measured.row;
-                reasons_md += &measured.reasons;
+                reason_rows.push(measured.reasons);
                 metric_sets.push((format!("real: {label} (test)"), measured.metrics));
                 diagram.push(measured.reliability);
                 corrections_md += &corrections_row(
@@ -783,7 +788,13 @@ impl TrustReport {
             );
             progress(path);
         }
-        let mut sections = reasons_md;
+        let mut sections = String::from(
+            "## What keeps estimates from `ok`\n\n\
+             Per set, the share of photos (%) whose verdict carries each reason, and in brackets \
+             the share for which it is the only one (patch-level flags as above: no detection, \
+             so no confidence; reasons no photo carries are left out).\n\n",
+        );
+        sections += &reasons_table(&reason_rows);
         sections += &margins_md;
         sections.push('\n');
         sections += &metrics_md;
@@ -884,6 +895,25 @@ mod tests {
         // A small margin cannot make ok easier than the expected GFC's own level.
         cal.gfc_model.gap_margin95 = 0.0;
         assert!(margin_row("m.spdm", &cal).ends_with("| × 1.0 | 0.950 |\n"));
+    }
+
+    #[test]
+    fn the_reasons_table_has_a_column_per_reason_any_set_carries() {
+        let row = |label: &str, photos, counts: &[(&'static str, (usize, usize))]| ReasonCounts {
+            label: label.into(),
+            photos,
+            counts: counts.iter().copied().collect(),
+        };
+        let table = reasons_table(&[
+            row("a", 4, &[("glare", (2, 1))]),
+            row("b", 8, &[("may_be_poor", (8, 6)), ("clipped", (1, 0))]),
+        ]);
+        assert_eq!(
+            table,
+            "| model · photos | `clipped` | `glare` | `may_be_poor` |\n|---|---:|---:|---:|\n\
+             | a | 0 (0) | 50 (25) | 0 (0) |\n\
+             | b | 12 (0) | 0 (0) | 100 (75) |\n"
+        );
     }
 
     #[test]
