@@ -113,13 +113,56 @@ impl Estimator {
     /// estimates lie on `grid`: each model's calibration parsed and chart check built here,
     /// once.
     pub fn new(models: ModelSet, data_dir: DataDir, grid: Grid) -> Result<Estimator> {
+        let calibrations = models
+            .models()
+            .iter()
+            .map(|m| trust::calibration_for(&m.model))
+            .collect::<Result<Vec<_>>>()?;
+        Estimator::judged_by(models, calibrations, data_dir, grid)
+    }
+
+    /// The estimator of one model judged by `calibration`, a calibration made for it (`spdcam
+    /// trust calibrate`) that is not among the shipped ones: how a candidate model is judged
+    /// before it ships. An error when the calibration was made for another model.
+    pub fn calibrated(
+        model: NamedModel,
+        calibration: TrustCalibration,
+        data_dir: DataDir,
+        grid: Grid,
+    ) -> Result<Estimator> {
+        if calibration.model != model.model.fingerprint() {
+            return Err(InferError::invalid(format!(
+                "the trust calibration was made for another model than {} (its fingerprint \
+                 {}, the model's {}): calibrate this model with `spdcam trust calibrate`",
+                model.name,
+                calibration.model,
+                model.model.fingerprint()
+            )));
+        }
+        Estimator::judged_by(
+            ModelSet::single(model.model, model.name),
+            vec![Some(calibration)],
+            data_dir,
+            grid,
+        )
+    }
+
+    /// The estimator of `models`, each judged by its calibration in `calibrations` (in
+    /// order; `None`: no calibration).
+    fn judged_by(
+        models: ModelSet,
+        calibrations: Vec<Option<TrustCalibration>>,
+        data_dir: DataDir,
+        grid: Grid,
+    ) -> Result<Estimator> {
         let trust = models
             .models()
             .iter()
-            .map(|m| {
+            .zip(calibrations)
+            .map(|(m, calibration)| {
                 let check = ChartCheck::for_model(&m.model, &data_dir)?;
                 Ok(ModelTrust {
-                    calibration: trust::calibration_for(&m.model)?,
+                    calibration,
                     identity: ChartIdentity::for_model(&m.model),
                     check,
                 })
@@ -1248,6 +1291,54 @@ mod tests {
             LightKind::Incandescent
         );
         assert_eq!(estimator.light_kinds().unwrap(), LightKind::ALL);
+    }
+
+    #[test]
+    fn a_candidate_is_judged_by_the_calibration_given_and_refuses_another_models() {
+        use spdcam_core::cie_illuminant::StandardIlluminant;
+        let shipped_set = ModelSet::shipped().unwrap();
+        let cc24 = shipped_set.for_chart("colorchecker24").unwrap().clone();
+        let sg = shipped_set.for_chart("colorchecker_sg96").unwrap().clone();
+        let own = trust::calibration_for(&cc24.model).unwrap().unwrap();
+        let row = colorchecker24_row(&StandardIlluminant::D65.spd(&Grid::SIMULATION).unwrap());
+        let judge = |cal: TrustCalibration| {
+            let e = Estimator::calibrated(cc24.clone(), cal, DataDir::new(None), Grid::ESTIMATION)
+                .unwrap();
+            e.estimate_rows(&row, "D65")
+                .unwrap()
+                .remove(0)
+                .trust
+                .unwrap()
+        };
+        // With its own calibration, exactly as the shipped estimator judges it.
+        let as_shipped = shipped()
+            .estimate_rows(&row, "D65")
+            .unwrap()
+            .remove(0)
+            .trust
+            .unwrap();
+        let given = judge(own.clone());
+        assert_eq!(given.verdict, as_shipped.verdict);
+        assert_eq!(given.reasons, as_shipped.reasons);
+        // A calibration that calls every spread too large is the one that judges.
+        let strict = TrustCalibration {
+            difficulty_doubtful: 0.0,
+            ..own
+        };
+        let judged = judge(strict);
+        assert_ne!(judged.verdict, Verdict::Ok);
+        assert!(
+            judged.reasons.len() > as_shipped.reasons.len(),
+            "{:?}",
+            judged.reasons
+        );
+        // The SG's calibration is not this model's.
+        let other = trust::calibration_for(&sg.model).unwrap().unwrap();
+        let err = Estimator::calibrated(cc24, other, DataDir::new(None), Grid::ESTIMATION)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(err.contains("made for another model"), "{err}");
     }
 
     #[test]

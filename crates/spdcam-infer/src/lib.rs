@@ -102,4 +102,4 @@ pub use estimator::{AnalysedPhoto, Estimator, PhotoEstimate, PhotoProgress, RowS
 pub use feature_rows::FeatureRows;
 pub use model::Model;
 pub use photo_options::PhotoOptions;
-pub use shipped::ModelSet;
+pub use shipped::{ModelSet, NamedModel};

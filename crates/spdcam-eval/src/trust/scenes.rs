@@ -19,7 +19,7 @@ use spdcam_core::seed;
 use spdcam_core::spectral::SpectralSet;
 use spdcam_infer::trust::{TrustCalibration, Verdict};
 use spdcam_infer::PhotoOptions;
-use spdcam_infer::{Estimator, Model, ModelSet};
+use spdcam_infer::{Estimator, Model, ModelSet, NamedModel};
 
 /// Scene photos per kind in [`scene_verdicts`].
 pub const SCENES: usize = 20;
@@ -33,18 +33,31 @@ pub(crate) fn photo_chart(model_chart: &str) -> &str {
     }
 }
 
-/// `model` as a user's photo meets it, looking for `photo_chart` only: its estimator and
-/// the options of every photo.
+/// `model` as a user's photo meets it, looking for `photo_chart` only: its estimator (judged
+/// by `calibration` when given, else by the shipped calibration made for the model, if any)
+/// and the options of every photo.
 fn user_estimator(
     model: &Model,
     photo_chart: &str,
     data_dir: &DataDir,
+    calibration: Option<&TrustCalibration>,
 ) -> Result<(Estimator, PhotoOptions)> {
-    let estimator = Estimator::new(
-        ModelSet::single(model.clone(), "model"),
-        data_dir.clone(),
-        model.grid(),
-    )?;
+    let estimator = match calibration {
+        Some(cal) => Estimator::calibrated(
+            NamedModel {
+                name: "model".to_string(),
+                model: model.clone(),
+            },
+            cal.clone(),
+            data_dir.clone(),
+            model.grid(),
+        )?,
+        None => Estimator::new(
+            ModelSet::single(model.clone(), "model"),
+            data_dir.clone(),
+            model.grid(),
+        )?,
+    };
     let options = PhotoOptions {
         chart: Some(photo_chart.to_string()),
         ..PhotoOptions::default()
@@ -101,7 +114,7 @@ pub fn scene_verdicts(
     let ids = setup
         .library
         .positions(setup.split.lamps(LampPart::Test), "the split's test lamps")?;
-    let (estimator, options) = user_estimator(model, name, data_dir)?;
+    let (estimator, options) = user_estimator(model, name, data_dir, Some(cal))?;
     let plain = scene_options();
     let balanced = SceneOptions {
         balance_halves: true,
@@ -193,7 +206,7 @@ pub fn scene_rows(
     let ids = setup
         .library
         .positions(setup.split.lamps(part), "the split's lamps")?;
-    let (estimator, options) = user_estimator(model, name, data_dir)?;
+    let (estimator, options) = user_estimator(model, name, data_dir, None)?;
     let scene_options = scene_options();
     let found: Vec<Option<(usize, Vec<f64>)>> = (0..ids.len() * per_lamp)
         .into_par_iter()
