@@ -8,7 +8,7 @@ import { chromium } from 'playwright-core';
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join } from 'node:path';
+import { dirname, join } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
 const [url, expectedPath, photoPath, truthPath, artefacts, reportPath, csvPath] = process.argv.slice(2);
@@ -203,7 +203,7 @@ await test('an uploaded photo shows the SPD and xy of `spdcam estimate --json` a
   const points = await plottedSpd(page, expected.name);
   check(points && points.length === expected.spd.length, `plotted ${points && points.length} points`);
   const wl = expected.wavelength_nm;
-  const [left, right, top, bottom] = [52, 628, 40, 312];
+  const [left, right, top, bottom] = (await page.locator('#spd-plot').getAttribute('data-frame')).split(',').map(Number);
   const yTop = Number(await page.locator('#spd-plot').getAttribute('data-top'));
   check(yTop >= 1, `plot top ${yTop}`);
   points.forEach(([x, y], i) => {
@@ -358,12 +358,25 @@ await test('no metric shows a number where it is not meaningful, on the page and
   await tab.waitForSelector('#metrics');
   const result = await tab.evaluate(() => fetch('example.jpg').then((r) => r.blob()).then((b) => {
     const form = new FormData();
-    form.append('photo', new File([b], 'sg-telelumen.jpg'));
+    form.append('photo', new File([b], 'cc24-led.jpg'));
     return fetch('api/estimate', { method: 'POST', body: form }).then((r) => r.json());
   }));
   const greyed = await checkNotMeaningful(tab, 'main', result);
-  // The example light is far from the Planckian locus: at least CCT and Ra are greyed.
-  check(greyed >= 2, `${greyed} metrics greyed`);
+  // A light far from the Planckian locus (the SG example, a purple LED mix): at least CCT
+  // and Ra are greyed on the page, with no number of theirs anywhere.
+  const coloured = await context.newPage();
+  await coloured.goto(url);
+  await coloured.setInputFiles('#files', join(dirname(photoPath), 'sg-telelumen.jpg'));
+  await coloured.waitForSelector('#metrics');
+  const sgResult = await coloured.evaluate(async () => {
+    const input = document.querySelector('#files');
+    const form = new FormData();
+    form.append('photo', input.files[0]);
+    return fetch('api/estimate', { method: 'POST', body: form }).then((r) => r.json());
+  });
+  const sgGreyed = await checkNotMeaningful(coloured, 'main', sgResult);
+  check(sgGreyed >= 2, `${sgGreyed} metrics greyed for a coloured light`);
+  await coloured.close();
   const cli = await context.newPage();
   await cli.goto(pathToFileURL(reportPath).href);
   check(await checkNotMeaningful(cli, '#estimate-1', result) === greyed, 'the CLI report greys other metrics');
@@ -637,6 +650,19 @@ await test('the page reads from 360 to 1,920 px: nothing spills out of its box, 
       return out;
     });
     check(spills.length === 0, `${width} px: ${spills.slice(0, 5).join('; ')}`);
+    // Every drawing's text at least 11 px high as shown (its font size times the drawing's
+    // scale on screen).
+    const small = await tab.evaluate(() => [...document.querySelectorAll('main svg text')].map((t) => {
+      const px = parseFloat(getComputedStyle(t).fontSize) * t.getScreenCTM().a;
+      return [t.textContent, Math.round(px * 10) / 10];
+    }).filter(([, px]) => px < 11));
+    check(small.length === 0, `${width} px: text below 11 px: ${JSON.stringify(small.slice(0, 5))}`);
+    // From 1,400 px the metrics stand beside the photo, not below it.
+    if (width >= 1400) {
+      const [photo, details] = await Promise.all(['#photo-view', '#details'].map((sel) => tab.locator(sel).boundingBox()));
+      check(details.x >= photo.x + photo.width && details.y < photo.y + photo.height,
+        `${width} px: the metrics start at ${Math.round(details.y)} px, below the photo (${Math.round(photo.y)}–${Math.round(photo.y + photo.height)} px)`);
+    }
     const words = await tab.locator('body').innerText();
     check(!COMMAND_LINE.test(words) && !/debug image|\(features? \d/.test(words), `${width} px: command-line words on the page`);
     await tab.screenshot({ path: join(artefacts, `width-${width}.png`), fullPage: true });

@@ -13,8 +13,10 @@ here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(dirname "$here")"
 target="${CARGO_TARGET_DIR:-$repo/target}"
 artefacts="${SPDCAM_WEB_ARTEFACTS:-$target/web-tests}"
-photo="$repo/examples/sg-telelumen.jpg"
-truth="$repo/examples/sg-telelumen.truth.csv"
+# The page's example (a ColorChecker 24 under a white LED), so that the page's "Try the
+# example photo" and the CLI's estimate of PHOTO are one photo.
+photo="$repo/examples/cc24-led.jpg"
+truth="$repo/examples/cc24-led.truth.csv"
 
 if ! [ -x /usr/bin/chromium ]; then
     if [ "$(id -u)" != 0 ]; then

@@ -264,6 +264,9 @@ class Estimate:
                 if m["value"] is not None:
                     unit = f" {m['unit']}" if m["unit"] else ""
                     shown.append(f"{m['label']} {m['value']}{unit}")
+                elif (m["not_meaningful"] or "").startswith("not determinable"):
+                    # No number, but the interval the photo does support.
+                    shown.append(f"{m['label']} {m['not_meaningful']}")
         verdict = f"; verdict {self.verdict}" if self.verdict else ""
         return f"Estimate({self.name!r}: {', '.join(shown)}{verdict})"
 

@@ -1,8 +1,8 @@
 //! `spdcam._native`: the Python binding of spdcam's libraries. Thin on purpose: every step
-//! is a library call (`spdcam_infer`, `spdcam_core`; `spdcam_learn` in [`train`]); this
-//! module only converts Python values, releases the GIL for the work, reports progress to a
-//! Python callback, and turns errors into `spdcam.SpdcamError` with the command line's
-//! messages. The typed API is the Python package `spdcam` around it.
+//! is a library call (`spdcam_infer`, `spdcam_core`; `spdcam_learn` in `train`, built with
+//! that feature); this module only converts Python values, releases the GIL for the work,
+//! reports progress to a Python callback, and turns errors into `spdcam.SpdcamError` with
+//! the command line's messages. The typed API is the Python package `spdcam` around it.
 //!
 //! Estimating needs no training stack: training and fine-tuning (burn, through
 //! `spdcam-learn`) are built only with the cargo feature `train`, so a package that only

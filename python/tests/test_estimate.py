@@ -25,7 +25,7 @@ def gfc(a, b):
 def test_the_example_photo_round_trip(example):
     e = spdcam.estimate(example)
     assert e.name == "sg-telelumen.jpg"
-    assert e.model == "the shipped colorchecker_sg96 model"
+    assert e.model == "the shipped ColorChecker Digital SG model"
     np.testing.assert_array_equal(e.wavelengths, np.arange(400.0, 701.0, 5.0))
     assert e.spd.shape == (61,) and e.spd.max() == pytest.approx(1.0)
     d = e.detection
@@ -131,6 +131,9 @@ def test_repr_shows_the_numbers_as_the_command_line_does(example, cli):
         for m in group["metrics"]:
             if m["value"] is not None:
                 assert m["value"] in shown and m["value"] in text, m
+            elif m["not_meaningful"].startswith("not determinable"):
+                # Said with the interval the photo supports, as the command line says it.
+                assert m["not_meaningful"] in shown and m["not_meaningful"] in text, m
     assert "PPF per 1000 lx" in shown
 
 

@@ -241,9 +241,12 @@ impl fmt::Display for Advice {
             ),
             Advice::NoChartData { chart } => write!(
                 f,
-                "the light found is not checked against the chart: spdcam was started \
-                 without the measured data, which holds the {chart}'s reflectances; give \
-                 it the data directory to have the check"
+                "the light found is not checked against the chart: the {chart}'s measured \
+                 reflectances are not shipped with spdcam, and it was started without the \
+                 folder that holds them (charts/colorchecker_sg.csv in the measured data). \
+                 To have the check, start spdcam with that data folder (its data-directory \
+                 option or the SPDCAM_DATA variable), or photograph a ColorChecker 24, \
+                 which is checked with nothing else"
             ),
             Advice::UnknownChart { chart } => write!(
                 f,

@@ -209,13 +209,20 @@ fn needs_data(chart: KnownChart, error: Error, data_dir: &DataDir) -> Error {
     };
     Error::invalid(format!(
         "chart {} needs its measured reflectances from the data directory, and {place}; \
-         charts available without data: {} (or a reflectance CSV with --layout ROWSxCOLS); \
+         charts available without data: {} (or a reflectance CSV: {CSV_LAYOUT}); \
          set the data directory with --data-dir DIR or {}",
         chart.name(),
         without_data.join(", "),
         builtin::DATA_DIR_ENV
     ))
 }
+
+/// How a chart given as a reflectance CSV gets its layout, in every message that offers one:
+/// `spdcam render` takes any as `--layout ROWSxCOLS`; `estimate` has no such option, so it
+/// reads only the layouts it can guess, with a model trained on that chart.
+const CSV_LAYOUT: &str = "24 patches are laid out 4×6 and 96 as 8×12; `spdcam render` takes \
+     any other layout as --layout ROWSxCOLS; `spdcam estimate` reads a 24- or 96-patch chart \
+     with a model trained on it (--model)";
 
 /// The official names of the ColorChecker Classic 24's patches (X-Rite, "ColorChecker
 /// Classic" product sheet), row by row from dark skin to black.
@@ -565,7 +572,7 @@ impl Chart {
                     kind: "chart",
                     name,
                     valid: KnownChart::ALL.map(KnownChart::name).join(", ")
-                        + ", or a reflectance CSV with --layout ROWSxCOLS",
+                        + &format!(", or a reflectance CSV ({CSV_LAYOUT})"),
                 },
                 other => other,
             })?,
@@ -580,7 +587,8 @@ impl Chart {
             (None, 96) => (8, 12),
             (None, n) => {
                 return Err(Error::invalid(format!(
-                    "chart '{name}' has {n} patches; give its layout as ROWSxCOLS"
+                    "chart '{name}' has {n} patches, not 24 or 96, so its layout cannot be \
+                     guessed: {CSV_LAYOUT}"
                 )))
             }
         };

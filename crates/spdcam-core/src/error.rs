@@ -6,7 +6,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// A file could not be read or written.
-    #[error("{path}: {source}")]
+    #[error("{}: {}", path.display(), io_words(source))]
     Io {
         /// The file or directory.
         path: PathBuf,
@@ -68,6 +68,25 @@ impl Error {
     }
 }
 
+/// What the operating system said about a file, in words that say what to do for the
+/// errors a person meets most (a wrong path, a file they may not read, a folder given for a
+/// file); the system's own words otherwise.
+fn io_words(source: &std::io::Error) -> String {
+    use std::io::ErrorKind;
+    match source.kind() {
+        ErrorKind::NotFound => {
+            "no such file or folder: check the path's spelling, and that it is relative to \
+             the folder the command runs in"
+                .into()
+        }
+        ErrorKind::PermissionDenied => {
+            "permission denied: this user may not open it (check its permissions)".into()
+        }
+        ErrorKind::IsADirectory => "is a folder: give a file in it".into(),
+        _ => source.to_string(),
+    }
+}
+
 /// A number for a message, short whatever its size: as written (`0.8`, `1500`) between
 /// 1e-4 and 1e6, else in scientific notation (`1e300`, `2.5e-320`), so that a huge value
 /// does not become a 300-digit line.
@@ -101,6 +120,18 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_missing_file_says_what_to_do() {
+        let missing = std::io::Error::from(std::io::ErrorKind::NotFound);
+        let text = Error::io("missing.jpg", missing).to_string();
+        assert!(
+            text.starts_with("missing.jpg: no such file or folder: check the path"),
+            "{text}"
+        );
+        let other = std::io::Error::other("disk on fire");
+        assert_eq!(Error::io("x", other).to_string(), "x: disk on fire");
+    }
 
     #[test]
     fn long_name_lists_are_cut() {

@@ -31,11 +31,11 @@ pub struct ResolvedSpd {
 /// subtracted), and a real light has no negative power.
 pub const SPD_NEGATIVE_TOLERANCE: f64 = 0.01;
 
-/// The peaks a light's SPD file may have: the camera computes in single precision (whose
-/// range ends near 1e±38, with sums over the bands and the sensitivities on top), so a
-/// file in units far beyond these overflows or vanishes there. Only the SPD's shape (and,
-/// for two lights, their ratio) matters, so such a file is refused with the advice to
-/// rescale it.
+/// The peaks a light's SPD file may have as it is: the camera computes in single precision
+/// (whose range ends near 1e±38, with sums over the bands and the sensitivities on top), so
+/// a file in units far beyond these would overflow or vanish there. Only the SPD's shape
+/// matters, so such a file is divided by its peak before anything else, with a note (two
+/// lights mixed keep their ratio only when both are within this range).
 pub const SPD_PEAK_RANGE: (f64, f64) = (1e-30, 1e30);
 
 /// Resolves `spec` (see [`SPD_FORMS`]) to an SPD on `grid`. A file's small negatives are
@@ -99,25 +99,22 @@ pub fn resolve_spd(spec: &str, data_dir: &DataDir, grid: &Grid) -> Result<Resolv
             )))
         }
     };
-    let (one, notes) =
+    let (mut one, mut notes) =
         set.select(&[index])
             .clamp_negative_noise("SPD", Some(&file), SPD_NEGATIVE_TOLERANCE)?;
     let peak = one.item(0).iter().fold(0.0f64, |m, &v| m.max(v));
     let (lowest, highest) = SPD_PEAK_RANGE;
     if peak > highest || (peak > 0.0 && peak < lowest) {
-        let what = if peak > highest {
-            "overflows"
-        } else {
-            "is below the range of"
-        };
-        return Err(Error::invalid(format!(
-            "{file}, column '{}': the SPD's peak {} {what} the camera's arithmetic ({}…{}); \
-             only the SPD's shape matters: rescale it (divide the values by their peak)",
+        one = one.normalised_by_max()?;
+        notes.push(format!(
+            "{file}, column '{}': its peak {} lies outside what the camera's single-precision \
+             arithmetic holds ({}…{}); only the SPD's shape matters, so it was divided by its \
+             peak",
             one.names()[0],
             short_number(peak),
             short_number(lowest),
             short_number(highest)
-        )));
+        ));
     }
     let (resampled, report) = one.resample(grid, Interpolation::Auto, Extrapolation::Zero)?;
     let spd = Spd::new(*grid, resampled.item(0).to_vec())?;

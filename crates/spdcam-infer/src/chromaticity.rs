@@ -5,7 +5,7 @@
 //!   it), closed by the line of purples; u′ = 4X/(X + 15Y + 3Z), v′ = 9Y/(X + 15Y + 3Z)
 //!   (CIE 015:2018 §8.1; u′ = u, v′ = 1.5 v of CIE 1960 uv).
 //! - The Planckian locus (1000–20,000 K, Planck's law through the same observer) with
-//!   isotemperature lines at 2000, 2700, 3000, 4000, 5000, 6500 and 10,000 K, each drawn
+//!   isotemperature lines at 2000, 3000, 6500 and 10,000 K, each drawn
 //!   ±0.05 along the locus normal in CIE 1960 uv (the range in which a CCT means anything,
 //!   Ohno 2014; isotemperature lines are normal to the locus in uv, CIE 015:2018 §9.5).
 //! - The estimate's point and, when its CCT and Δuv have calibrated 95 % intervals, the 95 %
@@ -20,18 +20,37 @@ use spdcam_core::quality::uv::uv1960_to_uv1976;
 use spdcam_core::spectral::Grid;
 use std::fmt::Write as _;
 
-/// The isotemperature lines drawn, kelvin.
-pub const ISOTEMPERATURE_K: [f64; 7] = [2000.0, 2700.0, 3000.0, 4000.0, 5000.0, 6500.0, 10000.0];
+/// The isotemperature lines drawn, kelvin, and at which end each is labelled: `true` at
+/// Duv +0.05 (above the locus), `false` at −0.05. Above 3000 K the locus is short in u′v′
+/// and the lines crowd: few lines, labelled at alternate ends, keep every label readable
+/// (4000 and 5000 K would sit on the 560 nm label or on their neighbours' labels).
+pub const ISOTEMPERATURE_K: [(f64, bool); 4] = [
+    (2000.0, true),
+    (3000.0, false),
+    (6500.0, false),
+    (10000.0, true),
+];
 
 /// The SVG's size, in its own units.
 const SIZE: (f64, f64) = (400.0, 400.0);
 
+/// The size of the drawing's text, in its units: the drawing is shown no narrower than
+/// about 300 px (a phone's column), where this is 11 px.
+pub const FONT: f64 = 15.0;
+
 /// The main panel: pixel box (left, top, right, bottom) and the u′, v′ ranges it shows.
 const MAIN: View = View {
-    px: (40.0, 10.0, 390.0, 365.0),
+    px: (44.0, 8.0, 392.0, 362.0),
     u: (0.0, 0.63),
     v: (0.0, 0.64),
 };
+
+/// The inset's pixel box (left, top, right, bottom).
+const INSET_PX: (f64, f64, f64, f64) = (232.0, 200.0, 388.0, 340.0);
+
+/// How far inside the inset's edge (a share of its half-width) the region and the truth are
+/// kept, so that the truth's × is never cut at the edge.
+const INSET_MARGIN: f64 = 0.2;
 
 /// A window of u′v′ drawn into a pixel box.
 #[derive(Debug, Clone, Copy)]
@@ -147,31 +166,39 @@ pub fn uv_diagram_svg(e: &Estimate, truth_xy: Option<[f64; 2]>) -> String {
         let _ = write!(
             s,
             "<line x1=\"{x:.1}\" x2=\"{x:.1}\" y1=\"{t}\" y2=\"{b}\" stroke=\"#eceef2\"/>\
-             <text x=\"{x:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"middle\" fill=\"#5b6475\">{g:.1}</text>\
-             <line x1=\"{l}\" x2=\"{r}\" y1=\"{y:.1}\" y2=\"{y:.1}\" stroke=\"#eceef2\"/>\
-             <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"end\" fill=\"#5b6475\">{g:.1}</text>",
-            b + 14.0,
-            l - 4.0,
-            y + 4.0
+             <text class=\"tick\" x=\"{x:.1}\" y=\"{:.1}\" font-size=\"{FONT}\" text-anchor=\"middle\" fill=\"#5b6475\">{g:.1}</text>\
+             <line x1=\"{l}\" x2=\"{r}\" y1=\"{y:.1}\" y2=\"{y:.1}\" stroke=\"#eceef2\"/>",
+            b + FONT + 1.0,
         );
+        // The origin's 0.0 once, under the u′ axis.
+        if i > 0 {
+            let _ = write!(
+                s,
+                "<text class=\"tick\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"{FONT}\" text-anchor=\"end\" fill=\"#5b6475\">{g:.1}</text>",
+                l - 4.0,
+                y + 5.0
+            );
+        }
     }
     let _ = write!(
         s,
-        "<text x=\"{:.0}\" y=\"396\" font-size=\"12\" text-anchor=\"middle\">u′</text>\
-         <text x=\"8\" y=\"{:.0}\" font-size=\"12\">v′</text>",
-        (l + r) / 2.0,
-        (t + b) / 2.0
+        "<text x=\"{:.0}\" y=\"{:.0}\" font-size=\"{FONT}\" text-anchor=\"middle\">u′</text>\
+         <text x=\"2\" y=\"{:.0}\" font-size=\"{FONT}\">v′</text>",
+        MAIN.at([0.35, 0.0]).0,
+        SIZE.1 - 2.0,
+        MAIN.at([0.0, 0.35]).1 + 5.0
     );
     draw_view(&mut s, &MAIN, point, truth, region.as_deref(), true);
-    // The inset: 0.06 × 0.06 around the estimate (wider when the region or truth needs it).
+    // The inset: 0.06 × 0.06 around the estimate, wider when the region or the truth needs
+    // it, so that each lies at least INSET_MARGIN of the inset's half-width inside it.
     let mut half = 0.03_f64;
     for p in region.iter().flatten().chain(truth.iter()) {
         half = half
-            .max((p[0] - point[0]).abs() * 1.15)
-            .max((p[1] - point[1]).abs() * 1.15);
+            .max((p[0] - point[0]).abs() / (1.0 - INSET_MARGIN))
+            .max((p[1] - point[1]).abs() / (1.0 - INSET_MARGIN));
     }
     let inset = View {
-        px: (235.0, 215.0, 385.0, 355.0),
+        px: INSET_PX,
         u: (point[0] - half, point[0] + half),
         v: (point[1] - half, point[1] + half),
     };
@@ -189,7 +216,7 @@ pub fn uv_diagram_svg(e: &Estimate, truth_xy: Option<[f64; 2]>) -> String {
     draw_view(&mut s, &inset, point, truth, region.as_deref(), false);
     let _ = write!(
         s,
-        "</g><text x=\"{:.0}\" y=\"{:.0}\" font-size=\"10\" fill=\"#5b6475\">enlarged ±{}</text></svg>",
+        "</g><text x=\"{:.0}\" y=\"{:.0}\" font-size=\"{FONT}\" fill=\"#5b6475\">enlarged ±{}</text></svg>",
         il + 4.0,
         ib - 4.0,
         crate::rounding::round_sig(half, 1)
@@ -215,20 +242,23 @@ fn draw_view(
         view.points(&pts)
     );
     if labels {
-        for (nm, p) in locus.iter().filter(|(nm, _)| {
-            [
-                460.0, 480.0, 500.0, 520.0, 540.0, 560.0, 580.0, 600.0, 620.0,
-            ]
-            .contains(nm)
-        }) {
+        for (nm, p) in locus
+            .iter()
+            .filter(|(nm, _)| [460.0, 480.0, 500.0, 520.0, 560.0, 600.0].contains(nm))
+        {
             let (x, y) = view.at(*p);
-            let left = p[0] < 0.15;
+            // Left of the locus where there is room; 500 and 520 nm lie by the v′ axis, so
+            // their labels go inside the locus, clear of the axis's numbers.
+            let (dx, anchor) = match p[0] {
+                u if u < 0.05 => (7.0, "start"),
+                u if u < 0.15 => (-7.0, "end"),
+                _ => (7.0, "start"),
+            };
             let _ = write!(
                 s,
-                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" fill=\"#5b6475\" text-anchor=\"{}\">{nm:.0}</text>",
-                if left { x - 5.0 } else { x + 5.0 },
-                y + 4.0,
-                if left { "end" } else { "start" }
+                "<text class=\"wavelength\" x=\"{:.1}\" y=\"{:.1}\" font-size=\"{FONT}\" fill=\"#5b6475\" text-anchor=\"{anchor}\">{nm:.0}</text>",
+                x + dx,
+                y + 5.0,
             );
         }
     }
@@ -237,7 +267,7 @@ fn draw_view(
         "<polyline class=\"planckian\" points=\"{}\" fill=\"none\" stroke=\"#8a5a00\"/>",
         view.points(&planckian_locus())
     );
-    for k in ISOTEMPERATURE_K {
+    for (k, above) in ISOTEMPERATURE_K {
         let (Ok(a), Ok(c)) = (cct_duv_to_uv(k, -0.05), cct_duv_to_uv(k, 0.05)) else {
             continue;
         };
@@ -247,12 +277,16 @@ fn draw_view(
             "<line class=\"isotemperature\" data-k=\"{k:.0}\" x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\" stroke=\"#c9a34a\" stroke-width=\"0.8\"/>",
             a.0, a.1, c.0, c.1
         );
-        if labels && k != 2700.0 {
+        if labels {
+            // Beyond the line's labelled end, away from the locus.
+            let (x, y) = if above {
+                (c.0, c.1 - 4.0)
+            } else {
+                (a.0, a.1 + FONT)
+            };
             let _ = write!(
                 s,
-                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"8\" fill=\"#8a5a00\" text-anchor=\"middle\">{}</text>",
-                a.0,
-                a.1 + 9.0,
+                "<text class=\"cct-label\" x=\"{x:.1}\" y=\"{y:.1}\" font-size=\"{FONT}\" fill=\"#8a5a00\" text-anchor=\"middle\">{}</text>",
                 k as u32
             );
         }
@@ -332,8 +366,78 @@ mod tests {
             (x - at520.0).hypot(y - at520.1) < 1.5
         });
         assert!(near, "no locus point near 520 nm at {at520:?}");
-        // Seven isotemperature lines on each panel, and the truth drawn.
-        assert_eq!(svg.matches("class=\"isotemperature\"").count(), 14);
+        // Four isotemperature lines on each panel, and the truth drawn.
+        assert_eq!(svg.matches("class=\"isotemperature\"").count(), 8);
         assert!(svg.contains("class=\"truth\""));
+    }
+
+    /// Each `<text>` of `svg` as (its estimated box left, top, right, bottom; its text): a
+    /// sans-serif digit is about 0.56 em wide, a line from 0.75 em above the baseline to
+    /// 0.2 em below it.
+    fn text_boxes(svg: &str) -> Vec<([f64; 4], String)> {
+        svg.split("<text ")
+            .skip(1)
+            .map(|rest| {
+                let (attrs, after) = rest.split_once('>').unwrap();
+                let content = after.split("</text>").next().unwrap().to_string();
+                let get = |name: &str| -> String {
+                    let at = attrs.find(&format!("{name}=\"")).unwrap() + name.len() + 2;
+                    attrs[at..].split('"').next().unwrap().to_string()
+                };
+                let (x, y): (f64, f64) = (get("x").parse().unwrap(), get("y").parse().unwrap());
+                let size: f64 = get("font-size").parse().unwrap();
+                let w = 0.56 * size * content.chars().count() as f64;
+                let anchor = attrs
+                    .contains("text-anchor=")
+                    .then(|| get("text-anchor"))
+                    .unwrap_or_else(|| "start".into());
+                let left = match anchor.as_str() {
+                    "middle" => x - w / 2.0,
+                    "end" => x - w,
+                    _ => x,
+                };
+                ([left, y - 0.75 * size, left + w, y + 0.2 * size], content)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn no_label_covers_another_and_the_truth_is_never_cut_by_the_inset() {
+        let e = crate::test_support::estimate_of_d65();
+        // A truth far off (the SG report's case): it widens the inset, not leaves it.
+        let truth_xy = [0.36, 0.30];
+        let svg = uv_diagram_svg(&e, Some(truth_xy));
+        let boxes = text_boxes(&svg);
+        assert!(boxes.len() > 20, "{}", boxes.len());
+        for (i, (a, ta)) in boxes.iter().enumerate() {
+            for (b, tb) in &boxes[i + 1..] {
+                let apart = a[2] <= b[0] || b[2] <= a[0] || a[3] <= b[1] || b[3] <= a[1];
+                assert!(apart, "'{ta}' {a:?} overlaps '{tb}' {b:?}");
+            }
+            // Nothing of the main panel hides under the inset but the inset's own label.
+            let (l, t, r, bottom) = INSET_PX;
+            let under = a[0] < r && a[2] > l && a[1] < bottom && a[3] > t;
+            assert!(
+                !under || ta.starts_with("enlarged"),
+                "'{ta}' under the inset"
+            );
+        }
+        assert!(svg
+            .split("<text ")
+            .skip(1)
+            .all(|t| t.contains(&format!("font-size=\"{FONT}\""))));
+        // The truth's × (8 units across) lies wholly inside the inset.
+        let inset = svg.split("class=\"inset\"").nth(1).unwrap();
+        let d = inset.split("class=\"truth\" d=\"M").nth(1).unwrap();
+        let mut xy = d
+            .split(['l', ' '])
+            .take(2)
+            .map(|v| v.parse::<f64>().unwrap());
+        let (x, y) = (xy.next().unwrap(), xy.next().unwrap());
+        let (l, t, r, b) = INSET_PX;
+        assert!(
+            x >= l && x + 8.0 <= r && y >= t && y + 8.0 <= b,
+            "× at {x},{y} in {INSET_PX:?}"
+        );
     }
 }

@@ -42,6 +42,13 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
+/// The narrowest output range an estimate is given on: a sixth of 400–700 nm (a spectrum
+/// over less is a few numbers, and a GFC over them says nothing of its shape).
+pub const MIN_RANGE_NM: f64 = 50.0;
+
+/// The fewest wavelengths an output range holds.
+pub const MIN_RANGE_WAVELENGTHS: usize = 3;
+
 /// What judging one model's estimates needs, made once per model.
 struct ModelTrust {
     /// The shipped calibration measured on the model, parsed once.
@@ -193,9 +200,10 @@ impl Estimator {
         Estimator::new(ModelSet::shipped()?, data_dir, grid)
     }
 
-    /// The estimator of `prepared` on the output grid `grid`, which must hold two or more
-    /// wavelengths within one model's at least (an SPD is not one wavelength's value, and
-    /// no model says anything outside its own range).
+    /// The estimator of `prepared` on the output grid `grid`, which must span
+    /// [`MIN_RANGE_NM`] in [`MIN_RANGE_WAVELENGTHS`] wavelengths or more, within one model's
+    /// at least (an SPD is not one wavelength's value nor two's, and no model says anything
+    /// outside its own range).
     fn with(
         prepared: Arc<Prepared>,
         priors: Arc<OnceLock<Vec<Option<KindPriors>>>>,
@@ -207,6 +215,16 @@ impl Estimator {
                 "the range {}: a single wavelength is not a spectrum; give START-END[:STEP] \
                  with END above START (e.g. 400-700:5)",
                 grid.label()
+            )));
+        }
+        let span = grid.end_nm() - grid.start_nm;
+        if span < MIN_RANGE_NM || grid.count < MIN_RANGE_WAVELENGTHS {
+            return Err(InferError::invalid(format!(
+                "the range {}: {} wavelength(s) over {span} nm are too few to be a spectrum \
+                 (a GFC or a plot over them says nothing); give at least {MIN_RANGE_NM} nm in \
+                 {MIN_RANGE_WAVELENGTHS} or more wavelengths, e.g. 400-700:5 or 500-600:5",
+                grid.label(),
+                grid.count
             )));
         }
         let maps: Vec<Result<GridMap>> = prepared
@@ -1479,7 +1497,10 @@ mod tests {
         let source =
             FeatureStream::new(Box::new(std::io::Cursor::new(text.into_bytes())), "f.csv").unwrap();
         let mut stream = estimator.stream(source, "f.csv").unwrap();
-        assert_eq!(stream.model_name(), "the shipped colorchecker_sg96 model");
+        assert_eq!(
+            stream.model_name(),
+            "the shipped ColorChecker Digital SG model"
+        );
         let block = stream.next_block().unwrap().unwrap();
         assert_eq!((block.first_row, block.rows), (0, 3));
         assert!(stream.next_block().unwrap().is_none());

@@ -9,7 +9,7 @@
 use crate::estimate::Estimate;
 use crate::estimate::MAX_CCT_DUV;
 use crate::meaningful::{cct_meaningful, cri_meaningful};
-use crate::rounding::{round_sig, shown, shown_with_unit, NOT_DETERMINABLE};
+use crate::rounding::{round_sig, shown, shown_with_unit, undetermined_words, NOT_DETERMINABLE};
 use serde::Serialize;
 use spdcam_core::quality::dominant::{dominant_wavelength, peak_wavelength_nm, ILLUMINANT_E_XY};
 use spdcam_core::quality::film_tv::{
@@ -17,6 +17,9 @@ use spdcam_core::quality::film_tv::{
     DAYLIGHT_K, TUNGSTEN_K,
 };
 use spdcam_core::quality::LightSpectrum;
+
+/// What an SSI carries in place of an interval: the trust calibration has none for it.
+pub const SSI_UNCALIBRATED: &str = "uncalibrated: no interval";
 
 /// One number of the meter's screen.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -43,6 +46,10 @@ pub struct Meter {
     /// calibrated 95 % interval is too wide ([`crate::rounding::determinable`]), the others
     /// have no calibrated interval.
     pub r1_r15: Option<Vec<Option<f64>>>,
+    /// Why R9 has no bar, with the interval the photo supports
+    /// ([`crate::rounding::undetermined_words`]): `R9 not determinable from this photo
+    /// (between -20 and 60, 95 %)`; `None` when R9 is shown.
+    pub r9_note: Option<String>,
     /// SSI and the filter corrections to 3200 K and 5600 K, for white light.
     pub film_tv: Vec<Reading>,
 }
@@ -80,14 +87,20 @@ impl Meter {
         } else {
             match dominant_wavelength(e.colorimetry.xy, ILLUMINANT_E_XY) {
                 Ok(d) => {
+                    let hue = spectral_hue(d.wavelength_nm);
                     headline.push(Reading {
                         key: "dominant_nm",
-                        label: if d.complementary {
-                            "Complementary wavelength"
+                        label: "Dominant wavelength",
+                        value: if d.complementary {
+                            format!(
+                                "none: a purple light, a mix of red and blue that no single \
+                                 wavelength matches; it lies opposite {:.0} nm ({hue}), its \
+                                 complementary wavelength",
+                                d.wavelength_nm
+                            )
                         } else {
-                            "Dominant wavelength"
+                            format!("{:.0} nm ({hue})", d.wavelength_nm)
                         },
-                        value: format!("{:.0} nm", d.wavelength_nm),
                     });
                     headline.push(Reading {
                         key: "excitation_purity",
@@ -118,10 +131,18 @@ impl Meter {
             _ => None,
         };
         let cct_duv = cct.zip(duv).filter(|_| white);
+        let mut r9_note = None;
         let r1_r15 = match (&light, cct_duv) {
             (Some(light), Some((cct, _))) if cri_meaningful(e).is_ok() => {
                 special_rendering_indices_r1_r15(light, cct).ok().map(|r| {
-                    let r9_shown = shown("cri_r9", r[8], half95(e, "cri_r9")).is_ok();
+                    let r9_half = half95(e, "cri_r9");
+                    let r9_shown = shown("cri_r9", r[8], r9_half).is_ok();
+                    if !r9_shown {
+                        r9_note = Some(format!(
+                            "R9 {}",
+                            undetermined_words("cri_r9", r[8], r9_half)
+                        ));
+                    }
                     r.iter()
                         .enumerate()
                         .map(|(i, v)| (i != 8 || r9_shown).then_some(*v))
@@ -135,6 +156,7 @@ impl Meter {
             headline,
             illuminance,
             r1_r15,
+            r9_note,
             film_tv: film_tv(e, light.as_ref(), cct_duv),
         }
     }
@@ -150,6 +172,9 @@ fn film_tv(
     let (Some(light), Some((cct, duv))) = (light, cct_duv) else {
         return Vec::new();
     };
+    let cct_half = half95(e, "cct_k");
+    let cct_undetermined = shown("cct_k", cct, cct_half).is_err();
+    let calibrated = e.trust.as_ref().is_some_and(|t| t.uncertainty.is_some());
     let mut out = Vec::new();
     for (key, label, reference) in [
         ("ssi", "SSI (own CCT)", SsiReference::CctMatched),
@@ -165,16 +190,23 @@ fn film_tv(
         ),
     ] {
         if let Ok(v) = spectral_similarity_index(light, &reference) {
-            out.push(Reading {
-                key,
-                label,
-                value: format!("{v:.0}"),
-            });
+            let value = if key == "ssi" && cct_undetermined {
+                // Its reference is a light of the estimate's own CCT, which the photo does not
+                // determine.
+                format!("{NOT_DETERMINABLE} (its reference needs the CCT)")
+            } else if calibrated {
+                // SSI has no calibrated interval (the calibration covers the metrics of
+                // `spdcam_core::quality::SCALAR_KEYS`): say so rather than print a bare number
+                // beside numbers that carry theirs.
+                format!("{v:.0} ({SSI_UNCALIBRATED})")
+            } else {
+                format!("{v:.0}")
+            };
+            out.push(Reading { key, label, value });
         }
     }
     // The mired shift's 95 % half-width from the CCT's: d(10⁶/T) = 10⁶·dT/T² (first order).
-    let mired_half = half95(e, "cct_k").map(|h| 1e6 * h / (cct * cct));
-    let cct_undetermined = shown("cct_k", cct, half95(e, "cct_k")).is_err();
+    let mired_half = cct_half.map(|h| 1e6 * h / (cct * cct));
     for (key, label, target) in [
         ("mired_3200", "To 3200 K", TUNGSTEN_K),
         ("mired_5600", "To 5600 K", DAYLIGHT_K),
@@ -182,35 +214,125 @@ fn film_tv(
         let Ok(c) = cct_correction(cct, duv, target) else {
             continue;
         };
-        let value = if cct_undetermined {
-            NOT_DETERMINABLE.to_string()
-        } else {
-            match shown(key, c.mired_shift, mired_half) {
-                Ok(v) => format!("{v} mired ({})", filter_words(c.mired_shift)),
-                Err(words) => words.to_string(),
+        let shift = c.mired_shift;
+        let value = match (shown(key, shift, mired_half), mired_half) {
+            (Ok(v), _) if !cct_undetermined => {
+                format!("{v} mired ({})", gel_words(shift))
             }
+            // Too wide for one number: the interval, and the gels it spans.
+            (_, Some(h)) => mired_range_words(key, shift, h),
+            (_, None) => NOT_DETERMINABLE.to_string(),
         };
         out.push(Reading { key, label, value });
     }
     out.push(Reading {
         key: "green_magenta_duv",
         label: "Green–magenta",
-        value: match shown("duv", duv, half95(e, "duv")) {
-            Ok(v) if duv > 0.0 => format!("Δuv {v}: a magenta (minus-green) filter"),
-            Ok(v) => format!("Δuv {v}: a green (plus-green) filter"),
-            Err(words) => words.to_string(),
-        },
+        value: green_magenta_words(duv, half95(e, "duv")),
     });
     out
 }
 
-/// Which way a mired shift goes, in a filter's words (positive warms: amber, CTO; negative
-/// cools: blue, CTB; Wyszecki & Stiles 1982 §3.11).
-fn filter_words(mired: f64) -> &'static str {
-    if mired > 0.0 {
+/// The green–magenta correction in words: a filter only where the 95 % interval of Δuv
+/// excludes zero ("no filter"); otherwise none is called for within what the photo can tell.
+fn green_magenta_words(duv: f64, half95: Option<f64>) -> String {
+    match shown("duv", duv, half95) {
+        Ok(v) if half95.is_some_and(|h| duv.abs() <= h) => format!(
+            "no correction needed within what this photo can tell (Δuv {v}: the interval \
+             holds 0)"
+        ),
+        Ok(v) if duv > 0.0 => format!("Δuv {v}: a magenta (minus-green) filter"),
+        Ok(v) => format!("Δuv {v}: a green (plus-green) filter"),
+        Err(_) => undetermined_words("duv", duv, half95),
+    }
+}
+
+/// LEE Filters' colour-temperature gels and their mired shifts (LEE Filters, "Colour
+/// correction" technical data: 204 full, 205 ½, 206 ¼, 223 ⅛ CT Orange; 201 full, 202 ½,
+/// 203 ¼, 218 ⅛ CT Blue); other makers' are within a few mired.
+const GELS: [(f64, &str); 8] = [
+    (159.0, "a full CTO"),
+    (109.0, "a ½ CTO"),
+    (64.0, "a ¼ CTO"),
+    (26.0, "an ⅛ CTO"),
+    (-18.0, "an ⅛ CTB"),
+    (-35.0, "a ¼ CTB"),
+    (-78.0, "a ½ CTB"),
+    (-137.0, "a full CTB"),
+];
+
+/// The gel nearest a mired shift, in a filter's words: `warming: about a ¼ CTO`; `no gel`
+/// within half the smallest gel's shift (Wyszecki & Stiles 1982 §3.11: positive warms,
+/// negative cools).
+fn gel_words(mired: f64) -> String {
+    let smallest = if mired > 0.0 { 26.0 } else { 18.0 };
+    if mired.abs() < smallest / 2.0 {
+        return "no gel: less than half an ⅛".to_string();
+    }
+    let side: Vec<&(f64, &str)> = GELS
+        .iter()
+        .filter(|(m, _)| (*m > 0.0) == (mired > 0.0))
+        .collect();
+    let strongest = side
+        .iter()
+        .max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
+        .expect("gels on both sides");
+    let way = if mired > 0.0 {
         "warming: amber, CTO"
     } else {
         "cooling: blue, CTB"
+    };
+    if mired.abs() > 1.25 * strongest.0.abs() {
+        return format!("{way}; more than {}", strongest.1);
+    }
+    let nearest = side
+        .iter()
+        .min_by(|a, b| (a.0 - mired).abs().total_cmp(&(b.0 - mired).abs()))
+        .expect("gels on both sides");
+    format!("{way}; about {}", nearest.1)
+}
+
+/// A mired shift whose 95 % interval is too wide for one number: the interval and the gels
+/// at its ends, or that the photo cannot tell which way the light needs correcting.
+fn mired_range_words(key: &str, shift: f64, half95: f64) -> String {
+    let (lo, hi) = crate::rounding::interval_bounds(key, shift, half95);
+    let r = |x: f64| {
+        let (v, _) = crate::rounding::round_with_uncertainty(x, half95);
+        if x >= 0.0 {
+            format!("+{v}")
+        } else {
+            v
+        }
+    };
+    let span = format!("between {} and {} mired (95 %)", r(lo), r(hi));
+    if lo < 0.0 && hi > 0.0 {
+        format!("{span}: the photo cannot tell whether it needs warming or cooling")
+    } else {
+        let end = |m: f64| {
+            gel_words(m).split_once("; ").map_or_else(
+                || "no gel".to_string(),
+                |(_, g)| g.trim_start_matches("about ").to_string(),
+            )
+        };
+        let way = if shift > 0.0 { "warming" } else { "cooling" };
+        let (weak, strong) = if shift > 0.0 { (lo, hi) } else { (hi, lo) };
+        format!("{span}: {way}, between {} and {}", end(weak), end(strong))
+    }
+}
+
+/// The hue name of a spectral colour of wavelength `nm` (coarsened from Kelly 1943, "Color
+/// designations for lights", J. Opt. Soc. Am. 33, 627–632).
+fn spectral_hue(nm: f64) -> &'static str {
+    match nm {
+        n if n < 450.0 => "violet",
+        n if n < 485.0 => "blue",
+        n if n < 500.0 => "blue-green",
+        n if n < 530.0 => "green",
+        n if n < 565.0 => "yellowish green",
+        n if n < 580.0 => "yellow",
+        n if n < 600.0 => "orange",
+        n if n < 620.0 => "reddish orange",
+        _ => "red",
     }
 }
 
@@ -252,11 +374,87 @@ mod tests {
         assert_eq!(red.headline[0].label, "Dominant wavelength");
         let nm: f64 = red.headline[0]
             .value
-            .trim_end_matches(" nm")
+            .split_once(" nm (")
+            .unwrap()
+            .0
             .parse()
             .unwrap();
         assert!((nm - 610.0).abs() < 3.0, "{nm}");
+        assert!(red.headline[0].value.ends_with("(reddish orange)"));
         assert_eq!(red.headline[2].value, "610 nm");
         assert!(red.film_tv.is_empty() && red.r1_r15.is_none());
+        // Red and blue together: a purple, which has no dominant wavelength; the words say
+        // so and name the complementary one.
+        let purple: Vec<f64> = grid
+            .wavelengths()
+            .iter()
+            .map(|w| (-((w - 450.0) / 10.0).powi(2)).exp() + (-((w - 640.0) / 10.0).powi(2)).exp())
+            .collect();
+        let purple = Meter::of(&estimate_of(Spd::new(grid, purple).unwrap(), &[]));
+        let words = &purple.headline[0].value;
+        assert!(
+            words.starts_with("none: a purple light") && words.contains("complementary wavelength"),
+            "{words}"
+        );
+        assert!(
+            words.contains("nm (green") || words.contains("nm (yellowish green"),
+            "{words}"
+        );
+    }
+
+    #[test]
+    fn a_filter_is_advised_only_where_its_interval_excludes_no_filter() {
+        // The issue's example: Δuv +0.002 ± 0.008 holds 0 (the true light needed the other
+        // filter): no advice.
+        let none = green_magenta_words(0.002, Some(0.008));
+        assert!(none.starts_with("no correction needed"), "{none}");
+        assert!(none.contains("+0.002 ± 0.008"), "{none}");
+        assert_eq!(
+            green_magenta_words(0.006, Some(0.002)),
+            "Δuv +0.0060 ± 0.0020: a magenta (minus-green) filter"
+        );
+        assert_eq!(
+            green_magenta_words(-0.006, Some(0.002)),
+            "Δuv -0.0060 ± 0.0020: a green (plus-green) filter"
+        );
+        // Too wide to say anything: the interval, not advice.
+        assert!(green_magenta_words(0.01, Some(0.02)).starts_with(NOT_DETERMINABLE));
+    }
+
+    #[test]
+    fn a_mired_shift_names_the_nearest_gel_and_a_wide_interval_the_gels_it_spans() {
+        // LEE's gels: +64 is a ¼ CTO, −137 a full CTB, +5 no gel, +250 more than a full CTO.
+        assert_eq!(gel_words(60.0), "warming: amber, CTO; about a ¼ CTO");
+        assert_eq!(gel_words(-130.0), "cooling: blue, CTB; about a full CTB");
+        assert!(gel_words(5.0).starts_with("no gel"));
+        assert_eq!(
+            gel_words(250.0),
+            "warming: amber, CTO; more than a full CTO"
+        );
+        // +90 ± 30 mired: from +60 to +120, a ¼ to a ½ CTO (the issue's "between a ¼ and a ½
+        // CTO").
+        assert_eq!(
+            mired_range_words("mired_5600", 90.0, 30.0),
+            "between +60 and +120 mired (95 %): warming, between a ¼ CTO and a ½ CTO"
+        );
+        // An interval across zero cannot tell the way.
+        assert!(mired_range_words("mired_3200", -10.0, 40.0).ends_with("warming or cooling"));
+    }
+
+    #[test]
+    fn ssi_says_it_has_no_interval_and_follows_an_undetermined_cct() {
+        let mut e = estimate_of_d65();
+        let m = Meter::of(&e);
+        let ssi = m.film_tv.iter().find(|r| r.key == "ssi").unwrap();
+        assert!(ssi.value.contains(SSI_UNCALIBRATED), "{ssi:?}");
+        // A CCT the photo does not determine leaves the SSI against the light's own CCT
+        // undetermined too, and the filter corrections give their intervals.
+        let u = e.trust.as_mut().unwrap().uncertainty.as_mut().unwrap();
+        u.metrics.get_mut("cct_k").unwrap().half95 = 2000.0;
+        let m = Meter::of(&e);
+        let ssi = m.film_tv.iter().find(|r| r.key == "ssi").unwrap();
+        assert!(ssi.value.starts_with(NOT_DETERMINABLE), "{ssi:?}");
+        let to3200 = m.film_tv.iter().find(|r| r.key == "mired_3200").unwrap();
+        assert!(to3200.value.starts_with("between "), "{to3200:?}");
     }
 }

@@ -16,7 +16,7 @@ use crate::estimate::{Estimate, MAX_CCT_DUV};
 use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::meter::Meter;
 pub use crate::rounding::{round_sig, round_with_uncertainty};
-use crate::rounding::{shown, NOT_DETERMINABLE};
+use crate::rounding::{shown, undetermined_words};
 use crate::trust::Verdict;
 use serde::Serialize;
 use spdcam_core::light_families::LightKind;
@@ -188,7 +188,7 @@ impl Presentation {
                         let (value, not_meaningful) = match meaningful_value(estimate, key) {
                             Ok(v) => match shown(key, v, half95) {
                                 Ok(text) => (Some(text), None),
-                                Err(_) => (None, Some(not_determinable_words(key, half95))),
+                                Err(_) => (None, Some(undetermined_words(key, v, half95))),
                             },
                             Err(why) => (None, Some(why)),
                         };
@@ -222,7 +222,10 @@ impl Presentation {
         {
             Some(cct) => match shown("cct_k", cct, cct_half) {
                 Ok(text) => summary.push_str(&format!(", CCT {text} K")),
-                Err(words) => summary.push_str(&format!(", its colour temperature {words}")),
+                Err(_) => summary.push_str(&format!(
+                    ", its colour temperature {}",
+                    undetermined_words("cct_k", cct, cct_half)
+                )),
             },
             None => summary.push_str(", too far from white for a colour temperature"),
         }
@@ -343,21 +346,6 @@ pub fn meaningful_value(estimate: &Estimate, key: &str) -> Result<f64, String> {
         _ => {}
     }
     Ok(value)
-}
-
-/// Why a metric has no number although it is meaningful: its 95 % interval is too wide.
-fn not_determinable_words(key: &str, half95: Option<f64>) -> String {
-    match half95 {
-        Some(h) => format!(
-            "{NOT_DETERMINABLE} (95 % interval ± {}{})",
-            round_sig(crate::rounding::scale(key) * h, 2),
-            match crate::rounding::unit(key) {
-                "" => String::new(),
-                u => format!(" {u}"),
-            }
-        ),
-        None => NOT_DETERMINABLE.to_string(),
-    }
 }
 
 /// The mean half-width of the 95 % band over the wavelengths (the SPD's peak is 1).

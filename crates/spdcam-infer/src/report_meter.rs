@@ -106,11 +106,9 @@ pub(crate) fn film_tv_html(out: &mut String, m: &Meter) {
             "<figure>{}<figcaption>R1–R15: how true each test colour looks (CIE 13.3; R15 \
              Japanese skin, JIS Z 8726); R9 is the saturated red{}.</figcaption></figure>",
             r_bars_svg(r),
-            if r.get(8).is_some_and(Option::is_none) {
-                " (—: not determinable from this photo)"
-            } else {
-                ""
-            }
+            m.r9_note
+                .as_ref()
+                .map_or_else(String::new, |note| format!(" (—: {})", esc(note)))
         );
     }
     out.push_str("</div>\n<div><table class=\"film-tv small\">");

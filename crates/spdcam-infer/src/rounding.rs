@@ -13,10 +13,13 @@
 //!   half-width beyond 15 % of the value (a ±15 % CCT spans warm to neutral white, the
 //!   whole of an EN 12464-1 colour-appearance group); for indices on a 0–100 scale (CRI Ra
 //!   and R1–R15, TM-30 Rf and Rg, SSI) a half-width beyond 25, a quarter of the scale; for
-//!   Δuv beyond 0.0125, a quarter of the ±0.05 within which a CCT means anything (Ohno 2014);
+//!   Δuv beyond 0.0125, a quarter of the ±0.05 within which a CCT means anything (Ohno 2014),
+//!   unless the whole interval lies beyond ±0.05 (the photo then shows a coloured light, and
+//!   by about how much);
 //!   for ratios (melanopic DER, S/P, blue-light hazard, PPF per lux) a half-width beyond
 //!   half the value (the interval then spans more than a factor of three); for a filter's
-//!   mired shift beyond 25 mired (about a quarter CTO, the smallest correction gel).
+//!   mired shift beyond 25 mired (about an eighth CTO, the smallest correction gel). In
+//!   place of the number, the interval itself ([`undetermined_words`]).
 //! - One unit per quantity: PPF per lux in µmol s⁻¹ m⁻² per 1000 lx ([`scale`]).
 
 /// The words that stand in place of a number its photo does not determine.
@@ -49,7 +52,9 @@ pub fn unit(key: &str) -> &'static str {
 pub fn determinable(key: &str, value: f64, half: f64) -> bool {
     match key {
         "cct_k" => half <= 0.15 * value.abs(),
-        "duv" => half <= 0.0125,
+        // Or, far from white, an interval wholly beyond the ±0.05 within which a CCT means
+        // anything: the photo then shows the light is coloured, and by about how much.
+        "duv" => half <= 0.0125 || value.abs() - half > crate::estimate::MAX_CCT_DUV,
         "mel_der" | "sp_ratio" | "ppf_per_lux" | "blh_efficacy_w_per_lm" => {
             half <= 0.5 * value.abs()
         }
@@ -83,13 +88,56 @@ pub fn shown(key: &str, value: f64, half95: Option<f64>) -> Result<String, &'sta
     }
 }
 
-/// [`shown`] with the unit, and the words in place of an undeterminable number: what a
-/// line of text prints, e.g. `6480 ± 310 K`.
+/// [`shown`] with the unit, and the words in place of an undeterminable number
+/// ([`undetermined_words`]): what a line of text prints, e.g. `6480 ± 310 K`.
 pub fn shown_with_unit(key: &str, value: f64, half95: Option<f64>) -> String {
     match shown(key, value, half95) {
         Ok(v) if unit(key).is_empty() => v,
         Ok(v) => format!("{v} {}", unit(key)),
-        Err(words) => words.to_string(),
+        Err(_) => undetermined_words(key, value, half95),
+    }
+}
+
+/// The 95 % interval `value ± half95` of the metric of `key` (both as stored), cut to the
+/// values the quantity can take: indices on the 0–100 scale (CIE 13.3 Ra and R1–R15, TM-30
+/// Rf, SSI) never exceed 100, and quantities that cannot be negative (CCT, TM-30 Rg, the
+/// ratios and efficacies) never fall below 0.
+pub fn interval_bounds(key: &str, value: f64, half95: f64) -> (f64, f64) {
+    let (mut lo, mut hi) = (value - half95, value + half95);
+    let at_most_100 = key.starts_with("cri_r") || key == "tm30_rf" || key.starts_with("ssi");
+    let signed = key == "duv" || key.starts_with("mired") || key.starts_with("cri_r");
+    if at_most_100 {
+        hi = hi.min(100.0);
+        lo = lo.min(hi);
+    }
+    if !signed {
+        lo = lo.max(0.0);
+        hi = hi.max(lo);
+    }
+    (lo, hi)
+}
+
+/// What stands in place of a number whose 95 % interval is too wide to round to one
+/// ([`determinable`]): [`NOT_DETERMINABLE`] and, when the interval is known, what the photo
+/// does say, e.g. `not determinable from this photo (between 2400 and 4200 K, 95 %)`. A
+/// person can still act on a range ("warmer than 2400 K"); a rounded middle would claim more.
+pub fn undetermined_words(key: &str, value: f64, half95: Option<f64>) -> String {
+    let k = scale(key);
+    match half95.filter(|h| *h > 0.0 && h.is_finite()) {
+        Some(half) if value.is_finite() => {
+            let (lo, hi) = interval_bounds(key, k * value, k * half);
+            let rounded = |x: f64| round_with_uncertainty(x, k * half).0;
+            let unit = match unit(key) {
+                "" => String::new(),
+                u => format!(" {u}"),
+            };
+            format!(
+                "{NOT_DETERMINABLE} (between {} and {}{unit}, 95 %)",
+                rounded(lo),
+                rounded(hi)
+            )
+        }
+        _ => NOT_DETERMINABLE.to_string(),
     }
 }
 
@@ -187,7 +235,38 @@ mod tests {
         assert_eq!(shown_with_unit("cct_k", 6504.2, None), "6504 K");
         assert_eq!(
             shown_with_unit("cct_k", 5000.0, Some(900.0)),
-            NOT_DETERMINABLE
+            format!("{NOT_DETERMINABLE} (between 4100 and 5900 K, 95 %)")
         );
+    }
+
+    #[test]
+    fn an_undetermined_number_gives_the_interval_the_photo_supports() {
+        // R9 20 ± 44: −24 to 64, rounded at the half-width's place (one digit of 44: tens).
+        assert_eq!(
+            undetermined_words("cri_r9", 20.0, Some(44.0)),
+            format!("{NOT_DETERMINABLE} (between -20 and 60, 95 %)")
+        );
+        // Ra 90 ± 30 cannot exceed 100; a CCT cannot fall below 0 K.
+        assert_eq!(interval_bounds("cri_ra", 90.0, 30.0), (60.0, 100.0));
+        assert_eq!(interval_bounds("cct_k", 3000.0, 4000.0), (0.0, 7000.0));
+        // A mired shift and Δuv keep their sign.
+        assert_eq!(interval_bounds("mired_5600", -10.0, 40.0), (-50.0, 30.0));
+        // PPF per lux in its shown unit (per 1000 lx).
+        assert_eq!(
+            undetermined_words("ppf_per_lux", 0.0296, Some(0.02)),
+            format!("{NOT_DETERMINABLE} (between 10 and 50 µmol s⁻¹ m⁻² per 1000 lx, 95 %)")
+        );
+        // Without an interval, the words alone.
+        assert_eq!(undetermined_words("cri_r9", 20.0, None), NOT_DETERMINABLE);
+    }
+
+    #[test]
+    fn a_duv_wholly_beyond_the_white_limit_is_shown() {
+        // The SG example: |Duv| 0.090 ± 0.025 lies wholly beyond 0.05, so the photo says the
+        // light is coloured and by about how much.
+        assert_eq!(shown("duv", 0.090, Some(0.025)).unwrap(), "+0.090 ± 0.025");
+        assert_eq!(shown("duv", -0.090, Some(0.025)).unwrap(), "-0.090 ± 0.025");
+        // 0.06 ± 0.025 reaches back inside ±0.05: not determinable.
+        assert_eq!(shown("duv", 0.06, Some(0.025)), Err(NOT_DETERMINABLE));
     }
 }

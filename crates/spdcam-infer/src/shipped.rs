@@ -3,7 +3,7 @@
 
 use crate::error::{InferError, Result};
 use crate::model::Model;
-use spdcam_core::chart::KnownChart;
+use spdcam_core::chart::{shown_chart_name, KnownChart};
 
 /// The shipped models: chart name and `.spdm` bytes (`models/<chart>.spdm`, each made by the
 /// seeded commands in the README).
@@ -21,7 +21,8 @@ const SHIPPED: &[(&str, &[u8])] = &[
 /// A model with the name messages use for it.
 #[derive(Debug, Clone)]
 pub struct NamedModel {
-    /// `the shipped colorchecker24 model` or the model file's path.
+    /// `the shipped ColorChecker 24 model` (the chart as people know it) or the model file's
+    /// path.
     pub name: String,
     /// The model.
     pub model: Model,
@@ -41,7 +42,7 @@ impl ModelSet {
     ///
     /// let models = ModelSet::shipped()?;
     /// let cc24 = models.for_chart("colorchecker24").unwrap();
-    /// assert_eq!(cc24.name, "the shipped colorchecker24 model");
+    /// assert_eq!(cc24.name, "the shipped ColorChecker 24 model");
     /// assert_eq!(cc24.model.feature_names().len(), 72);
     /// # Ok::<(), spdcam_infer::InferError>(())
     /// ```
@@ -53,7 +54,7 @@ impl ModelSet {
                     InferError::invalid(format!("the shipped {chart} model is damaged: {e}"))
                 })?;
                 Ok(NamedModel {
-                    name: format!("the shipped {chart} model"),
+                    name: format!("the shipped {} model", shown_chart_name(chart)),
                     model,
                 })
             })

@@ -43,7 +43,7 @@ use std::process::ExitCode;
 /// Estimate the spectrum of the light from an sRGB photo of a colour chart, and simulate
 /// the camera that takes such photos.
 #[derive(Debug, Parser)]
-#[command(name = "spdcam", version, about)]
+#[command(name = "spdcam", version, about, max_term_width = 100)]
 struct Cli {
     /// Directory where named data (cameras, charts, luminaires) are found; default: $SPDCAM_DATA.
     #[arg(long, global = true, value_name = "DIR")]

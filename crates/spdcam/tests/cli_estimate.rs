@@ -39,11 +39,23 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
         "--debug",
         &s(&debug),
     ]);
-    assert!(out.contains("colorchecker_sg140 detected"), "{out}");
-    assert!(out.contains("the shipped colorchecker_sg96 model"), "{out}");
+    assert!(out.contains("ColorChecker Digital SG detected"), "{out}");
     assert!(
-        out.contains("GFC: goodness-of-fit"),
-        "the output explains GFC:\n{out}"
+        out.contains("the shipped ColorChecker Digital SG model"),
+        "{out}"
+    );
+    // One name for one chart: no identifier of the chart in what a person reads.
+    assert!(
+        !out.contains("colorchecker_sg96") && !out.contains("colorchecker_sg140"),
+        "{out}"
+    );
+    // The glossary is printed on request only.
+    assert!(!out.contains("GFC: goodness-of-fit"), "{out}");
+    assert!(out.contains("--explain"), "{out}");
+    let explained = ok(&["estimate", EXAMPLE, "--explain"]);
+    assert!(
+        explained.contains("GFC: goodness-of-fit"),
+        "--explain explains GFC:\n{explained}"
     );
     // The lighting-quality line and its legend. This purple LED mix is far from white
     // (|Duv| ≈ 0.1): CRI and TM-30 are not meaningful and shown as "—", as the report does;
@@ -178,8 +190,8 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
         "-o",
         &s(&csv),
     ]);
-    assert!(out.contains("colorchecker24 detected"), "{out}");
-    assert!(out.contains("the shipped colorchecker24 model"), "{out}");
+    assert!(out.contains("ColorChecker 24 detected"), "{out}");
+    assert!(out.contains("the shipped ColorChecker 24 model"), "{out}");
     let gfc = number_after(&out, "against the true SPD: GFC");
     assert!(gfc > 0.95, "CIE A through the CC24 model: GFC {gfc}\n{out}");
     // A clean rendered photo: trusted, with its expected GFC and band.
@@ -284,7 +296,7 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
     // Feature rows are matched to the model for their columns (JSON Lines: a row a line).
     let out = ok(&["estimate", "--features", &s(&features), "--json"]);
     let json: serde_json::Value = serde_json::from_str(out.lines().next().unwrap()).unwrap();
-    assert_eq!(json["model"], "the shipped colorchecker24 model");
+    assert_eq!(json["model"], "the shipped ColorChecker 24 model");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -305,6 +317,13 @@ fn bad_photos_give_clear_errors_and_no_output() {
 
     let err = fails(&["estimate", &s(&dir.join("missing.jpg")), "-o", &s(&csv)]);
     assert!(err.contains("missing.jpg"), "{err}");
+    // Issue 55: "No such file or directory (os error 2)"; now what to do, the photo named
+    // once and called unusable.
+    assert!(
+        err.contains("unusable photo: no such file or folder: check the path"),
+        "{err}"
+    );
+    assert_eq!(err.matches("missing.jpg").count(), 1, "{err}");
 
     let err = fails(&[
         "estimate",
@@ -375,7 +394,7 @@ fn a_chart_image_from_render_is_estimated() {
     // The chart with a margin around it, as a photo shows it (detection looks for a chart
     // inside the photo, not for one that is the whole image), found among every chart.
     let out = ok(&["--data-dir", &data, "estimate", &s(&chart)]);
-    assert!(out.contains("colorchecker_sg96 detected"), "{out}");
+    assert!(out.contains("ColorChecker Digital SG detected"), "{out}");
     let gfc = number_after(&out, "against the true SPD: GFC");
     assert!(gfc > 0.99, "GFC {gfc}:\n{out}");
     // The text withholds a CCT whose interval is too wide; the JSON has every number.
@@ -524,7 +543,7 @@ fn a_photo_of_another_chart_is_refused_and_the_batch_goes_on() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(
-        stderr.contains("other.jpg: what was found is not a ColorChecker 24: show where the chart is by its four outer corners (")
+        stderr.contains("other.jpg: unusable photo: what was found is not a ColorChecker 24: show where the chart is by its four outer corners (")
             && stderr.contains("give its corners with --corners")
             && stderr.contains("1 of 2 photo(s)"),
         "{stderr}"
@@ -703,4 +722,48 @@ fn the_exif_exposure_gives_approximate_absolute_levels() {
         .unwrap()
         .contains("EXIF"));
     assert!(!ok(&["estimate", &s(&plain)]).contains("absolute"));
+}
+
+#[test]
+fn help_lines_fit_a_terminal() {
+    // Issue 55: `estimate --help` had lines of up to 374 characters.
+    for command in [
+        &["estimate", "--help"][..],
+        &["render", "--help"],
+        &["--help"],
+    ] {
+        let help = ok(command);
+        let longest = help.lines().map(|l| l.chars().count()).max().unwrap();
+        assert!(
+            longest <= 100,
+            "{command:?}: a line of {longest} characters"
+        );
+    }
+}
+
+#[test]
+fn corners_in_any_order_give_the_same_estimate() {
+    // Issue 55: corners given in a crossed (bow-tie) order were refused. Every order of the
+    // example's four corners (the README: "any order") finds the same chart and light.
+    let photo = "../../examples/cc24-led.jpg";
+    let corners = [[1644, 791], [889, 1187], [752, 717], [1380, 405]];
+    let mut xy = Vec::new();
+    for order in [
+        [0, 1, 2, 3],
+        [0, 2, 1, 3],
+        [0, 1, 3, 2],
+        [2, 0, 3, 1],
+        [3, 1, 0, 2],
+    ] {
+        let text = order
+            .iter()
+            .map(|&k| format!("{},{}", corners[k][0], corners[k][1]))
+            .collect::<Vec<_>>()
+            .join(",");
+        let out = ok(&["estimate", photo, "--corners", &text, "--json"]);
+        let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(json[0]["verdict"], "ok", "{order:?}");
+        xy.push(json[0]["colorimetry"]["xy"].to_string());
+    }
+    assert!(xy.windows(2).all(|w| w[0] == w[1]), "{xy:?}");
 }

@@ -698,7 +698,7 @@ fn pipes_and_devices_are_read_through_the_byte_cap() {
         "{e}"
     );
     assert!(
-        e.contains("/dev/stdin: more than 100,000 bytes of a photo")
+        e.contains("/dev/stdin: unusable photo: more than 100,000 bytes of a photo")
             && e.contains("set SPDCAM_MAX_PHOTO_BYTES=N"),
         "{e}"
     );

@@ -80,7 +80,7 @@ fn a_tilted_shadowed_chart_is_placed_as_asked_and_found_with_a_full_size_debug_i
         String::from_utf8_lossy(&out.stderr),
     );
     assert!(out.status.success(), "{stdout}\n{stderr}");
-    assert!(stdout.contains("colorchecker24 detected"), "{stdout}");
+    assert!(stdout.contains("ColorChecker 24 detected"), "{stdout}");
     assert!(
         stderr.contains(&format!("debug → {}", debug.display())),
         "{stderr}"

@@ -275,6 +275,9 @@ fn the_range_changes_what_is_shown_not_the_colorimetry() {
     }
     for (range, expected) in [
         ("550-550", "single wavelength"),
+        // Issue 55: two wavelengths 5 nm apart were estimated and scored.
+        ("550-555", "too few to be a spectrum"),
+        ("500-540:1", "too few to be a spectrum"),
         ("300-400", "the model estimates"),
     ] {
         let e = fails_fast(&["estimate", &photo, "--range", range]);
@@ -359,9 +362,41 @@ fn messages_say_what_is_wrong_and_what_to_do() {
         &s(&dir.join("cal.json")),
     ]);
     assert!(e.contains("spectral CSV") && e.contains("transpose"), "{e}");
-    // SPDs in units the camera's single precision cannot hold: rescale, not "non-finite"
-    // or "no signal".
-    for (factor, expected) in [("1e308", "overflows"), ("1e-320", "below the range")] {
+    // SPDs in units the camera's single precision cannot hold: only the shape matters, so
+    // they are divided by their peak (with a note) and render as the unscaled file does; a
+    // truth so scaled scores as the unscaled one.
+    let unscaled = dir.join("x1.csv");
+    std::fs::write(&unscaled, lamp_csv([0.03, 0.0])).unwrap();
+    // The chart's patches as rendered (mean sRGB 0–255 each).
+    let patches = |spd: &Path, name: &str| -> (Vec<f64>, String) {
+        let features = dir.join(format!("{name}.features.csv"));
+        let (_, err) = succeeds(&[
+            "render",
+            "--spd",
+            &s(spd),
+            "-o",
+            &s(&dir.join(format!("{name}.png"))),
+            "--features",
+            &s(&features),
+        ]);
+        let text = std::fs::read_to_string(&features).unwrap();
+        let row = text.lines().nth(1).unwrap();
+        (row.split(',').map(|v| v.parse().unwrap()).collect(), err)
+    };
+    let (reference, plain_err) = patches(&unscaled, "x1");
+    assert!(!plain_err.contains("divided by its peak"), "{plain_err}");
+    let score = |truth: &Path| {
+        let (out, _) = succeeds(&[
+            "estimate",
+            &s(&example("cc24-led.jpg")),
+            "--truth",
+            &s(truth),
+            "--json",
+        ]);
+        json_field(&out, "truth")["gfc"].as_f64().unwrap()
+    };
+    let reference_gfc = score(&unscaled);
+    for factor in ["1e308", "1e-320"] {
         let scaled = dir.join(format!("x{factor}.csv"));
         let rows: String = lamp_csv([0.03, 0.0])
             .lines()
@@ -375,10 +410,25 @@ fn messages_say_what_is_wrong_and_what_to_do() {
             })
             .collect();
         std::fs::write(&scaled, format!("wavelength_nm,tl841\n{rows}")).unwrap();
-        let e = fails_fast(&["render", "--spd", &s(&scaled), "-o", &s(&dir.join("c.png"))]);
+        let (rendered, e) = patches(&scaled, factor);
         assert!(
-            e.contains(expected) && e.contains("rescale") && e.contains("column 'tl841'"),
+            e.contains("divided by its peak") && e.contains("column 'tl841'"),
             "{factor}: {e}"
+        );
+        // The same chart but for the last bits (subnormal values carry fewer digits).
+        assert!(
+            rendered
+                .iter()
+                .zip(&reference)
+                .all(|(a, b)| (a - b).abs() <= 1.0),
+            "{factor}: {rendered:?} against {reference:?}"
+        );
+        // The same score, to the digits a subnormal file holds (1e-320 is a multiple of
+        // 4.9e-324: about three significant digits).
+        let gfc = score(&scaled);
+        assert!(
+            (gfc - reference_gfc).abs() < 1e-3,
+            "{factor}: GFC {gfc} against {reference_gfc}"
         );
     }
     let e = fails_fast(&["estimate", &photo, "--truth", &photo]);

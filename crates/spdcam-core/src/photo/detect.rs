@@ -86,14 +86,15 @@ pub fn detect(photo: &Photo, templates: &[ChartTemplate]) -> Result<Detection> {
 
 /// The error for a photo that shows none of `templates`.
 pub(crate) fn no_chart(photo: &Photo, templates: &[ChartTemplate]) -> Error {
+    let mut charts: Vec<String> = templates
+        .iter()
+        .map(|t| crate::chart::shown_chart_name(&t.name))
+        .collect();
+    charts.dedup();
     Error::invalid(format!(
         "{}: no chart found (looked for {}); give its corners with --corners x1,y1,…,x4,y4",
         photo.source,
-        templates
-            .iter()
-            .map(|t| t.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
+        charts.join(", ")
     ))
 }
 

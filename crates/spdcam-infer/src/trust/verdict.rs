@@ -639,7 +639,8 @@ mod tests {
         let said = |w: &str| all.iter().any(|t| t.contains(w));
         assert!(said("(dark skin)") && said("(magenta, cyan"), "{all:?}");
         assert!(said("place them again") && said("place the corners by hand"));
-        assert!(said("spdcam was started without the measured data"));
+        assert!(said("not shipped with spdcam"));
+        assert!(said("charts/colorchecker_sg.csv") && said("photograph a ColorChecker 24"));
         assert!(!plain("worst at p07") && !plain("use --data-dir") && !plain("features 1, 2"));
     }
 

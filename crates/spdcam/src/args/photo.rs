@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use spdcam_core::chart::shown_chart_name;
 use spdcam_core::photo::PhotoAnalysis;
 use spdcam_infer::PhotoOptions;
 use std::path::{Path, PathBuf};
@@ -74,7 +75,7 @@ pub fn describe(analysis: &PhotoAnalysis) -> String {
         .unwrap_or_else(|| analysis.source.clone());
     format!(
         "{name}: {} {} (confidence {:.2}), {} patches sampled",
-        analysis.chart,
+        shown_chart_name(&analysis.chart),
         analysis.method,
         analysis.confidence,
         analysis.patches.len()

@@ -5,7 +5,7 @@
 
 use spdcam_infer::meter::Meter;
 use spdcam_infer::presentation::meaningful_value;
-use spdcam_infer::rounding::{shown, unit, NOT_DETERMINABLE};
+use spdcam_infer::rounding::shown_with_unit;
 use spdcam_infer::Estimate;
 
 /// `xy (0.3127, 0.3290); CCT 6500 ± 300 K, Δuv +0.0031 ± 0.0012`, or for coloured light
@@ -40,11 +40,7 @@ pub(super) fn metrics_line(e: &Estimate) -> String {
         let Ok(v) = meaningful_value(e, key) else {
             return "—".to_string();
         };
-        match shown(key, v, intervals.and_then(|i| i.get(key)).map(|i| i.half95)) {
-            Ok(text) if unit(key).is_empty() => text,
-            Ok(text) => format!("{text} {}", unit(key)),
-            Err(_) => NOT_DETERMINABLE.to_string(),
-        }
+        shown_with_unit(key, v, intervals.and_then(|i| i.get(key)).map(|i| i.half95))
     };
     format!(
         "Ra {}, R9 {}, Rf {}, Rg {}, M-EDER {}, S/P {}, blue-light hazard {}, PPF {}",
@@ -68,12 +64,8 @@ pub(super) fn film_tv_line(meter: &Meter) -> Option<String> {
             .iter()
             .map(|v| v.map_or_else(|| "—".into(), |v| format!("{v:.0}")))
             .collect();
-        let r9 = if r.get(8).is_some_and(Option::is_none) {
-            format!(" (R9 {NOT_DETERMINABLE})")
-        } else {
-            String::new()
-        };
-        parts.push(format!("R1–R15 {}{r9}", bars.join(" ")));
+        parts.push(format!("R1–R15 {}", bars.join(" ")));
+        parts.extend(meter.r9_note.clone());
     }
     parts.extend(
         meter
@@ -91,6 +83,7 @@ mod tests {
     use spdcam_core::spectral::Grid;
     use spdcam_infer::presentation::Presentation;
     use spdcam_infer::report::{report_html, ReportItem};
+    use spdcam_infer::rounding::NOT_DETERMINABLE;
     use spdcam_infer::trust::MetricInterval;
     use spdcam_infer::{Estimator, ModelSet, PhotoOptions};
 
@@ -172,7 +165,10 @@ mod tests {
                             .starts_with(NOT_DETERMINABLE) =>
                         {
                             not_determinable += 1;
-                            assert!(cli.contains(NOT_DETERMINABLE), "{key}: {cli}");
+                            // The same words, with the same interval, everywhere.
+                            let words = m["not_meaningful"].as_str().unwrap();
+                            assert!(words.contains("between"), "{key}: {words}");
+                            assert!(cli.contains(words), "{key}: {words} not in {cli}");
                         }
                         None => {}
                     }

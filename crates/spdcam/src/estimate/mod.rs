@@ -84,6 +84,9 @@ pub struct EstimateArgs {
     /// is then moved to the lights of that kind (`spdcam light-kinds list`).
     #[arg(long, default_value = "unknown", value_name = "KIND", value_parser = parse_light)]
     light: LightKind,
+    /// Also print what each number, the verdict and the GFC mean (a short glossary).
+    #[arg(long)]
+    explain: bool,
     #[command(flatten)]
     photo: PhotoArgs,
 }

@@ -83,7 +83,13 @@ fn analysed(args: &EstimateArgs, photos: &[PhotoEstimate]) -> Result<()> {
                 }
                 analyses.push(a.analysis.clone());
             }
-            Err(e) => eprintln!("error: cannot use photo {}: {e}", path.display()),
+            Err(e) => {
+                // The library's message names the photo already; it is named once.
+                let why = e.to_string();
+                let shown = path.display().to_string();
+                let why = why.strip_prefix(&format!("{shown}: ")).unwrap_or(&why);
+                eprintln!("error: {shown}: unusable photo: {why}");
+            }
         }
     }
     if let Some(out) = &args.photo.features_out {

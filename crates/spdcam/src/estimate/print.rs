@@ -16,7 +16,7 @@ use spdcam_infer::Estimate;
 use std::path::Path;
 
 /// The estimates as text: colorimetry and the SPD every 25 nm (for up to 20), the score
-/// against the truth, what each number means, and where the files went.
+/// against the truth, with `--explain` what each number means, and where the files went.
 pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Result<()> {
     let mut models: Vec<&str> = estimates.iter().map(|e| e.model.as_str()).collect();
     models.dedup();
@@ -87,35 +87,10 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Re
             )?;
         }
     }
-    if estimates.iter().any(|e| e.photo.is_some()) {
-        outln!(
-            "confidence: how sure the chart's detection is (0–1; below 0.8 check the --debug image)"
-        )?;
-    }
-    if detailed {
-        outln!(
-            "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and gamut; \
-             M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: scotopic/photopic; \
-             PPF: 400–700 nm photons per 1000 lx; ± the 95 % interval when calibrated, \
-             \"{NOT_DETERMINABLE}\" where it is too wide to say anything; \
-             — where not defined or not meaningful (CRI and TM-30 need a light near white); \
-             computed on the estimate's {}–{} nm only \
-             (`spdcam metrics` on a wider SPD, `--json` for every number)",
-            estimates[0].spd.grid().start_nm,
-            estimates[0].spd.grid().end_nm()
-        )?;
-    }
-    if estimates.iter().any(|e| e.trust.is_some()) {
-        outln!(
-            "verdict: ok, doubtful (use with care) or unusable, from the detection, clipped and \
-             dark patches, the self-check (the chart re-rendered under the estimate) and the \
-             calibrated uncertainty; the bands hold the true SPD at 68 % and 95 % per wavelength"
-        )?;
-    }
-    if estimates.iter().any(|e| e.truth.is_some()) {
-        outln!(
-            "GFC: goodness-of-fit of the spectral shape, 1 = identical (≥ 0.999 excellent, ≥ 0.99 good)"
-        )?;
+    if args.explain {
+        explain(estimates, detailed)?;
+    } else {
+        outln!("(--explain: what each number and the verdict mean)")?;
     }
     if let Some(out) = &args.output {
         outln!(
@@ -129,6 +104,47 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Re
     }
     if let Some(report) = &args.report {
         outln!("report → {}", report.display())?;
+    }
+    Ok(())
+}
+
+/// What each number means, printed with `--explain`: the detection's confidence, the metrics'
+/// abbreviations, the verdict and the GFC, for those the estimates carry.
+fn explain(estimates: &[Estimate], detailed: bool) -> Result<()> {
+    if estimates.iter().any(|e| e.photo.is_some()) {
+        outln!("confidence: how sure the chart's detection is (0–1; below 0.8 check the --debug image)")?;
+    }
+    if detailed {
+        outln!(
+            "Ra: CIE 13.3 colour rendering (R9 saturated red); Rf, Rg: TM-30 fidelity and \
+             gamut; M-EDER: melanopic daylight efficacy ratio (CIE S 026); S/P: \
+             scotopic/photopic; PPF: 400–700 nm photons per 1000 lx"
+        )?;
+        outln!(
+            "±: the 95 % interval when calibrated; \"{NOT_DETERMINABLE}\" with the interval \
+             where it is too wide for one number; — where not defined or not meaningful (CRI \
+             and TM-30 need a light near white)"
+        )?;
+        outln!(
+            "computed on the estimate's {}–{} nm only (`spdcam metrics` on a wider SPD, \
+             `--json` for every number)",
+            estimates[0].spd.grid().start_nm,
+            estimates[0].spd.grid().end_nm()
+        )?;
+    }
+    if estimates.iter().any(|e| e.trust.is_some()) {
+        outln!(
+            "verdict: ok, doubtful (use with care) or unusable, from the detection, clipped \
+             and dark patches, the self-check (the chart re-rendered under the estimate) and \
+             the calibrated uncertainty; the bands hold the true SPD at 68 % and 95 % per \
+             wavelength"
+        )?;
+    }
+    if estimates.iter().any(|e| e.truth.is_some()) {
+        outln!(
+            "GFC: goodness-of-fit of the spectral shape, 1 = identical (≥ 0.999 excellent, \
+             ≥ 0.99 good)"
+        )?;
     }
     Ok(())
 }

@@ -28,6 +28,11 @@ pub(super) fn read_truths(path: &Path, grid: &Grid) -> Result<SpectralSet> {
             )
         })?;
     check_coverage(path, set.wavelengths(), grid)?;
+    // Only the shape is scored (GFC, and RMSE between peak-normalised SPDs): each truth is
+    // divided by its peak first, so that a file in any units (1e300 W/nm or 1e-300) is
+    // resampled without overflowing or vanishing. A truth with no light keeps its zeros and
+    // is refused below.
+    let set = set.normalised_by_max().unwrap_or(set);
     let (set, _) = set.resample(grid, Interpolation::Auto, Extrapolation::HoldEdge)?;
     if let Some(i) = (0..set.len()).find(|&i| set.item(i).iter().all(|&v| v <= 0.0)) {
         bail!(

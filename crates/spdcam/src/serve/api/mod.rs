@@ -22,7 +22,9 @@ use std::sync::Arc;
 const INDEX_HTML: &str = include_str!("../page/index.html");
 const APP_JS: &str = include_str!("../page/app.js");
 const STYLE_CSS: &str = include_str!("../page/style.css");
-const EXAMPLE_JPG: &[u8] = include_bytes!("../../../../../examples/sg-telelumen.jpg");
+/// The example photo "Try the example photo" loads: the ColorChecker 24 one, whose
+/// reflectances are built in, so its verdict is judged with nothing beside the program.
+const EXAMPLE_JPG: &[u8] = include_bytes!("../../../../../examples/cc24-led.jpg");
 /// Room for the multipart framing and the small fields beside the photo; also the longest
 /// field other than the photo.
 const FORM_OVERHEAD: usize = 64 * 1024;

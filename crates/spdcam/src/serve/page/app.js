@@ -141,6 +141,12 @@ function addFiles(files) {
 }
 
 function setupInputs() {
+  // The plot is drawn at the width it is shown: drawn again when that width changes.
+  let plotWidth = 0;
+  new ResizeObserver(([entry]) => {
+    const width = Math.round(entry.contentRect.width);
+    if (width !== plotWidth) { plotWidth = width; renderSpd(); }
+  }).observe($('spd-plot'));
   const drop = $('drop');
   $('files').addEventListener('change', (e) => { addFiles([...e.target.files]); e.target.value = ''; });
   drop.addEventListener('dragover', (e) => { e.preventDefault(); drop.classList.add('over'); });
@@ -161,7 +167,7 @@ function setupInputs() {
   });
   $('example').addEventListener('click', async () => {
     const blob = await (await fetch('example.jpg')).blob();
-    addFiles([new File([blob], 'sg-telelumen.jpg', { type: 'image/jpeg' })]);
+    addFiles([new File([blob], 'cc24-led.jpg', { type: 'image/jpeg' })]);
   });
   $('reference').addEventListener('change', async (e) => {
     const file = e.target.files[0];
@@ -508,7 +514,9 @@ function band(result, key) {
   return null;
 }
 
-const SPD_BOX = { left: 52, right: 628, top: 40, bottom: 312 };
+/** The smallest size of the plot's text, in CSS pixels: the plot is drawn in the pixels it
+ *  is shown at (its viewBox follows its width), so no width makes its text smaller. */
+const PLOT_FONT = 12;
 
 /** The plot's top value: 1, raised in steps of 0.25 to hold the shown bands and curves. */
 function spdTop(shown) {
@@ -527,17 +535,43 @@ function renderSpd() {
   const wl = shown.length ? shown[0].result.wavelength_nm : [400, 700];
   const x0 = Math.min(...shown.map((e) => e.result.wavelength_nm[0]), wl[0]);
   const x1 = Math.max(...shown.map((e) => e.result.wavelength_nm[e.result.wavelength_nm.length - 1]), wl[wl.length - 1]);
-  const { left, right, top, bottom } = SPD_BOX;
+  // Drawn at the width it is shown (one viewBox unit a CSS pixel), so its text keeps its size
+  // from a phone to a wide screen; redrawn when that width changes.
+  const W = Math.max(260, Math.round(svg.getBoundingClientRect().width) || 640);
+  const H = Math.round(Math.min(380, Math.max(260, W * 0.56)));
+  svg.setAttribute('viewBox', `0 0 ${W} ${H}`);
+  // The legend above the frame, in rows: it covers no curve.
+  const items = shown.slice(0, 3).map((e) => ({ label: e.name.slice(0, 22), attrs: { stroke: e.color, 'stroke-width': 2.5 } }));
+  if (shown.length > 3) items.push({ label: `… ${shown.length - 3} more`, attrs: { stroke: 'none' } });
+  const ref = state.reference;
+  if (ref) items.push({ label: `reference: ${ref.name.slice(0, 16)}`, attrs: { stroke: '#1d2330', 'stroke-dasharray': '5 4', 'stroke-width': 1.5 } });
+  if (shown.some((e) => band(e.result, 'band95') || band(e.result, 'band68'))) {
+    items.push({ label: '68 % band', attrs: { stroke: '#5b6475', 'stroke-opacity': 0.45, 'stroke-width': 10 } });
+    items.push({ label: '95 % band', attrs: { stroke: '#5b6475', 'stroke-opacity': 0.22, 'stroke-width': 10 } });
+  }
+  const left = 58, right = W - 12, bottom = H - 40;
+  const rowHeight = PLOT_FONT + 5;
+  const placed = [];
+  let lx = left, ly = PLOT_FONT + 2;
+  for (const item of items) {
+    const width = 30 + 0.62 * PLOT_FONT * item.label.length;
+    if (lx + width > right && lx > left) { lx = left; ly += rowHeight; }
+    placed.push({ ...item, x: lx, y: ly });
+    lx += width + 10;
+  }
+  const top = ly + 12;
+  svg.dataset.frame = [left, right, top, bottom].join(',');
   const yTop = spdTop(shown);
   svg.dataset.top = yTop;
   const X = (w) => left + ((w - x0) / (x1 - x0)) * (right - left);
   // Values are clamped to the frame: nothing is drawn above or below it.
   const Y = (v) => bottom - (Math.min(Math.max(v, 0), yTop) / yTop) * (bottom - top);
-  const text = (attrs, content) => el('text', { 'font-size': 12, fill: '#5b6475', 'font-family': 'sans-serif', ...attrs }, svg, content);
-  el('rect', { x: 0, y: 0, width: 640, height: 356, fill: '#fff' }, svg);
+  const text = (attrs, content) => el('text', { 'font-size': PLOT_FONT, fill: '#5b6475', 'font-family': 'sans-serif', ...attrs }, svg, content);
+  el('rect', { x: 0, y: 0, width: W, height: H, fill: '#fff' }, svg);
   const clip = el('clipPath', { id: 'spd-frame' }, el('defs', {}, svg));
   el('rect', { x: left, y: top, width: right - left, height: bottom - top }, clip);
-  for (let w = Math.ceil(x0 / 50) * 50; w <= x1; w += 50) {
+  const step = right - left < 360 ? 100 : 50;
+  for (let w = Math.ceil(x0 / step) * step; w <= x1; w += step) {
     el('line', { x1: X(w), x2: X(w), y1: top, y2: bottom, stroke: '#eceef2' }, svg);
     text({ x: X(w), y: bottom + 16, 'text-anchor': 'middle' }, w);
   }
@@ -546,16 +580,14 @@ function renderSpd() {
     text({ x: left - 6, y: Y(v) + 4, 'text-anchor': 'end' }, v.toFixed(2));
   }
   el('rect', { x: left, y: top, width: right - left, height: bottom - top, fill: 'none', stroke: '#9aa6bd' }, svg);
-  text({ x: (left + right) / 2, y: 348, 'text-anchor': 'middle', 'font-size': 13, fill: '#1d2330' }, 'wavelength (nm)');
-  text({ x: 14, y: (top + bottom) / 2, transform: `rotate(-90 14 ${(top + bottom) / 2})`, 'text-anchor': 'middle', 'font-size': 13, fill: '#1d2330' }, 'relative power');
+  text({ x: (left + right) / 2, y: H - 8, 'text-anchor': 'middle', 'font-size': PLOT_FONT + 1, fill: '#1d2330' }, 'wavelength (nm)');
+  text({ x: 14, y: (top + bottom) / 2, transform: `rotate(-90 14 ${(top + bottom) / 2})`, 'text-anchor': 'middle', 'font-size': PLOT_FONT + 1, fill: '#1d2330' }, 'relative power');
   const plot = el('g', { 'clip-path': 'url(#spd-frame)' }, svg);
-  let banded = false;
   for (const e of shown) {
     const r = e.result;
     for (const [key, opacity] of [['band95', 0.12], ['band68', 0.24]]) {
       const b = band(r, key);
       if (!b) continue;
-      banded = true;
       const pts = r.wavelength_nm.map((w, i) => `${X(w).toFixed(2)},${Y(b.hi[i]).toFixed(2)}`)
         .concat(r.wavelength_nm.map((w, i) => `${X(w).toFixed(2)},${Y(b.lo[i]).toFixed(2)}`).reverse());
       el('polygon', { class: 'band', 'data-band': key, points: pts.join(' '), fill: e.color, 'fill-opacity': opacity, stroke: 'none' }, plot);
@@ -565,29 +597,16 @@ function renderSpd() {
       points: r.wavelength_nm.map((w, i) => `${X(w).toFixed(3)},${Y(r.spd[i]).toFixed(3)}`).join(' '),
     }, plot);
   }
-  const ref = state.reference;
   if (ref) {
     const m = Math.max(...ref.wl.map((w, i) => (w >= x0 && w <= x1 ? ref.v[i] : -Infinity)));
     const pts = ref.wl.map((w, i) => [w, ref.v[i]]).filter(([w]) => w >= x0 && w <= x1)
       .map(([w, v]) => `${X(w).toFixed(2)},${Y(v / m).toFixed(2)}`);
     el('polyline', { class: 'reference', fill: 'none', stroke: '#1d2330', 'stroke-dasharray': '5 4', 'stroke-width': 1.5, points: pts.join(' ') }, plot);
   }
-  // The legend above the frame, in rows: it covers no curve.
-  const items = shown.slice(0, 3).map((e) => ({ label: e.name.slice(0, 22), attrs: { stroke: e.color, 'stroke-width': 2.5 } }));
-  if (shown.length > 3) items.push({ label: `… ${shown.length - 3} more`, attrs: { stroke: 'none' } });
-  if (ref) items.push({ label: `reference: ${ref.name.slice(0, 16)}`, attrs: { stroke: '#1d2330', 'stroke-dasharray': '5 4', 'stroke-width': 1.5 } });
-  if (banded) {
-    items.push({ label: '68 % band', attrs: { stroke: '#5b6475', 'stroke-opacity': 0.45, 'stroke-width': 10 } });
-    items.push({ label: '95 % band', attrs: { stroke: '#5b6475', 'stroke-opacity': 0.22, 'stroke-width': 10 } });
-  }
-  let lx = left, ly = 12;
-  for (const item of items) {
-    const width = 34 + 6.6 * item.label.length;
-    if (lx + width > right && lx > left) { lx = left; ly += 15; }
+  for (const item of placed) {
     const g = el('g', { class: 'legend' }, svg);
-    el('line', { x1: lx, x2: lx + 20, y1: ly - 4, y2: ly - 4, ...item.attrs }, g);
-    el('text', { x: lx + 25, y: ly, 'font-size': 12, fill: '#1d2330', 'font-family': 'sans-serif' }, g, item.label);
-    lx += width + 10;
+    el('line', { x1: item.x, x2: item.x + 20, y1: item.y - 4, y2: item.y - 4, ...item.attrs }, g);
+    el('text', { x: item.x + 25, y: item.y, 'font-size': PLOT_FONT, fill: '#1d2330', 'font-family': 'sans-serif' }, g, item.label);
   }
 }
 
@@ -661,7 +680,7 @@ function filmTv(box, meter) {
   if (!meter || (!meter.r1_r15 && !meter.film_tv.length)) return;
   html('h3', {}, box, 'Film and TV');
   const table = html('table', { id: 'film-tv', class: 'film-tv' }, box);
-  if (meter.r1_r15) row(table, 'R1–R15', meter.r1_r15.map((v) => (v === null ? '—' : v.toFixed(0))).join(' ') + (meter.r1_r15[8] === null ? ' (R9 not determinable from this photo)' : ''), 'r1-r15');
+  if (meter.r1_r15) row(table, 'R1–R15', meter.r1_r15.map((v) => (v === null ? '—' : v.toFixed(0))).join(' ') + (meter.r9_note ? ` (${meter.r9_note})` : ''), 'r1-r15');
   meter.film_tv.forEach((r) => row(table, r.label, r.value, `film-${r.key}`));
 }
 

@@ -1,6 +1,6 @@
 //! The page and its assets, `HEAD` and unknown methods, and a server on a host name.
 
-use super::{json, request, start, EXAMPLE};
+use super::{json, request, start};
 use crate::serve::{resolve, shipped_engine, Config, Server, Timeouts};
 use spdcam_core::builtin::DataDir;
 
@@ -16,9 +16,13 @@ fn the_page_and_its_assets_are_embedded() {
         assert_eq!(status, 200, "{path}");
         assert!(String::from_utf8_lossy(&body).contains(needle), "{path}");
     }
+    // The page's example is the ColorChecker 24 one, judged with nothing beside the program.
     let (status, body) = request(server.addr(), "GET", "/example.jpg", None);
     assert_eq!(status, 200);
-    assert_eq!(body, EXAMPLE);
+    assert_eq!(
+        body,
+        include_bytes!("../../../../../examples/cc24-led.jpg").as_slice()
+    );
     server.stop();
 }
 
