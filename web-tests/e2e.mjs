@@ -123,7 +123,7 @@ const context = await chromium.launchPersistentContext(profile, {
   acceptDownloads: true,
 });
 /**
- * The example photo blurred (a Gaussian of 12 px): the patches' edges are gone, so no chart
+ * The example photo blurred (a Gaussian of 40 px): the patches' edges are gone, so no chart
  * is found, yet the chart is there, its patches flat in their middles, and its corners are
  * the sharp photo's. Made in the browser (canvas, JPEG) into a file. (A mirrored chart is
  * found by no one: its patches are not the chart's, and placed corners are refused.)
@@ -139,7 +139,7 @@ async function noChartPhoto() {
     canvas.width = img.naturalWidth;
     canvas.height = img.naturalHeight;
     const ctx = canvas.getContext('2d');
-    ctx.filter = 'blur(12px)';
+    ctx.filter = 'blur(40px)';
     ctx.drawImage(img, 0, 0);
     return canvas.toDataURL('image/jpeg', 0.92).split(',')[1];
   });
@@ -364,16 +364,14 @@ await test('no metric shows a number where it is not meaningful, on the page and
   const greyed = await checkNotMeaningful(tab, 'main', result);
   // A light far from the Planckian locus (the SG example, a purple LED mix): at least CCT
   // and Ra are greyed on the page, with no number of theirs anywhere.
+  const sgPath = join(dirname(photoPath), 'sg-telelumen.jpg');
   const coloured = await context.newPage();
   await coloured.goto(url);
-  await coloured.setInputFiles('#files', join(dirname(photoPath), 'sg-telelumen.jpg'));
+  await coloured.setInputFiles('#files', sgPath);
   await coloured.waitForSelector('#metrics');
-  const sgResult = await coloured.evaluate(async () => {
-    const input = document.querySelector('#files');
-    const form = new FormData();
-    form.append('photo', input.files[0]);
-    return fetch('api/estimate', { method: 'POST', body: form }).then((r) => r.json());
-  });
+  const form = new FormData();
+  form.append('photo', new Blob([readFileSync(sgPath)]), 'sg-telelumen.jpg');
+  const sgResult = await (await fetch(new URL('api/estimate', url), { method: 'POST', body: form })).json();
   const sgGreyed = await checkNotMeaningful(coloured, 'main', sgResult);
   check(sgGreyed >= 2, `${sgGreyed} metrics greyed for a coloured light`);
   await coloured.close();
@@ -400,8 +398,10 @@ await test('the report prints on one page on A4 and Letter, from the CLI and fro
   const overflow = await cli.evaluate(() => [...document.querySelectorAll('table')].filter((t) => t.scrollWidth > t.parentElement.clientWidth + 1).map((t) => t.className));
   await cli.emulateMedia({ media: 'screen' });
   check(overflow.length === 0, `tables wider than their column: ${overflow}`);
+  // R9 has no bar where its interval is too wide: the caption gives the interval instead.
   const bars = await cli.locator('#estimate-1 svg.r-bars rect').count();
-  check(bars === 15 || bars === 0, `R1–R15: ${bars} bars`);
+  const r9Note = /R9 not determinable from this photo \(between/.test(await cli.locator('#estimate-1').innerText());
+  check(bars === 15 || (bars === 14 && r9Note) || bars === 0, `R1–R15: ${bars} bars`);
   await cli.close();
   // The page's report of one of two photos: that photo's name and curve only.
   const tab = await context.newPage();
@@ -474,13 +474,13 @@ await test('a photo where no chart is found: shown large, four clicks, the chart
   await tab.waitForSelector('#chart-choice');
   check(await tab.locator('#estimate-corners').isDisabled(), 'the chart is guessed, not asked');
   await tab.screenshot({ path: join(artefacts, 'corners-placed.png') });
-  await tab.check('input[name="chart"][value="colorchecker_sg96"]');
+  await tab.check('input[name="chart"][value="colorchecker24"]');
   await tab.click('#estimate-corners');
   await tab.waitForFunction(() => {
     const m = document.getElementById('method');
     return m && m.textContent === 'your corners';
   }, null, { timeout: 60000 });
-  check((await text(tab, '#chart')).startsWith('colorchecker_sg'), `chart ${await text(tab, '#chart')}`);
+  check(await text(tab, '#chart') === 'ColorChecker 24', `chart ${await text(tab, '#chart')}`);
   check(await tab.locator('#spd-plot polyline.spd').count() === 1, 'no SPD');
   check(await tab.locator('#plain-summary.plain-summary').count() === 1, 'no summary');
   await tab.screenshot({ path: join(artefacts, 'corners-estimated.png'), fullPage: true });
@@ -653,7 +653,9 @@ await test('the page reads from 360 to 1,920 px: nothing spills out of its box, 
     // Every drawing's text at least 11 px high as shown (its font size times the drawing's
     // scale on screen).
     const small = await tab.evaluate(() => [...document.querySelectorAll('main svg text')].map((t) => {
-      const px = parseFloat(getComputedStyle(t).fontSize) * t.getScreenCTM().a;
+      // The drawing's scale on screen, whatever the text's rotation.
+      const m = t.getScreenCTM();
+      const px = parseFloat(getComputedStyle(t).fontSize) * Math.hypot(m.a, m.b);
       return [t.textContent, Math.round(px * 10) / 10];
     }).filter(([, px]) => px < 11));
     check(small.length === 0, `${width} px: text below 11 px: ${JSON.stringify(small.slice(0, 5))}`);

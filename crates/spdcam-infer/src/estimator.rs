@@ -367,9 +367,12 @@ impl Estimator {
     }
 
     /// The model's SPDs `spds` (row-major on its grid) moved to the kind of light named.
-    fn told_of_light(&self, index: usize, spds: Vec<f64>) -> Result<Vec<f64>> {
+    fn told_of_light(&self, index: usize, spds: Vec<f64>) -> Result<ModelSpds> {
         if self.light == LightKind::Unknown {
-            return Ok(spds);
+            return Ok(ModelSpds {
+                told: spds,
+                own: None,
+            });
         }
         let priors = self.priors()?[index]
             .as_ref()
@@ -381,7 +384,10 @@ impl Estimator {
             .par_chunks(d)
             .map(|spd| priors.told(self.light, spd, map))
             .collect::<Result<Vec<_>>>()?;
-        Ok(moved.concat())
+        Ok(ModelSpds {
+            told: moved.concat(),
+            own: Some(spds),
+        })
     }
 
     /// The wavelengths of the estimates.
@@ -447,7 +453,7 @@ impl Estimator {
         for (photo, label) in photos.iter_mut().zip(photo_labels(paths)) {
             if let Ok(analysed) = &photo.analysed {
                 progress(PhotoProgress::Estimating(&analysed.analysis))?;
-                photo.estimate = Some(self.estimate_analysis(analysed.analysis.clone(), label));
+                self.estimate_analysed(photo, label);
             }
         }
         Ok(photos)
@@ -490,9 +496,7 @@ impl Estimator {
             Ok(templates) => self.analyse_with(&decoded, options, templates, options.debug.clone()),
             Err(e) => PhotoEstimate::unusable(e),
         };
-        if let Ok(analysed) = &photo.analysed {
-            photo.estimate = Some(self.estimate_analysis(analysed.analysis.clone(), name.into()));
-        }
+        self.estimate_analysed(&mut photo, name.into());
         photo
     }
 
@@ -527,8 +531,10 @@ impl Estimator {
             debug,
         };
         let (analysis, debug) = photo::analyse_telling_debug(photo, &analyse);
+        let mut identified = None;
         let analysed = analysis.map_err(InferError::from).and_then(|analysis| {
-            let analysis = self.the_chart_placed(photo, &analyse, analysis)?;
+            let (analysis, found) = self.the_chart_placed(photo, &analyse, analysis)?;
+            identified = found.map(Carried);
             let overlay = match options.overlay_width {
                 Some(width) => Some(overlay_of(photo, &analyse.templates, &analysis, width)?),
                 None => None,
@@ -539,6 +545,7 @@ impl Estimator {
             debug,
             analysed,
             estimate: None,
+            identified,
         }
     }
 
@@ -549,20 +556,46 @@ impl Estimator {
     /// them, whether the chart was detected or its corners given.
     pub fn estimate_analysis(&self, analysis: PhotoAnalysis, name: String) -> Result<Estimate> {
         let identified = self.identify(&analysis)?;
+        self.estimate_identified(analysis, identified, name)
+    }
+
+    /// [`Estimator::estimate_analysis`] of a photo already identified: the model's SPD made
+    /// when the analysis was checked is the estimate's, not made again.
+    fn estimate_identified(
+        &self,
+        analysis: PhotoAnalysis,
+        identified: Identified,
+        name: String,
+    ) -> Result<Estimate> {
         self.prepared.trust[identified.index].identity.require(
             &identified.identity,
             sampled(&analysis),
             &analysis.source,
         )?;
         let model_spds = identified.model_spds?;
+        let own = model_spds.own().to_vec();
         self.judged(
             identified.index,
             name,
-            model_spds,
+            model_spds.told,
+            &own,
             &identified.rows.values,
             &identified.flags,
             Some(analysis),
         )
+    }
+
+    /// The estimate of a photo analysed by [`Estimator::analyse_with`], from what its check
+    /// identified when there is that (else identified now), labelled `name`.
+    fn estimate_analysed(&self, photo: &mut PhotoEstimate, name: String) {
+        let Ok(analysed) = &photo.analysed else {
+            return;
+        };
+        let analysis = analysed.analysis.clone();
+        photo.estimate = Some(match photo.identified.take() {
+            Some(identified) => self.estimate_identified(analysis, identified.0, name),
+            None => self.estimate_analysis(analysis, name),
+        });
     }
 
     /// `analysis` when its patches are the chart; else, with corners given and several
@@ -574,9 +607,9 @@ impl Estimator {
         photo: &Photo,
         analyse: &AnalyseOptions,
         analysis: PhotoAnalysis,
-    ) -> Result<PhotoAnalysis> {
+    ) -> Result<(PhotoAnalysis, Option<Identified>)> {
         let refusal = match self.refuse_not_the_chart(&analysis) {
-            Ok(()) => return Ok(analysis),
+            Ok(identified) => return Ok((analysis, identified)),
             Err(refusal) => refusal,
         };
         if analyse.corners.is_none() {
@@ -592,22 +625,28 @@ impl Estimator {
                     ..analyse.clone()
                 };
                 let other = photo::analyse(photo, &one).ok()?;
-                self.refuse_not_the_chart(&other).ok().map(|()| other)
+                self.refuse_not_the_chart(&other)
+                    .ok()
+                    .map(|identified| (other, identified))
             })
             .ok_or(refusal)
     }
 
     /// Refuses an analysed photo whose patches are not the chart ([`InferError::NotTheChart`]),
     /// so that it is told with the photos that cannot be used, before any estimate; other
-    /// errors are left for the estimate to give.
-    fn refuse_not_the_chart(&self, analysis: &PhotoAnalysis) -> Result<()> {
+    /// errors are left for the estimate to give. What was identified is kept for the
+    /// estimate, so that the model runs once per photo.
+    fn refuse_not_the_chart(&self, analysis: &PhotoAnalysis) -> Result<Option<Identified>> {
         match self.identify(analysis) {
-            Ok(found) => self.prepared.trust[found.index].identity.require(
-                &found.identity,
-                sampled(analysis),
-                &analysis.source,
-            ),
-            Err(_) => Ok(()),
+            Ok(found) => {
+                self.prepared.trust[found.index].identity.require(
+                    &found.identity,
+                    sampled(analysis),
+                    &analysis.source,
+                )?;
+                Ok(Some(found))
+            }
+            Err(_) => Ok(None),
         }
     }
 
@@ -650,7 +689,7 @@ impl Estimator {
         };
         if let Some(check) = &judge.check {
             let light = match &model_spds {
-                Ok(spds) => spds.clone(),
+                Ok(spds) => spds.told.clone(),
                 Err(_) => vec![1.0; chosen.model.grid().count],
             };
             judge.identity.add_shuffled(
@@ -676,7 +715,7 @@ impl Estimator {
     /// [`Estimator::stream`] refuse a row when they find anything against the chart.
     pub fn row_identities(&self, features: &FeatureRows, source: &str) -> Result<Vec<Identity>> {
         let index = self.choose(&features.names, source)?;
-        let model_spds = self.run_model(index, features, source)?;
+        let model_spds = self.run_model(index, features, source)?.told;
         let width = features.names.len().max(1);
         let d = self.named(index).model.grid().count.max(1);
         features
@@ -766,19 +805,21 @@ impl Estimator {
     pub fn estimate_rows(&self, features: &FeatureRows, source: &str) -> Result<Vec<Estimate>> {
         let index = self.choose(&features.names, source)?;
         let model_spds = self.run_model(index, features, source)?;
-        self.require_chart_rows(index, &features.values, &model_spds, source, 0)?;
+        self.require_chart_rows(index, &features.values, &model_spds.told, source, 0)?;
         let width = features.names.len();
         let d = self.named(index).model.grid().count;
         features
             .values
             .par_chunks(width)
-            .zip(model_spds.par_chunks(d))
+            .zip(model_spds.told.par_chunks(d))
+            .zip(model_spds.own().par_chunks(d))
             .enumerate()
-            .map(|(i, (row, spd))| {
+            .map(|(i, ((row, spd), own))| {
                 self.judged(
                     index,
                     row_name(i),
                     spd.to_vec(),
+                    own,
                     row,
                     &PhotoFlags::default(),
                     None,
@@ -868,7 +909,7 @@ impl Estimator {
 
     /// The model's SPDs (on its own grid, peak 1, row-major) for `features`, checked against
     /// its columns first (rows that say nothing about the light are refused by name).
-    fn run_model(&self, index: usize, features: &FeatureRows, source: &str) -> Result<Vec<f64>> {
+    fn run_model(&self, index: usize, features: &FeatureRows, source: &str) -> Result<ModelSpds> {
         let model = &self.named(index).model;
         model.check_features(&features.names, source)?;
         self.map(index)?;
@@ -885,11 +926,15 @@ impl Estimator {
     /// THE constructor of every estimate: the model's SPD `model_spd` (on its grid, peak 1)
     /// for `row`, judged (the self-check, the perturbed spread, the calibration; `flags`
     /// what a photo analysis found), and everything read from it on the output grid.
+    /// `own` is the model's output before a kind of light moved it (`model_spd` itself
+    /// when none was named), which the kind's check weighs.
+    #[allow(clippy::too_many_arguments)]
     fn judged(
         &self,
         index: usize,
         name: String,
         model_spd: Vec<f64>,
+        own: &[f64],
         row: &[f64],
         flags: &PhotoFlags,
         photo: Option<PhotoAnalysis>,
@@ -906,7 +951,7 @@ impl Estimator {
             flags,
         )?;
         self.bands_on_grid(&mut trust, map)?;
-        self.check_kind(index, row, &mut trust)?;
+        self.check_kind(index, own, &mut trust)?;
         // The colorimetry, the metrics and the absolute level are of the model's whole
         // estimate, whatever part of it the output grid shows.
         let full = Spd::new(chosen.model.grid(), model_spd.clone())?;
@@ -946,17 +991,17 @@ impl Estimator {
         })
     }
 
-    /// With a kind of light named: whether the model's own estimate for `row` lies among the
-    /// kind's lights; when it does not, `trust` says so and is at best doubtful.
-    fn check_kind(&self, index: usize, row: &[f64], trust: &mut Trust) -> Result<()> {
+    /// With a kind of light named: whether the model's own estimate `own` (before the kind
+    /// moved it) lies among the kind's lights; when it does not, `trust` says so and is at
+    /// best doubtful.
+    fn check_kind(&self, index: usize, own: &[f64], trust: &mut Trust) -> Result<()> {
         if self.light == LightKind::Unknown {
             return Ok(());
         }
         let Some(priors) = self.priors()?[index].as_ref() else {
             return Ok(());
         };
-        let own = self.named(index).model.estimate_rows(row)?;
-        if priors.unlike(self.light, &own)? {
+        if priors.unlike(self.light, own)? {
             let advice = Advice::UnlikeKind {
                 kind: self.light.label().to_string(),
             };
@@ -1073,7 +1118,33 @@ struct Identified {
     /// Whether it is the chart.
     identity: Identity,
     /// The model's SPD (on its grid), or why there is none.
-    model_spds: Result<Vec<f64>>,
+    model_spds: Result<ModelSpds>,
+}
+
+/// The model's SPDs for some rows (on its grid, peak 1, row-major): as a named kind of
+/// light moved them, and the model's own output when a kind moved them.
+struct ModelSpds {
+    /// The SPDs the estimates are made of.
+    told: Vec<f64>,
+    /// The model's own output, when a kind of light moved it to `told`.
+    own: Option<Vec<f64>>,
+}
+
+impl ModelSpds {
+    /// The model's own output (before a kind of light moved it).
+    fn own(&self) -> &[f64] {
+        self.own.as_deref().unwrap_or(&self.told)
+    }
+}
+
+/// What [`Estimator::identify`] found of a photo, carried from its analysis to its estimate
+/// (opaque: the printed form says only that it is there).
+struct Carried(Identified);
+
+impl std::fmt::Debug for Carried {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Carried(identified)")
+    }
 }
 
 /// One photo's way through the [`Estimator`] ([`Estimator::estimate_photos`],
@@ -1090,6 +1161,8 @@ pub struct PhotoEstimate {
     /// The estimate, or why the model gave none; `None` while not made (the photo could
     /// not be used, or [`PhotoProgress::Analysed`] reports before any estimate).
     pub estimate: Option<Result<Estimate>>,
+    /// What checking the analysis identified (the model's SPD among it), for the estimate.
+    identified: Option<Carried>,
 }
 
 impl PhotoEstimate {
@@ -1098,6 +1171,7 @@ impl PhotoEstimate {
             debug: None,
             analysed: Err(error),
             estimate: None,
+            identified: None,
         }
     }
 
@@ -1154,6 +1228,9 @@ pub struct EstimatedBlock {
     pub spds: Vec<f64>,
     /// The SPDs on the model's grid, as the judge takes them.
     model_spds: Vec<f64>,
+    /// The model's own SPDs before a named kind of light moved them (`None` when none was
+    /// named: they are `model_spds`).
+    own_spds: Option<Vec<f64>>,
 }
 
 impl RowStream<'_> {
@@ -1171,7 +1248,10 @@ impl RowStream<'_> {
         };
         let names = self.stream.names();
         check_feature_rows(&block.values, names, &self.source, block.first_row, true)?;
-        let model_spds = self.estimator.told_of_light(
+        let ModelSpds {
+            told: model_spds,
+            own,
+        } = self.estimator.told_of_light(
             self.index,
             self.estimator
                 .named(self.index)
@@ -1193,6 +1273,7 @@ impl RowStream<'_> {
             features: block.values,
             spds,
             model_spds,
+            own_spds: own,
         }))
     }
 
@@ -1217,10 +1298,12 @@ impl RowStream<'_> {
         let (estimator, index) = (self.estimator, self.index);
         rows.into_par_iter()
             .map(|k| {
+                let own = block.own_spds.as_ref().unwrap_or(&block.model_spds);
                 estimator.judged(
                     index,
                     row_name(block.first_row + k),
                     block.model_spds[k * d..(k + 1) * d].to_vec(),
+                    &own[k * d..(k + 1) * d],
                     &block.features[k * width..(k + 1) * width],
                     &PhotoFlags::default(),
                     None,
@@ -1386,6 +1469,24 @@ mod tests {
         );
         assert_eq!(bare.light_kinds().unwrap(), [LightKind::Unknown]);
         assert!(bare.for_light(LightKind::Unknown).is_ok());
+    }
+
+    #[test]
+    fn a_photo_runs_the_model_once_for_its_estimate_and_once_for_its_spread() {
+        // Issue 52: the chart check and the estimate each ran the model, and a named kind of
+        // light ran it a third time. Now: once for the estimate (whose SPD the chart check
+        // also uses) and once for the perturbed copies the bands need, by design.
+        let bytes = std::fs::read(example_photo()).unwrap();
+        for estimator in [
+            shipped(),
+            shipped().for_light(LightKind::Luminaire).unwrap(),
+        ] {
+            let before = crate::model::RUNS.with(|r| r.get());
+            let photo = estimator.photo_bytes(&bytes, "example.jpg", &PhotoOptions::default());
+            let runs = crate::model::RUNS.with(|r| r.get()) - before;
+            assert!(photo.into_estimate().is_ok());
+            assert_eq!(runs, 2, "{:?}", estimator.light());
+        }
     }
 
     #[test]

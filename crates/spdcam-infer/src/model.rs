@@ -119,6 +119,13 @@ impl<'a> Cursor<'a> {
     }
 }
 
+#[cfg(test)]
+thread_local! {
+    /// How often this thread ran a model ([`Model::estimate_rows`]): what the tests count to
+    /// show that a photo is worked through once.
+    pub(crate) static RUNS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
 impl Model {
     /// Puts a model together after training; the chart and camera are those of the
     /// training data (`training.data`).
@@ -423,6 +430,8 @@ impl Model {
     /// SPD estimates for rows of features (row-major, in the model's column order, on any
     /// brightness scale): one max-normalised SPD on [`Model::grid`] per row.
     pub fn estimate_rows(&self, features: &[f64]) -> Result<Vec<f64>> {
+        #[cfg(test)]
+        RUNS.with(|runs| runs.set(runs.get() + 1));
         let x = self.header.feature_scaler.transform(features)?;
         let outputs = self.network.forward(&x)?;
         let k = self.network.outputs();

@@ -39,6 +39,9 @@ pub struct Presentation {
     pub summary: String,
     /// The light in words, e.g. `warm white light with an LED-like spectrum`.
     pub light: String,
+    /// The chart the photo showed, as people know it (`ColorChecker 24`); `None` for an
+    /// estimate of feature rows.
+    pub chart: Option<String>,
     /// The verdict in plain words, when the estimate was judged.
     pub verdict: Option<VerdictWords>,
     /// What the goodness-of-fit coefficient is, and what this estimate's expected one means.
@@ -259,6 +262,10 @@ impl Presentation {
         Presentation {
             summary,
             light,
+            chart: estimate
+                .photo
+                .as_ref()
+                .map(|p| spdcam_core::chart::shown_chart_name(&p.chart)),
             verdict,
             gfc: gfc_words(uncertainty.map(|u| u.expected_gfc)),
             meter: Meter::of(estimate),

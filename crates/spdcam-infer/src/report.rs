@@ -338,7 +338,7 @@ fn facts(out: &mut String, e: &Estimate) {
             format!(
                 "{} found by {method} (confidence {:.2}) in a {} × {} px photo; {} patches \
                  sampled, {clipped} clipped, {dark} dark",
-                a.chart,
+                spdcam_core::chart::shown_chart_name(&a.chart),
                 a.confidence,
                 a.width,
                 a.height,

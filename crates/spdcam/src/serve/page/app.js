@@ -738,7 +738,7 @@ function renderSummary() {
     if (r.absolute.melanopic_edi_lux != null) row(table, 'melanopic EDI (approx.)', `${fmt(r.absolute.melanopic_edi_lux, 0)} lx`);
   }
   if (r.photo) {
-    row(table, 'chart', r.photo.chart, 'chart');
+    row(table, 'chart', (r.presentation && r.presentation.chart) || r.photo.chart, 'chart');
     row(table, 'found by', r.photo.method === 'corners' ? 'your corners' : 'detection', 'method');
     row(table, 'detection confidence', fmt(r.photo.confidence, 2));
     row(table, 'photo', `${r.photo.width} × ${r.photo.height} px`);
