@@ -387,10 +387,11 @@ mod tests {
                 let (x, y): (f64, f64) = (get("x").parse().unwrap(), get("y").parse().unwrap());
                 let size: f64 = get("font-size").parse().unwrap();
                 let w = 0.56 * size * content.chars().count() as f64;
-                let anchor = attrs
-                    .contains("text-anchor=")
-                    .then(|| get("text-anchor"))
-                    .unwrap_or_else(|| "start".into());
+                let anchor = if attrs.contains("text-anchor=") {
+                    get("text-anchor")
+                } else {
+                    "start".into()
+                };
                 let left = match anchor.as_str() {
                     "middle" => x - w / 2.0,
                     "end" => x - w,
