@@ -108,7 +108,7 @@ pub(crate) fn film_tv_html(out: &mut String, m: &Meter) {
             r_bars_svg(r),
             m.r9_note
                 .as_ref()
-                .map_or_else(String::new, |note| format!(" (—: {})", esc(note)))
+                .map_or_else(String::new, |note| format!("; no bar: {}", esc(note)))
         );
     }
     out.push_str("</div>\n<div><table class=\"film-tv small\">");

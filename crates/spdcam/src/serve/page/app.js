@@ -680,7 +680,7 @@ function filmTv(box, meter) {
   if (!meter || (!meter.r1_r15 && !meter.film_tv.length)) return;
   html('h3', {}, box, 'Film and TV');
   const table = html('table', { id: 'film-tv', class: 'film-tv' }, box);
-  if (meter.r1_r15) row(table, 'R1–R15', meter.r1_r15.map((v) => (v === null ? '—' : v.toFixed(0))).join(' ') + (meter.r9_note ? ` (${meter.r9_note})` : ''), 'r1-r15');
+  if (meter.r1_r15) row(table, 'R1–R15', meter.r1_r15.map((v) => (v === null ? '—' : v.toFixed(0))).join(' ') + (meter.r9_note ? `; ${meter.r9_note}` : ''), 'r1-r15');
   meter.film_tv.forEach((r) => row(table, r.label, r.value, `film-${r.key}`));
 }
 
