@@ -399,7 +399,9 @@ def _estimate_one(
     elif isinstance(photo, (str, os.PathLike)):
         name = native = os.fspath(photo)
         if not os.path.isfile(name):
-            raise FileNotFoundError(f"cannot use photo {name}: no such file")
+            raise FileNotFoundError(
+                f"{name}: unusable photo: no such file or folder: check the path's spelling"
+            )
     else:
         raise TypeError(
             "a photo is a path, the bytes of a JPEG/PNG/TIFF file, or an H×W×3 numpy array; "

@@ -23,6 +23,7 @@ use spdcam_core::photo::{load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
 use spdcam_core::{fsio, named_light};
+use spdcam_infer::error::unusable_photo;
 use spdcam_infer::presentation::Presentation;
 use spdcam_infer::{Estimate, Estimator, FeatureRows, Model, ModelSet, PhotoOptions};
 use std::path::PathBuf;
@@ -149,7 +150,7 @@ fn estimate_photo_json(
     let estimate = match photo {
         PhotoInput::Path(path) => py
             .allow_threads(|| estimator.estimate_photo(&path, &options))
-            .map_err(|e| py_err(format!("cannot use photo {}: {e}", path.display())))?,
+            .map_err(|e| py_err(unusable_photo(&path, &e)))?,
         PhotoInput::Encoded(data) => {
             let data = data.as_bytes();
             py.allow_threads(|| estimator.estimate_photo_bytes(data, source, &options))

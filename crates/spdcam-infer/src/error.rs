@@ -37,5 +37,14 @@ impl InferError {
     }
 }
 
+/// Why the photo at `path` gave no estimate, as every front end says it: `PATH: unusable
+/// photo: WHY`, the photo named once (the library's message often names it already).
+pub fn unusable_photo(path: &std::path::Path, why: &dyn std::fmt::Display) -> String {
+    let shown = path.display().to_string();
+    let why = why.to_string();
+    let why = why.strip_prefix(&format!("{shown}: ")).unwrap_or(&why);
+    format!("{shown}: unusable photo: {why}")
+}
+
 /// Result with the crate's [`InferError`].
 pub type Result<T, E = InferError> = std::result::Result<T, E>;

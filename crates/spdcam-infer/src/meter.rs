@@ -114,6 +114,17 @@ impl Meter {
                     value: format!("not defined: {err}"),
                 }),
             }
+            // How far from white, where the photo says so: a calibrated interval wholly
+            // beyond the ±0.05 of white light (`crate::rounding::determinable`).
+            if let (Some(duv), Some(half)) = (duv, half95(e, "duv")) {
+                if shown("duv", duv, Some(half)).is_ok() {
+                    headline.push(Reading {
+                        key: "duv",
+                        label: "Δuv",
+                        value: shown_with_unit("duv", duv, Some(half)),
+                    });
+                }
+            }
         }
         if let (false, Some(light)) = (white, &light) {
             headline.push(Reading {

@@ -7,6 +7,7 @@ use crate::args::photo::describe;
 use crate::outln;
 use anyhow::Result;
 use spdcam_core::photo::{self, PhotoAnalysis};
+use spdcam_infer::error::unusable_photo;
 use spdcam_infer::report::REPORT_IMAGE_WIDTH;
 use spdcam_infer::{Estimate, Estimator, PhotoEstimate, PhotoProgress};
 use std::path::PathBuf;
@@ -83,13 +84,7 @@ fn analysed(args: &EstimateArgs, photos: &[PhotoEstimate]) -> Result<()> {
                 }
                 analyses.push(a.analysis.clone());
             }
-            Err(e) => {
-                // The library's message names the photo already; it is named once.
-                let why = e.to_string();
-                let shown = path.display().to_string();
-                let why = why.strip_prefix(&format!("{shown}: ")).unwrap_or(&why);
-                eprintln!("error: {shown}: unusable photo: {why}");
-            }
+            Err(e) => eprintln!("error: {}", unusable_photo(path, e)),
         }
     }
     if let Some(out) = &args.photo.features_out {
