@@ -302,8 +302,9 @@ fn verdict_words(verdict: Verdict) -> (&'static str, &'static str) {
     match verdict {
         Verdict::Ok => (
             "Good: nothing was found against this estimate.",
-            "The chart was found clearly, its patches are well exposed, and the light found \
-             explains them as well as it explains the photos spdcam was calibrated on.",
+            "The chart was found clearly, none of its patches is nearly black nor more of them \
+             clipped than in the photos spdcam was calibrated on, and the light found explains \
+             them as well as it explains those photos.",
         ),
         Verdict::Doubtful => (
             "Use with care: something makes this estimate less sure than usual.",

@@ -767,3 +767,30 @@ fn corners_in_any_order_give_the_same_estimate() {
     }
     assert!(xy.windows(2).all(|w| w[0] == w[1]), "{xy:?}");
 }
+
+#[test]
+fn a_photo_with_nearly_black_patches_is_never_ok_nor_well_exposed() {
+    // Issue 53: the example darkened to 6 % of its brightness warned "nearly black … expose
+    // more" and, beside it, said "verdict: ok" and "its patches are well exposed".
+    use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
+    let dir = scratch("dark");
+    let photo = image::open("../../examples/cc24-led.jpg").unwrap().to_rgb8();
+    let mut dark = photo.clone();
+    for p in dark.pixels_mut() {
+        for v in &mut p.0 {
+            let linear = srgb_decode(f64::from(*v) / 255.0) * 0.06;
+            *v = (srgb_encode(linear) * 255.0).round() as u8;
+        }
+    }
+    let path = dir.join("dark.png");
+    dark.save(&path).unwrap();
+    let report = dir.join("dark.html");
+    let out = ok(&["estimate", &s(&path), "--report", &s(&report)]);
+    assert!(out.contains("nearly black"), "{out}");
+    assert!(out.contains("verdict: doubtful"), "{out}");
+    let page = std::fs::read_to_string(&report).unwrap();
+    assert!(!page.contains("well exposed"), "the report says well exposed");
+    // The example as it is: ok, and the same words never claim what was not checked.
+    let out = ok(&["estimate", "../../examples/cc24-led.jpg"]);
+    assert!(out.contains("verdict: ok"), "{out}");
+}

@@ -88,7 +88,7 @@ came out `ok`: ok with GFC below 0.90 fell (SG held-out virtual 17 → 6, scene 
 ColorChecker 24 16 → 5, 6 → 2) but so did the ok share (SG scene 58 → 48 %, ColorChecker \
 24 scene 53 → 41 %) and every Hue test photo lost its `ok` (13 → 0 %, mean GFC 0.97).\n- **Verdict** (constants in `spdcam_infer::trust`, levels in the calibration file): `doubtful` \
 when the detection confidence is below 0.8, more feature patches are clipped than in 99 % of \
-the calibration photos, more than a quarter are nearly black, the self-check's mean or split \
+the calibration photos, any is nearly black, the self-check's mean or split \
 residual, colour gradient, glare or two-lights ratio exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
 99th percentile (many lights give nearly this photo, or it is unlike the training lights), \
 or the expected GFC is below 0.95; `unusable` when more than half the patches are clipped, \

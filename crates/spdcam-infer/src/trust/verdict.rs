@@ -28,8 +28,6 @@ pub const POOR_GFC: f64 = 0.90;
 /// A share of clipped feature patches above this makes an estimate unusable: half the
 /// chart says only that it is brighter than the camera records.
 pub const UNUSABLE_CLIPPED_SHARE: f64 = 0.5;
-/// A share of dark feature patches above this makes an estimate doubtful.
-pub const DOUBTFUL_DARK_SHARE: f64 = 0.25;
 
 /// Whether a patch's encoded RGB has a channel at the top of the scale.
 pub fn clipped_patch(rgb: &[f64], scale: f64) -> bool {
@@ -203,7 +201,9 @@ pub fn weigh(
                 || row[3 * i..3 * i + 3].iter().all(|&v| v < 0.02 * scale)
         })
         .collect();
-    if dark.len() as f64 > DOUBTFUL_DARK_SHARE * patches as f64 {
+    // Any nearly black patch: the photo analysis warns of it ("expose more"), and a verdict
+    // of `ok` beside that warning would contradict it.
+    if !dark.is_empty() {
         lower(
             Verdict::Doubtful,
             Advice::Dark {
