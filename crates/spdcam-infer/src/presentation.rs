@@ -17,7 +17,7 @@ use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::meter::Meter;
 pub use crate::rounding::{round_sig, round_with_uncertainty};
 use crate::rounding::{shown, undetermined_words};
-use crate::trust::Verdict;
+use crate::trust::{Veil, Verdict};
 use serde::Serialize;
 use spdcam_core::light_families::LightKind;
 
@@ -70,6 +70,9 @@ pub struct VerdictWords {
     pub explanation: &'static str,
     /// What lowered it, and checks that could not be made.
     pub reasons: Vec<String>,
+    /// The glare read on the chart's dark patches ([`glare_words`]), when the self-check
+    /// was made.
+    pub glare: Option<String>,
 }
 
 /// A group of metrics under one heading.
@@ -257,6 +260,11 @@ impl Presentation {
                 headline,
                 explanation,
                 reasons: t.reasons.clone(),
+                glare: t
+                    .self_check
+                    .as_ref()
+                    .and_then(|c| c.veil.as_ref())
+                    .map(glare_words),
             }
         });
         Presentation {
@@ -295,6 +303,62 @@ impl Presentation {
             .flat_map(|g| &g.metrics)
             .find(|m| m.key == key)
     }
+}
+
+/// Glare below this share of the chart's mean reads as none.
+const NO_GLARE: f64 = 0.02;
+
+/// The glare read on the chart in a person's words: "Glare on the chart: about 31 % of its
+/// mean brightness in the photo is light laid over it (read on its 9 darkest patches); a
+/// glow near its centre adds 56 % more there." Where it is strongest is said on the chart as printed (its top is the
+/// top of its layout).
+pub fn glare_words(veil: &Veil) -> String {
+    let on = match veil.patches {
+        1 => "its darkest patch".to_string(),
+        n => format!("its {n} darkest patches"),
+    };
+    let mut words = if veil.share < -NO_GLARE {
+        format!(
+            "Glare on the chart: none seen; {on} read darker than the light found gives \
+             them (a camera's tone curve that deepens blacks does that)"
+        )
+    } else if veil.share < NO_GLARE {
+        format!("Glare on the chart: none seen on {on}")
+    } else {
+        format!(
+            "Glare on the chart: about {:.0} % of its mean brightness in the photo is light \
+             laid over it (read on {on})",
+            100.0 * veil.share
+        )
+    };
+    if let Some(([x, y], local)) = veil.strongest {
+        let third = 1.0 / 6.0;
+        let vertical = if y < -third {
+            "top"
+        } else if y > third {
+            "bottom"
+        } else {
+            ""
+        };
+        let horizontal = if x < -third {
+            "left"
+        } else if x > third {
+            "right"
+        } else {
+            ""
+        };
+        let place = match (vertical, horizontal) {
+            ("", "") => "near its centre".to_string(),
+            (v, "") | ("", v) => format!("towards its {v}"),
+            (v, h) => format!("towards its {v} {h}"),
+        };
+        words.push_str(&format!(
+            "; a glow {place} adds {:.0} % more there",
+            100.0 * local
+        ));
+    }
+    words.push('.');
+    words
 }
 
 /// The verdict's headline and what it rests on.
@@ -499,6 +563,34 @@ fn capitalised(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn glare_is_said_with_where_it_is_strongest_on_the_chart_as_printed() {
+        let veil = |share: f64, strongest: Option<([f64; 2], f64)>| Veil {
+            share,
+            patches: 9,
+            strongest,
+        };
+        assert_eq!(
+            glare_words(&veil(0.314, Some(([-0.04, 0.06], 0.56)))),
+            "Glare on the chart: about 31 % of its mean brightness in the photo is light laid \
+             over it (read on its 9 darkest patches); a glow near its centre adds 56 % more there."
+        );
+        assert!(glare_words(&veil(0.3, Some(([-0.3, -0.3], 0.4))))
+            .ends_with("; a glow towards its top left adds 40 % more there."));
+        assert!(glare_words(&veil(0.3, Some(([0.4, 0.0], 0.4)))).contains("towards its right"));
+        assert!(glare_words(&veil(0.3, Some(([0.0, 0.4], 0.4)))).contains("towards its bottom"));
+        assert_eq!(
+            glare_words(&veil(0.01, None)),
+            "Glare on the chart: none seen on its 9 darkest patches."
+        );
+        assert!(glare_words(&veil(-0.09, None)).contains("read darker than the light found"));
+        let one = Veil {
+            patches: 1,
+            ..veil(0.2, None)
+        };
+        assert!(glare_words(&one).contains("(read on its darkest patch)"));
+    }
 
     #[test]
     fn peaks_and_shapes_follow_the_documented_rules() {

@@ -146,6 +146,9 @@ fn section(out: &mut String, index: usize, item: &ReportItem) {
             }
             out.push_str("</ul>");
         }
+        if let Some(glare) = &v.glare {
+            let _ = write!(out, "<p class=\"glare\">{}</p>", esc(glare));
+        }
         out.push_str("</div>\n");
     }
     out.push_str("<div class=\"row three\">\n");

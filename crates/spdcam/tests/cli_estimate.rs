@@ -774,7 +774,9 @@ fn a_photo_with_nearly_black_patches_is_never_ok_nor_well_exposed() {
     // more" and, beside it, said "verdict: ok" and "its patches are well exposed".
     use spdcam_core::colorimetry::{srgb_decode, srgb_encode};
     let dir = scratch("dark");
-    let photo = image::open("../../examples/cc24-led.jpg").unwrap().to_rgb8();
+    let photo = image::open("../../examples/cc24-led.jpg")
+        .unwrap()
+        .to_rgb8();
     let mut dark = photo.clone();
     for p in dark.pixels_mut() {
         for v in &mut p.0 {
@@ -789,8 +791,19 @@ fn a_photo_with_nearly_black_patches_is_never_ok_nor_well_exposed() {
     assert!(out.contains("nearly black"), "{out}");
     assert!(out.contains("verdict: doubtful"), "{out}");
     let page = std::fs::read_to_string(&report).unwrap();
-    assert!(!page.contains("well exposed"), "the report says well exposed");
+    assert!(
+        !page.contains("well exposed"),
+        "the report says well exposed"
+    );
     // The example as it is: ok, and the same words never claim what was not checked.
     let out = ok(&["estimate", "../../examples/cc24-led.jpg"]);
     assert!(out.contains("verdict: ok"), "{out}");
+    // With the glare read on its darkest patches (the ColorChecker 24 has two: black and
+    // blue), in words and in the JSON.
+    assert!(out.contains("Glare on the chart: none seen"), "{out}");
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", "../../examples/cc24-led.jpg", "--json"])).unwrap();
+    let veil = &json[0]["self_check"]["veil"];
+    assert_eq!(veil["patches"], 2, "{veil}");
+    assert!(veil["share"].as_f64().unwrap().abs() < 0.2, "{veil}");
 }

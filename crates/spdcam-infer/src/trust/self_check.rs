@@ -44,7 +44,38 @@ pub struct SelfCheck {
     /// top or bottom; the larger) is lit by a light of its own, as an F ratio: large when two
     /// different lights each light a half, even when the camera balanced each half to grey.
     pub two_lights: f64,
+    /// Glare laid over the chart, read on its dark patches ([`ChartCheck::veil`]); `None`
+    /// when no dark patch is usable.
+    pub veil: Option<Veil>,
 }
+
+/// Glare laid over the chart, read where it shows most: on the patches the light found
+/// leaves dark. Shares are of the chart's mean level (green channel, linear light).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Veil {
+    /// The share of the chart's mean level in the photo that is light added to every
+    /// patch: the median over the dark patches (negative when they read darker than the light found gives them, as a
+    /// camera's tone curve that crushes blacks makes them).
+    pub share: f64,
+    /// How many dark patches it was read on.
+    pub patches: usize,
+    /// Where the glare is strongest, when one dark patch reads at least [`LOCAL_GLARE`]
+    /// more than their median: its centre across the chart (−½…½, x to the right, y down)
+    /// and its excess over the median, as a share of the chart's mean.
+    pub strongest: Option<([f64; 2], f64)>,
+}
+
+/// A feature patch counts as dark for [`ChartCheck::veil`] when the light found gives it
+/// less than this share of the chart's mean green.
+const VEIL_DARK_SHARE: f64 = 0.25;
+/// A dark patch reading this much more than the dark patches' median (a share of the
+/// chart's mean) shows where the glare is strongest ([`Veil::strongest`]). Chosen on the
+/// real SG sets' training and validation photos (docs/glow.md): the glare-free Hue photos'
+/// blackest patch reads up to 0.15 above the others' median through the camera's tone
+/// curve, the Telelumen photos' glow about 0.5.
+pub const LOCAL_GLARE: f64 = 0.2;
+/// At least this many dark patches are needed to say where the glare is strongest.
+const LOCAL_GLARE_PATCHES: usize = 3;
 
 /// The chart's feature patches seen by a reference camera, ready to be lit by an SPD.
 #[derive(Debug, Clone)]
@@ -206,11 +237,66 @@ impl ChartCheck {
         }
         let best = best.ok_or_else(|| InferError::invalid("self-check: no tone curve to try"))?;
         let mut best = self.judge_fit(&best, &used)?;
+        best.veil = self.veil(&predicted, features, scale);
         best.colour_gradient =
             UnevenLight::fit_neutrals(&self.neutrals, &self.centres, features, scale)
                 .ok()
                 .map(|u| u.colour_gradient());
         Ok(best)
+    }
+
+    /// Glare laid over the chart, read on its dark patches: veiling glare adds light to
+    /// every patch (ISO 18844's veiling glare; as `spdcam_core::camera::optics::VeilingGlare`
+    /// renders it); when it is a share w of the photo's mean level, a patch the light found
+    /// gives q of the chart's mean reads r = q·(1 − w) + w of the photo's mean, so
+    /// w = (r − q)/(1 − q). Read in green (the photo's sRGB decoded to linear light) on the
+    /// unclipped patches with q below [`VEIL_DARK_SHARE`], where glare shows most and the
+    /// light's colour least; their median is the veil, and a patch reading
+    /// [`LOCAL_GLARE`] more shows where it is strongest.
+    pub fn veil(&self, predicted: &[[f64; 3]], features: &[f64], scale: f64) -> Option<Veil> {
+        let unclipped: Vec<usize> = (0..predicted.len())
+            .filter(|&i| {
+                features
+                    .get(3 * i..3 * i + 3)
+                    .is_some_and(|p| !super::verdict::clipped_patch(p, scale))
+            })
+            .collect();
+        if unclipped.is_empty() {
+            return None;
+        }
+        let green = |i: usize| srgb_decode((features[3 * i + 1] / scale).clamp(0.0, 1.0));
+        let n = unclipped.len() as f64;
+        let observed_mean = unclipped.iter().map(|&i| green(i)).sum::<f64>() / n;
+        let predicted_mean = unclipped.iter().map(|&i| predicted[i][1]).sum::<f64>() / n;
+        if !(observed_mean > 0.0 && predicted_mean > 0.0) {
+            return None;
+        }
+        let mut dark: Vec<(usize, f64)> = unclipped
+            .iter()
+            .filter_map(|&i| {
+                let q = predicted[i][1] / predicted_mean;
+                let r = green(i) / observed_mean;
+                (q < VEIL_DARK_SHARE).then(|| (i, (r - q) / (1.0 - q)))
+            })
+            .collect();
+        if dark.is_empty() {
+            return None;
+        }
+        dark.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let m = dark.len();
+        let share = if m % 2 == 1 {
+            dark[m / 2].1
+        } else {
+            0.5 * (dark[m / 2 - 1].1 + dark[m / 2].1)
+        };
+        let (top, most) = dark[m - 1];
+        let strongest = (m >= LOCAL_GLARE_PATCHES && most - share >= LOCAL_GLARE)
+            .then(|| (self.centres[top], most - share));
+        Some(Veil {
+            share,
+            patches: m,
+            strongest,
+        })
     }
 
     /// The per-photo map of `predicted` raw RGB to `observed` linear RGB over the patches
@@ -317,6 +403,7 @@ impl ChartCheck {
                 0.0
             },
             colour_gradient: None,
+            veil: None,
             mean,
             split,
             worst: fitted.residuals[0].1,
@@ -551,6 +638,84 @@ pub(super) mod tests {
                 })
             })
             .collect()
+    }
+
+    #[test]
+    fn a_veil_laid_over_the_chart_is_read_back_on_its_dark_patches() {
+        let grid = Grid::parse("400-700:5").unwrap();
+        let check = cc24_check(&grid);
+        for light in [StandardIlluminant::A, StandardIlluminant::D65] {
+            let spd = light.spd(&grid).unwrap();
+            let raw = check.rendered(&spd).unwrap();
+            let peak = raw.iter().flatten().copied().fold(0.0f64, f64::max);
+            let mean: [f64; 3] =
+                std::array::from_fn(|c| raw.iter().map(|p| p[c]).sum::<f64>() / raw.len() as f64);
+            // Veiling glare as the virtual camera lays it: v of the chart's mean raw level
+            // added to every patch, per channel; then exposure and sRGB encoding.
+            let photo = |veil: f64| -> Vec<f64> {
+                raw.iter()
+                    .flat_map(|p| {
+                        (0..3).map(move |c| {
+                            255.0 * srgb_encode(0.7 * (p[c] + veil * mean[c]) / peak / (1.0 + veil))
+                        })
+                    })
+                    .collect()
+            };
+            for veil in [0.0, 0.05, 0.3, 0.6] {
+                let read = check.veil(&raw, &photo(veil), 255.0).unwrap();
+                // v of the mean raw level added is v/(1 + v) of the photo's mean.
+                assert!(
+                    (read.share - veil / (1.0 + veil)).abs() < 1e-9,
+                    "{light:?}: laid {veil}, read {}",
+                    read.share
+                );
+                assert!(read.patches >= 1 && read.strongest.is_none());
+            }
+            // The ColorChecker 24 has two patches dark in green (black and blue): too few
+            // to say where glare is strongest.
+            assert_eq!(check.veil(&raw, &photo(0.2), 255.0).unwrap().patches, 2);
+        }
+        // Two ColorChecker 24s side by side (6 × 8): four dark patches, and a glow on the
+        // second black patch (bottom right) is where the glare is strongest.
+        let cc24 = spdcam_core::builtin::COLORCHECKER24.load().unwrap();
+        let double = spdcam_core::spectral::SpectralSet::new(
+            cc24.wavelengths().to_vec(),
+            (0..48).map(|i| format!("p{i}")).collect(),
+            cc24.items().iter().chain(cc24.items()).cloned().collect(),
+        )
+        .unwrap();
+        let chart = Chart::from_reflectances("double", &double, 6, 8, &grid).unwrap();
+        let table = &builtin::CAMERAS[0];
+        let camera = Sensitivities::new(table.name, &table.load().unwrap(), &grid).unwrap();
+        let check = ChartCheck::new(&chart, &camera, &grid).unwrap();
+        let raw = check
+            .rendered(&StandardIlluminant::D65.spd(&grid).unwrap())
+            .unwrap();
+        let peak = raw.iter().flatten().copied().fold(0.0f64, f64::max);
+        let mut photo: Vec<f64> = raw
+            .iter()
+            .flat_map(|p| p.map(|v| 255.0 * srgb_encode(0.7 * v / peak)))
+            .collect();
+        let even = check.veil(&raw, &photo, 255.0).unwrap();
+        assert_eq!((even.patches, even.strongest), (4, None));
+        photo[3 * 47 + 1] = 255.0 * srgb_encode(srgb_decode(photo[3 * 47 + 1] / 255.0) * 4.0);
+        let glow = check.veil(&raw, &photo, 255.0).unwrap();
+        let (at, local) = glow.strongest.unwrap();
+        assert_eq!(at, check.centres()[47]);
+        assert!(
+            at[0] > 0.4 && at[1] > 0.4 && local > LOCAL_GLARE,
+            "{at:?} {local}"
+        );
+        // A chart with every patch clipped has nothing to read glare on.
+        assert!(check
+            .veil(
+                &check
+                    .rendered(&StandardIlluminant::A.spd(&grid).unwrap())
+                    .unwrap(),
+                &vec![255.0; 72],
+                255.0
+            )
+            .is_none());
     }
 
     #[test]

@@ -9,6 +9,7 @@ use spdcam_core::fsio;
 use spdcam_core::light_families::LightKind;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_infer::meter::Meter;
+use spdcam_infer::presentation::glare_words;
 use spdcam_infer::report::{report_html, ReportImage, ReportItem};
 use spdcam_infer::rounding::NOT_DETERMINABLE;
 use spdcam_infer::trust::{Trust, Verdict};
@@ -62,6 +63,9 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Re
         }
         if let Some(t) = &e.trust {
             outln!("  {}", trust_line(t))?;
+            if let Some(veil) = t.self_check.as_ref().and_then(|c| c.veil.as_ref()) {
+                outln!("  {}", glare_words(veil))?;
+            }
             if let (Some(u), false) = (&t.uncertainty, unusable) {
                 outln!(
                     "  expected GFC {:.3}; 95 % band {:.2} wide on average (68 %: {:.2}; SPD peak 1){}",

@@ -657,6 +657,7 @@ function renderOverview() {
       const ul = html('ul', { class: 'reasons' }, v);
       p.verdict.reasons.forEach((t) => html('li', {}, ul, t));
     }
+    if (p.verdict.glare) html('p', { class: 'glare', id: 'glare' }, v, p.verdict.glare);
   }
   html('p', { class: 'note', id: 'gfc-words' }, box, p.gfc);
 }
