@@ -317,13 +317,8 @@ pub fn glare_words(veil: &Veil) -> String {
         1 => "its darkest patch".to_string(),
         n => format!("its {n} darkest patches"),
     };
-    let mut words = if veil.share < -NO_GLARE {
-        format!(
-            "Glare on the chart: none seen; {on} read darker than the light found gives \
-             them (a camera's tone curve that deepens blacks does that)"
-        )
-    } else if veil.share < NO_GLARE {
-        format!("Glare on the chart: none seen on {on}")
+    let mut words = if veil.share < NO_GLARE {
+        format!("Glare on the chart: none seen (read on {on})")
     } else {
         format!(
             "Glare on the chart: about {:.0} % of its mean brightness in the photo is light \
@@ -366,9 +361,9 @@ fn verdict_words(verdict: Verdict) -> (&'static str, &'static str) {
     match verdict {
         Verdict::Ok => (
             "Good: nothing was found against this estimate.",
-            "The chart was found clearly, none of its patches is nearly black nor more of them \
-             clipped than in the photos spdcam was calibrated on, and the light found explains \
-             them as well as it explains those photos.",
+            "The chart was found clearly, no patch is nearly black nor more are clipped than \
+             in spdcam's calibration photos, and the light found explains them as well as it \
+             explains those.",
         ),
         Verdict::Doubtful => (
             "Use with care: something makes this estimate less sure than usual.",
@@ -580,11 +575,13 @@ mod tests {
             .ends_with("; a glow towards its top left adds 40 % more there."));
         assert!(glare_words(&veil(0.3, Some(([0.4, 0.0], 0.4)))).contains("towards its right"));
         assert!(glare_words(&veil(0.3, Some(([0.0, 0.4], 0.4)))).contains("towards its bottom"));
-        assert_eq!(
-            glare_words(&veil(0.01, None)),
-            "Glare on the chart: none seen on its 9 darkest patches."
-        );
-        assert!(glare_words(&veil(-0.09, None)).contains("read darker than the light found"));
+        // Below 2 %, or negative (a camera's tone curve that deepens blacks): none.
+        for share in [0.01, -0.09] {
+            assert_eq!(
+                glare_words(&veil(share, None)),
+                "Glare on the chart: none seen (read on its 9 darkest patches)."
+            );
+        }
         let one = Veil {
             patches: 1,
             ..veil(0.2, None)
