@@ -382,6 +382,15 @@ impl KnownChart {
         }
     }
 
+    /// The patches of the physical chart a photo shows ([`KnownChart::physical`]), rows ×
+    /// columns as printed: what a person counts to tell the charts apart.
+    pub fn printed_layout(self) -> Option<(usize, usize)> {
+        match self.physical()? {
+            KnownChart::ColorChecker24 => Some((4, 6)),
+            KnownChart::Sg96 | KnownChart::Sg96Thesis | KnownChart::Sg140 => Some((10, 14)),
+        }
+    }
+
     /// The physical chart a photo shows when features come from this one: the whole SG for
     /// its 96 centre patches; `None` for the thesis's file order, which no photo shows.
     pub fn physical(self) -> Option<KnownChart> {

@@ -1,5 +1,5 @@
 //! The handlers of the API's routes: uploads to estimate, jobs polled, reports, the locus,
-//! and the answers to unknown pages and methods.
+//! the charts, and the answers to unknown pages and methods.
 
 use super::answer::Answer;
 use super::plain_error::plain_error;
@@ -29,6 +29,11 @@ pub(super) async fn submit(State(api): State<Arc<Api>>, request: Request) -> Ans
         },
         Err(answer) => answer,
     }
+}
+
+/// `GET /api/charts`: the charts a person can name for placed corners.
+pub(super) async fn charts(State(api): State<Arc<Api>>) -> Answer {
+    Answer(200, "application/json", api.charts.clone().into())
 }
 
 /// `GET /api/locus`: the outlines of the chromaticity diagram.

@@ -9,14 +9,14 @@ mod plain_error;
 mod upload;
 
 use super::body::{Budget, Pace};
-use super::jobs::Jobs;
+use super::jobs::{Jobs, CHARTS};
 use answer::Answer;
 use anyhow::Result;
 use axum::body::Body;
 use axum::routing::{get, post};
 use axum::Router;
 use chromaticity::locus_json;
-use handlers::{estimate, job, locus, not_allowed, not_found, report, submit};
+use handlers::{charts, estimate, job, locus, not_allowed, not_found, report, submit};
 use std::sync::Arc;
 
 const INDEX_HTML: &str = include_str!("../page/index.html");
@@ -29,6 +29,22 @@ const EXAMPLE_JPG: &[u8] = include_bytes!("../../../../../examples/cc24-led.jpg"
 /// field other than the photo.
 const FORM_OVERHEAD: usize = 64 * 1024;
 
+/// The charts a person can name for placed corners ([`CHARTS`]), each with its name and
+/// a label that tells it apart: `{"name": "colorchecker24", "label": "ColorChecker 24
+/// (4 × 6 patches)"}`.
+fn charts_json() -> serde_json::Value {
+    CHARTS
+        .iter()
+        .map(|c| {
+            let label = match c.printed_layout() {
+                Some((rows, cols)) => format!("{} ({rows} × {cols} patches)", c.shown_name()),
+                None => c.shown_name().to_string(),
+            };
+            serde_json::json!({ "name": c.name(), "label": label })
+        })
+        .collect()
+}
+
 /// The request handler's state, shared by the connections.
 pub struct Api {
     jobs: Arc<Jobs>,
@@ -36,6 +52,7 @@ pub struct Api {
     pace: Pace,
     budget: Budget,
     locus: String,
+    charts: String,
 }
 
 impl Api {
@@ -53,6 +70,7 @@ impl Api {
             pace,
             budget: Budget::new(budget_bytes.max(max_upload_bytes + FORM_OVERHEAD)),
             locus: locus_json()?.to_string(),
+            charts: charts_json().to_string(),
         })
     }
 
@@ -77,6 +95,7 @@ impl Api {
             )
             .route("/example.jpg", page("image/jpeg", EXAMPLE_JPG))
             .route("/api/locus", get(locus))
+            .route("/api/charts", get(charts))
             .route("/api/estimate", post(estimate))
             .route("/api/jobs", post(submit))
             .route("/api/jobs/{id}", get(job))

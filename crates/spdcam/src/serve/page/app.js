@@ -326,11 +326,13 @@ function renderStage() {
   }
 }
 
-/** The charts a person can name for placed corners (the server's names). */
-const CHARTS = [
-  ['colorchecker24', 'ColorChecker 24 (classic, 4 × 6 patches)'],
-  ['colorchecker_sg96', 'ColorChecker Digital SG (14 × 10 patches)'],
-];
+/** The charts a person can name for placed corners, [name, label] as the server lists
+ *  them (`GET api/charts`), loaded when the page opens. */
+let charts = [];
+fetch('api/charts')
+  .then((r) => r.json())
+  .then((list) => { charts = list.map((c) => [c.name, c.label]); })
+  .catch(() => { charts = []; });
 
 /**
  * The photo large, with zoom (wheel or buttons) and pan (drag), where four clicks place the
@@ -437,7 +439,7 @@ function renderPlacer(stage, e) {
   if (p.points.length === 4) {
     const ask = html('fieldset', { class: 'chart-choice', id: 'chart-choice' }, stage);
     html('legend', {}, ask, 'Which chart is in the photo?');
-    for (const [name, label] of CHARTS) {
+    for (const [name, label] of charts) {
       const l = html('label', {}, ask);
       const radio = html('input', { type: 'radio', name: 'chart', value: name }, l);
       radio.checked = p.chart === name;

@@ -27,6 +27,35 @@ fn the_page_and_its_assets_are_embedded() {
 }
 
 #[test]
+fn the_charts_to_name_come_from_the_server_with_labels_that_tell_them_apart() {
+    let server = start(16 << 20);
+    let (status, body) = request(server.addr(), "GET", "/api/charts", None);
+    assert_eq!(status, 200);
+    let charts = json(&body);
+    let listed: Vec<(&str, &str)> = charts
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| (c["name"].as_str().unwrap(), c["label"].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        listed,
+        [
+            ("colorchecker24", "ColorChecker 24 (4 × 6 patches)"),
+            (
+                "colorchecker_sg96",
+                "ColorChecker Digital SG (10 × 14 patches)"
+            ),
+        ]
+    );
+    // The page holds no list of its own.
+    let (_, page) = request(server.addr(), "GET", "/app.js", None);
+    let page = String::from_utf8_lossy(&page);
+    assert!(page.contains("api/charts") && !page.contains("ColorChecker"));
+    server.stop();
+}
+
+#[test]
 fn the_page_offers_every_kind_of_light_and_no_other() {
     use spdcam_core::light_families::LightKind;
     let page = include_str!("../page/index.html");
