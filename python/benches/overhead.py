@@ -3,7 +3,9 @@
 For the example photo and for 10,000 feature rows, times the library alone (the compiled
 module calls it without any Python conversion) and ``spdcam.estimate`` /
 ``spdcam.estimate_features`` (the same work plus converting the inputs and results), and
-prints the overhead as a share of the Rust time; the goal is at most 5 %.
+prints the overhead as a share of the Rust time; the goal is at most 5 %. Then a list of
+photos in one ``spdcam.estimate`` call (several at once on every core) against the same
+photos one call each, as a speed-up.
 
     python python/benches/overhead.py [--repeats N]
 """
@@ -20,6 +22,8 @@ from spdcam import _native
 ROOT = Path(__file__).resolve().parents[2]
 PHOTO = ROOT / "examples" / "sg-telelumen.jpg"
 ROWS = 10_000
+#: Photos in the list case.
+LIST = 8
 
 
 def best_of(runs: int, work) -> float:
@@ -58,6 +62,14 @@ def main() -> None:
         (f"{ROWS:,} feature rows", rows_rust, rows_py),
     ]:
         print(f"{name:<22}{rust * 1e3:>11.1f}{py * 1e3:>13.1f}{(py - rust) / rust:>10.1%}")
+
+    photos = [PHOTO] * LIST
+    one_call = best_of(args.repeats, timed(lambda: spdcam.estimate(photos, model=models)))
+    each = best_of(args.repeats, timed(lambda: [spdcam.estimate(p, model=models) for p in photos]))
+    print(
+        f"{LIST} photos: one call {one_call * 1e3:.0f} ms, one call each {each * 1e3:.0f} ms: "
+        f"{each / one_call:.2f}× faster as a list"
+    )
 
 
 if __name__ == "__main__":

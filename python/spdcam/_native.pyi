@@ -22,16 +22,17 @@ class Models:
 PhotoInput = Union[str, bytes, tuple[bytes, int, int, int]]
 """A photo file's path, an encoded photo's bytes, or ``(pixels, width, height, bits)``."""
 
-def estimate_photo_json(
-    photo: PhotoInput,
-    source: str,
+def estimate_photos(
+    photos: Sequence[PhotoInput],
+    sources: Sequence[str],
     models: Models,
     chart: Optional[str] = None,
     corners: Optional[Sequence[tuple[float, float]]] = None,
     range: str = "400-700:5",
     light: str = "unknown",
-) -> str:
-    """Estimates the light from a photo; the estimate as JSON text."""
+    progress: Progress = None,
+) -> list[dict]:
+    """Estimates the light from photos, several at once; each estimate as a dict."""
 
 def estimate_rows(
     values: bytes,
@@ -41,7 +42,7 @@ def estimate_rows(
     source: str = "features",
     range: str = "400-700:5",
     light: str = "unknown",
-) -> tuple[str, bytes, bytes, bytes, bytes, bytes, str]: ...
+) -> tuple[str, bytes, bytes, bytes, bytes, bytes, list[dict]]: ...
 def read_photo(path: str) -> tuple[int, int, int, bytes]: ...
 def library_seconds_photo(path: str, models: Models, repeats: int) -> float: ...
 def library_seconds_rows(values: bytes, rows: int, models: Models, repeats: int) -> float: ...

@@ -12,6 +12,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
+use rayon::prelude::*;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
@@ -19,10 +20,10 @@ use spdcam_core::chart::{Chart, Layout, THESIS_PATCH_PX};
 use spdcam_core::dataset::randomise::RandomiseRequest;
 use spdcam_core::dataset::{GenerateEvent, GenerateOptions, GenerateRequest, Pipeline};
 use spdcam_core::light_families::LightKind;
+use spdcam_core::named_light;
 use spdcam_core::photo::{load_photo, Photo};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
-use spdcam_core::{fsio, named_light};
 use spdcam_infer::error::unusable_photo;
 use spdcam_infer::presentation::Presentation;
 use spdcam_infer::{Estimate, Estimator, FeatureRows, Model, ModelSet, PhotoOptions};
@@ -106,12 +107,13 @@ impl Models {
     }
 }
 
-/// An estimate as the JSON text of `Estimate::to_json`, with its `presentation` (the
-/// numbers as the command line, the report and the web page write them, for `repr`).
-fn estimate_json(estimate: &Estimate) -> PyResult<String> {
+/// An estimate as a Python dict: `Estimate::to_json` with its `presentation` (the numbers as
+/// the command line, the report and the web page write them, for `repr`), converted value by
+/// value (pythonize), never through JSON text.
+fn estimate_dict<'py>(py: Python<'py>, estimate: &Estimate) -> PyResult<Bound<'py, PyAny>> {
     let mut value = estimate.to_json().map_err(py_err)?;
     value["presentation"] = serde_json::to_value(Presentation::of(estimate)).map_err(py_err)?;
-    serde_json::to_string(&value).map_err(py_err)
+    pythonize::pythonize(py, &value).map_err(py_err)
 }
 
 /// A photo as Python hands it over.
@@ -126,54 +128,107 @@ enum PhotoInput<'py> {
     Path(PathBuf),
 }
 
-/// Estimates the light from a photo: a file path, an encoded photo's bytes, or a tuple
-/// `(pixels, width, height, bits)` of RGB pixels; `source` names in-memory photos in
-/// messages. The result as JSON text.
-#[pyfunction]
-#[pyo3(signature = (photo, source, models, chart=None, corners=None, range="400-700:5", light="unknown"))]
-fn estimate_photo_json(
-    py: Python<'_>,
-    photo: PhotoInput<'_>,
+/// A [`PhotoInput`] with its bytes borrowed from Python's objects, for work without the GIL.
+enum PhotoData<'a> {
+    Encoded(&'a [u8]),
+    Pixels(&'a [u8], usize, usize, u32),
+    Path(&'a PathBuf),
+}
+
+impl PhotoInput<'_> {
+    fn data(&self) -> PhotoData<'_> {
+        match self {
+            PhotoInput::Encoded(b) => PhotoData::Encoded(b.as_bytes()),
+            PhotoInput::Pixels(b, w, h, bits) => PhotoData::Pixels(b.as_bytes(), *w, *h, *bits),
+            PhotoInput::Path(p) => PhotoData::Path(p),
+        }
+    }
+}
+
+/// One photo's estimate, or the message of why it cannot be used (the command line's).
+fn estimate_one(
+    estimator: &Estimator,
+    photo: &PhotoData<'_>,
     source: &str,
+    options: &PhotoOptions,
+) -> Result<Estimate, String> {
+    match photo {
+        PhotoData::Path(path) => estimator
+            .estimate_photo(path, options)
+            .map_err(|e| unusable_photo(path, &e)),
+        PhotoData::Encoded(data) => estimator
+            .estimate_photo_bytes(data, source, options)
+            .map_err(|e| e.to_string()),
+        PhotoData::Pixels(pixels, width, height, bits) => {
+            let photo = if *bits == 16 {
+                let values = pixels
+                    .chunks_exact(2)
+                    .map(|c| u16::from_ne_bytes([c[0], c[1]]))
+                    .collect();
+                Photo::from_rgb16(source, *width, *height, values)
+            } else {
+                Photo::from_rgb8(source, *width, *height, pixels.to_vec())
+            };
+            photo
+                .map_err(spdcam_infer::InferError::from)
+                .and_then(|p| estimator.estimate_decoded(&p, options))
+                .map_err(|e| e.to_string())
+        }
+    }
+}
+
+/// Estimates the light from photos, each a file path, an encoded photo's bytes, or a tuple
+/// `(pixels, width, height, bits)` of RGB pixels, named in messages by `sources`; several
+/// at once on every core, without the GIL, `progress(done, total)` told after each batch.
+/// The estimates as dicts, in order; the first photo that cannot be used raises its
+/// message.
+#[pyfunction]
+#[pyo3(signature = (photos, sources, models, chart=None, corners=None, range="400-700:5", light="unknown", progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn estimate_photos<'py>(
+    py: Python<'py>,
+    photos: Vec<PhotoInput<'py>>,
+    sources: Vec<String>,
     models: &Models,
     chart: Option<String>,
     corners: Option<Vec<[f64; 2]>>,
     range: &str,
     light: &str,
-) -> PyResult<String> {
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    if sources.len() != photos.len() {
+        return Err(py_err(format!(
+            "{} photos and {} names for them",
+            photos.len(),
+            sources.len()
+        )));
+    }
     let estimator = models.on(range, light)?;
     let options = PhotoOptions {
         chart,
         corners,
         ..PhotoOptions::default()
     };
-    let estimate = match photo {
-        PhotoInput::Path(path) => py
-            .allow_threads(|| estimator.estimate_photo(&path, &options))
-            .map_err(|e| py_err(unusable_photo(&path, &e)))?,
-        PhotoInput::Encoded(data) => {
-            let data = data.as_bytes();
-            py.allow_threads(|| estimator.estimate_photo_bytes(data, source, &options))
-                .map_err(py_err)?
+    let data: Vec<PhotoData<'_>> = photos.iter().map(PhotoInput::data).collect();
+    // Batches of a few photos per core: parallel within, progress told between them.
+    let batch = 2 * rayon::current_num_threads().max(1);
+    let mut out = Vec::with_capacity(data.len());
+    for (chunk, names) in data.chunks(batch).zip(sources.chunks(batch)) {
+        let estimates: Vec<Result<Estimate, String>> = py.allow_threads(|| {
+            chunk
+                .par_iter()
+                .zip(names)
+                .map(|(photo, name)| estimate_one(&estimator, photo, name, &options))
+                .collect()
+        });
+        for e in estimates {
+            out.push(estimate_dict(py, &e.map_err(py_err)?)?);
         }
-        PhotoInput::Pixels(pixels, width, height, bits) => {
-            let pixels = pixels.as_bytes();
-            py.allow_threads(|| {
-                let photo = if bits == 16 {
-                    let values = pixels
-                        .chunks_exact(2)
-                        .map(|c| u16::from_ne_bytes([c[0], c[1]]))
-                        .collect();
-                    Photo::from_rgb16(source, width, height, values)?
-                } else {
-                    Photo::from_rgb8(source, width, height, pixels.to_vec())?
-                };
-                estimator.estimate_decoded(&photo, &options)
-            })
-            .map_err(py_err)?
+        if let Some(callback) = &progress {
+            callback.call1(py, (out.len(), data.len()))?;
         }
-    };
-    estimate_json(&estimate)
+    }
+    Ok(out)
 }
 
 /// Native-endian `f64` bytes as numbers.
@@ -196,8 +251,8 @@ fn f64_bytes<'py>(py: Python<'py>, values: impl Iterator<Item = f64>) -> Bound<'
 
 /// What `estimate_rows` returns: the model's name, then as `f64` bytes the wavelengths,
 /// the SPDs (rows × wavelengths), xy (rows × 2), CCT and Duv (NaN where undefined), then
-/// the judgement of each row as JSON text (a list of objects with the keys of
-/// [`JUDGEMENT_KEYS`], as `spdcam estimate --json` writes them).
+/// the judgement of each row (a list of dicts with the keys of [`JUDGEMENT_KEYS`], as
+/// `spdcam estimate --json` writes them).
 type RowsResult<'py> = (
     String,
     Bound<'py, PyBytes>,
@@ -205,7 +260,7 @@ type RowsResult<'py> = (
     Bound<'py, PyBytes>,
     Bound<'py, PyBytes>,
     Bound<'py, PyBytes>,
-    String,
+    Bound<'py, PyAny>,
 );
 
 /// The keys of an estimate's JSON that say how far it can be trusted.
@@ -220,8 +275,8 @@ const JUDGEMENT_KEYS: [&str; 8] = [
     "metric_uncertainty",
 ];
 
-/// The judgements of `estimates` as a JSON list (see [`RowsResult`]).
-fn judgements_json(estimates: &[Estimate]) -> PyResult<String> {
+/// The judgements of `estimates` as a list of dicts (see [`RowsResult`]).
+fn judgements<'py>(py: Python<'py>, estimates: &[Estimate]) -> PyResult<Bound<'py, PyAny>> {
     let judged = estimates
         .iter()
         .map(|e| {
@@ -232,7 +287,7 @@ fn judgements_json(estimates: &[Estimate]) -> PyResult<String> {
                 .collect::<serde_json::Map<_, _>>())
         })
         .collect::<PyResult<Vec<_>>>()?;
-    serde_json::to_string(&judged).map_err(py_err)
+    pythonize::pythonize(py, &judged).map_err(py_err)
 }
 
 /// Estimates the light for feature rows, each judged as `spdcam estimate --features`
@@ -275,7 +330,7 @@ fn estimate_rows<'py>(
             py,
             estimates.iter().map(|e| e.colorimetry.duv.unwrap_or(nan)),
         ),
-        judgements_json(&estimates)?,
+        judgements(py, &estimates)?,
     ))
 }
 
@@ -568,7 +623,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SpdcamError", m.py().get_type::<SpdcamError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<Models>()?;
-    m.add_function(wrap_pyfunction!(estimate_photo_json, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate_photos, m)?)?;
     m.add_function(wrap_pyfunction!(estimate_rows, m)?)?;
     m.add_function(wrap_pyfunction!(read_photo, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;

@@ -152,3 +152,22 @@ def test_the_kind_of_light_can_be_named(example, cli):
     assert set(spdcam.LIGHT_KINDS) >= {"unknown", "daylight", "white-led", "rgb-led"}
     with pytest.raises(spdcam.SpdcamError, match="'candle' is not a kind of light"):
         spdcam.estimate(example, light="candle")
+
+
+def test_a_list_of_photos_is_estimated_at_once_as_each_alone(example):
+    cc24 = ROOT / "examples" / "cc24-led.jpg"
+    photos = [example, cc24.read_bytes(), spdcam.read_photo(cc24), example]
+    heard = []
+    together = spdcam.estimate(photos, source="cc24-led.jpg", progress=lambda d, t: heard.append((d, t)))
+    alone = [spdcam.estimate(p, source="cc24-led.jpg") for p in photos]
+    assert [e.name for e in together] == [e.name for e in alone]
+    for a, b in zip(together, alone):
+        np.testing.assert_array_equal(a.spd, b.spd)
+        assert a.verdict == b.verdict and a.json == b.json
+    # Progress heard after each batch, ending with every photo done.
+    assert heard and heard[-1] == (4, 4) and all(d <= t == 4 for d, t in heard)
+    # Dicts straight from the library: the numbers keep their JSON types.
+    assert isinstance(together[0].json["colorimetry"]["xy"][0], float)
+    # One photo that cannot be used raises its message, as alone.
+    with pytest.raises(spdcam.SpdcamError, match="^upload.png: not an image"):
+        spdcam.estimate([example, b"\x00" * 64], source="upload.png")

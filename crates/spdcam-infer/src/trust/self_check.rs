@@ -67,7 +67,7 @@ pub struct Veil {
 
 /// A feature patch counts as dark for [`ChartCheck::veil`] when the light found gives it
 /// less than this share of the chart's mean green.
-const VEIL_DARK_SHARE: f64 = 0.25;
+pub const VEIL_DARK_SHARE: f64 = 0.25;
 /// A dark patch reading this much more than the dark patches' median (a share of the
 /// chart's mean) shows where the glare is strongest ([`Veil::strongest`]). Chosen on the
 /// real SG sets' training and validation photos (docs/glow.md): the glare-free Hue photos'
