@@ -25,8 +25,9 @@
 //! - [`spectral_error`] (RMSE, GFC, SAM, SID between spectra), [`colorimetry`] (XYZ, CCT/Duv,
 //!   sRGB, CIELAB) and [`quality`] (CRI, TM-30, α-opic and other metrics of a light).
 //! - [`advice`]: every warning and reason a person reads, with what to do, in one place.
-//! - [`error`], [`fsio`] (atomic file writes), [`output_guard`] (no output onto an input)
-//!   and [`limits`] (resource limits) serve all of them.
+//! - [`error`], [`fsio`] (atomic file writes), [`output_guard`] (no output onto an input),
+//!   [`limits`] (resource limits) and `minimise` (derivative-free minimisation for the
+//!   few small fits without a gradient) serve all of them.
 //!
 //! Rendering the ColorChecker 24 under CIE D65 through the built-in Nikon D5100:
 //!

@@ -23,12 +23,17 @@
 //!   [`photo_options`] (how photos are analysed, the charts looked for); [`estimate`]: what
 //!   an estimate is (SPD, colorimetry, lighting metrics, verdict, bands); [`stream`]: feature
 //!   rows read a block at a time, and the CSV layouts of many SPDs.
-//! - [`trust`]: how far an estimate can be trusted (self-check, uncertainty bands,
-//!   verdict); [`presentation`]: what an estimate means in words and rounded numbers
+//! - Beside the spectrum's shape: [`colour_head`] (the light's u′v′ as the model predicts
+//!   it), [`colour_map`] (a white light's CCT and Duv corrected as learnt on validation
+//!   photos), [`kind_prior`] (the estimate kept among lights of the kind a person names) and
+//!   [`absolute`] (approximate absolute levels from the photo's EXIF exposure).
+//! - [`trust`]: how far an estimate can be trusted (self-check with the glare read on the
+//!   chart, uncertainty bands, verdict); [`presentation`]: what an estimate means in words and rounded numbers
 //!   ([`meaningful`]: which metrics mean anything for the light);
 //!   [`rounding`]: the one rule every front end writes numbers by; [`meter`]: what a
 //!   colour meter's screen shows; [`plot`] and [`report`]: SVG plots (with the CIE 1976
-//!   u′v′ diagram of [`chromaticity`]) and the HTML report.
+//!   u′v′ diagram of [`chromaticity`]) and the HTML report (its meter parts in
+//!   `report_meter`, its escaping in `html`).
 //! - [`ridge`]: closed-form ridge regression, the `linear` model's fit and the simple
 //!   learner every protocol compares against (here, so that it runs without burn).
 //! - [`error`]: the crate's error type.

@@ -9,7 +9,8 @@
 //!   datasets come from `spdcam_core::dataset`).
 //! - [`train`]: PCA or channel-weight targets, the scalings, and the training loop (Adam,
 //!   early stopping) for the networks, or [`spdcam_infer::ridge`] regression in closed form for the
-//!   `linear` model; fine-tuning a trained model on a new dataset.
+//!   `linear` model; fine-tuning a trained model on a new dataset. `burn_net`: the
+//!   networks as burn modules, their weights laid out as `spdcam_infer::network`'s.
 //! - [`recipe`]: choosing a fine-tuning recipe for a few photos by cross-validation.
 //! - [`evaluate`]: scoring a model on a dataset (RMSE, GFC, SAM, SID; plots).
 //! - [`experiment`]: the thesis's model-selection experiment on its virtual datasets.

@@ -1,4 +1,13 @@
 //! spdcam: what light is in the room, from a photo of a colour chart.
+//!
+//! One module per subcommand, each parsing its arguments and calling the libraries
+//! (`spdcam_infer` to estimate, `spdcam_core` to render and generate, `spdcam_learn` and
+//! `spdcam_eval` to train and measure): `estimate`, `metrics`, `serve` (the web app),
+//! `render`, `generate`, `dataset`, `list`, `lamps`, `detection`, `coverage`, `light_kinds`,
+//! `trust`, `colour_map`, `calibrate`; with the `train` feature `train`, `average`,
+//! `evaluate`, `finetune`, `experiment` and `sim2real`. Shared by them: `args` (argument
+//! groups), `command_paths` (the paths a command reads and writes), `messages` and `stdout` (where text
+//! goes, and failed writes reported), `plot_file` (SVG or PNG plots).
 
 // The commands' doc comments are clap's help text, where `[:STEP]` marks an optional part,
 // not a link.
