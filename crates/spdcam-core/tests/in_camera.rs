@@ -4,7 +4,7 @@
 
 use spdcam_core::builtin::{self, DataDir};
 use spdcam_core::camera::colour::ColourTransform;
-use spdcam_core::camera::in_camera::{calibrate, CalibrationPhoto, InCamera};
+use spdcam_core::camera::in_camera::{fit_to_photos, InCamera, ReferencePhoto};
 use spdcam_core::camera::optics::ChartGlow;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::tone::jpeg_quantise;
@@ -209,7 +209,7 @@ fn calibration_recovers_known_parameters() {
         StandardIlluminant::D65,
         StandardIlluminant::D50,
     ];
-    let mut photos: Vec<CalibrationPhoto> = lights
+    let mut photos: Vec<ReferencePhoto> = lights
         .iter()
         .map(|l| {
             let spd = l.spd(&GRID).unwrap();
@@ -217,7 +217,7 @@ fn calibration_recovers_known_parameters() {
                 .iter()
                 .map(|&v| f64::from(v))
                 .collect();
-            CalibrationPhoto { features, spd }
+            ReferencePhoto { features, spd }
         })
         .collect();
     // A bluish light too: D65 with its red end attenuated.
@@ -226,14 +226,14 @@ fn calibration_recovers_known_parameters() {
         *v *= 1.5 - k as f64 / GRID.count as f64;
     }
     let blue = Spd::new(GRID, blue).unwrap();
-    photos.push(CalibrationPhoto {
+    photos.push(ReferencePhoto {
         features: fast(&cam, Some(&truth), &blue)
             .iter()
             .map(|&v| f64::from(v))
             .collect(),
         spd: blue,
     });
-    let fit = calibrate(&cam, &photos, InCamera::NEUTRAL, 6000).unwrap();
+    let fit = fit_to_photos(&cam, &photos, InCamera::NEUTRAL, 6000).unwrap();
     println!("{fit:?}");
     assert!(fit.rms_before > 5.0, "{}", fit.rms_before);
     assert!(fit.rms_after < 0.3, "{}", fit.rms_after);
@@ -242,12 +242,12 @@ fn calibration_recovers_known_parameters() {
     assert!((ic.adaptation - 0.7).abs() < 0.05, "{ic:?}");
     assert!((ic.saturation - 0.85).abs() < 0.05, "{ic:?}");
     // Bad input is an error, not a panic.
-    let bad = [CalibrationPhoto {
+    let bad = [ReferencePhoto {
         features: vec![1.0; 5],
         spd: photos[0].spd.clone(),
     }];
-    assert!(calibrate(&cam, &bad, InCamera::NEUTRAL, 100).is_err());
-    assert!(calibrate(&cam, &[], InCamera::NEUTRAL, 100).is_err());
+    assert!(fit_to_photos(&cam, &bad, InCamera::NEUTRAL, 100).is_err());
+    assert!(fit_to_photos(&cam, &[], InCamera::NEUTRAL, 100).is_err());
 }
 
 #[test]

@@ -50,7 +50,7 @@ pub struct GenerateArgs {
     /// Replace what the output directory holds instead of refusing or resuming.
     #[arg(long)]
     force: bool,
-    /// The camera's in-camera rendering, as written by `spdcam calibrate` (JSON).
+    /// The camera's in-camera rendering, as written by `spdcam fit-in-camera` (JSON).
     #[arg(long, value_name = "FILE.json")]
     in_camera: Option<PathBuf>,
     /// Domain randomisation per sample, comma-separated: camera (draw the camera from
@@ -165,7 +165,7 @@ pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
     };
     let mut config = args.camera.config()?;
     if let Some(path) = &args.in_camera {
-        config.in_camera = Some(crate::calibrate::read_in_camera(path)?);
+        config.in_camera = Some(crate::fit_in_camera::read_in_camera(path)?);
     }
     let request = GenerateRequest {
         lighting: args.lighting,
@@ -188,7 +188,7 @@ pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
         args.force,
         data_dir,
         &mut |event| match event {
-            GenerateEvent::Skipped(path, e) => crate::calibrate::warn_skipped(path, e),
+            GenerateEvent::Skipped(path, e) => crate::fit_in_camera::warn_skipped(path, e),
             GenerateEvent::Planned(plan) => {
                 report_plan(plan, &args.output, args.chunk_size);
                 new = plan.total() - plan.done();

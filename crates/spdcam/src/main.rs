@@ -4,7 +4,7 @@
 //! (`spdcam_infer` to estimate, `spdcam_core` to render and generate, `spdcam_learn` and
 //! `spdcam_eval` to train and measure): `estimate`, `metrics`, `serve` (the web app),
 //! `render`, `generate`, `dataset`, `list`, `lamps`, `detection`, `coverage`, `light_kinds`,
-//! `trust`, `colour_map`, `calibrate`; with the `train` feature `train`, `average`,
+//! `trust`, `colour_map`, `fit_in_camera`; with the `train` feature `train`, `average`,
 //! `evaluate`, `finetune`, `experiment` and `sim2real`. Shared by them: `args` (argument
 //! groups), `command_paths` (the paths a command reads and writes), `messages` and `stdout` (where text
 //! goes, and failed writes reported), `plot_file` (SVG or PNG plots).
@@ -16,7 +16,6 @@
 mod args;
 #[cfg(feature = "train")]
 mod average;
-mod calibrate;
 mod colour_map;
 mod command_paths;
 mod coverage;
@@ -29,6 +28,7 @@ mod evaluate;
 mod experiment;
 #[cfg(feature = "train")]
 mod finetune;
+mod fit_in_camera;
 mod generate;
 mod lamps;
 mod light_kinds;
@@ -93,7 +93,7 @@ enum Command {
     /// Reproduce the thesis's experiments on its own datasets.
     Experiment(experiment::ExperimentArgs),
     /// Fit a real camera's in-camera rendering to a few of its chart photos with known light.
-    Calibrate(Box<calibrate::CalibrateArgs>),
+    FitInCamera(Box<fit_in_camera::FitInCameraArgs>),
     #[cfg(feature = "train")]
     /// The sim-to-real ablation: virtual-only models scored on the real photo sets.
     Sim2real(sim2real::Sim2realArgs),
@@ -163,7 +163,7 @@ fn main() -> ExitCode {
         Command::Finetune(args) => finetune::run(*args),
         #[cfg(feature = "train")]
         Command::Experiment(args) => experiment::run(args, &data_dir),
-        Command::Calibrate(args) => calibrate::run(*args, &data_dir),
+        Command::FitInCamera(args) => fit_in_camera::run(*args, &data_dir),
         #[cfg(feature = "train")]
         Command::Sim2real(args) => sim2real::run(args, &data_dir),
         Command::Serve(args) => serve::run(args, &data_dir),

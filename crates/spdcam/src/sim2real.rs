@@ -5,7 +5,7 @@
 //! With `--finetune`, the fine-tuning learning curve instead. The protocols are
 //! `spdcam_learn::sim2real`'s; this parses their options and writes their results.
 
-use crate::calibrate::sensitivities_in;
+use crate::fit_in_camera::sensitivities_in;
 use anyhow::{Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;

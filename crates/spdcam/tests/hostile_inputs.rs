@@ -353,7 +353,7 @@ fn messages_say_what_is_wrong_and_what_to_do() {
         "{e}"
     );
     let e = fails_fast(&[
-        "calibrate",
+        "fit-in-camera",
         "--features",
         &s(&features),
         "--spds",

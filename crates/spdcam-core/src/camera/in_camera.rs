@@ -12,7 +12,7 @@
 //! | `adaptation` | ISP: white balance | [`super::white_balance`] |
 //! | `saturation`, `shoulder`, `gamma`, `contrast`, `jpeg_quality` | ISP: rendering | [`super::tone`] |
 //!
-//! The record is what calibration fits ([`calibrate`]), domain randomisation draws per
+//! The record is what a fit to real photos finds ([`fit_to_photos`]), domain randomisation draws per
 //! sample and dataset manifests store. Every setting's neutral value leaves the image
 //! unchanged; the whole record is off unless [`crate::camera::CameraConfig::in_camera`] is
 //! set.
@@ -91,7 +91,7 @@ impl Default for InCamera {
 /// Largest lighting-gradient magnitude: the gain stays positive over the whole chart.
 const MAX_GRADIENT: f64 = 1.5;
 
-/// Parameter names and ranges, for messages and for calibration bounds.
+/// Parameter names and ranges, for messages and for the fit's bounds.
 const RANGES: [(&str, f64, f64); 7] = [
     ("exposure_target", 0.01, 1.0),
     ("flare", 0.0, 1.0),
@@ -238,16 +238,16 @@ impl InCamera {
 /// One real photo of the chart: its features (0–255, the camera's feature order) and the
 /// measured SPD of its light on the camera's simulation grid.
 #[derive(Debug, Clone)]
-pub struct CalibrationPhoto {
+pub struct ReferencePhoto {
     /// The photo's chart features (0–255).
     pub features: Vec<f64>,
     /// The light's measured SPD on the camera's simulation grid.
     pub spd: Spd,
 }
 
-/// The result of [`calibrate`].
+/// The result of [`fit_to_photos`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Calibration {
+pub struct InCameraFit {
     /// The fitted in-camera rendering.
     pub in_camera: InCamera,
     /// Root-mean-square feature error (0–255) over the photos, before (neutral in-camera
@@ -262,33 +262,35 @@ pub struct Calibration {
 /// Fits the in-camera parameters (all but the JPEG quality, kept from `start`) of `camera`
 /// to `photos` by least squares on the features, with Nelder–Mead inside the parameter
 /// ranges, from `start`.
-pub fn calibrate(
+pub fn fit_to_photos(
     camera: &Camera,
-    photos: &[CalibrationPhoto],
+    photos: &[ReferencePhoto],
     start: InCamera,
     max_evaluations: usize,
-) -> Result<Calibration> {
+) -> Result<InCameraFit> {
     if photos.is_empty() {
-        return Err(Error::invalid("calibration needs at least one photo"));
+        return Err(Error::invalid(
+            "fitting the in-camera stage needs at least one photo",
+        ));
     }
     let expected = camera.chart().feature_patches.len() * 3;
     let mut lights = Vec::with_capacity(photos.len());
     for (i, p) in photos.iter().enumerate() {
         if p.features.len() != expected {
             return Err(Error::invalid(format!(
-                "calibration photo {i} has {} features; the chart needs {expected}",
+                "reference photo {i} has {} features; the chart needs {expected}",
                 p.features.len()
             )));
         }
         if p.features.iter().any(|v| !v.is_finite()) {
             return Err(Error::invalid(format!(
-                "calibration photo {i} has a feature that is not a number"
+                "reference photo {i} has a feature that is not a number"
             )));
         }
         lights.push(
             camera
                 .light(&p.spd)
-                .map_err(|e| Error::invalid(format!("calibration photo {i}: {e}")))?,
+                .map_err(|e| Error::invalid(format!("reference photo {i}: {e}")))?,
         );
     }
     start.validate()?;
@@ -324,7 +326,7 @@ pub fn calibrate(
     };
     let best = nelder_mead(&mut f, start.to_vector(), 0.1, max_evaluations);
     let in_camera = start.with_vector(clamp(best.0));
-    Ok(Calibration {
+    Ok(InCameraFit {
         in_camera,
         rms_before,
         rms_after: best.1,

@@ -98,18 +98,18 @@ pub struct MeasuredPhotos {
 }
 
 impl MeasuredPhotos {
-    /// The photos `indices` as photos an in-camera stage is calibrated on
-    /// ([`crate::camera::in_camera::calibrate`]).
+    /// The photos `indices` as photos an in-camera stage is fitted to
+    /// ([`crate::camera::in_camera::fit_to_photos`]).
     ///
     /// # Panics
     /// If an index is out of range.
-    pub fn calibration_photos(
+    pub fn reference_photos(
         &self,
         indices: &[usize],
-    ) -> Vec<crate::camera::in_camera::CalibrationPhoto> {
+    ) -> Vec<crate::camera::in_camera::ReferencePhoto> {
         indices
             .iter()
-            .map(|&i| crate::camera::in_camera::CalibrationPhoto {
+            .map(|&i| crate::camera::in_camera::ReferencePhoto {
                 features: self.features[i].clone(),
                 spd: self.spds[i].clone(),
             })

@@ -29,9 +29,9 @@ pub use calibration::{
 };
 pub use chart_identity::{ChartIdentity, Identity};
 pub use self_check::{ChartCheck, SelfCheck, Veil};
-pub use spread::{feature_scale, Perturbed, JITTER_COPIES, JITTER_SIGMA};
+pub use spread::{clipped_patch, feature_scale, Perturbed, JITTER_COPIES, JITTER_SIGMA};
 pub use verdict::{
-    assess, clipped_patch, clipped_patches, flag_patches, photo_flags, skipped_patches, weigh,
-    PhotoFlags, Trust, Verdict, Weighed, DOUBTFUL_GFC, POOR_GFC, SURE_DETECTION,
-    UNUSABLE_CLIPPED_SHARE, UNUSABLE_SELF_CHECK_FACTOR,
+    assess, clipped_patches, flag_patches, photo_flags, skipped_patches, weigh, PhotoFlags, Trust,
+    Verdict, Weighed, DOUBTFUL_GFC, POOR_GFC, SURE_DETECTION, UNUSABLE_CLIPPED_SHARE,
+    UNUSABLE_SELF_CHECK_FACTOR,
 };

@@ -258,7 +258,7 @@ impl ChartCheck {
             .filter(|&i| {
                 features
                     .get(3 * i..3 * i + 3)
-                    .is_some_and(|p| !super::verdict::clipped_patch(p, scale))
+                    .is_some_and(|p| !super::spread::clipped_patch(p, scale))
             })
             .collect();
         if unclipped.is_empty() {

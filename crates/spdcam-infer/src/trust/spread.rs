@@ -28,6 +28,11 @@ pub fn feature_scale(row: &[f64]) -> f64 {
     }
 }
 
+/// Whether a patch's encoded RGB has a channel at the top of the scale.
+pub fn clipped_patch(rgb: &[f64], scale: f64) -> bool {
+    rgb.iter().any(|&v| v >= 0.995 * scale)
+}
+
 /// The model's estimates of [`JITTER_COPIES`] copies of one feature row, each feature
 /// perturbed by ±[`JITTER_SIGMA`] (multiplicative, log-normal), peak-normalised. Where many
 /// lights give nearly the same photo the network's answer is steep in its input and the

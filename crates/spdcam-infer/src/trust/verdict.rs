@@ -4,7 +4,7 @@
 
 use super::calibration::{TrustCalibration, Uncertainty};
 use super::self_check::{ChartCheck, SelfCheck, MIN_CHECK_PATCHES};
-use super::spread::{feature_scale, Perturbed};
+use super::spread::{clipped_patch, feature_scale, Perturbed};
 use crate::error::Result;
 use crate::model::Model;
 use serde::Serialize;
@@ -28,11 +28,6 @@ pub const POOR_GFC: f64 = 0.90;
 /// A share of clipped feature patches above this makes an estimate unusable: half the
 /// chart says only that it is brighter than the camera records.
 pub const UNUSABLE_CLIPPED_SHARE: f64 = 0.5;
-
-/// Whether a patch's encoded RGB has a channel at the top of the scale.
-pub fn clipped_patch(rgb: &[f64], scale: f64) -> bool {
-    rgb.iter().any(|&v| v >= 0.995 * scale)
-}
 
 /// The number of clipped patches of a feature row (see [`clipped_patch`]).
 pub fn clipped_patches(row: &[f64]) -> usize {

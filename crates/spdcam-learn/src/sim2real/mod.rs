@@ -13,7 +13,7 @@ pub mod ridge;
 use crate::error::Result;
 use ridge::{real_to_real, score, train_virtual};
 use spdcam_core::builtin::DataDir;
-use spdcam_core::camera::in_camera::{calibrate, InCamera};
+use spdcam_core::camera::in_camera::{fit_to_photos, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::{Chart, KnownChart};
@@ -263,9 +263,9 @@ impl Ablation {
                     .take(options.calibration_photos)
                     .copied()
                     .collect();
-                let fit = calibrate(
+                let fit = fit_to_photos(
                     &base,
-                    &set.calibration_photos(&pick),
+                    &set.reference_photos(&pick),
                     InCamera::NEUTRAL,
                     CALIBRATION_EVALUATIONS,
                 )?;

@@ -1,4 +1,4 @@
-//! `spdcam calibrate`: fits the in-camera rendering (auto exposure, partial white balance,
+//! `spdcam fit-in-camera`: fits the in-camera rendering (auto exposure, partial white balance,
 //! tone curve, flare) of a real camera to a few of its photos of the chart under known
 //! lights, and writes it as JSON for `spdcam generate --in-camera`.
 
@@ -6,7 +6,7 @@ use crate::render::CameraArgs;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
-use spdcam_core::camera::in_camera::{calibrate, InCamera};
+use spdcam_core::camera::in_camera::{fit_to_photos, InCamera};
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::Camera;
 use spdcam_core::chart::Chart;
@@ -15,9 +15,9 @@ use spdcam_core::fsio::write_atomic;
 use spdcam_core::spectral::Grid;
 use std::path::{Path, PathBuf};
 
-/// Options of `spdcam calibrate`.
+/// Options of `spdcam fit-in-camera`.
 #[derive(Debug, Args)]
-pub struct CalibrateArgs {
+pub struct FitInCameraArgs {
     /// Features of the real photos: CSV with a header, one row per photo (0–255, the
     /// chart's feature order, e.g. p01_r,p01_g,…).
     #[arg(long)]
@@ -55,7 +55,7 @@ pub fn warn_skipped(path: &Path, error: &spdcam_core::Error) {
     eprintln!("warning: skipping camera {}: {error}", path.display());
 }
 
-/// Reads an in-camera stage written by `spdcam calibrate` (or a bare in-camera JSON object).
+/// Reads an in-camera stage written by `spdcam fit-in-camera` (or a bare in-camera JSON object).
 pub fn read_in_camera(path: &Path) -> Result<InCamera> {
     let text = spdcam_core::fsio::read_text(path)?;
     let value: serde_json::Value =
@@ -67,8 +67,8 @@ pub fn read_in_camera(path: &Path) -> Result<InCamera> {
     Ok(ic)
 }
 
-/// Runs `spdcam calibrate`.
-pub fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
+/// Runs `spdcam fit-in-camera`.
+pub fn run(args: FitInCameraArgs, data_dir: &DataDir) -> Result<()> {
     let grid = Grid::SIMULATION;
     let chart: Chart = args.camera.chart(data_dir, &grid)?;
     let sens = Sensitivities::resolve(&args.camera.camera, data_dir, &grid)?;
@@ -79,9 +79,9 @@ pub fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
     }
     let n = args.photos.min(measured.features.len());
     let indices: Vec<usize> = (0..n).collect();
-    let fit = calibrate(
+    let fit = fit_to_photos(
         &camera,
-        &measured.calibration_photos(&indices),
+        &measured.reference_photos(&indices),
         InCamera::NEUTRAL,
         args.evaluations,
     )?;
