@@ -21,6 +21,7 @@ use crate::error::{InferError, Result};
 use crate::estimate::{Colorimetry, Estimate};
 use crate::feature_rows::FeatureRows;
 use crate::kind_prior::{self, KindPriors};
+use crate::measured_colour;
 use crate::photo_options::{chart_templates, PhotoOptions};
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
@@ -683,7 +684,12 @@ impl Estimator {
         let scale = feature_scale(&rows.values);
         let mut identity = judge.identity.of_photo(analysis, scale);
         let model_spds = if identity.mismatches().is_empty() {
-            self.run_model(index, &rows, &analysis.source)
+            self.run_model_measured(
+                index,
+                &rows,
+                &analysis.source,
+                analysis.raw.as_ref().map(|r| r.light_xy),
+            )
         } else {
             Err(InferError::invalid("the patches are not the chart"))
         };
@@ -910,6 +916,19 @@ impl Estimator {
     /// The model's SPDs (on its own grid, peak 1, row-major) for `features`, checked against
     /// its columns first (rows that say nothing about the light are refused by name).
     fn run_model(&self, index: usize, features: &FeatureRows, source: &str) -> Result<ModelSpds> {
+        self.run_model_measured(index, features, source, None)
+    }
+
+    /// [`Estimator::run_model`] with the light's chromaticity a raw photo measured
+    /// (`measured`), which the model's SPDs are moved to ([`measured_colour::conform`])
+    /// before a kind of light moves them.
+    fn run_model_measured(
+        &self,
+        index: usize,
+        features: &FeatureRows,
+        source: &str,
+        measured: Option<[f64; 2]>,
+    ) -> Result<ModelSpds> {
         let model = &self.named(index).model;
         model.check_features(&features.names, source)?;
         self.map(index)?;
@@ -920,7 +939,11 @@ impl Estimator {
             0,
             features.rows > 1,
         )?;
-        self.told_of_light(index, model.estimate_rows(&features.values)?)
+        let mut spds = model.estimate_rows(&features.values)?;
+        if let Some(xy) = measured {
+            measured_colour::conform(model, &mut spds, xy);
+        }
+        self.told_of_light(index, spds)
     }
 
     /// THE constructor of every estimate: the model's SPD `model_spd` (on its grid, peak 1)

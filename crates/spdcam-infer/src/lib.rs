@@ -25,7 +25,8 @@
 //!   rows read a block at a time, and the CSV layouts of many SPDs.
 //! - Beside the spectrum's shape: [`colour_head`] (the light's u′v′ as the model predicts
 //!   it), [`colour_map`] (a white light's CCT and Duv corrected as learnt on validation
-//!   photos), [`kind_prior`] (the estimate kept among lights of the kind a person names) and
+//!   photos), [`measured_colour`] (the light's chromaticity a raw photo measured, given to
+//!   the spectrum), [`kind_prior`] (the estimate kept among lights of the kind a person names) and
 //!   [`absolute`] (approximate absolute levels from the photo's EXIF exposure).
 //! - [`trust`]: how far an estimate can be trusted (self-check with the glare read on the
 //!   chart, uncertainty bands, verdict); [`presentation`]: what an estimate means in words and rounded numbers
@@ -81,6 +82,7 @@ pub mod feature_rows;
 mod html;
 pub mod kind_prior;
 pub mod meaningful;
+pub mod measured_colour;
 pub mod meter;
 pub mod model;
 pub mod network;

@@ -22,6 +22,7 @@
 pub mod aberration;
 pub mod colour;
 pub mod demosaic;
+mod dng_profile;
 pub mod in_camera;
 pub mod noise;
 pub mod optics;
@@ -193,6 +194,9 @@ pub struct Rendering {
 pub struct Developed {
     /// The final image: encoded sRGB, quantised, on 0…1.
     pub image: RgbImage,
+    /// The sensor's mosaic with its noise, before any processing (normalised raw, 1 = full
+    /// scale): what a raw file holds. A three-sensor camera has none.
+    pub mosaic: Option<Mosaic>,
     /// The gains (R, G, B) white balance applied to the camera signal.
     pub white_balance_gains: [f32; 3],
 }
@@ -458,8 +462,12 @@ impl Camera {
         }
         let gains = self.sense_and_balance(&shot, seed, &mut buffers, None);
         self.finish_image(&shot, &mut buffers, None);
+        // Demosaicing read the noisy mosaic and left it in place.
+        let mosaic = matches!(self.config.sensor.mode, SensorMode::SingleSensor(_))
+            .then_some(buffers.mosaic);
         Developed {
             image: buffers.image,
+            mosaic,
             white_balance_gains: gains,
         }
     }

@@ -11,6 +11,7 @@ use crate::advice::Advice;
 use crate::chart::patch_name;
 use crate::error::{Error, Result};
 use crate::fsio;
+use crate::raw::RawReading;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -62,6 +63,10 @@ pub struct PhotoAnalysis {
     pub warnings: Vec<String>,
     /// The camera's exposure from the photo's EXIF, when it gives aperture, time and ISO.
     pub exposure: Option<Exposure>,
+    /// For a raw photo, what its mosaic said beyond the features (the light's chromaticity
+    /// through the file's matrices); `None` for an encoded photo.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub raw: Option<RawReading>,
 }
 
 impl PhotoAnalysis {
@@ -141,13 +146,13 @@ fn analyse_decoded(
         .find(|t| t.name == detection.chart)
         .ok_or_else(|| Error::invalid("detected chart has no template"))?;
     let h = detection.map();
-    let patches = sample(photo, template, &h)?;
+    let (patches, raw) = sample(photo, template, &h)?;
     if let Some(path) = &options.debug {
         let image = debug_overlay_full(photo, Some((template, &detection, &patches)), None);
         write_overlay(path, &image)?;
         *written = Some(path.clone());
     }
-    Ok(assemble(photo, template, detection, method, patches))
+    Ok(assemble(photo, template, detection, method, patches, raw))
 }
 
 fn assemble(
@@ -156,6 +161,7 @@ fn assemble(
     detection: Detection,
     method: &'static str,
     patches: Vec<PatchSample>,
+    raw: Option<RawReading>,
 ) -> PhotoAnalysis {
     let features: Vec<f32> = template
         .feature_patches
@@ -219,6 +225,7 @@ fn assemble(
         patches,
         warnings,
         exposure: photo.exposure,
+        raw,
     }
 }
 

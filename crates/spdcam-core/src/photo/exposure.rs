@@ -66,6 +66,12 @@ impl Exposure {
                 .or_else(|| number(Tag::ISOSpeed))
                 .filter(|&v| positive(v)),
         }?;
+        Exposure::new(f_number, exposure_time_s, iso)
+    }
+
+    /// The exposure of aperture `f_number`, time `exposure_time_s` and ISO `iso`; `None`
+    /// unless all three are finite and positive (a raw file's EXIF as its decoder reads it).
+    pub fn new(f_number: f64, exposure_time_s: f64, iso: f64) -> Option<Exposure> {
         [f_number, exposure_time_s, iso]
             .iter()
             .all(|v| v.is_finite() && *v > 0.0)

@@ -1,13 +1,17 @@
 //! Reading photos: JPEG, PNG (8/16-bit), TIFF, with the EXIF orientation applied, into one
-//! compact buffer of encoded sRGB values (8 or 16 bits per channel, as the file had).
+//! compact buffer of encoded sRGB values (8 or 16 bits per channel, as the file had); and
+//! camera raw files ([`crate::raw`]), whose encoded pixels are a preview to find the chart
+//! in, the linear mosaic held beside them.
 
 use super::exposure::Exposure;
 use crate::advice::{Advice, CORRUPT, TRUNCATED};
 use crate::error::{Error, Result};
+use crate::raw::{self, RawMosaic};
 use crate::{fsio, limits};
 use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader};
 use std::io::Cursor;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Smallest width and height of a photo that can show a chart.
 pub const MIN_PHOTO_SIDE: usize = 16;
@@ -25,7 +29,9 @@ enum Pixels {
 }
 
 /// A decoded photo, upright (EXIF orientation applied): encoded sRGB, 8 or 16 bits per
-/// channel, interleaved, without any conversion that would multiply its size.
+/// channel, interleaved, without any conversion that would multiply its size. A raw photo
+/// holds its linear mosaic beside them ([`Photo::raw`]); its encoded pixels are then the
+/// preview the chart is found in, and its patches are read on the mosaic.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Photo {
     /// Where the photo came from (file path or a name), for messages.
@@ -39,6 +45,7 @@ pub struct Photo {
     /// The camera's exposure from the file's EXIF, when it gives aperture, time and ISO.
     pub exposure: Option<Exposure>,
     pixels: Pixels,
+    raw: Option<Arc<RawMosaic>>,
 }
 
 impl Photo {
@@ -77,7 +84,21 @@ impl Photo {
             warnings: Vec::new(),
             exposure: None,
             pixels,
+            raw: None,
         })
+    }
+
+    /// A raw photo: the preview of `mosaic` ([`RawMosaic::preview`]) with the mosaic kept
+    /// beside it.
+    pub fn from_raw(source: &str, mosaic: RawMosaic) -> Result<Photo> {
+        let mut photo = mosaic.preview(source)?;
+        photo.raw = Some(Arc::new(mosaic));
+        Ok(photo)
+    }
+
+    /// The linear mosaic of a raw photo; `None` for an encoded one.
+    pub fn raw(&self) -> Option<&RawMosaic> {
+        self.raw.as_deref()
     }
 
     /// A photo from a decoded image (any colour type; alpha is dropped, grey becomes RGB).
@@ -194,14 +215,15 @@ pub fn load_photo(path: &Path) -> Result<Photo> {
         fsio::read_limited_checked(
             path,
             &limits::PHOTO_BYTES,
-            8,
+            12,
             |head| match fsio::image_format(head) {
                 Some(_) => Ok(()),
+                None if raw::looks_like_raw(head) => Ok(()),
                 None => Err(Error::Image {
                     context: source.clone(),
                     message: format!(
-                        "not a JPEG, PNG or TIFF image ({}); spdcam reads photos \
-                     in those formats",
+                        "not a JPEG, PNG, TIFF or camera raw image ({}); spdcam reads \
+                     photos in those formats",
                         describe_head(head)
                     ),
                 }),
@@ -221,8 +243,22 @@ fn describe_head(head: &[u8]) -> String {
 
 /// Decodes a photo held in memory; `source` names it in messages. The pixel count is read
 /// from the header and checked against [`limits::IMAGE_PIXELS`] before any pixel is
-/// decoded; a JPEG that ends before its end-of-image marker decodes with a warning.
+/// decoded; a JPEG that ends before its end-of-image marker decodes with a warning. A
+/// camera raw file (told by its signature, or a TIFF the raw decoder knows a camera for)
+/// becomes a raw photo ([`Photo::from_raw`]).
 pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
+    // DNG and most raw formats are TIFF files: the raw decoder is asked whether it knows
+    // the file; an ordinary TIFF image goes to the image decoder.
+    if raw::looks_like_raw(bytes)
+        || (fsio::image_format(bytes) == Some("TIFF") && raw::is_raw_file(bytes))
+    {
+        return Photo::from_raw(source, raw::decode(bytes, source)?);
+    }
+    decode_encoded(bytes, source)
+}
+
+/// Decodes an encoded (JPEG, PNG, TIFF) photo held in memory.
+fn decode_encoded(bytes: &[u8], source: &str) -> Result<Photo> {
     let image_error = |message: String| Error::Image {
         context: source.to_string(),
         message,

@@ -42,6 +42,7 @@ pub use overlay::{
     analysis_overlay_jpeg, debug_factor, debug_overlay, debug_overlay_full, write_overlay,
     DEBUG_MAX_PIXELS, OVERLAY_SIZE,
 };
+pub(crate) use sample::DARK_LEVEL;
 pub use sample::{sample, PatchSample};
 
 use crate::builtin::DataDir;

@@ -7,6 +7,7 @@ use super::geometry::Homography;
 use super::load::Photo;
 use super::ChartTemplate;
 use crate::error::{Error, Result};
+use crate::raw::RawReading;
 use crate::sampler::{robust_mean, SampleBuffers, SAMPLING_FRACTION};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -16,7 +17,7 @@ const MAX_PIXELS: usize = 40_000;
 /// A patch is clipped when more than this share of its pixels has a clipped channel.
 const CLIPPED_SHARE: f64 = 0.25;
 /// A patch is dark when its brightest channel's mean is below this (encoded, 0…1).
-const DARK_LEVEL: f32 = 8.0 / 255.0;
+pub(crate) const DARK_LEVEL: f32 = 8.0 / 255.0;
 /// Fewest pixels a sampled square must cover.
 const MIN_PIXELS: usize = 4;
 
@@ -39,10 +40,28 @@ pub struct PatchSample {
     pub clipped: bool,
     /// The patch is nearly black in every channel: its colour is mostly noise.
     pub dark: bool,
+    /// For a raw photo, the patch's linear camera RGB (share of full scale, black
+    /// subtracted) before development: the values `rgb` was made from.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_rgb: Option<[f32; 3]>,
 }
 
-/// Samples every patch of `template` placed by `homography` (chart → photo pixels).
+/// Samples every patch of `template` placed by `homography` (chart → photo pixels); a raw
+/// photo on its mosaic ([`crate::raw::sample`]), which also reads the light's chromaticity.
 pub fn sample(
+    photo: &Photo,
+    template: &ChartTemplate,
+    homography: &Homography,
+) -> Result<(Vec<PatchSample>, Option<RawReading>)> {
+    if let Some(raw) = photo.raw() {
+        let (patches, reading) = crate::raw::sample(raw, &photo.source, template, homography)?;
+        return Ok((patches, Some(reading)));
+    }
+    sample_encoded(photo, template, homography).map(|patches| (patches, None))
+}
+
+/// Samples the encoded pixels of a photo.
+fn sample_encoded(
     photo: &Photo,
     template: &ChartTemplate,
     homography: &Homography,
@@ -140,5 +159,6 @@ fn sample_patch(
         clipped_share: clipped_share as f32,
         clipped: is_clipped,
         dark: mean.iter().all(|&v| v < DARK_LEVEL as f64),
+        camera_rgb: None,
     })
 }

@@ -192,6 +192,9 @@ pub struct ScenePhoto {
     /// vignetting and glow included (encoded sRGB, 0–255, `p01_r, p01_g, …`): the features
     /// a perfect sampler would read.
     pub expected_features: Vec<f32>,
+    /// The sensor's mosaic before any processing, for a raw file (`None` for a
+    /// three-sensor camera or two halves developed apart).
+    pub mosaic: Option<crate::raster::Mosaic>,
 }
 
 /// Checks that a scene of `width × height` px is large enough to show a chart and within
@@ -240,6 +243,7 @@ pub fn photograph(
                         .copy_from_slice(&right.expected_features[3 * k..3 * k + 3]);
                 }
             }
+            left.mosaic = None;
             left
         }
         _ => develop_scene(camera, light, seed, options)?,
@@ -249,6 +253,7 @@ pub fn photograph(
         corners: shot.corners,
         patch_px: shot.patch_px,
         expected_features: shot.expected_features,
+        mosaic: shot.mosaic,
     })
 }
 
@@ -259,6 +264,7 @@ struct DevelopedScene {
     corners: [[f64; 2]; 4],
     patch_px: f64,
     expected_features: Vec<f32>,
+    mosaic: Option<crate::raster::Mosaic>,
     /// Photo → chart canvas.
     inverse: Homography,
     /// The chart canvas's width and height: canvas points right of its middle are the
@@ -423,6 +429,7 @@ fn develop_scene(
         .collect();
     Ok(DevelopedScene {
         image: developed.image,
+        mosaic: developed.mosaic,
         quality,
         corners,
         patch_px,

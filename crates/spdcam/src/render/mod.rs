@@ -12,10 +12,13 @@ use clap::Args;
 use parse::parse_pair;
 use scene_photo::render_scene;
 use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::Camera;
 use spdcam_core::imageio;
 use spdcam_core::light_families::Lighting;
 use spdcam_core::photo::scene;
-use spdcam_core::spectral::{Grid, SpectralSet};
+use spdcam_core::raster::Mosaic;
+use spdcam_core::raw::dng::{encode_dng, DngMetadata};
+use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_core::{fsio, limits, named_light};
 use std::path::{Path, PathBuf};
 
@@ -36,7 +39,9 @@ pub struct RenderArgs {
     /// Which draw of --lighting (the sample index of a generated dataset).
     #[arg(long, value_name = "INDEX", requires = "lighting")]
     draw: Option<u64>,
-    /// Output PNG (JPEG with --scene); `-` writes it to standard output.
+    /// Output PNG (JPEG with --scene), or FILE.dng for a raw DNG of the sensor's mosaic
+    /// before any processing (black and white levels, CFA pattern, colour matrices fitted
+    /// under A and D65, the light's neutral as shot); `-` writes it to standard output.
     #[arg(short, long)]
     output: PathBuf,
     /// Also write the feature row (mean sRGB 0–255 of each patch) as CSV; `-` for standard
@@ -53,7 +58,7 @@ pub struct RenderArgs {
     seed: u64,
     /// Photograph the chart in a scene of WxH px instead: placed at a random position,
     /// rotation and perspective on a cluttered background under the same light, with blur,
-    /// vignetting, noise, written as a JPEG (`-o photo.jpg`).
+    /// vignetting, noise, written as a JPEG (`-o photo.jpg`) or a raw DNG (`-o photo.dng`).
     #[arg(long, value_name = "WxH")]
     scene: Option<String>,
     /// With --scene: the patch grid's width as a share of the photo's width (face-on),
@@ -165,11 +170,16 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         .output
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let dng = extension.as_deref() == Some("dng");
     match (&scene, extension.as_deref()) {
-        (Some(_), Some("jpg" | "jpeg")) | (None, Some("png")) => {}
+        (Some(_), Some("jpg" | "jpeg" | "dng")) | (None, Some("png" | "dng")) => {}
         _ if fsio::is_stdout(&args.output) => {}
-        (Some(_), _) => bail!("a scene is written as JPEG: name the output FILE.jpg"),
-        (None, _) => bail!("the chart is written as PNG: name the output FILE.png"),
+        (Some(_), _) => bail!(
+            "a scene is written as JPEG or as a raw DNG: name the output FILE.jpg or FILE.dng"
+        ),
+        (None, _) => bail!(
+            "the chart is written as PNG or as a raw DNG: name the output FILE.png or FILE.dng"
+        ),
     }
     let spd = match (&args.spd, &args.lighting, args.draw) {
         (Some(spec), _, _) => named_light::resolve_spd(spec, data_dir, &grid)?,
@@ -212,7 +222,7 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         );
     }
     let camera = args.camera.camera(data_dir, &grid)?;
-    let rendering = camera.render(&spd.spd, args.seed, args.stages.is_some())?;
+    let rendering = camera.render(&spd.spd, args.seed, args.stages.is_some() || dng)?;
     let depth = camera.config().colour.bit_depth;
     if let Some(dir) = &args.stages {
         write_stages(dir, &rendering.stages)?;
@@ -230,22 +240,45 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
             messages.say(format_args!("features: {}", path.display()))?;
         }
     }
-    fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
+    if dng {
+        let mosaic = rendering.stages.cfa.as_ref().ok_or_else(|| {
+            anyhow::anyhow!("a three-sensor camera has no mosaic to write as a DNG")
+        })?;
+        fsio::write_output(&args.output, &dng_bytes(&camera, &spd.spd, mosaic)?)?;
+    } else {
+        fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
+    }
     if fsio::is_stdout(&args.output) {
         return Ok(());
     }
     let l = &camera.chart().layout;
     messages.say(format_args!(
-        "rendered {} under {} with {} ({}×{} px, {}-bit sRGB): {}",
+        "rendered {} under {} with {} ({}×{} px, {}): {}",
         camera.chart().name,
         spd.name,
         camera.camera_name(),
         l.width,
         l.height,
-        depth,
+        if dng {
+            "raw DNG".to_string()
+        } else {
+            format!("{depth}-bit sRGB")
+        },
         args.output.display()
     ))?;
     Ok(())
+}
+
+/// The DNG of a rendered `mosaic` by `camera` under `spd`: its matrices fitted under A and
+/// D65 and its exact neutral under the light as shot.
+pub(super) fn dng_bytes(camera: &Camera, spd: &Spd, mosaic: &Mosaic) -> Result<Vec<u8>> {
+    let meta = DngMetadata {
+        camera: camera.camera_name().to_string(),
+        matrices: camera.dng_colour_matrices()?,
+        as_shot_neutral: camera.neutral_under(spd)?,
+        exposure: None,
+    };
+    Ok(encode_dng(mosaic, &meta)?)
 }
 
 fn write_stages(dir: &Path, stages: &spdcam_core::camera::Stages) -> Result<()> {

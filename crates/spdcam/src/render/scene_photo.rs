@@ -82,7 +82,21 @@ pub(super) fn render_scene(
     };
     let shot = scene::photograph(&camera, light, args.seed, &options)?;
     let chart = camera.chart();
-    fsio::write_output(&args.output, &shot.jpeg)?;
+    let dng = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("dng"));
+    if dng {
+        let mosaic = shot.mosaic.as_ref().ok_or_else(|| {
+            anyhow::anyhow!(
+                "this scene has no single mosaic to write as a DNG (a three-sensor camera, or \
+                 two halves developed apart)"
+            )
+        })?;
+        fsio::write_output(&args.output, &super::dng_bytes(&camera, spd, mosaic)?)?;
+    } else {
+        fsio::write_output(&args.output, &shot.jpeg)?;
+    }
     if fsio::is_stdout(&args.output) {
         return Ok(());
     }

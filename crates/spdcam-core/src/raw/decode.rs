@@ -1,0 +1,213 @@
+//! Reading a raw file with rawler into a [`RawMosaic`]: the active area's photosites, black
+//! and white levels, colour-filter layout, orientation, colour matrices, as-shot neutral and
+//! EXIF exposure. rawler panics on some damaged files; the panic is caught here and becomes
+//! an error naming the file.
+
+use super::colour::{illuminant_cct, CalibratedMatrix, RawColour};
+use super::{CfaTile, RawMosaic};
+use crate::error::{Error, Result};
+use crate::limits;
+use crate::photo::Exposure;
+use nalgebra::Matrix3;
+use rawler::decoders::{Orientation, RawDecodeParams};
+use rawler::rawimage::{RawImageData, RawPhotometricInterpretation};
+use rawler::rawsource::RawSource;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// Whether the file's first bytes (at least 12) are those of a raw format whose container
+/// is not TIFF (CR3, RAF, ORF, RW2); TIFF-based raw files (DNG, CR2, NEF, ARW, PEF, …)
+/// are told from ordinary TIFF images by trying rawler first.
+pub fn looks_like_raw(head: &[u8]) -> bool {
+    let cr3 = head.len() >= 12 && &head[4..8] == b"ftyp" && &head[8..11] == b"crx";
+    cr3 || head.starts_with(b"FUJIFILM")
+        || head.starts_with(b"IIRO")
+        || head.starts_with(b"IIRS")
+        || head.starts_with(b"MMOR")
+        || head.starts_with(b"IIU\0")
+}
+
+/// Whether rawler knows `bytes` as a raw file (a DNG, or a camera's TIFF-based format); an
+/// ordinary TIFF image is not one.
+pub fn is_raw_file(bytes: &[u8]) -> bool {
+    catch_unwind(|| rawler::get_decoder(&RawSource::new_from_slice(bytes)).is_ok()).unwrap_or(false)
+}
+
+/// Decodes the raw file `bytes` (named `source` in messages). The photosite count is
+/// checked against [`limits::IMAGE_PIXELS`] from the decoder's metadata before the values
+/// are kept; any panic inside the decoder becomes an error.
+pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
+    let fail = |message: String| Error::Image {
+        context: source.to_string(),
+        message,
+    };
+    let decoded = catch_unwind(AssertUnwindSafe(|| {
+        let file = RawSource::new_from_slice(bytes);
+        let params = RawDecodeParams::default();
+        let decoder = rawler::get_decoder(&file)?;
+        let image = decoder.raw_image(&file, &params, false)?;
+        let exif = decoder.raw_metadata(&file, &params).ok().map(|m| m.exif);
+        Ok::<_, rawler::RawlerError>((image, exif))
+    }));
+    let (image, exif) = match decoded {
+        Ok(Ok(decoded)) => decoded,
+        Ok(Err(e)) => {
+            return Err(fail(format!(
+                "cannot decode this raw file ({e}); is it damaged or truncated? A raw file \
+                 must be copied whole from the camera; or develop it to JPEG or TIFF in a \
+                 raw converter and give spdcam that"
+            )))
+        }
+        Err(_) => {
+            return Err(fail(
+                "the raw decoder failed on this file (damaged or truncated?); copy it whole \
+                 from the camera again, or develop it to JPEG or TIFF in a raw converter and \
+                 give spdcam that"
+                    .into(),
+            ))
+        }
+    };
+    let max_pixels = limits::IMAGE_PIXELS.value()?;
+    let pixels = limits::product(&[image.width as u64, image.height as u64]);
+    limits::IMAGE_PIXELS.check_against(
+        pixels,
+        max_pixels,
+        &format!("{source} ({}×{} photosites)", image.width, image.height),
+    )?;
+    let channels = image.cpp;
+    let cfa = match (&image.photometric, channels) {
+        (RawPhotometricInterpretation::Cfa(config), 1) => Some(config.cfa.clone()),
+        (RawPhotometricInterpretation::LinearRaw, 3) => None,
+        (RawPhotometricInterpretation::BlackIsZero, 1) => {
+            return Err(fail(
+                "this raw file is monochrome; a chart's colours need a colour sensor".into(),
+            ))
+        }
+        _ => {
+            return Err(fail(format!(
+                "this raw file's layout ({channels} values per photosite, {:?}) is not one \
+                 spdcam reads",
+                image.photometric
+            )))
+        }
+    };
+    let (x0, y0, width, height) = match image.active_area {
+        Some(r) => (r.p.x, r.p.y, r.d.w, r.d.h),
+        None => (0, 0, image.width, image.height),
+    };
+    if x0 + width > image.width || y0 + height > image.height {
+        return Err(fail(
+            "the raw file's active area lies outside its image".into(),
+        ));
+    }
+    let cfa = cfa.map(|pattern| {
+        let colours = (0..pattern.height)
+            .flat_map(|r| (0..pattern.width).map(move |c| (r, c)))
+            .map(|(r, c)| pattern.color_at(r + y0, c + x0) as u8)
+            .collect();
+        CfaTile {
+            width: pattern.width,
+            height: pattern.height,
+            colours,
+        }
+    });
+    let stride = image.width * channels;
+    let crop = |all: &[u16]| -> Vec<u16> {
+        (y0..y0 + height)
+            .flat_map(|y| {
+                all[y * stride + x0 * channels..y * stride + (x0 + width) * channels]
+                    .iter()
+                    .copied()
+            })
+            .collect()
+    };
+    let mut white = image.whitelevel.as_vec();
+    let (values, scale) = match &image.data {
+        RawImageData::Integer(all) if all.len() == stride * image.height => (crop(all), 1.0),
+        RawImageData::Float(all) if all.len() == stride * image.height => {
+            // Floating-point DNGs store 0…white; kept as 16-bit steps of the white level.
+            let top = white.iter().cloned().fold(1.0f32, f32::max);
+            let scale = 65535.0 / top;
+            let ints: Vec<u16> = all
+                .iter()
+                .map(|v| (v * scale).round().clamp(0.0, 65535.0) as u16)
+                .collect();
+            (crop(&ints), scale)
+        }
+        _ => return Err(fail("the raw image's values do not fill its size".into())),
+    };
+    white.iter_mut().for_each(|w| *w *= scale);
+    let white = match white.as_slice() {
+        [w] => [*w; 3],
+        [r, g, b, ..] => [*r, *g, *b],
+        _ => return Err(fail("the raw file gives no white level".into())),
+    };
+    let black = image
+        .blacklevel
+        .as_vec()
+        .iter()
+        .map(|b| b * scale)
+        .collect();
+    let mut matrices = Vec::new();
+    for (illuminant, flat) in &image.color_matrix {
+        let Some((name, cct_k)) = illuminant_cct(*illuminant as u16) else {
+            continue;
+        };
+        if flat.len() < 9 {
+            continue;
+        }
+        let m: Vec<f64> = flat[..9].iter().map(|&v| v as f64).collect();
+        matrices.push(CalibratedMatrix {
+            illuminant: name.to_string(),
+            cct_k,
+            xyz_to_camera: Matrix3::from_row_slice(&m),
+        });
+    }
+    let wb = image.wb_coeffs;
+    let as_shot_neutral = (wb[..3].iter().all(|v| v.is_finite() && *v > 0.0))
+        .then(|| [wb[1] / wb[0], 1.0, wb[1] / wb[2]].map(|v| v as f64));
+    let colour = RawColour::new(matrices, as_shot_neutral).map_err(|e| fail(e.to_string()))?;
+    let exposure = exif.and_then(|exif| {
+        let number = |r: Option<rawler::formats::tiff::Rational>| {
+            r.filter(|r| r.d != 0).map(|r| r.n as f64 / r.d as f64)
+        };
+        let f_number = number(exif.fnumber)?;
+        let exposure_time_s = number(exif.exposure_time)?;
+        let iso = exif
+            .iso_speed_ratings
+            .map(f64::from)
+            .or(exif.iso_speed.map(f64::from))?;
+        Exposure::new(f_number, exposure_time_s, iso)
+    });
+    let mosaic = RawMosaic {
+        camera: format!("{} {}", image.clean_make, image.clean_model)
+            .trim()
+            .to_string(),
+        width,
+        height,
+        channels,
+        cfa,
+        black,
+        black_tile: (image.blacklevel.width, image.blacklevel.height),
+        white,
+        colour,
+        orientation: orientation_code(image.orientation),
+        exposure,
+        values,
+    };
+    mosaic.validate().map_err(|e| fail(e.to_string()))?;
+    Ok(mosaic)
+}
+
+/// The EXIF orientation code of rawler's orientation.
+fn orientation_code(orientation: Orientation) -> u16 {
+    match orientation {
+        Orientation::HorizontalFlip => 2,
+        Orientation::Rotate180 => 3,
+        Orientation::VerticalFlip => 4,
+        Orientation::Transpose => 5,
+        Orientation::Rotate90 => 6,
+        Orientation::Transverse => 7,
+        Orientation::Rotate270 => 8,
+        Orientation::Normal | Orientation::Unknown => 1,
+    }
+}
