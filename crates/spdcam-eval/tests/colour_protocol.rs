@@ -61,6 +61,7 @@ fn one_camera_a_few_photos() {
         patch_photos: 2,
         light_named: true,
         light_priors: Vec::new(),
+        raw: false,
     };
     let report = ColourReport::measure(&options, &data, &mut |_| {}).unwrap();
     assert_eq!(report.cameras, 1);

@@ -113,7 +113,7 @@ impl FeatureRows {
     /// ```
     pub fn from_values(names: Vec<String>, values: Vec<f64>, source: &str) -> Result<FeatureRows> {
         let columns = names.len();
-        if columns == 0 || values.is_empty() || values.len() % columns != 0 {
+        if columns == 0 || values.is_empty() || !values.len().is_multiple_of(columns) {
             return Err(InferError::invalid(format!(
                 "{source}: {} values do not make rows of {columns} features",
                 values.len()

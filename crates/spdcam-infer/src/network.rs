@@ -441,7 +441,7 @@ impl Network {
     /// networks, plain linear outputs for `linear`, their mean for `average`. Blocks of rows
     /// run in parallel.
     pub fn forward(&self, x: &[f32]) -> Result<Vec<f32>> {
-        if x.len() % self.inputs != 0 {
+        if !x.len().is_multiple_of(self.inputs) {
             return Err(InferError::invalid(format!(
                 "{} values do not form rows of {} features",
                 x.len(),

@@ -39,7 +39,7 @@ pub struct Pca {
 impl Pca {
     /// Fits the PCA of `data`: `rows` rows of `dim` values each, row-major.
     pub fn fit(data: &[f64], dim: usize, choice: Components) -> Result<Pca> {
-        if dim == 0 || data.len() % dim != 0 {
+        if dim == 0 || !data.len().is_multiple_of(dim) {
             return Err(InferError::invalid(format!(
                 "PCA: {} values do not form rows of {dim}",
                 data.len()

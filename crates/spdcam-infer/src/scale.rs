@@ -72,7 +72,7 @@ fn validate_bounds(min: &[f64], max: &[f64], what: &str) -> Result<()> {
 }
 
 fn check_rows(data: &[f64], width: usize, what: &str) -> Result<usize> {
-    if width == 0 || data.len() % width != 0 {
+    if width == 0 || !data.len().is_multiple_of(width) {
         return Err(InferError::invalid(format!(
             "{what}: {} values do not form rows of {width}",
             data.len()

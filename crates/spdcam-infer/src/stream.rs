@@ -421,8 +421,8 @@ mod tests {
     #[test]
     fn blocks_hold_every_row_and_errors_name_the_line() {
         let mut text = String::from("a,\"b\", c\r\n");
-        for i in 0..3000 {
-            if i % 700 == 0 {
+        for i in 0..3000usize {
+            if i.is_multiple_of(700) {
                 text.push('\n');
             }
             text.push_str(&format!("{i}, {}.5,\"{}\"\r\n", i * 2, -(i as i64)));

@@ -181,7 +181,7 @@ impl Channels {
     /// whose weight is always 0 gets a zero spectrum.
     pub fn fit(names: Vec<String>, weights: &[f64], spds: &[f64], d: usize) -> Result<Channels> {
         let k = names.len();
-        if k == 0 || d == 0 || weights.len() % k != 0 || spds.len() % d != 0 {
+        if k == 0 || d == 0 || !weights.len().is_multiple_of(k) || !spds.len().is_multiple_of(d) {
             return Err(InferError::invalid(
                 "the weights and SPDs do not form rows for a channel fit",
             ));

@@ -195,11 +195,11 @@ fn slow_clients_never_stop_uploads_and_memory_stays_bounded() {
     let peak_rss_kb = Arc::new(AtomicU64::new(0));
     let sampling = Arc::new(AtomicBool::new(true));
     let uploads = std::thread::scope(|s| {
-        let slow: Vec<_> = (0..32)
+        let slow: Vec<_> = (0..32usize)
             .map(|i| {
                 let cuts = Arc::clone(&cuts);
                 s.spawn(move || {
-                    let (body, trickle) = (i < 16, i % 2 == 0);
+                    let (body, trickle) = (i < 16, i.is_multiple_of(2));
                     while started.elapsed() < SLOW_UNTIL {
                         let (status, took) = slow_connection(addr, body, trickle);
                         cuts.lock().unwrap().push((body, status, took));

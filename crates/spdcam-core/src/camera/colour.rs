@@ -275,7 +275,7 @@ mod tests {
             for (c, plane) in image.planes.iter_mut().enumerate() {
                 for (i, v) in plane.iter_mut().enumerate() {
                     let k = (i * (7 + 2 * c) + 3 * c) % 20_011;
-                    *v = if k % 97 == 0 {
+                    *v = if k.is_multiple_of(97) {
                         (k % 16_385) as f32 / ENCODE_TABLE_STEPS as f32
                     } else {
                         k as f32 / 16_000.0 - 0.1

@@ -290,7 +290,7 @@ impl Grid {
 fn edge_columns(w: usize) -> [(usize, usize); 2 * PAD] {
     std::array::from_fn(|i| {
         let k = i / 2 + 1;
-        if i % 2 == 0 {
+        if i.is_multiple_of(2) {
             (PAD - k, PAD + reflect(-(k as isize), w))
         } else {
             (PAD + w - 1 + k, PAD + reflect((w - 1 + k) as isize, w))

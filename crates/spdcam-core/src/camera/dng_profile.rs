@@ -31,7 +31,7 @@ impl Camera {
         let spd = illuminant.spd(&self.grid)?;
         let observer = Observer::cie1931(&self.grid)?;
         let white = observer.spd_to_xyz(spd.values());
-        if !(white[1] > 0.0) {
+        if white[1].is_nan() || white[1] <= 0.0 {
             return Err(Error::invalid(
                 "the calibration illuminant has no luminance",
             ));
@@ -47,7 +47,7 @@ impl Camera {
         let fitted = super::colour::fit_correction_matrix(&xyz, &raw)?;
         let neutral = fitted * Vector3::new(white[0], white[1], white[2]) / white[1];
         let top = neutral.max();
-        if !(top > 0.0) {
+        if top.is_nan() || top <= 0.0 {
             return Err(Error::invalid(
                 "the camera gives the calibration illuminant's white no signal",
             ));
@@ -84,7 +84,7 @@ impl Camera {
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .ok_or_else(|| Error::invalid("the chart has no patches"))?;
         let v = raw[p].map(|c| c / r);
-        if !(v[1] > 0.0) {
+        if v[1].is_nan() || v[1] <= 0.0 {
             return Err(Error::invalid(
                 "the light gives this camera no green signal",
             ));

@@ -381,9 +381,13 @@ mod tests {
     fn a_grey_scene_under_coloured_light_comes_out_grey() {
         let light = [0.8f32, 0.5, 0.2];
         let mut img = RgbImage::new(32, 32);
-        for y in 0..32 {
+        for y in 0..32usize {
             for x in 0..32 {
-                let grey = if (x / 8 + y / 8) % 2 == 0 { 0.3 } else { 0.9 };
+                let grey = if (x / 8 + y / 8).is_multiple_of(2) {
+                    0.3
+                } else {
+                    0.9
+                };
                 for (plane, tint) in img.planes.iter_mut().zip(light) {
                     plane[y * 32 + x] = grey * tint;
                 }

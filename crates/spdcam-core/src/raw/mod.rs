@@ -295,7 +295,7 @@ impl RawMosaic {
         }
         for c in 0..3 {
             let black = self.black.iter().cloned().fold(f32::NEG_INFINITY, f32::max);
-            if !(self.white[c] > black) {
+            if self.white[c].is_nan() || self.white[c] <= black {
                 return Err(Error::invalid(format!(
                     "the raw file's white level {} is not above its black level {black}",
                     self.white[c]

@@ -96,6 +96,7 @@ impl MapFit {
             cameras: &cameras.cameras,
             lights,
             seed: seed::derive(options.seed, stream),
+            raw: false,
         };
         let mut scores: Vec<PhotoScore> = Vec::new();
         if options.scene_photos > 0 {

@@ -56,6 +56,8 @@ pub struct ColourOptions {
     /// Light-kind priors (`spdcam light-kinds fit`) for models without built-in ones, each
     /// used for the model whose fingerprint it names.
     pub light_priors: Vec<KindPriors>,
+    /// (a) is taken as raw DNGs of the same scenes instead of JPEGs.
+    pub raw: bool,
 }
 
 /// What a row of a table groups.
@@ -134,6 +136,8 @@ pub struct ColourReport {
     pub seed: u64,
     /// The held-out cameras left out (unreadable curves), for the caller to report.
     pub skipped: Vec<SkippedCamera>,
+    /// Whether (a) was raw DNGs.
+    pub raw: bool,
 }
 
 /// Every group of `lights` with a light: per lamp set its lamp types (in [`LampType::ALL`]'s
@@ -234,11 +238,13 @@ impl ColourReport {
             cameras: &setup.cameras,
             lights: &scene_lights,
             seed: seed::derive(held_out.seed, 1),
+            raw: options.raw,
         };
         let patches = Shoot {
             cameras: &setup.cameras,
             lights: &patch_lights,
             seed: seed::derive(held_out.seed, 2),
+            raw: false,
         };
 
         let mut models = Vec::new();
@@ -300,6 +306,7 @@ impl ColourReport {
             cameras: setup.cameras.len(),
             seed: held_out.seed,
             skipped: setup.skipped,
+            raw: options.raw,
         })
     }
 }

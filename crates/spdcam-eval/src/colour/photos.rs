@@ -10,17 +10,34 @@ use crate::trust::scenes::photo_chart;
 use rayon::prelude::*;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
-use spdcam_core::camera::CameraConfig;
+use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::randomise::camera_pool;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
+use spdcam_core::raw::dng::{encode_dng, DngMetadata};
 use spdcam_core::seed;
 use spdcam_core::spectral::Spd;
 use spdcam_core::spectral_error;
 use spdcam_infer::photo_options::PhotoOptions;
 use spdcam_infer::trust::Verdict;
 use spdcam_infer::{Estimate, Estimator, FeatureRows};
+
+/// The DNG of a scene photo `shot` by `camera` under `spd`, as `spdcam render --scene -o
+/// x.dng` writes it.
+fn raw_scene(camera: &Camera, spd: &Spd, shot: &scene::ScenePhoto) -> Result<Vec<u8>> {
+    let mosaic = shot
+        .mosaic
+        .as_ref()
+        .ok_or_else(|| EvalError::invalid("a scene photo without a sensor mosaic"))?;
+    let meta = DngMetadata {
+        camera: camera.camera_name().to_string(),
+        matrices: camera.dng_colour_matrices()?,
+        as_shot_neutral: camera.neutral_under(spd)?,
+        exposure: None,
+    };
+    Ok(encode_dng(mosaic, &meta)?)
+}
 
 /// Width and height of the scene photos: the trust report's scenes.
 pub const SCENE_SIZE: (usize, usize) = (1200, 900);
@@ -86,6 +103,9 @@ pub struct Shoot<'a> {
     pub lights: &'a [(Light, u64)],
     /// Seed of this set's draws.
     pub seed: u64,
+    /// Scene photos are raw DNGs of the sensor's mosaic (the camera's matrices fitted under
+    /// A and D65, its neutral under the light as shot), not JPEGs.
+    pub raw: bool,
 }
 
 /// The estimator a light's photos are estimated by (the same for every light, or one told
@@ -142,11 +162,15 @@ impl Shoot<'_> {
                     &scene_options,
                 )?;
                 let estimator = estimator_for(light)?;
-                let estimate =
-                    match estimator.estimate_photo_bytes(&shot.jpeg, "scene.jpg", &options) {
-                        Ok(e) => Some(Scored::of(&e, light)?),
-                        Err(_) => None,
-                    };
+                let (bytes, name) = if self.raw {
+                    (raw_scene(camera, &light.spd, &shot)?, "scene.dng")
+                } else {
+                    (shot.jpeg, "scene.jpg")
+                };
+                let estimate = match estimator.estimate_photo_bytes(&bytes, name, &options) {
+                    Ok(e) => Some(Scored::of(&e, light)?),
+                    Err(_) => None,
+                };
                 Ok(PhotoScore {
                     light: j,
                     camera: Some(camera_index),

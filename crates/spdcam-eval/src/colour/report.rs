@@ -14,6 +14,8 @@ const COLUMNS: &str = "photos | refused | ok | mean GFC | median Δu′v′ | CC
 const ALIGN: &str = "---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
 /// The names of a model's two kinds of photo.
 const PATHS: [&str; 2] = ["(a) scene", "(b) patch level"];
+/// The same with raw scene photos.
+const RAW_PATHS: [&str; 2] = ["(a) raw scene", "(b) patch level"];
 /// The names of the two baselines.
 const BASELINES: [&str; 2] = ["constant", "truth over 400–700 nm"];
 
@@ -165,7 +167,7 @@ impl ColourReport {
                 .map(|r| (r.lights, r.scores))
         };
         for m in &self.models {
-            for (k, path) in PATHS.iter().enumerate() {
+            for (k, path) in self.paths().iter().enumerate() {
                 for set in LightSet::ALL {
                     if let Some((n, s)) = all(&m.rows, set) {
                         md += &format!(
@@ -196,7 +198,7 @@ impl ColourReport {
                 "| set | group | lights | kind of photo | {COLUMNS}\n|---|---|---:|---|{ALIGN}\n"
             );
             for r in &m.rows {
-                for (k, path) in PATHS.iter().enumerate() {
+                for (k, path) in self.paths().iter().enumerate() {
                     md += &format!(
                         "| {} | {} | {} | {path} | {}\n",
                         r.set.label(),
@@ -230,6 +232,15 @@ impl ColourReport {
         md
     }
 
+    /// The names of the two kinds of photo measured.
+    fn paths(&self) -> [&'static str; 2] {
+        if self.raw {
+            RAW_PATHS
+        } else {
+            PATHS
+        }
+    }
+
     /// The protocol in words.
     fn protocol(&self) -> String {
         let [lamp, reference, patch] = self.photos;
@@ -244,7 +255,7 @@ impl ColourReport {
              outside every training pool. (a) Scene photos: the code of `spdcam render --scene` \
              ({}×{} pixels; the chart in a cluttered scene with perspective, blur, vignetting, \
              the default camera stage — Bayer mosaic, sensor noise, demosaicing, white balance, \
-             colour matrix, tone — and a JPEG), each camera in turn; {lamp} per lamp and \
+             colour matrix, tone — and a JPEG{}), each camera in turn; {lamp} per lamp and \
              {reference} per reference; found, sampled and estimated by the program's `Estimator` \
              as a user's photo is (an SG 96 model reads the 140-patch chart's photo). \
              (b) Patch-level photos: each camera drawn at random with the randomised in-camera \
@@ -267,6 +278,13 @@ impl ColourReport {
             self.cameras,
             super::photos::SCENE_SIZE.0,
             super::photos::SCENE_SIZE.1,
+            if self.raw {
+                "; here the sensor's mosaic before all of that, written as a DNG with the \
+                 camera's matrices fitted under A and D65 and its neutral under the light, as \
+                 `-o scene.dng` writes it"
+            } else {
+                ""
+            },
             self.seed,
             wavelengths(&Grid::ESTIMATION),
         )
@@ -329,6 +347,7 @@ mod tests {
             cameras: 13,
             seed: 1,
             skipped: Vec::new(),
+            raw: false,
         };
         let md = report.markdown();
         assert!(md.contains("| `cc24.spdm` (a) scene | validation lamps | 2 | 4 | 25 % | 50 % | 0.9500 | 0.0042 | 3 | -5.5 % | 33 % | 6.0 % | ±4.0 % | 90 % |\n"), "{md}");
@@ -391,6 +410,7 @@ mod tests {
             cameras: 2,
             seed: 1,
             skipped: Vec::new(),
+            raw: false,
         };
         let csv = report.photos_csv().unwrap();
         let lines: Vec<&str> = csv.lines().collect();

@@ -49,6 +49,10 @@ pub(super) struct ColourArgs {
     /// (repeatable; each used for the model it was fitted to).
     #[arg(long, value_name = "PRIORS.json")]
     light_priors: Vec<PathBuf>,
+    /// Take the scene photos (a) as raw DNGs of the same scenes (`render --scene -o x.dng`)
+    /// instead of JPEGs.
+    #[arg(long)]
+    raw: bool,
     /// Also write every photo's scores as CSV (model, light, camera, GFC, the true and
     /// estimated u′v′ and CCT, verdict): a row each.
     #[arg(long, value_name = "FILE.csv")]
@@ -75,6 +79,9 @@ impl ColourArgs {
         if self.light_named {
             out += " --light-named";
         }
+        if self.raw {
+            out += " --raw";
+        }
         for p in &self.light_priors {
             out += &format!(" --light-priors {}", p.display());
         }
@@ -98,6 +105,7 @@ pub(super) fn run(args: ColourArgs, data_dir: &DataDir) -> Result<()> {
         reference_photos,
         patch_photos: args.patch_photos,
         light_named: args.light_named,
+        raw: args.raw,
         light_priors: args
             .light_priors
             .iter()
