@@ -18,7 +18,7 @@ rm -rf "$venv"
 pip=("$venv/bin/python" -m pip install --quiet --disable-pip-version-check)
 # `--config-settings` reaches maturin from pip 23.1 on.
 "${pip[@]}" "pip>=23.1"
-"${pip[@]}" pytest numpy colour-science nbclient nbformat ipykernel matplotlib pandas pyarrow
+"${pip[@]}" pytest numpy colour-science nbclient nbformat ipykernel matplotlib pandas pyarrow rawpy
 # The command line the tests compare with (with `train`, for the training tests).
 cargo build --release --quiet --manifest-path "$root/Cargo.toml" --features spdcam/train
 export SPDCAM_BIN="$target/release/spdcam"

@@ -315,7 +315,7 @@ await test('a file that is no image shows a plain error in the page', async () =
   const error = page.locator('#list li').filter({ hasText: 'notes.txt' }).locator('.error');
   await error.waitFor({ timeout: 30000 });
   const message = await error.textContent();
-  check(message === 'This file is not a photo the page can read: use a JPEG, PNG or TIFF.', message);
+  check(message === 'This file is not a photo the page can read: use a JPEG, PNG, TIFF or a camera raw file (DNG, CR2, CR3, NEF, ARW, RAF, …).', message);
   // The earlier estimate is still there and the page still works.
   check(await page.locator('#spd-plot polyline.spd').count() >= 1, 'the earlier SPD vanished');
   await page.screenshot({ path: join(artefacts, 'error.png'), fullPage: true });

@@ -142,6 +142,11 @@ class Detection:
     warnings: list[str]
     #: The photo's size in pixels, (width, height).
     size: tuple[int, int]
+    #: For a camera raw file (DNG, CR2, CR3, NEF, ARW, RAF, …): what its mosaic said
+    #: (``camera``; ``light_xy``, the light's CIE 1931 xy from the chart's grey patches
+    #: through the file's own colour matrices; ``neutral_patches``; ``colour``, how the
+    #: matrices were used); ``None`` for a JPEG, PNG or TIFF.
+    raw: Optional[dict[str, Any]] = None
 
     @staticmethod
     def _from_json(p: dict[str, Any]) -> "Detection":
@@ -161,6 +166,7 @@ class Detection:
             dark=np.asarray([q["dark"] for q in patches], dtype=bool),
             warnings=list(p["warnings"]),
             size=(int(p["width"]), int(p["height"])),
+            raw=p.get("raw"),
         )
 
 
@@ -350,7 +356,9 @@ class Estimates:
 
 def read_photo(path: Union[str, "os.PathLike[str]"]) -> np.ndarray:
     """The photo file at ``path`` decoded as spdcam decodes it (JPEG, PNG, TIFF; EXIF
-    orientation applied): an H×W×3 array of encoded sRGB, uint8 or uint16 as stored."""
+    orientation applied): an H×W×3 array of encoded sRGB, uint8 or uint16 as stored. For a
+    camera raw file, the upright preview the chart is found in (one pixel per colour-filter
+    tile, white-balanced as shot); its patches are read on the raw mosaic itself."""
     width, height, bits, data = _native.read_photo(os.fspath(path))
     dtype = np.uint8 if bits == 8 else np.uint16
     return np.frombuffer(data, dtype=dtype).reshape(height, width, 3)
@@ -447,8 +455,9 @@ def estimate(
 ) -> Union[Estimate, list[Estimate]]:
     """Estimates the light from a photo of a colour chart, as ``spdcam estimate PHOTO``.
 
-    ``photo`` is a path, the bytes of a JPEG/PNG/TIFF file, or an H×W×3 array of encoded
-    sRGB (uint8, uint16, or float in 0–1); a list of them gives a list of estimates.
+    ``photo`` is a path, the bytes of a JPEG/PNG/TIFF or camera raw file (DNG, CR2, CR3,
+    NEF, ARW, RAF, …), or an H×W×3 array of encoded sRGB (uint8, uint16, or float in 0–1);
+    a list of them gives a list of estimates.
     ``chart`` looks only for that chart; ``corners`` gives the chart's four outer corners
     in pixels (any order) instead of detecting it; ``range`` is the output grid
     ``START-END[:STEP]`` in nm; ``model`` a :class:`Model` or a ``.spdm`` path (default:

@@ -119,7 +119,7 @@ fn estimate_dict<'py>(py: Python<'py>, estimate: &Estimate) -> PyResult<Bound<'p
 /// A photo as Python hands it over.
 #[derive(FromPyObject)]
 enum PhotoInput<'py> {
-    /// An encoded photo file's bytes (JPEG, PNG, TIFF).
+    /// A photo file's bytes (JPEG, PNG, TIFF, or camera raw).
     Encoded(Bound<'py, PyBytes>),
     /// Interleaved RGB pixels (`height × width × 3`, encoded sRGB) as native-endian bytes of
     /// `u8` values, or of `u16` values when `bits` is 16: `(pixels, width, height, bits)`.

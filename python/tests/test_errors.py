@@ -19,7 +19,7 @@ def test_a_file_that_is_no_image_gives_the_cli_message(cli, tmp_path):
     with pytest.raises(spdcam.SpdcamError) as caught:
         spdcam.estimate(notes)
     message = str(caught.value)
-    assert "notes.jpg" in message and "not a JPEG, PNG or TIFF image" in message
+    assert "notes.jpg" in message and "not a JPEG, PNG, TIFF or camera raw image" in message
     done = cli("estimate", str(notes))
     assert done.returncode != 0
     assert f"error: {message}" in done.stderr

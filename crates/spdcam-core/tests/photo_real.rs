@@ -186,7 +186,7 @@ fn bad_input_is_a_clear_error_and_writes_no_features() {
     std::fs::write(&text, b"these are notes, not a photo").unwrap();
     let e = analyse_photo(&text, &options()).unwrap_err().to_string();
     assert!(
-        e.contains("notes.jpg") && e.contains("not a JPEG, PNG or TIFF image"),
+        e.contains("notes.jpg") && e.contains("not a JPEG, PNG, TIFF or camera raw image"),
         "{e}"
     );
     // A truncated JPEG.

@@ -71,6 +71,17 @@ pub fn absolute_level(
     metrics: &LightingMetrics,
     unusable: &[bool],
 ) -> Result<Absolute> {
+    if analysis.raw.is_some() {
+        // A raw value relates to exposure by the sensor's saturation (ISO 12232's
+        // saturation-based speed), not by the JPEG rendering's SOS this module assumes; the
+        // developed features are scaled to the chart's white besides.
+        return Ok(Err(
+            "absolute levels are not read from raw files yet (their relation to the EXIF \
+             exposure is the sensor's saturation, which spdcam does not calibrate yet); \
+             the JPEG of the same shot gives them"
+                .into(),
+        ));
+    }
     let Some(exposure) = analysis.exposure else {
         return Ok(Err(
             "the photo's EXIF gives no aperture, exposure time and ISO".into(),

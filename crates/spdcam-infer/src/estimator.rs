@@ -980,6 +980,12 @@ impl Estimator {
         let full = Spd::new(chosen.model.grid(), model_spd.clone())?;
         let spd = Spd::new(self.grid, map.apply(model_spd))?;
         let metrics = LightingMetrics::of_spd(&full);
+        let colorimetry = Colorimetry::of(&full)?;
+        if photo.as_ref().is_some_and(|a| a.raw.is_some()) {
+            if let (Some(u), Some(cct)) = (&mut trust.uncertainty, colorimetry.cct) {
+                measured_colour::set_intervals(&mut u.metrics, cct);
+            }
+        }
         let absolute = match &photo {
             Some(analysis) => {
                 let unusable: Vec<bool> = (0..flags.clipped.len())
@@ -1004,7 +1010,7 @@ impl Estimator {
             name,
             model: chosen.name.clone(),
             light: self.light,
-            colorimetry: Colorimetry::of(&full)?,
+            colorimetry,
             metrics,
             spd,
             truth: None,

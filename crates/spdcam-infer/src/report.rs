@@ -348,6 +348,9 @@ fn facts(out: &mut String, e: &Estimate) {
                 a.patches.len()
             ),
         ));
+        if let Some(raw) = &a.raw {
+            rows.push(("raw", "raw", raw.describe()));
+        }
     }
     if let Some(w) = e
         .trust

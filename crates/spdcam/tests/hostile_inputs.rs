@@ -157,14 +157,19 @@ fn a_photo_that_is_no_image_is_refused_from_its_first_bytes() {
         .unwrap();
     let e = refusal(&out, started, 10, "estimate /dev/zero");
     assert!(
-        e.contains("/dev/zero") && e.contains("JPEG, PNG or TIFF") && e.contains("00 00"),
+        e.contains("/dev/zero")
+            && e.contains("JPEG, PNG, TIFF or camera raw")
+            && e.contains("00 00"),
         "{e}"
     );
     let dir = scratch("notimage");
     let csv = dir.join("photo.jpg");
     std::fs::write(&csv, "wavelength_nm,a\n400,1\n410,1\n").unwrap();
     let e = fails_fast(&["estimate", &s(&csv)]);
-    assert!(e.contains("not a JPEG, PNG or TIFF image"), "{e}");
+    assert!(
+        e.contains("not a JPEG, PNG, TIFF or camera raw image"),
+        "{e}"
+    );
 }
 
 #[test]

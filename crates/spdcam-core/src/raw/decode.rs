@@ -32,14 +32,23 @@ pub fn is_raw_file(bytes: &[u8]) -> bool {
     catch_unwind(|| rawler::get_decoder(&RawSource::new_from_slice(bytes)).is_ok()).unwrap_or(false)
 }
 
-/// Decodes the raw file `bytes` (named `source` in messages). The photosite count is
-/// checked against [`limits::IMAGE_PIXELS`] from the decoder's metadata before the values
-/// are kept; any panic inside the decoder becomes an error.
+/// Decodes the raw file `bytes` (named `source` in messages). The largest image a
+/// TIFF-structured file claims is checked against [`limits::IMAGE_PIXELS`] before the
+/// decoder allocates it, the decoded photosite count again after; any panic inside the
+/// decoder becomes an error.
 pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
     let fail = |message: String| Error::Image {
         context: source.to_string(),
         message,
     };
+    let max_pixels = limits::IMAGE_PIXELS.value()?;
+    if let Some(claimed) = super::header::largest_claimed_pixels(bytes) {
+        limits::IMAGE_PIXELS.check_against(
+            claimed,
+            max_pixels,
+            &format!("{source} (an image of {claimed} pixels, as the file claims)"),
+        )?;
+    }
     let decoded = catch_unwind(AssertUnwindSafe(|| {
         let file = RawSource::new_from_slice(bytes);
         let params = RawDecodeParams::default();
@@ -66,7 +75,6 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
             ))
         }
     };
-    let max_pixels = limits::IMAGE_PIXELS.value()?;
     let pixels = limits::product(&[image.width as u64, image.height as u64]);
     limits::IMAGE_PIXELS.check_against(
         pixels,

@@ -20,6 +20,7 @@
 pub mod colour;
 mod decode;
 pub mod dng;
+mod header;
 mod sample;
 
 pub use colour::{CalibratedMatrix, RawColour, RawColourUse};

@@ -42,6 +42,25 @@ pub struct RawReading {
     pub colour: RawColourUse,
 }
 
+impl RawReading {
+    /// One line for a person: "raw file (camera …): patches read on the sensor's mosaic,
+    /// the light's colour from N grey patches through the file's A and D65 matrices".
+    pub fn describe(&self) -> String {
+        format!(
+            "raw file ({}): patches read on the sensor's mosaic, the light's colour from {} \
+             grey patches through the file's {} colour matri{}",
+            self.camera,
+            self.neutral_patches.len(),
+            self.colour.matrices.join(" and "),
+            if self.colour.matrices.len() == 1 {
+                "x"
+            } else {
+                "ces"
+            }
+        )
+    }
+}
+
 /// One patch's cells: camera RGB (share of full scale) and whether each is clipped.
 struct PatchCells {
     cells: Vec<[f32; 3]>,

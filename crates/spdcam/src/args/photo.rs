@@ -73,13 +73,17 @@ pub fn describe(analysis: &PhotoAnalysis) -> String {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| analysis.source.clone());
-    format!(
+    let line = format!(
         "{name}: {} {} (confidence {:.2}), {} patches sampled",
         shown_chart_name(&analysis.chart),
         analysis.method,
         analysis.confidence,
         analysis.patches.len()
-    )
+    );
+    match &analysis.raw {
+        Some(raw) => format!("{line}; {}", raw.describe()),
+        None => line,
+    }
 }
 
 #[cfg(test)]

@@ -35,7 +35,8 @@ const DETAILED_MAX: usize = 20;
 /// Options of `spdcam estimate`.
 #[derive(Debug, Args)]
 pub struct EstimateArgs {
-    /// Photos of a colour chart (JPEG, PNG, TIFF), or chart images from `spdcam render`;
+    /// Photos of a colour chart (JPEG, PNG, TIFF, or camera raw: DNG, CR2, CR3, NEF, ARW, RAF,
+    /// ORF, RW2, PEF, …), or chart images from `spdcam render`;
     /// one estimate each.
     #[arg(value_name = "PHOTO", required_unless_present = "features")]
     photos: Vec<PathBuf>,

@@ -19,7 +19,9 @@ pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
     } else if error.contains("not an image") || error.contains("decod") {
         (
             "bad_photo",
-            "This file is not a photo the page can read: use a JPEG, PNG or TIFF.".to_string(),
+            "This file is not a photo the page can read: use a JPEG, PNG, TIFF or a camera raw \
+             file (DNG, CR2, CR3, NEF, ARW, RAF, …)."
+                .to_string(),
         )
     } else if error.contains("no model for chart") {
         (
