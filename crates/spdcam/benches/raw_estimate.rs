@@ -21,6 +21,8 @@ use spdcam_infer::{Estimator, PhotoOptions};
 use std::hint::black_box;
 use support::median;
 
+// Only `median` and the photo size of the shared support are used here.
+#[allow(dead_code)]
 #[path = "../../spdcam-core/benches/support/mod.rs"]
 mod support;
 
@@ -39,8 +41,8 @@ fn dng() -> Vec<u8> {
         Camera::new(&sensitivities, chart, CameraConfig::default(), &grid).expect("camera");
     let d65 = StandardIlluminant::D65.spd(&grid).expect("D65");
     let options = SceneOptions {
-        width: 6000,
-        height: 4000,
+        width: support::WIDTH as usize,
+        height: support::HEIGHT as usize,
         ..SceneOptions::default()
     };
     let shot = scene::photograph(&camera, SceneLight::single(&d65), 1, &options).expect("scene");

@@ -1,5 +1,5 @@
 //! What the 24-megapixel photo benchmarks share (`spdcam-core`'s photo bench and `spdcam`'s
-//! photo_estimate bench include this file by path): the photo and the timing.
+//! photo_estimate and raw_estimate benches include this file by path): the photo and the timing.
 
 use std::time::{Duration, Instant};
 

@@ -30,11 +30,14 @@ pub use sample::{sample, RawReading};
 use crate::colorimetry::srgb_encode;
 use crate::error::{Error, Result};
 use crate::photo::{Exposure, Photo};
-use nalgebra::Vector3;
+use rayon::prelude::*;
 
 /// The longest side of the preview detection runs on, in pixels; more colour-filter tiles
 /// are binned together beyond it.
-const PREVIEW_MAX_SIDE: usize = 3000;
+const PREVIEW_MAX_SIDE: usize = 2000;
+/// Linear steps of the preview's sRGB table: finer than an 8-bit code everywhere above
+/// black's first code.
+const ENCODE_STEPS: usize = 16384;
 /// The preview's brightest 1 % of pixels (by green) is put at this linear level, so that the
 /// chart is neither dark nor clipped whatever the raw exposure.
 const PREVIEW_WHITE: f64 = 0.9;
@@ -147,26 +150,29 @@ impl RawMosaic {
     }
 
     /// The upright photo the chart is looked for in and drawn on: one pixel per cell (binned
-    /// beyond [`PREVIEW_MAX_SIDE`]), white-balanced to the camera's as-shot neutral (or the
+    /// beyond 2000 pixels a side), white-balanced to the camera's as-shot neutral (or the
     /// mean of the photo where the file gives none) with the file's own matrix, its
-    /// brightest 1 % at [`PREVIEW_WHITE`], sRGB-encoded at 8 bits.
+    /// brightest 1 % at 0.9 of white, sRGB-encoded at 8 bits.
     pub fn preview(&self, source: &str) -> Result<Photo> {
         let bin = self.preview_bin();
         let (cells_x, cells_y) = self.cells();
         let (w, h) = (cells_x / bin, cells_y / bin);
         let mut linear = vec![[0f32; 3]; w * h];
-        for (py, row) in linear.chunks_mut(w.max(1)).enumerate() {
-            for (px, out) in row.iter_mut().enumerate() {
-                let mut s = [0f32; 3];
-                for by in 0..bin {
-                    for bx in 0..bin {
-                        let (v, _) = self.cell(px * bin + bx, py * bin + by);
-                        (0..3).for_each(|c| s[c] += v[c]);
+        linear
+            .par_chunks_mut(w.max(1))
+            .enumerate()
+            .for_each(|(py, row)| {
+                for (px, out) in row.iter_mut().enumerate() {
+                    let mut s = [0f32; 3];
+                    for by in 0..bin {
+                        for bx in 0..bin {
+                            let (v, _) = self.cell(px * bin + bx, py * bin + by);
+                            (0..3).for_each(|c| s[c] += v[c]);
+                        }
                     }
+                    *out = s.map(|v| v / (bin * bin) as f32);
                 }
-                *out = s.map(|v| v / (bin * bin) as f32);
-            }
-        }
+            });
         let neutral = match self.colour.as_shot_neutral {
             Some(n) => n,
             None => {
@@ -178,14 +184,11 @@ impl RawMosaic {
             }
         };
         let (m, _) = self.colour.development(neutral)?;
-        let developed: Vec<[f32; 3]> = linear
-            .iter()
-            .map(|v| {
-                let out = m * Vector3::new(v[0] as f64, v[1] as f64, v[2] as f64);
-                [out[0] as f32, out[1] as f32, out[2] as f32]
-            })
-            .collect();
-        let mut greens: Vec<f32> = developed.iter().map(|v| v[1]).collect();
+        let m: [[f32; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)] as f32));
+        linear.par_iter_mut().for_each(|v| {
+            *v = std::array::from_fn(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2]);
+        });
+        let mut greens: Vec<f32> = linear.iter().map(|v| v[1]).collect();
         let k = ((greens.len() as f64 * 0.99) as usize).min(greens.len().saturating_sub(1));
         let bright = if greens.is_empty() {
             1.0
@@ -193,18 +196,24 @@ impl RawMosaic {
             *greens.select_nth_unstable_by(k, |a, b| a.total_cmp(b)).1
         };
         let gain = (PREVIEW_WHITE / (bright as f64).max(1e-6)) as f32;
+        // The sRGB curve as a table of 8-bit codes over linear steps of 1/ENCODE_STEPS.
+        let table: Vec<u8> = (0..=ENCODE_STEPS)
+            .map(|k| (srgb_encode(k as f64 / ENCODE_STEPS as f64) * 255.0).round() as u8)
+            .collect();
+        let encode = |v: f32| table[((v * gain).clamp(0.0, 1.0) * ENCODE_STEPS as f32) as usize];
         let (uw, uh) = self.upright_size(w, h);
         let mut data = vec![0u8; uw * uh * 3];
-        for y in 0..uh {
-            for x in 0..uw {
-                let (sx, sy) = self.stored_pixel(x, y, w, h);
-                let v = developed[sy * w + sx];
-                for c in 0..3 {
-                    let encoded = srgb_encode((v[c] * gain).clamp(0.0, 1.0) as f64);
-                    data[(y * uw + x) * 3 + c] = (encoded * 255.0).round() as u8;
+        data.par_chunks_mut(uw * 3)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for x in 0..uw {
+                    let (sx, sy) = self.stored_pixel(x, y, w, h);
+                    let v = linear[sy * w + sx];
+                    for c in 0..3 {
+                        row[x * 3 + c] = encode(v[c]);
+                    }
                 }
-            }
-        }
+            });
         let mut photo = Photo::from_rgb8(source, uw, uh, data)?;
         photo.exposure = self.exposure;
         Ok(photo)
