@@ -21,9 +21,9 @@
 //! - [`sampler`]: the one patch sampler (the region read and its robust statistic) that
 //!   turns pixels into features, for simulated images and photos alike.
 //! - [`photo`]: real photos — find the chart, rectify it, sample the patches into the same
-//!   feature row; [`raw`]: camera raw files, the chart sampled on the sensor's mosaic and the
-//!   light's colour read through the file's own matrices; [`feature_check`] rejects rows
-//!   that cannot say anything about the light.
+//!   feature row, from encoded pixels or, for camera raw files ([`photo::raw`]), from the
+//!   sensor's mosaic with the light's colour read through the file's own matrices;
+//!   [`feature_check`] rejects rows that cannot say anything about the light.
 //! - [`spectral_error`] (RMSE, GFC, SAM, SID between spectra), [`colorimetry`] (XYZ, CCT/Duv,
 //!   sRGB, CIELAB) and [`quality`] (CRI, TM-30, α-opic and other metrics of a light).
 //! - [`advice`]: every warning and reason a person reads, with what to do, in one place.
@@ -114,7 +114,6 @@ pub mod output_guard;
 pub mod photo;
 pub mod quality;
 pub mod raster;
-pub mod raw;
 pub mod sampler;
 pub mod seed;
 pub mod simple_camera;

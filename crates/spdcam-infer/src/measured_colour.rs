@@ -1,5 +1,5 @@
 //! A raw photo's light colour, measured through the file's own colour matrices
-//! ([`spdcam_core::raw::RawReading::light_xy`]), given to the model's spectrum: the model
+//! ([`spdcam_core::photo::raw::RawReading::light_xy`]), given to the model's spectrum: the model
 //! reads the shape from the developed patches, the chromaticity comes from the sensor.
 //!
 //! Why: after white balance (the camera's, or the raw development's) a light's colour lives

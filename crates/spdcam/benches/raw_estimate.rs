@@ -13,9 +13,9 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::cie_illuminant::StandardIlluminant;
+use spdcam_core::photo::raw::dng::{encode_dng, DngMetadata};
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
-use spdcam_core::raw::dng::{encode_dng, DngMetadata};
 use spdcam_core::spectral::Grid;
 use spdcam_infer::{Estimator, PhotoOptions};
 use std::hint::black_box;
@@ -68,7 +68,7 @@ fn main() {
         .and_then(|p| p.raw.as_ref())
         .is_some());
     let decoder = median(5, || {
-        black_box(spdcam_core::raw::decode(&bytes, "bench.dng").expect("decoded"));
+        black_box(spdcam_core::photo::raw::decode(&bytes, "bench.dng").expect("decoded"));
     });
     let whole = median(5, || {
         black_box(

@@ -1,12 +1,12 @@
 //! Reading photos: JPEG, PNG (8/16-bit), TIFF, with the EXIF orientation applied, into one
 //! compact buffer of encoded sRGB values (8 or 16 bits per channel, as the file had); and
-//! camera raw files ([`crate::raw`]), whose encoded pixels are a preview to find the chart
+//! camera raw files ([`super::raw`]), whose encoded pixels are a preview to find the chart
 //! in, the linear mosaic held beside them.
 
 use super::exposure::Exposure;
+use super::raw::{self, RawMosaic};
 use crate::advice::{Advice, CORRUPT, TRUNCATED};
 use crate::error::{Error, Result};
-use crate::raw::{self, RawMosaic};
 use crate::{fsio, limits};
 use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader};
 use std::io::Cursor;

@@ -1,5 +1,6 @@
 //! Real photos of a colour chart: decode ─► find the chart ─► rectify ─► sample the patches
-//! ─► the feature row a model reads.
+//! ─► the feature row a model reads. Camera raw files ([`raw`]) take the same path, their
+//! patches read on the sensor's mosaic.
 //!
 //! Coordinates: image points are continuous pixel coordinates (pixel `(i, j)` covers
 //! `[i, i+1) × [j, j+1)`, its centre is `(i + 0.5, j + 0.5)`), x to the right, y down. Chart
@@ -22,6 +23,7 @@ mod lattice;
 mod load;
 mod overlay;
 mod pyramid;
+pub mod raw;
 mod refine;
 mod sample;
 pub mod scene;

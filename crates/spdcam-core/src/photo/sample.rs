@@ -5,9 +5,9 @@
 
 use super::geometry::Homography;
 use super::load::Photo;
+use super::raw::RawReading;
 use super::ChartTemplate;
 use crate::error::{Error, Result};
-use crate::raw::RawReading;
 use crate::sampler::{robust_mean, SampleBuffers, SAMPLING_FRACTION};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -47,14 +47,14 @@ pub struct PatchSample {
 }
 
 /// Samples every patch of `template` placed by `homography` (chart → photo pixels); a raw
-/// photo on its mosaic ([`crate::raw::sample`]), which also reads the light's chromaticity.
+/// photo on its mosaic ([`super::raw::sample`]), which also reads the light's chromaticity.
 pub fn sample(
     photo: &Photo,
     template: &ChartTemplate,
     homography: &Homography,
 ) -> Result<(Vec<PatchSample>, Option<RawReading>)> {
     if let Some(raw) = photo.raw() {
-        let (patches, reading) = crate::raw::sample(raw, &photo.source, template, homography)?;
+        let (patches, reading) = super::raw::sample(raw, &photo.source, template, homography)?;
         return Ok((patches, Some(reading)));
     }
     sample_encoded(photo, template, homography).map(|patches| (patches, None))

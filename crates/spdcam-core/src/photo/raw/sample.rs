@@ -4,7 +4,7 @@
 //!
 //! Then the chart's own neutral patches give the light: their camera RGB per unit of
 //! reflectance is the camera's reading of the light itself, which the file's matrices take
-//! to its chromaticity ([`crate::raw::RawColour::light_xy`]); and every patch is developed as a raw
+//! to its chromaticity ([`super::RawColour::light_xy`]); and every patch is developed as a raw
 //! converter's "as shot" rendering would (white-balanced to that neutral, the file's
 //! matrix, sRGB), so that the feature row has the meaning and scale of a JPEG's.
 
