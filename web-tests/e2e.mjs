@@ -625,7 +625,9 @@ if (reportPath) {
 
 await test('the page reads from 360 to 1,920 px: nothing spills out of its box, no command-line words', async () => {
   const input = page.locator('#files');
-  check(await input.getAttribute('accept') === 'image/*' && await input.getAttribute('capture') !== null, 'the file input offers no camera');
+  const accept = (await input.getAttribute('accept')).split(',');
+  check(accept[0] === 'image/*' && await input.getAttribute('capture') !== null, 'the file input offers no camera');
+  check(['.dng', '.cr3', '.nef', '.arw'].every((e) => accept.includes(e)), `the file input does not offer raw files: ${accept}`);
   for (const width of [360, 768, 1400, 1920]) {
     // 360 px as a phone: a touch screen at twice the pixel density.
     const phone = width === 360;
