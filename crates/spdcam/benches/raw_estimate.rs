@@ -13,7 +13,7 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::cie_illuminant::StandardIlluminant;
-use spdcam_core::photo::raw::dng::{encode_dng, DngMetadata};
+use spdcam_core::photo::raw::dng::virtual_camera_dng;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::Grid;
@@ -46,13 +46,7 @@ fn dng() -> Vec<u8> {
         ..SceneOptions::default()
     };
     let shot = scene::photograph(&camera, SceneLight::single(&d65), 1, &options).expect("scene");
-    let meta = DngMetadata {
-        camera: camera.camera_name().to_string(),
-        matrices: camera.dng_colour_matrices().expect("matrices"),
-        as_shot_neutral: camera.neutral_under(&d65).expect("neutral"),
-        exposure: None,
-    };
-    encode_dng(shot.mosaic.as_ref().expect("a mosaic"), &meta).expect("DNG")
+    virtual_camera_dng(&camera, &d65, shot.mosaic.as_ref().expect("a mosaic"), None).expect("DNG")
 }
 
 fn main() {

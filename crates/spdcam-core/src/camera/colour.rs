@@ -86,6 +86,21 @@ fn encode_table() -> &'static [f32] {
     })
 }
 
+/// The sRGB transfer curve on a linear value clipped to 0…1, interpolated in the shared
+/// table (within 1e-6 of [`colorimetry::srgb_encode`]): for image loops.
+#[inline]
+pub fn srgb_encode_fast(linear: f32) -> f32 {
+    encode_from_table(encode_table(), linear)
+}
+
+#[inline]
+fn encode_from_table(table: &[f32], linear: f32) -> f32 {
+    let x = linear.clamp(0.0, 1.0) * ENCODE_TABLE_STEPS as f32;
+    let i = (x as usize).min(ENCODE_TABLE_STEPS - 1);
+    let f = x - i as f32;
+    table[i] + f * (table[i + 1] - table[i])
+}
+
 /// Camera RGB → encoded, quantised sRGB, as one matrix, a table and a number of levels.
 #[derive(Debug, Clone)]
 pub struct ColourTransform {
@@ -124,10 +139,7 @@ impl ColourTransform {
     /// The sRGB transfer curve on a clipped linear value, from the table.
     #[inline]
     pub fn encode(&self, linear: f32) -> f32 {
-        let x = linear.clamp(0.0, 1.0) * ENCODE_TABLE_STEPS as f32;
-        let i = (x as usize).min(ENCODE_TABLE_STEPS - 1);
-        let f = x - i as f32;
-        self.table[i] + f * (self.table[i + 1] - self.table[i])
+        encode_from_table(self.table, linear)
     }
 
     /// Quantises an encoded value to the output bit depth (result still on 0…1).

@@ -13,7 +13,7 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::dataset::randomise::camera_pool;
-use spdcam_core::photo::raw::dng::{encode_dng, DngMetadata};
+use spdcam_core::photo::raw::dng::virtual_camera_dng;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::seed;
@@ -30,13 +30,7 @@ fn raw_scene(camera: &Camera, spd: &Spd, shot: &scene::ScenePhoto) -> Result<Vec
         .mosaic
         .as_ref()
         .ok_or_else(|| EvalError::invalid("a scene photo without a sensor mosaic"))?;
-    let meta = DngMetadata {
-        camera: camera.camera_name().to_string(),
-        matrices: camera.dng_colour_matrices()?,
-        as_shot_neutral: camera.neutral_under(spd)?,
-        exposure: None,
-    };
-    Ok(encode_dng(mosaic, &meta)?)
+    Ok(virtual_camera_dng(camera, spd, mosaic, None)?)
 }
 
 /// Width and height of the scene photos: the trust report's scenes.

@@ -12,13 +12,11 @@ use clap::Args;
 use parse::parse_pair;
 use scene_photo::render_scene;
 use spdcam_core::builtin::DataDir;
-use spdcam_core::camera::Camera;
 use spdcam_core::imageio;
 use spdcam_core::light_families::Lighting;
-use spdcam_core::photo::raw::dng::{encode_dng, DngMetadata};
+use spdcam_core::photo::raw::dng::virtual_camera_dng;
 use spdcam_core::photo::scene;
-use spdcam_core::raster::Mosaic;
-use spdcam_core::spectral::{Grid, Spd, SpectralSet};
+use spdcam_core::spectral::{Grid, SpectralSet};
 use spdcam_core::{fsio, limits, named_light};
 use std::path::{Path, PathBuf};
 
@@ -244,7 +242,10 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         let mosaic = rendering.stages.cfa.as_ref().ok_or_else(|| {
             anyhow::anyhow!("a three-sensor camera has no mosaic to write as a DNG")
         })?;
-        fsio::write_output(&args.output, &dng_bytes(&camera, &spd.spd, mosaic)?)?;
+        fsio::write_output(
+            &args.output,
+            &virtual_camera_dng(&camera, &spd.spd, mosaic, None)?,
+        )?;
     } else {
         fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
     }
@@ -267,18 +268,6 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         args.output.display()
     ))?;
     Ok(())
-}
-
-/// The DNG of a rendered `mosaic` by `camera` under `spd`: its matrices fitted under A and
-/// D65 and its exact neutral under the light as shot.
-pub(super) fn dng_bytes(camera: &Camera, spd: &Spd, mosaic: &Mosaic) -> Result<Vec<u8>> {
-    let meta = DngMetadata {
-        camera: camera.camera_name().to_string(),
-        matrices: camera.dng_colour_matrices()?,
-        as_shot_neutral: camera.neutral_under(spd)?,
-        exposure: None,
-    };
-    Ok(encode_dng(mosaic, &meta)?)
 }
 
 fn write_stages(dir: &Path, stages: &spdcam_core::camera::Stages) -> Result<()> {

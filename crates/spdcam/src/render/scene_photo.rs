@@ -6,6 +6,7 @@ use super::{RenderArgs, TiltAxisArg};
 use crate::messages::Messages;
 use anyhow::{bail, Result};
 use spdcam_core::builtin::DataDir;
+use spdcam_core::photo::raw::dng::virtual_camera_dng;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions, Shadow, Tilt, TiltAxis};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::spectral::{Grid, Spd};
@@ -93,7 +94,10 @@ pub(super) fn render_scene(
                  two halves developed apart)"
             )
         })?;
-        fsio::write_output(&args.output, &super::dng_bytes(&camera, spd, mosaic)?)?;
+        fsio::write_output(
+            &args.output,
+            &virtual_camera_dng(&camera, spd, mosaic, None)?,
+        )?;
     } else {
         fsio::write_output(&args.output, &shot.jpeg)?;
     }

@@ -5,9 +5,11 @@
 //! IFD 0). The virtual camera writes its photos this way (`spdcam render -o photo.dng`), so
 //! that tests have raw photos of a known light; any DNG reader opens them.
 
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::photo::Exposure;
 use crate::raster::{CfaPattern, Mosaic};
+use crate::spectral::Spd;
 use nalgebra::Matrix3;
 use std::io::Cursor;
 use tiff::encoder::{colortype, Rational, SRational, TiffEncoder};
@@ -140,6 +142,24 @@ pub fn encode_dng(mosaic: &Mosaic, meta: &DngMetadata) -> Result<Vec<u8>> {
     }
     image.write_data(&values).map_err(fail)?;
     Ok(bytes.into_inner())
+}
+
+/// The DNG of `mosaic` as `camera` took it under `spd` (`spdcam render … -o x.dng`): the
+/// camera's matrices fitted under A and D65, its exact neutral under the light as shot,
+/// `exposure` when given.
+pub fn virtual_camera_dng(
+    camera: &Camera,
+    spd: &Spd,
+    mosaic: &Mosaic,
+    exposure: Option<Exposure>,
+) -> Result<Vec<u8>> {
+    let meta = DngMetadata {
+        camera: camera.camera_name().to_string(),
+        matrices: camera.dng_colour_matrices()?,
+        as_shot_neutral: camera.neutral_under(spd)?,
+        exposure,
+    };
+    encode_dng(mosaic, &meta)
 }
 
 /// The `CFAPattern` bytes (0 red, 1 green, 2 blue) of a 2×2 layout, row-major.

@@ -27,7 +27,7 @@ pub use colour::{CalibratedMatrix, RawColour, RawColourUse};
 pub use decode::{decode, is_raw_file, looks_like_raw};
 pub use sample::{sample, RawReading};
 
-use crate::colorimetry::srgb_encode;
+use crate::camera::colour::srgb_encode_fast;
 use crate::error::{Error, Result};
 use crate::photo::{Exposure, Photo};
 use rayon::prelude::*;
@@ -35,9 +35,6 @@ use rayon::prelude::*;
 /// The longest side of the preview detection runs on, in pixels; more colour-filter tiles
 /// are binned together beyond it.
 const PREVIEW_MAX_SIDE: usize = 2000;
-/// Linear steps of the preview's sRGB table: finer than an 8-bit code everywhere above
-/// black's first code.
-const ENCODE_STEPS: usize = 16384;
 /// The preview's brightest 1 % of pixels (by green) is put at this linear level, so that the
 /// chart is neither dark nor clipped whatever the raw exposure.
 const PREVIEW_WHITE: f64 = 0.9;
@@ -196,11 +193,7 @@ impl RawMosaic {
             *greens.select_nth_unstable_by(k, |a, b| a.total_cmp(b)).1
         };
         let gain = (PREVIEW_WHITE / (bright as f64).max(1e-6)) as f32;
-        // The sRGB curve as a table of 8-bit codes over linear steps of 1/ENCODE_STEPS.
-        let table: Vec<u8> = (0..=ENCODE_STEPS)
-            .map(|k| (srgb_encode(k as f64 / ENCODE_STEPS as f64) * 255.0).round() as u8)
-            .collect();
-        let encode = |v: f32| table[((v * gain).clamp(0.0, 1.0) * ENCODE_STEPS as f32) as usize];
+        let encode = |v: f32| (srgb_encode_fast(v * gain) * 255.0).round() as u8;
         let (uw, uh) = self.upright_size(w, h);
         let mut data = vec![0u8; uw * uh * 3];
         data.par_chunks_mut(uw * 3)
@@ -318,7 +311,7 @@ impl RawMosaic {
 
 #[cfg(test)]
 mod tests {
-    use super::dng::{encode_dng, DngMetadata, DNG_BLACK, DNG_WHITE};
+    use super::dng::{virtual_camera_dng, DNG_BLACK, DNG_WHITE};
     use crate::builtin;
     use crate::camera::sensor::Sensitivities;
     use crate::camera::{Camera, CameraConfig};
@@ -348,13 +341,8 @@ mod tests {
             ..SceneOptions::default()
         };
         let shot = scene::photograph(camera, SceneLight::single(spd), seed, &options).unwrap();
-        let meta = DngMetadata {
-            camera: camera.camera_name().into(),
-            matrices: camera.dng_colour_matrices().unwrap(),
-            as_shot_neutral: camera.neutral_under(spd).unwrap(),
-            exposure: crate::photo::Exposure::new(4.0, 0.01, 200.0),
-        };
-        encode_dng(shot.mosaic.as_ref().unwrap(), &meta).unwrap()
+        let exposure = crate::photo::Exposure::new(4.0, 0.01, 200.0);
+        virtual_camera_dng(camera, spd, shot.mosaic.as_ref().unwrap(), exposure).unwrap()
     }
 
     #[test]

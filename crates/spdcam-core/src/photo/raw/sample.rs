@@ -78,8 +78,7 @@ pub fn sample(
     homography: &Homography,
 ) -> Result<(Vec<PatchSample>, RawReading)> {
     let to_sensor = Homography::from_rows(&raw.preview_to_sensor());
-    let chart_to_sensor =
-        Homography::from_rows(&compose(&raw.preview_to_sensor(), &homography.to_rows()));
+    let chart_to_sensor = Homography(to_sensor.0 * homography.0);
     let inverse = chart_to_sensor
         .inverse()
         .ok_or_else(|| Error::invalid("the chart's homography is singular"))?;
@@ -250,9 +249,4 @@ fn patch_cells(
         clipped,
         centre,
     })
-}
-
-/// `a · b` of two 3×3 matrices given by rows.
-fn compose(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
 }
