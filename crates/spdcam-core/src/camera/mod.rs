@@ -421,6 +421,17 @@ impl Camera {
     /// photo of the chart is composed from ([`crate::photo::scene`]), a second light lighting
     /// part of the chart as the camera metered the first.
     pub fn exposed_chart(&self, spds: &[&Spd]) -> Result<Vec<Vec<[f32; 3]>>> {
+        Ok(self.exposed_chart_at(spds, None)?.0)
+    }
+
+    /// [`Camera::exposed_chart`] at the exposure `scale` another chart of the same photo
+    /// was metered at (`None`: metered on the first light here), and that scale: the
+    /// charts of one photo share its exposure, so their levels compare.
+    pub fn exposed_chart_at(
+        &self,
+        spds: &[&Spd],
+        scale: Option<f32>,
+    ) -> Result<(Vec<Vec<[f32; 3]>>, f32)> {
         let shot = self.shot(self.config.in_camera.as_ref());
         let mut out: Vec<Vec<[f32; 3]>> = Vec::with_capacity(spds.len());
         for spd in spds {
@@ -429,12 +440,14 @@ impl Camera {
             self.lit_regions(&shot, &light, &mut raw);
             out.push(raw);
         }
-        if let Some(first) = out.first() {
-            let scale = self.exposure_scale(&shot, first);
-            out.iter_mut()
-                .for_each(|raw| expose(raw, scale, shot.full_scale));
-        }
-        Ok(out)
+        let scale = match (scale, out.first()) {
+            (Some(scale), _) => scale,
+            (None, Some(first)) => self.exposure_scale(&shot, first),
+            (None, None) => 1.0,
+        };
+        out.iter_mut()
+            .for_each(|raw| expose(raw, scale, shot.full_scale));
+        Ok((out, scale))
     }
 
     /// Photographs a scene given as linear raw camera RGB at the sensor (exposed, 1 = full

@@ -1,10 +1,13 @@
 //! One call from a photo file to its feature row: decode ─► find (or place) the chart ─►
-//! sample ─► features, confidence, flags and warnings; several photos in parallel.
+//! sample ─► features, confidence, flags and warnings; several photos in parallel. A photo
+//! may show several charts ([`analyse_places_telling_debug`]): one analysis per chart, each
+//! with its [`Place`].
 
-use super::detect::{detect_traced, from_corners, from_corners_any, no_chart};
+use super::detect::{detect_all, detect_traced, from_corners, from_corners_any, no_chart};
 use super::exposure::Exposure;
+use super::geometry::quad_centre;
 use super::load::{load_photo, Photo};
-use super::overlay::{debug_overlay_full, write_overlay};
+use super::overlay::{debug_overlay_full, write_overlay, Found};
 use super::raw::RawReading;
 use super::sample::{sample, PatchSample};
 use super::{ChartTemplate, Detection};
@@ -67,6 +70,31 @@ pub struct PhotoAnalysis {
     /// through the file's matrices); `None` for an encoded photo.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub raw: Option<RawReading>,
+    /// Where the chart lies among several in the photo; `None` when the photo shows one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub place: Option<Place>,
+}
+
+/// Where one chart of several lies in a photo: the light at that place.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Place {
+    /// 1-based, numbered from left to right by the charts' centres (the number the debug
+    /// image draws on the chart).
+    pub number: usize,
+    /// How many charts the photo shows.
+    pub of: usize,
+    /// The centre of the chart's patch grid, photo pixels.
+    pub centre: [f64; 2],
+}
+
+impl Place {
+    /// "place 2 of 3 (at 1200, 640 px)".
+    pub fn label(&self) -> String {
+        format!(
+            "place {} of {} (at {:.0}, {:.0} px)",
+            self.number, self.of, self.centre[0], self.centre[1]
+        )
+    }
 }
 
 impl PhotoAnalysis {
@@ -102,14 +130,92 @@ pub fn analyse_telling_debug(
     options: &AnalyseOptions,
 ) -> (Result<PhotoAnalysis>, Option<PathBuf>) {
     let mut written = None;
-    let result = analyse_decoded(photo, options, &mut written).map_err(|e| {
-        if photo.warnings.is_empty() {
-            e
-        } else {
-            Error::invalid(format!("{e}; note: {}", photo.warnings.join("; ")))
-        }
-    });
+    let result = analyse_decoded(photo, options, &mut written).map_err(|e| noted(photo, e));
     (result, written)
+}
+
+/// [`analyse_telling_debug`] for every chart the photo shows ([`detect_all`]): one analysis
+/// per chart, numbered from left to right, each with its [`Place`] when there are several;
+/// the debug image draws them all with their numbers. With corners given, the one chart
+/// they hold.
+pub fn analyse_places_telling_debug(
+    photo: &Photo,
+    options: &AnalyseOptions,
+) -> (Result<Vec<PhotoAnalysis>>, Option<PathBuf>) {
+    let mut written = None;
+    let result = analyse_places(photo, options, &mut written).map_err(|e| noted(photo, e));
+    (result, written)
+}
+
+/// An error about `photo` with what its decoder noticed.
+fn noted(photo: &Photo, e: Error) -> Error {
+    if photo.warnings.is_empty() {
+        e
+    } else {
+        Error::invalid(format!("{e}; note: {}", photo.warnings.join("; ")))
+    }
+}
+
+fn analyse_places(
+    photo: &Photo,
+    options: &AnalyseOptions,
+    written: &mut Option<PathBuf>,
+) -> Result<Vec<PhotoAnalysis>> {
+    if options.corners.is_some() {
+        return Ok(vec![analyse_decoded(photo, options, written)?]);
+    }
+    let templates = &options.templates;
+    if templates.is_empty() {
+        return Err(Error::invalid("no chart to look for"));
+    }
+    let (detections, trace) = detect_all(photo, templates)?;
+    if detections.is_empty() {
+        if let Some(path) = &options.debug {
+            write_overlay(path, &debug_overlay_full(photo, &[], Some(&trace)))?;
+            *written = Some(path.clone());
+        }
+        return Err(no_chart(photo, templates));
+    }
+    let mut sampled = Vec::with_capacity(detections.len());
+    for detection in detections {
+        let template = template_of(templates, &detection)?;
+        let (patches, raw) = sample(photo, template, &detection.map())?;
+        sampled.push((template, detection, patches, raw));
+    }
+    if let Some(path) = &options.debug {
+        let found: Vec<Found<'_>> = sampled
+            .iter()
+            .map(|(t, d, p, _)| (*t, d, p.as_slice()))
+            .collect();
+        write_overlay(path, &debug_overlay_full(photo, &found, None))?;
+        *written = Some(path.clone());
+    }
+    let of = sampled.len();
+    Ok(sampled
+        .into_iter()
+        .enumerate()
+        .map(|(k, (template, detection, patches, raw))| {
+            let place = (of > 1).then(|| Place {
+                number: k + 1,
+                of,
+                centre: quad_centre(&detection.corners),
+            });
+            let mut analysis = assemble(photo, template, detection, "detected", patches, raw);
+            analysis.place = place;
+            analysis
+        })
+        .collect())
+}
+
+/// The template of the chart `detection` found.
+fn template_of<'a>(
+    templates: &'a [ChartTemplate],
+    detection: &Detection,
+) -> Result<&'a ChartTemplate> {
+    templates
+        .iter()
+        .find(|t| t.name == detection.chart)
+        .ok_or_else(|| Error::invalid("detected chart has no template"))
 }
 
 fn analyse_decoded(
@@ -136,19 +242,16 @@ fn analyse_decoded(
     };
     let Some(detection) = detection else {
         if let Some(path) = &options.debug {
-            write_overlay(path, &debug_overlay_full(photo, None, trace.as_ref()))?;
+            write_overlay(path, &debug_overlay_full(photo, &[], trace.as_ref()))?;
             *written = Some(path.clone());
         }
         return Err(no_chart(photo, templates));
     };
-    let template = templates
-        .iter()
-        .find(|t| t.name == detection.chart)
-        .ok_or_else(|| Error::invalid("detected chart has no template"))?;
+    let template = template_of(templates, &detection)?;
     let h = detection.map();
     let (patches, raw) = sample(photo, template, &h)?;
     if let Some(path) = &options.debug {
-        let image = debug_overlay_full(photo, Some((template, &detection, &patches)), None);
+        let image = debug_overlay_full(photo, &[(template, &detection, &patches)], None);
         write_overlay(path, &image)?;
         *written = Some(path.clone());
     }
@@ -226,6 +329,7 @@ fn assemble(
         warnings,
         exposure: photo.exposure,
         raw,
+        place: None,
     }
 }
 

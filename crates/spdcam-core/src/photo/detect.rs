@@ -3,7 +3,7 @@
 //! lightness as their reflectances are (which any light keeps) and which covers the most
 //! candidates wins. Or, from four corners the user gives, the rotation by the same rule.
 
-use super::geometry::{sort_corners, Homography};
+use super::geometry::{quad_centre, quads_near, sort_corners, Homography};
 use super::lateral_ca::{self, ChannelScales};
 use super::lattice::{find_lattices, Lattice};
 use super::load::Photo;
@@ -136,24 +136,9 @@ pub fn detect_at(
             }
         }
     };
-    // The lens's colour fringes, measured once (a relative magnification holds at every
-    // level) and taken out of every level searched.
-    let mut fringes: Option<ChannelScales> = None;
-    // They are measured and undone in the camera's own RGB (see `lateral_ca`).
-    let mut aligned = |level: Level| {
-        if fringes.is_some_and(|s| s.is_negligible()) {
-            return level;
-        }
-        let camera = lateral_ca::to_camera(&level);
-        let scales = *fringes.get_or_insert_with(|| lateral_ca::measure(&camera));
-        if scales.is_negligible() {
-            level
-        } else {
-            lateral_ca::to_display(&lateral_ca::undo(&camera, scales))
-        }
-    };
+    let mut fringes = Fringes::default();
     loop {
-        let level = aligned(Level::new(photo, factor));
+        let level = fringes.align(Level::new(photo, factor));
         if let Some(found) = keep(search_traced(&level, factor as f64, templates, &mut trace)) {
             return Ok((
                 Some(refined(photo, templates, found, finest, Start::Fitted)),
@@ -168,7 +153,7 @@ pub fn detect_at(
     }
     // Charts whose patches are only a few pixels wide: the full-resolution photo enlarged.
     if factor == 1 && 4 * photo.width * photo.height <= MAX_SEARCH_PIXELS {
-        let level = aligned(Level::new(photo, 1)).enlarged();
+        let level = fringes.align(Level::new(photo, 1)).enlarged();
         if let Some(found) = keep(search_traced(&level, 0.5, templates, &mut trace)) {
             return Ok((
                 Some(refined(photo, templates, found, finest, Start::Fitted)),
@@ -178,6 +163,186 @@ pub fn detect_at(
     }
     let found = extrapolated.map(|d| refined(photo, templates, d, finest, Start::Extrapolated));
     Ok((found, trace))
+}
+
+/// The lens's colour fringes, measured once (a relative magnification holds at every level)
+/// and taken out of every level searched; they are measured and undone in the camera's own
+/// RGB (see [`lateral_ca`]).
+#[derive(Default)]
+struct Fringes {
+    scales: Option<ChannelScales>,
+}
+
+impl Fringes {
+    /// `level` with the fringes taken out (measured on the first level given).
+    fn align(&mut self, level: Level) -> Level {
+        if self.scales.is_some_and(|s| s.is_negligible()) {
+            return level;
+        }
+        let camera = lateral_ca::to_camera(&level);
+        let scales = *self
+            .scales
+            .get_or_insert_with(|| lateral_ca::measure(&camera));
+        if scales.is_negligible() {
+            level
+        } else {
+            lateral_ca::to_display(&lateral_ca::undo(&camera, scales))
+        }
+    }
+}
+
+/// Finds every chart of `templates` in `photo` that no better placement overlaps, numbered
+/// from left to right by their centres; empty when none reaches [`MIN_CONFIDENCE`]. The
+/// levels are searched as [`detect_traced`] searches them, coarsest first; once charts are
+/// found, a finer level is searched only while a lattice of patches lies outside them (a
+/// smaller chart may be there), so a photo of one chart costs about what [`detect`] costs.
+/// A placement found only by its support in the photo joins where no chart found by its
+/// patches lies.
+pub fn detect_all(
+    photo: &Photo,
+    templates: &[ChartTemplate],
+) -> Result<(Vec<Detection>, SearchTrace)> {
+    if templates.is_empty() {
+        return Err(Error::invalid("no chart template to look for"));
+    }
+    let finest = finest_factor(photo.width, photo.height);
+    let mut factor = Level::factor_for(photo.width, photo.height, DETECTION_SIZE).max(finest);
+    let mut trace = SearchTrace::default();
+    let mut fringes = Fringes::default();
+    let mut found: Vec<Detection> = Vec::new();
+    let mut extrapolated: Vec<Detection> = Vec::new();
+    let mut keep = |placed: Vec<(Detection, Start)>, found: &mut Vec<Detection>| {
+        for (d, start) in placed {
+            match start {
+                Start::Fitted => found.push(refined(photo, templates, d, finest, start)),
+                Start::Extrapolated => extrapolated.push(d),
+            }
+        }
+    };
+    loop {
+        let level = fringes.align(Level::new(photo, factor));
+        let (placed, more) = search_all(&level, factor as f64, templates, &found, &mut trace);
+        keep(placed, &mut found);
+        if factor <= finest || (!found.is_empty() && !more) {
+            break;
+        }
+        factor = (factor / 2).max(finest);
+    }
+    if found.is_empty() && factor == 1 && 4 * photo.width * photo.height <= MAX_SEARCH_PIXELS {
+        let level = fringes.align(Level::new(photo, 1)).enlarged();
+        let (placed, _) = search_all(&level, 0.5, templates, &found, &mut trace);
+        keep(placed, &mut found);
+    }
+    extrapolated.sort_by(|a, b| b.confidence.total_cmp(&a.confidence));
+    for d in extrapolated {
+        if !found
+            .iter()
+            .any(|f| quads_near(&f.corners, &d.corners, 0.0))
+        {
+            found.push(refined(photo, templates, d, finest, Start::Extrapolated));
+        }
+    }
+    found.sort_by(|a, b| {
+        let (ca, cb) = (quad_centre(&a.corners), quad_centre(&b.corners));
+        ca[0].total_cmp(&cb[0]).then(ca[1].total_cmp(&cb[1]))
+    });
+    Ok((found, trace))
+}
+
+/// Every confident placement on one level whose pixels are `scale` photo pixels wide that
+/// overlaps neither a better one nor one of `found` (photo pixels), best first, each with
+/// how its grid was placed; and whether a lattice of patches lies outside all of them.
+fn search_all(
+    level: &Level,
+    scale: f64,
+    templates: &[ChartTemplate],
+    found: &[Detection],
+    trace: &mut SearchTrace,
+) -> (Vec<(Detection, Start)>, bool) {
+    let blobs = find_blobs(level);
+    let lattices = find_lattices(&blobs, MIN_LATTICE);
+    let mut candidates: Vec<Candidate> = lattices
+        .iter()
+        .flat_map(|lattice| {
+            templates
+                .iter()
+                .enumerate()
+                .filter_map(|(ti, t)| place(level, &blobs, lattice, ti, t))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    if trace.blobs.is_empty() || !candidates.is_empty() {
+        trace.blobs = blobs
+            .iter()
+            .map(|b| ([b.centre[0] * scale, b.centre[1] * scale], b.side() * scale))
+            .collect();
+    }
+    for c in &mut candidates {
+        if c.confidence() < MIN_CONFIDENCE {
+            let t = &templates[c.template];
+            c.support = grid_support(level, &t.patch_squares(), &c.map);
+            let ring = grid_support(level, &ring_squares(t), &c.map);
+            c.ring = c.ring.max((ring / FULL_SUPPORT).clamp(0.0, 1.0));
+        }
+    }
+    candidates.sort_by(|a, b| b.score().total_cmp(&a.score()));
+    let outline = |c: &Candidate| {
+        let map = c.map.scaled_output(scale);
+        templates[c.template].corners().map(|p| map.apply(p))
+    };
+    if let Some(best) = candidates
+        .iter()
+        .max_by(|a, b| a.confidence().total_cmp(&b.confidence()))
+    {
+        let confidence = best.confidence();
+        if trace.best.as_ref().is_none_or(|b| confidence >= b.1) {
+            trace.best = Some((outline(best), confidence));
+        }
+    }
+    let mut placed: Vec<(Detection, Start)> = Vec::new();
+    for c in candidates
+        .iter()
+        .filter(|c| c.confidence() >= MIN_CONFIDENCE)
+    {
+        let corners = outline(c);
+        let taken = found
+            .iter()
+            .chain(placed.iter().map(|p| &p.0))
+            .any(|d| quads_near(&d.corners, &corners, 0.0));
+        if taken {
+            continue;
+        }
+        let start = if c.support > 0.0 {
+            Start::Extrapolated
+        } else {
+            Start::Fitted
+        };
+        let detection = Detection {
+            chart: templates[c.template].name.clone(),
+            corners,
+            homography: c.map.scaled_output(scale).to_rows(),
+            confidence: c.confidence(),
+        };
+        placed.push((detection, start));
+    }
+    let charts: Vec<[[f64; 2]; 4]> = found
+        .iter()
+        .chain(placed.iter().map(|p| &p.0))
+        .map(|d| d.corners)
+        .collect();
+    let outside = |p: [f64; 2]| {
+        let p = [p[0] * scale, p[1] * scale];
+        !charts.iter().any(|q| quads_near(q, &[p, p, p, p], 0.0))
+    };
+    let more = lattices.iter().any(|l| {
+        let out = l
+            .members
+            .iter()
+            .filter(|m| outside(blobs[m.0].centre))
+            .count();
+        out >= MIN_LATTICE && 2 * out > l.members.len()
+    });
+    (placed, more)
 }
 
 /// `found` with its corners refined on the photo ([`refine`]).

@@ -231,6 +231,41 @@ pub fn sort_corners(corners: &[[f64; 2]], width: usize, height: usize) -> Result
     Ok(out)
 }
 
+/// Whether two convex quadrilaterals come nearer than `gap` (photo pixels; 0: whether they
+/// overlap): they are apart when the projections on the normal of some side of one of them
+/// lie more than `gap` apart (the separating axis theorem, Gottschalk, Lin & Manocha 1996,
+/// "OBBTree", SIGGRAPH '96).
+pub fn quads_near(a: &[[f64; 2]; 4], b: &[[f64; 2]; 4], gap: f64) -> bool {
+    let separated_by = |poly: &[[f64; 2]; 4], other: &[[f64; 2]; 4]| {
+        (0..4).any(|k| {
+            let (p, q) = (poly[k], poly[(k + 1) % 4]);
+            let normal = [q[1] - p[1], p[0] - q[0]];
+            let norm = normal[0].hypot(normal[1]).max(1e-12);
+            let range = |points: &[[f64; 2]; 4]| {
+                points
+                    .iter()
+                    .map(|v| (v[0] * normal[0] + v[1] * normal[1]) / norm)
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                        (lo.min(x), hi.max(x))
+                    })
+            };
+            let (own_lo, own_hi) = range(poly);
+            let (lo, hi) = range(other);
+            lo > own_hi + gap || hi < own_lo - gap
+        })
+    };
+    !(separated_by(a, b) || separated_by(b, a))
+}
+
+/// The centre of a quadrilateral: the mean of its corners.
+pub fn quad_centre(corners: &[[f64; 2]; 4]) -> [f64; 2] {
+    let n = corners.len() as f64;
+    [
+        corners.iter().map(|p| p[0]).sum::<f64>() / n,
+        corners.iter().map(|p| p[1]).sum::<f64>() / n,
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -288,5 +323,26 @@ mod tests {
         assert!(dart.unwrap_err().to_string().contains("convex"));
         let three = sort_corners(&[[0.0, 0.0], [90.0, 0.0], [30.0, 30.0]], 100, 100);
         assert!(three.is_err());
+    }
+
+    #[test]
+    fn quadrilaterals_apart_touching_and_overlapping() {
+        let square = |x: f64, y: f64, side: f64| {
+            [[x, y], [x + side, y], [x + side, y + side], [x, y + side]]
+        };
+        let a = square(0.0, 0.0, 10.0);
+        // 5 px apart: near within a gap of 6, apart within 4.
+        let b = square(15.0, 0.0, 10.0);
+        assert!(quads_near(&a, &b, 6.0));
+        assert!(!quads_near(&a, &b, 4.0));
+        assert!(quads_near(&a, &square(5.0, 5.0, 10.0), 0.0));
+        // One inside the other.
+        assert!(quads_near(&a, &square(2.0, 2.0, 3.0), 0.0));
+        // A diamond whose side faces the square's corner 3/√2 px away: apart though their
+        // bounding boxes overlap.
+        let diamond = [[9.0, 14.0], [14.0, 9.0], [19.0, 14.0], [14.0, 19.0]];
+        assert!(!quads_near(&a, &diamond, 0.0));
+        assert!(quads_near(&a, &diamond, 2.5));
+        assert_eq!(quad_centre(&a), [5.0, 5.0]);
     }
 }

@@ -27,21 +27,23 @@ pub mod raw;
 mod refine;
 mod sample;
 pub mod scene;
+pub mod scene_places;
 mod segment;
 
 pub use batch::{
-    analyse, analyse_photo, analyse_telling_debug, debug_path, debug_paths, features_csv,
-    write_features_csv, AnalyseOptions, PhotoAnalysis,
+    analyse, analyse_photo, analyse_places_telling_debug, analyse_telling_debug, debug_path,
+    debug_paths, features_csv, write_features_csv, AnalyseOptions, PhotoAnalysis, Place,
 };
 pub use detect::{
-    detect, detect_at, detect_traced, from_corners, from_corners_any, SearchTrace, DETECTION_SIZE,
+    detect, detect_all, detect_at, detect_traced, from_corners, from_corners_any, SearchTrace,
+    DETECTION_SIZE,
 };
 pub use exposure::Exposure;
-pub use geometry::{sort_corners, Homography};
+pub use geometry::{quad_centre, quads_near, sort_corners, Homography};
 pub use lateral_ca::TYPICAL_CAMERA_TO_SRGB;
 pub use load::{decode_photo, jpeg_end, load_photo, JpegEnd, Photo, MIN_PHOTO_SIDE};
 pub use overlay::{
-    analysis_overlay_jpeg, debug_factor, debug_overlay, debug_overlay_full, write_overlay,
+    analysis_overlay_jpeg, debug_factor, debug_overlay, debug_overlay_full, write_overlay, Found,
     DEBUG_MAX_PIXELS, OVERLAY_SIZE,
 };
 pub(crate) use sample::DARK_LEVEL;

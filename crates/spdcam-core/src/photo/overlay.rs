@@ -1,9 +1,11 @@
 //! The debug image: the photo (at full resolution up to [`DEBUG_MAX_PIXELS`], else reduced
 //! by [`debug_factor`]; for a report reduced to at most [`OVERLAY_SIZE`] px), the chart's
-//! outline with its first corner marked, every sampled region with its patch number, and,
-//! when no chart was found, the patch candidates the search saw.
+//! outline with its first corner marked, every sampled region with its patch number, each
+//! chart's place number where a photo shows several, and, when no chart was found, the
+//! patch candidates the search saw.
 
 use super::detect::SearchTrace;
+use super::geometry::quad_centre;
 use super::load::Photo;
 use super::pyramid::Level;
 use super::sample::PatchSample;
@@ -32,6 +34,10 @@ const RED: [u8; 3] = [255, 32, 32];
 const WHITE: [u8; 3] = [255, 255, 255];
 const BLACK: [u8; 3] = [0, 0, 0];
 const YELLOW: [u8; 3] = [255, 220, 0];
+const CYAN: [u8; 3] = [0, 230, 255];
+
+/// A chart found and sampled: its template, its placement and its sampled patches.
+pub type Found<'a> = (&'a ChartTemplate, &'a Detection, &'a [PatchSample]);
 
 /// 3×5 bitmaps of the digits 0–9, one row per 3 bits (MSB left).
 const DIGITS: [[u8; 5]; 10] = [
@@ -116,13 +122,14 @@ impl Canvas {
     }
 }
 
-/// Draws the debug image reduced to about [`OVERLAY_SIZE`] px (for a report). With a
-/// detection: its outline (green, first corner marked yellow) and each sampled square
-/// (white; red when clipped) with its 1-based patch number. Without one: the candidates in
-/// `trace` (red squares) and the best rejected outline.
+/// Draws the debug image reduced to about [`OVERLAY_SIZE`] px (for a report). For each
+/// chart found: its outline (green, first corner marked yellow), each sampled square
+/// (white; red when clipped) with its 1-based patch number and, where there are several,
+/// its place number (1, 2, … as the output numbers them; large, cyan, at its centre).
+/// Without one: the candidates in `trace` (red squares) and the best rejected outline.
 pub fn debug_overlay(
     photo: &Photo,
-    found: Option<(&ChartTemplate, &Detection, &[PatchSample])>,
+    found: &[Found<'_>],
     trace: Option<&SearchTrace>,
 ) -> image::RgbImage {
     let factor = Level::factor_for(photo.width, photo.height, OVERLAY_SIZE);
@@ -134,7 +141,7 @@ pub fn debug_overlay(
 /// told apart.
 pub fn debug_overlay_full(
     photo: &Photo,
-    found: Option<(&ChartTemplate, &Detection, &[PatchSample])>,
+    found: &[Found<'_>],
     trace: Option<&SearchTrace>,
 ) -> image::RgbImage {
     draw_overlay(photo, found, trace, debug_factor(photo.width, photo.height))
@@ -142,7 +149,7 @@ pub fn debug_overlay_full(
 
 fn draw_overlay(
     photo: &Photo,
-    found: Option<(&ChartTemplate, &Detection, &[PatchSample])>,
+    found: &[Found<'_>],
     trace: Option<&SearchTrace>,
     factor: usize,
 ) -> image::RgbImage {
@@ -178,7 +185,7 @@ fn draw_overlay(
             canvas.polygon(&corners.map(down), thick, YELLOW);
         }
     }
-    if let Some((template, detection, samples)) = found {
+    for (k, &(template, detection, samples)) in found.iter().enumerate() {
         let h = detection.map();
         let pitch = {
             let a = down(h.apply([0.0, 0.0]));
@@ -197,6 +204,10 @@ fn draw_overlay(
             canvas.polygon(&square, 0, colour);
             canvas.number(sample.patch + 1, down(sample.centre), digit, colour);
         }
+        if found.len() > 1 {
+            let centre = down(quad_centre(&detection.corners));
+            canvas.number(k + 1, centre, (pitch / 5.0).max(3.0) as i64, CYAN);
+        }
     }
     image::RgbImage::from_raw(canvas.width as u32, canvas.height as u32, canvas.rgb)
         .unwrap_or_default()
@@ -212,7 +223,7 @@ pub fn analysis_overlay_jpeg(
     patches: &[PatchSample],
     max_width: u32,
 ) -> Result<Vec<u8>> {
-    let mut image = debug_overlay(photo, Some((template, detection, patches)), None);
+    let mut image = debug_overlay(photo, &[(template, detection, patches)], None);
     if image.width() > max_width && max_width > 0 {
         let height = (u64::from(image.height()) * u64::from(max_width) / u64::from(image.width()))
             .max(1) as u32;

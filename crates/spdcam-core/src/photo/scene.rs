@@ -281,26 +281,107 @@ fn develop_scene(
     seed: u64,
     options: &SceneOptions,
 ) -> Result<DevelopedScene> {
-    let (w, h) = (options.width, options.height);
-    check_scene_size(w, h)?;
-    if !(options.width_share.0 > 0.0
-        && options.width_share.0 <= options.width_share.1
-        && options.width_share.1 < 1.0)
-    {
-        return Err(Error::invalid(format!(
-            "the chart's share of the scene width {:?} must lie in (0, 1)",
-            options.width_share
-        )));
-    }
+    check_scene_size(options.width, options.height)?;
+    check_width_share(options.width_share)?;
     check_placement(options)?;
+    let mut rng = SmallRng::seed_from_u64(seed);
+    let laid = lay(camera, &mut rng, options)?;
+    let spds: Vec<&Spd> = std::iter::once(light.spd).chain(light.right_half).collect();
+    let exposed = camera.exposed_chart(&spds)?;
+    let mut scene = RgbImage::new(options.width, options.height);
+    scene.planes = background(
+        &mut rng,
+        options.width,
+        options.height,
+        chart_white(camera, &exposed[0]),
+    );
+    paint(&mut scene, camera, &laid, &exposed, options.shadow);
+    let patch_mean = camera::patch_mean(&exposed[0], camera.chart().reflectances.len());
+    let glow = options
+        .glow
+        .map(|g| (g, laid.corners[0], laid.grid_width_px(), patch_mean));
+    let (developed, vignetting, quality) =
+        develop_whole(camera, &mut scene, &mut rng, seed, options, glow)?;
+    let seen = Seen {
+        developer: camera,
+        vignetting,
+        glow,
+        gains: developed.white_balance_gains,
+        size: (options.width, options.height),
+    };
+    let expected_features = seen.features(camera, &laid, &exposed, options.shadow);
+    let right_lit = laid.right_lit(camera);
+    Ok(DevelopedScene {
+        image: developed.image,
+        mosaic: developed.mosaic,
+        quality,
+        corners: laid.corners,
+        patch_px: laid.patch_px,
+        expected_features,
+        inverse: laid.inverse,
+        canvas: (laid.canvas.0 as f64, laid.canvas.1 as f64),
+        right_lit,
+    })
+}
+
+/// A glow into the lens: the glow, its centre (photo px), its reference length (px) and the
+/// mean raw level it is a share of.
+pub(super) type GlowAt = (Glow, [f64; 2], f64, [f32; 3]);
+
+/// A chart's canvas laid into the photo.
+pub(super) struct Laid {
+    /// Chart canvas → photo.
+    pub(super) homography: Homography,
+    /// Photo → chart canvas.
+    pub(super) inverse: Homography,
+    /// Outer corners of the patch grid in the photo: TL, TR, BR, BL.
+    pub(super) corners: [[f64; 2]; 4],
+    /// Mean patch side in photo pixels.
+    pub(super) patch_px: f64,
+    /// The canvas's width and height in its own pixels.
+    pub(super) canvas: (usize, usize),
+}
+
+impl Laid {
+    /// The patch grid's top side in photo pixels.
+    pub(super) fn grid_width_px(&self) -> f64 {
+        let [a, b, ..] = self.corners;
+        (b[0] - a[0]).hypot(b[1] - a[1])
+    }
+
+    /// Per feature patch of `camera`'s chart: whether it lies on the canvas's right half.
+    fn right_lit(&self, camera: &Camera) -> Vec<bool> {
+        let layout = &camera.chart().layout;
+        let half = self.canvas.0 as f64 / 2.0;
+        camera
+            .chart()
+            .feature_patches
+            .iter()
+            .map(|&p| layout.patch_origin(p).0 as f64 + layout.patch_px as f64 / 2.0 >= half)
+            .collect()
+    }
+}
+
+/// Checks a drawn share of the photo's width a chart's patch grid spans.
+pub(super) fn check_width_share(share: (f64, f64)) -> Result<()> {
+    if share.0 > 0.0 && share.0 <= share.1 && share.1 < 1.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!(
+            "the chart's share of the scene width {share:?} must lie in (0, 1)"
+        )))
+    }
+}
+
+/// `camera`'s chart laid into the photo as `options` place it ([`placement`]).
+pub(super) fn lay(camera: &Camera, rng: &mut SmallRng, options: &SceneOptions) -> Result<Laid> {
     let chart = camera.chart();
     let template = ChartTemplate::from_chart(chart)?;
     let layout = &chart.layout;
-    let mut rng = SmallRng::seed_from_u64(seed);
     let (cw, ch) = (layout.width, layout.height);
     let grid_w = (layout.cols * layout.patch_px + (layout.cols - 1) * layout.gap_px) as f64;
     let grid_h = (layout.rows * layout.patch_px + (layout.rows - 1) * layout.gap_px) as f64;
-    let placed = placement(&mut rng, (cw as f64, ch as f64), grid_w, options)?;
+    let placed = placement(rng, (cw as f64, ch as f64), grid_w, options)?;
     let canvas = [
         [0.0, 0.0],
         [cw as f64, 0.0],
@@ -319,38 +400,53 @@ fn develop_scene(
         [gx, gy + grid_h],
     ]
     .map(|p| homography.apply(p));
-    let area = 0.5
-        * (0..4)
-            .map(|k| {
-                corners[k][0] * corners[(k + 1) % 4][1] - corners[(k + 1) % 4][0] * corners[k][1]
-            })
-            .sum::<f64>()
-            .abs();
     let (tw, th) = template.size();
-    let patch_px = template.patch_fraction * (area / (tw * th)).sqrt();
+    let patch_px = template.patch_fraction * (quad_area(&corners) / (tw * th)).sqrt();
+    Ok(Laid {
+        homography,
+        inverse,
+        corners,
+        patch_px,
+        canvas: (cw, ch),
+    })
+}
 
-    let spds: Vec<&Spd> = std::iter::once(light.spd).chain(light.right_half).collect();
-    let exposed = camera.exposed_chart(&spds)?;
-    let patches = chart.reflectances.len();
-    // The light's colour on the chart's whitest surface tints the background.
-    let white = [0, 1, 2].map(|c| {
-        exposed[0][..patches]
-            .iter()
-            .map(|v| v[c])
-            .fold(0.0, f32::max)
-    });
-    let mut scene = RgbImage::new(w, h);
-    scene.planes = background(&mut rng, w, h, white);
-    let region_map = layout.region_map();
+/// The area of a simple quadrilateral (shoelace formula).
+pub(super) fn quad_area(corners: &[[f64; 2]; 4]) -> f64 {
+    0.5 * (0..4)
+        .map(|k| corners[k][0] * corners[(k + 1) % 4][1] - corners[(k + 1) % 4][0] * corners[k][1])
+        .sum::<f64>()
+        .abs()
+}
+
+/// The raw value of the chart's whitest surface under its light (`exposed`, per region),
+/// which tints the background.
+pub(super) fn chart_white(camera: &Camera, exposed: &[[f32; 3]]) -> [f32; 3] {
+    let patches = camera.chart().reflectances.len();
+    [0, 1, 2].map(|c| exposed[..patches].iter().map(|v| v[c]).fold(0.0, f32::max))
+}
+
+/// Paints `camera`'s chart, laid by `laid`, into the raw `scene`: each canvas pixel the
+/// exposed value of its region (`exposed[0]`, or the last light on the canvas's right
+/// half), bilinear between canvas pixels, dimmed by `shadow`.
+pub(super) fn paint(
+    scene: &mut RgbImage,
+    camera: &Camera,
+    laid: &Laid,
+    exposed: &[Vec<[f32; 3]>],
+    shadow: Option<Shadow>,
+) {
+    let (w, h) = (scene.width, scene.height);
+    let (cw, ch) = laid.canvas;
+    let region_map = camera.chart().layout.region_map();
     let half = cw as f64 / 2.0;
-    let shade = |u: f64, v: f64| {
-        options
-            .shadow
-            .map_or(1.0, |sh| sh.light_at(u / cw as f64, v / ch as f64) as f32)
-    };
-    for y in 0..h {
-        for x in 0..w {
-            let q = inverse.apply([x as f64 + 0.5, y as f64 + 0.5]);
+    let shade =
+        |u: f64, v: f64| shadow.map_or(1.0, |sh| sh.light_at(u / cw as f64, v / ch as f64) as f32);
+    // Only the photo pixels inside the canvas's outline are visited.
+    let xs = laid.homography_bounds(w, h);
+    for y in xs.1.clone() {
+        for x in xs.0.clone() {
+            let q = laid.inverse.apply([x as f64 + 0.5, y as f64 + 0.5]);
             let (u, v) = (q[0] - 0.5, q[1] - 0.5);
             if !(u >= 0.0 && v >= 0.0 && u <= (cw - 1) as f64 && v <= (ch - 1) as f64) {
                 continue;
@@ -375,69 +471,118 @@ fn develop_scene(
             }
         }
     }
-    let patch_mean = camera::patch_mean(&exposed[0], patches);
-    let grid_width_px =
-        ((corners[1][0] - corners[0][0]).powi(2) + (corners[1][1] - corners[0][1]).powi(2)).sqrt();
-    let glow_at = |p: [f64; 2]| {
-        options
-            .glow
-            .map_or(0.0, |g| g.share_at(p, corners[0], grid_width_px))
-    };
-    if let Some(glow) = &options.glow {
-        glow.apply(&mut scene, corners[0], patch_mean, grid_width_px);
+}
+
+impl Laid {
+    /// The photo's pixel columns and rows the canvas's outline covers (clipped to the
+    /// photo).
+    fn homography_bounds(
+        &self,
+        w: usize,
+        h: usize,
+    ) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+        let (cw, ch) = (self.canvas.0 as f64, self.canvas.1 as f64);
+        let outline =
+            [[0.0, 0.0], [cw, 0.0], [cw, ch], [0.0, ch]].map(|p| self.homography.apply(p));
+        let span = |axis: usize, size: usize| {
+            let lo = outline
+                .iter()
+                .map(|p| p[axis])
+                .fold(f64::INFINITY, f64::min);
+            let hi = outline
+                .iter()
+                .map(|p| p[axis])
+                .fold(f64::NEG_INFINITY, f64::max);
+            let lo = (lo.floor() - 1.0).clamp(0.0, size as f64) as usize;
+            let hi = (hi.ceil() + 1.0).clamp(0.0, size as f64) as usize;
+            lo..hi
+        };
+        (span(0, w), span(1, h))
+    }
+}
+
+/// The lens and the camera over the painted scene: the glow (if any), blur and vignetting
+/// drawn from `rng`, development by `camera`, then the JPEG quality drawn; the developed
+/// photo, its vignetting and the quality.
+pub(super) fn develop_whole(
+    camera: &Camera,
+    scene: &mut RgbImage,
+    rng: &mut SmallRng,
+    seed: u64,
+    options: &SceneOptions,
+    glow: Option<GlowAt>,
+) -> Result<(camera::Developed, Vignetting, u8)> {
+    if let Some((g, centre, length, mean)) = glow {
+        g.apply(scene, centre, mean, length);
     }
     let blur = LensBlur {
-        sigma: draw(&mut rng, options.blur_sigma),
+        sigma: draw(rng, options.blur_sigma),
     };
-    blur.apply(&mut scene);
+    blur.apply(scene);
     let vignetting = Vignetting {
-        strength: draw(&mut rng, options.vignetting),
+        strength: draw(rng, options.vignetting),
     };
-    vignetting.apply(&mut scene);
-    let developed = camera.develop(&scene, seed::derive(seed, 1));
+    vignetting.apply(scene);
+    let developed = camera.develop(scene, seed::derive(seed, 1));
     let (q0, q1) = options.jpeg_quality;
     let quality = rng.random_range(q0.clamp(1, 100)..=q1.clamp(q0.clamp(1, 100), 100));
-    let gains = developed.white_balance_gains;
-    let expected_features = chart
-        .feature_patches
-        .iter()
-        .flat_map(|&p| {
-            let (px, py) = layout.patch_origin(p);
-            let centre = layout.patch_px as f64 / 2.0;
-            let canvas_centre = [px as f64 + centre, py as f64 + centre];
-            let at = homography.apply(canvas_centre);
-            let lit = if canvas_centre[0] >= half {
-                exposed.len() - 1
-            } else {
-                0
-            };
-            let g = vignetting.gain(at, w, h) as f32;
-            let glow = glow_at(at) as f32;
-            let light = shade(canvas_centre[0], canvas_centre[1]);
-            let raw: [f32; 3] =
-                std::array::from_fn(|c| (exposed[lit][p][c] * light + glow * patch_mean[c]) * g);
-            camera.encode_exposed(raw, gains).map(|v| 255.0 * v)
-        })
-        .collect();
-    let right_lit = chart
-        .feature_patches
-        .iter()
-        .map(|&p| {
-            let (px, _) = layout.patch_origin(p);
-            px as f64 + layout.patch_px as f64 / 2.0 >= half
-        })
-        .collect();
-    Ok(DevelopedScene {
-        image: developed.image,
-        mosaic: developed.mosaic,
-        quality,
-        corners,
-        patch_px,
-        expected_features,
-        inverse,
-        canvas: (cw as f64, ch as f64),
-        right_lit,
-    })
+    Ok((developed, vignetting, quality))
+}
+
+/// How the developed photo shows a flat patch: the camera that developed it, its
+/// vignetting and glow, its white balance and the photo's size.
+pub(super) struct Seen<'a> {
+    pub(super) developer: &'a Camera,
+    pub(super) vignetting: Vignetting,
+    pub(super) glow: Option<GlowAt>,
+    pub(super) gains: [f32; 3],
+    pub(super) size: (usize, usize),
+}
+
+impl Seen<'_> {
+    /// Each feature patch of `camera`'s chart (laid by `laid`, exposed as `exposed`,
+    /// shaded by `shadow`) as a flat, noise-free, unblurred patch shows at its centre
+    /// (encoded sRGB, 0–255).
+    pub(super) fn features(
+        &self,
+        camera: &Camera,
+        laid: &Laid,
+        exposed: &[Vec<[f32; 3]>],
+        shadow: Option<Shadow>,
+    ) -> Vec<f32> {
+        let chart = camera.chart();
+        let layout = &chart.layout;
+        let (cw, ch) = laid.canvas;
+        let half = cw as f64 / 2.0;
+        chart
+            .feature_patches
+            .iter()
+            .flat_map(|&p| {
+                let (px, py) = layout.patch_origin(p);
+                let centre = layout.patch_px as f64 / 2.0;
+                let canvas_centre = [px as f64 + centre, py as f64 + centre];
+                let at = laid.homography.apply(canvas_centre);
+                let lit = if canvas_centre[0] >= half {
+                    exposed.len() - 1
+                } else {
+                    0
+                };
+                let g = self.vignetting.gain(at, self.size.0, self.size.1) as f32;
+                let (glow, mean) = match self.glow {
+                    Some((glow, c, length, mean)) => (glow.share_at(at, c, length) as f32, mean),
+                    None => (0.0, [0.0; 3]),
+                };
+                let light = shadow.map_or(1.0, |sh| {
+                    sh.light_at(canvas_centre[0] / cw as f64, canvas_centre[1] / ch as f64) as f32
+                });
+                let raw: [f32; 3] =
+                    std::array::from_fn(|c| (exposed[lit][p][c] * light + glow * mean[c]) * g);
+                self.developer
+                    .encode_exposed(raw, self.gains)
+                    .map(|v| 255.0 * v)
+            })
+            .collect()
+    }
 }
 
 fn draw(rng: &mut SmallRng, (lo, hi): (f64, f64)) -> f64 {
@@ -529,7 +674,7 @@ fn placement(
 
 /// Checks the placement options: the centre inside the photo, the rotation finite, the tilt
 /// within ±[`MAX_TILT_DEG`], the shadow's factor in (0, 1) and cover in [0, 1].
-fn check_placement(options: &SceneOptions) -> Result<()> {
+pub(super) fn check_placement(options: &SceneOptions) -> Result<()> {
     if let Some([x, y]) = options.centre {
         if !((0.0..=1.0).contains(&x) && (0.0..=1.0).contains(&y)) {
             return Err(Error::invalid(format!(
@@ -594,7 +739,7 @@ fn value_noise(rng: &mut SmallRng, w: usize, h: usize, cell: usize) -> Vec<f32> 
 /// Raw background: two octaves of value noise in colour, with clutter (random rectangles,
 /// some of them square tiles, and discs), reflecting 1–70 % of `white`, the raw value of a
 /// white surface under the scene's light.
-fn background(rng: &mut SmallRng, w: usize, h: usize, white: [f32; 3]) -> [Vec<f32>; 3] {
+pub(super) fn background(rng: &mut SmallRng, w: usize, h: usize, white: [f32; 3]) -> [Vec<f32>; 3] {
     let mut planes: [Vec<f32>; 3] = std::array::from_fn(|_| {
         let (coarse, fine) = (rng.random_range(40..200), rng.random_range(5..20));
         let a = value_noise(rng, w, h, coarse);

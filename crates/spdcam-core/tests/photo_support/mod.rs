@@ -70,6 +70,13 @@ impl ChartSetup {
     }
 }
 
+impl ChartSetup {
+    /// The ideal camera with automatic white balance, photographing this chart.
+    pub fn camera(&self) -> &Camera {
+        &self.cameras[0]
+    }
+}
+
 /// The ColorChecker 24 (built in).
 pub fn colorchecker24() -> ChartSetup {
     ChartSetup::new(Chart::colorchecker24(&GRID).unwrap(), (0.1, 0.6))
