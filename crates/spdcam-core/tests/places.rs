@@ -104,7 +104,7 @@ fn two_charts_under_two_lights_are_both_found() {
         },
     ];
     let (shot, photo) = shoot(&places, 1);
-    let (found, _) = detect_all(&photo, &[cc.template.clone()]).unwrap();
+    let (found, _) = detect_all(&photo, std::slice::from_ref(&cc.template)).unwrap();
     assert_found(&found, &shot, "two charts");
 }
 
@@ -141,7 +141,7 @@ fn small_and_tilted_charts_are_found_beside_a_large_one() {
         },
     ];
     let (shot, photo) = shoot(&places, 2);
-    let (found, _) = detect_all(&photo, &[cc.template.clone()]).unwrap();
+    let (found, _) = detect_all(&photo, std::slice::from_ref(&cc.template)).unwrap();
     assert_found(&found, &shot, "three charts");
     // One light at two levels: the second chart's light is half the first's.
     assert!((shot.places[1].relative_illuminance - 0.5).abs() < 1e-9);
