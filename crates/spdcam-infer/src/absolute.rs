@@ -92,52 +92,17 @@ pub fn absolute_level(
             "the reflectances of {chart_name} are not at hand (the data directory holds them)"
         )));
     };
-    let grid = spd.grid();
-    chart
-        .reflectances
-        .require_grid(grid, "the chart of the absolute levels")?;
-    let observer = Observer::cie1931(grid)?;
-    let patches = chart.feature_patches.len();
-    if analysis.features.len() != 3 * patches {
-        return Ok(Err(format!(
-            "the photo's features are not those of {chart_name}"
-        )));
-    }
-    let mut found: Vec<(usize, f64)> = chart
-        .neutral_features()
-        .into_iter()
-        .filter(|&(k, _)| !unusable.get(k).copied().unwrap_or(false))
-        .filter_map(|(k, _)| {
-            let refl = chart.reflectances.item(chart.feature_patches[k]);
-            let rgb = &analysis.features[3 * k..3 * k + 3];
-            let y: f64 = [0.2126, 0.7152, 0.0722]
-                .iter()
-                .zip(rgb)
-                .map(|(w, &v)| w * srgb_decode(f64::from(v) / 255.0))
-                .sum();
-            if !(USABLE_VALUES.0..=USABLE_VALUES.1).contains(&y) {
-                return None;
-            }
-            let factor = observer.reflectance_to_xyz(refl, spd)[1];
-            (factor > 0.0 && factor.is_finite())
-                .then(|| (k + 1, std::f64::consts::PI * exposure.luminance(y) / factor))
-        })
-        .collect();
-    if found.is_empty() {
-        return Ok(Err(format!(
-            "no neutral patch of {chart_name} is rendered between {} and {} of white without clipping",
-            USABLE_VALUES.0, USABLE_VALUES.1
-        )));
-    }
-    let mut values: Vec<f64> = found.iter().map(|p| p.1).collect();
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    let illuminance_lux = if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
+    let level = match chart_level(analysis, chart_name, chart, spd, unusable)? {
+        Ok(level) => level,
+        Err(reason) => return Ok(Err(reason)),
     };
-    found.sort_by_key(|p| p.0);
+    // The luminance is linear in the linear value: each patch's illuminance and the median
+    // are the level's, scaled.
+    let lux = |ratio: f64| std::f64::consts::PI * exposure.luminance(ratio);
+    let illuminance_lux = lux(level.level);
+    let found: Vec<(usize, f64)> = level.patches.iter().map(|&(k, r)| (k, lux(r))).collect();
+    let grid = spd.grid();
+    let observer = Observer::cie1931(grid)?;
     let luminous: f64 = observer
         .cmf(1)
         .iter()
@@ -155,5 +120,91 @@ pub fn absolute_level(
         exposure,
         patches: found,
         note: APPROXIMATE,
+    }))
+}
+
+/// The light's level on a chart in the photo's linear units, and the patches it was read
+/// from.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChartLevel {
+    /// The median over the patches used of y / ρ_Y (see [`chart_level`]).
+    pub level: f64,
+    /// The neutral feature patches used (1-based feature numbers), each with its y / ρ_Y.
+    pub patches: Vec<(usize, f64)>,
+}
+
+/// The light's level on the chart of `analysis` in the photo's linear units: over the
+/// chart's neutral feature patches that are usable (not `unusable`: clipped or dark), the
+/// median of y / ρ_Y, where ρ_Y is the patch's luminance factor under `spd` and y its linear
+/// value: for an encoded photo its sRGB-decoded luminance (0–1 of white), counted only
+/// between 0.05 and 0.6 of white where tone curves are nearest linear; for a raw photo the
+/// sensor's green channel read on the mosaic (linear, before any development). The charts
+/// of one photo share its exposure, so the ratio of two charts' levels is the ratio of the
+/// light on them. The reason instead when no patch can be used.
+pub fn chart_level(
+    analysis: &PhotoAnalysis,
+    chart_name: &str,
+    chart: &Chart,
+    spd: &Spd,
+    unusable: &[bool],
+) -> Result<std::result::Result<ChartLevel, String>> {
+    let grid = spd.grid();
+    chart
+        .reflectances
+        .require_grid(grid, "the chart of the light's level")?;
+    let observer = Observer::cie1931(grid)?;
+    let patches = chart.feature_patches.len();
+    if analysis.features.len() != 3 * patches {
+        return Ok(Err(format!(
+            "the photo's features are not those of {chart_name}"
+        )));
+    }
+    let raw = analysis.raw.is_some();
+    let mut found: Vec<(usize, f64)> = chart
+        .neutral_features()
+        .into_iter()
+        .filter(|&(k, _)| !unusable.get(k).copied().unwrap_or(false))
+        .filter_map(|(k, _)| {
+            let patch = chart.feature_patches[k];
+            let y = if raw {
+                f64::from(analysis.patches.get(patch)?.camera_rgb?[1])
+            } else {
+                let rgb = &analysis.features[3 * k..3 * k + 3];
+                let y: f64 = [0.2126, 0.7152, 0.0722]
+                    .iter()
+                    .zip(rgb)
+                    .map(|(w, &v)| w * srgb_decode(f64::from(v) / 255.0))
+                    .sum();
+                (USABLE_VALUES.0..=USABLE_VALUES.1)
+                    .contains(&y)
+                    .then_some(y)?
+            };
+            let factor = observer.reflectance_to_xyz(chart.reflectances.item(patch), spd)[1];
+            (factor > 0.0 && factor.is_finite() && y > 0.0).then(|| (k + 1, y / factor))
+        })
+        .collect();
+    if found.is_empty() {
+        return Ok(Err(if raw {
+            format!("no neutral patch of {chart_name} is read on the sensor without clipping")
+        } else {
+            format!(
+                "no neutral patch of {chart_name} is rendered between {} and {} of white \
+                 without clipping",
+                USABLE_VALUES.0, USABLE_VALUES.1
+            )
+        }));
+    }
+    let mut values: Vec<f64> = found.iter().map(|p| p.1).collect();
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    let level = if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    };
+    found.sort_by_key(|p| p.0);
+    Ok(Ok(ChartLevel {
+        level,
+        patches: found,
     }))
 }

@@ -10,6 +10,7 @@
 
 use crate::absolute::Absolute;
 use crate::error::{InferError, Result};
+use crate::places::LightAcrossPlaces;
 use crate::trust::Trust;
 use serde::Serialize;
 use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
@@ -149,6 +150,13 @@ pub struct Estimate {
     /// For photos: the approximate absolute levels from the EXIF exposure, or why there are
     /// none.
     pub absolute: Option<Absolute>,
+    /// For photos: the light's level on the chart in the photo's linear units
+    /// ([`crate::absolute::chart_level`]), comparable between the charts of one photo;
+    /// `None` when it could not be read.
+    pub light_level: Option<f64>,
+    /// For one of several charts in a photo: how the light compares across its places
+    /// ([`crate::places`]), the same on each of them.
+    pub across_places: Option<LightAcrossPlaces>,
 }
 
 impl Estimate {
@@ -163,7 +171,9 @@ impl Estimate {
     /// half95}} for the single-number metrics), the last five null without a calibration. Photo estimates add
     /// `absolute` (approximate illuminance, PPFD, melanopic EDI and spectral irradiance from
     /// the EXIF exposure, see [`crate::absolute`]) or, when there is none, `absolute: null`
-    /// and `absolute_reason`.
+    /// and `absolute_reason`, and `light_level` (the chart's level in the photo's linear
+    /// units, or null); one of several charts in a photo has `photo.place` ({number, of,
+    /// centre}) and `across_places` (see [`crate::places::LightAcrossPlaces`]).
     pub fn to_json(&self) -> Result<serde_json::Value> {
         let mut v = serde_json::json!({
             "name": self.name,
@@ -179,6 +189,10 @@ impl Estimate {
         }
         if let Some(a) = &self.photo {
             v["photo"] = analysis_json(a)?;
+            v["light_level"] = serde_json::json!(self.light_level);
+        }
+        if let Some(across) = &self.across_places {
+            v["across_places"] = serde_json::json!(across);
         }
         match &self.absolute {
             Some(Ok(level)) => v["absolute"] = serde_json::json!(level),

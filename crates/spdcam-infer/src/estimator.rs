@@ -16,13 +16,14 @@
 //! The command line, the web app and the Python package all estimate through it, so the
 //! same photo or row gives the same SPD and the same verdict in each.
 
-use crate::absolute::absolute_level;
+use crate::absolute::{absolute_level, chart_level};
 use crate::error::{InferError, Result};
 use crate::estimate::{Colorimetry, Estimate};
 use crate::feature_rows::FeatureRows;
 use crate::kind_prior::{self, KindPriors};
 use crate::measured_colour;
 use crate::photo_options::{chart_templates, PhotoOptions};
+use crate::places;
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, row_name, FeatureStream, GridMap};
 use crate::trust::{
@@ -420,8 +421,10 @@ impl Estimator {
 
     /// Photo files the whole way, in one call: each analysed (in parallel; one bad photo
     /// does not cost the others), then estimated by the model for its chart, labelled with
-    /// its file name (its path where names repeat). One [`PhotoEstimate`] per photo, in
-    /// order: the analysis, the debug image written for it and the estimate. `progress`
+    /// its file name (its path where names repeat). One [`PhotoEstimate`] per chart found
+    /// (every chart of a photo that shows several, each labelled `NAME place K` and compared
+    /// with the others, [`crate::places`]), or per photo that could not be used, in order:
+    /// the analysis, the debug image written for it and the estimate. `progress`
     /// hears of each step ([`PhotoProgress`]) so that a front end prints between them; an
     /// error it returns stops the work.
     pub fn estimate_photos<E: From<InferError>>(
@@ -439,24 +442,35 @@ impl Estimator {
         }
         let templates = self.templates(options.chart.as_deref())?;
         let debug = options.debug.as_ref().map(|d| debug_paths(d, paths));
-        let mut photos: Vec<PhotoEstimate> = paths
+        let per_photo: Vec<Vec<PhotoEstimate>> = paths
             .par_iter()
             .enumerate()
             .map(|(i, path)| {
                 let debug = debug.as_ref().map(|d| d[i].clone());
-                match photo::load_photo(path) {
-                    Ok(decoded) => self.analyse_with(&decoded, options, templates.clone(), debug),
-                    Err(e) => PhotoEstimate::unusable(e.into()),
-                }
+                let mut found = match photo::load_photo(path) {
+                    Ok(decoded) => {
+                        self.analyse_places_with(&decoded, options, templates.clone(), debug)
+                    }
+                    Err(e) => vec![PhotoEstimate::unusable(e.into())],
+                };
+                found.iter_mut().for_each(|p| p.photo = i);
+                found
             })
             .collect();
+        let mut photos: Vec<PhotoEstimate> = per_photo.into_iter().flatten().collect();
         progress(PhotoProgress::Analysed(&photos))?;
-        for (photo, label) in photos.iter_mut().zip(photo_labels(paths)) {
+        let labels = photo_labels(paths);
+        for photo in &mut photos {
             if let Ok(analysed) = &photo.analysed {
                 progress(PhotoProgress::Estimating(&analysed.analysis))?;
+                let label = match analysed.analysis.place {
+                    Some(place) => format!("{} place {}", labels[photo.photo], place.number),
+                    None => labels[photo.photo].clone(),
+                };
                 self.estimate_analysed(photo, label);
             }
         }
+        compare_photo_places(&mut photos);
         Ok(photos)
     }
 
@@ -547,7 +561,61 @@ impl Estimator {
             analysed,
             estimate: None,
             identified,
+            photo: 0,
         }
+    }
+
+    /// [`Estimator::analyse_with`] for every chart the photo shows (`options.corners`: the
+    /// one they hold): one [`PhotoEstimate`] per chart, the debug image (drawing them all)
+    /// on the first. A chart whose patches are refused as not the chart keeps its refusal.
+    fn analyse_places_with(
+        &self,
+        photo: &Photo,
+        options: &PhotoOptions,
+        templates: Vec<ChartTemplate>,
+        debug: Option<PathBuf>,
+    ) -> Vec<PhotoEstimate> {
+        if options.corners.is_some() {
+            return vec![self.analyse_with(photo, options, templates, debug)];
+        }
+        let analyse = AnalyseOptions {
+            templates,
+            corners: None,
+            debug,
+        };
+        let (analyses, debug) = photo::analyse_places_telling_debug(photo, &analyse);
+        let analyses = match analyses {
+            Ok(analyses) => analyses,
+            Err(e) => {
+                let mut unusable = PhotoEstimate::unusable(e.into());
+                unusable.debug = debug;
+                return vec![unusable];
+            }
+        };
+        let mut debug = debug;
+        analyses
+            .into_iter()
+            .map(|analysis| {
+                let mut identified = None;
+                let analysed = self.refuse_not_the_chart(&analysis).and_then(|found| {
+                    identified = found.map(Carried);
+                    let overlay = match options.overlay_width {
+                        Some(width) => {
+                            Some(overlay_of(photo, &analyse.templates, &analysis, width)?)
+                        }
+                        None => None,
+                    };
+                    Ok(AnalysedPhoto { analysis, overlay })
+                });
+                PhotoEstimate {
+                    debug: debug.take(),
+                    analysed,
+                    estimate: None,
+                    identified,
+                    photo: 0,
+                }
+            })
+            .collect()
     }
 
     /// The estimate for an analysed photo, by the model for the chart it shows, labelled
@@ -986,25 +1054,27 @@ impl Estimator {
                 measured_colour::set_intervals(&mut u.metrics, cct);
             }
         }
+        let unusable: Vec<bool> = (0..flags.clipped.len())
+            .map(|k| flags.clipped[k] || flags.dark.get(k).copied().unwrap_or(false))
+            .collect();
+        let chart_name = chosen.model.header().chart.as_deref();
+        let reflectances = self.prepared.charts[index].as_deref();
         let absolute = match &photo {
-            Some(analysis) => {
-                let unusable: Vec<bool> = (0..flags.clipped.len())
-                    .map(|k| flags.clipped[k] || flags.dark.get(k).copied().unwrap_or(false))
-                    .collect();
-                let chart = chosen.model.header().chart.as_deref();
-                Some(match chart {
-                    Some(chart) => absolute_level(
-                        analysis,
-                        chart,
-                        self.prepared.charts[index].as_deref(),
-                        &full,
-                        &metrics,
-                        &unusable,
-                    )?,
-                    None => Err("the model names no chart".into()),
-                })
-            }
+            Some(analysis) => Some(match chart_name {
+                Some(chart) => {
+                    absolute_level(analysis, chart, reflectances, &full, &metrics, &unusable)?
+                }
+                None => Err("the model names no chart".into()),
+            }),
             None => None,
+        };
+        let light_level = match (&photo, chart_name, reflectances) {
+            (Some(analysis), Some(name), Some(chart)) => {
+                chart_level(analysis, name, chart, &full, &unusable)?
+                    .ok()
+                    .map(|l| l.level)
+            }
+            _ => None,
         };
         Ok(Estimate {
             name,
@@ -1017,6 +1087,8 @@ impl Estimator {
             photo,
             trust: Some(trust),
             absolute,
+            light_level,
+            across_places: None,
         })
     }
 
@@ -1103,6 +1175,29 @@ fn overlay_of(
         &analysis.patches,
         width,
     )?)
+}
+
+/// Sets the comparison across places ([`crate::places::compare_places`]) on every estimate
+/// made of a photo with several charts.
+fn compare_photo_places(photos: &mut [PhotoEstimate]) {
+    let mut made: Vec<Estimate> = photos
+        .iter_mut()
+        .filter_map(|p| match p.estimate.take() {
+            Some(Ok(e)) => Some(e),
+            other => {
+                p.estimate = other;
+                None
+            }
+        })
+        .collect();
+    places::compare_places(&mut made);
+    let mut made = made.into_iter();
+    for p in photos
+        .iter_mut()
+        .filter(|p| p.estimate.is_none() && p.analysed.is_ok())
+    {
+        p.estimate = made.next().map(Ok);
+    }
 }
 
 /// Where the patches of `analysis` came from: corners placed by hand, or detection.
@@ -1192,6 +1287,10 @@ pub struct PhotoEstimate {
     pub estimate: Option<Result<Estimate>>,
     /// What checking the analysis identified (the model's SPD among it), for the estimate.
     identified: Option<Carried>,
+    /// The photo's position (0-based) among the paths given to
+    /// [`Estimator::estimate_photos`] (0 for a single photo): several charts of one photo
+    /// share it.
+    pub photo: usize,
 }
 
 impl PhotoEstimate {
@@ -1201,6 +1300,7 @@ impl PhotoEstimate {
             analysed: Err(error),
             estimate: None,
             identified: None,
+            photo: 0,
         }
     }
 

@@ -27,7 +27,9 @@
 //!   it), [`colour_map`] (a white light's CCT and Duv corrected as learnt on validation
 //!   photos), [`measured_colour`] (the light's chromaticity a raw photo measured, given to
 //!   the spectrum), [`kind_prior`] (the estimate kept among lights of the kind a person names) and
-//!   [`absolute`] (approximate absolute levels from the photo's EXIF exposure).
+//!   [`absolute`] (approximate absolute levels from the photo's EXIF exposure, and the
+//!   chart's linear level they rest on); [`places`]: the light compared across the charts
+//!   of one photo.
 //! - [`trust`]: how far an estimate can be trusted (self-check with the glare read on the
 //!   chart, uncertainty bands, verdict); [`presentation`]: what an estimate means in words and rounded numbers
 //!   ([`meaningful`]: which metrics mean anything for the light);
@@ -88,6 +90,7 @@ pub mod model;
 pub mod network;
 pub mod pca;
 pub mod photo_options;
+pub mod places;
 pub mod plot;
 pub mod presentation;
 pub mod record;

@@ -44,6 +44,8 @@ pub(crate) fn estimate_of(spd: Spd, halves: &[(&str, f64)]) -> Estimate {
             }),
         }),
         absolute: None,
+        light_level: None,
+        across_places: None,
         spd,
     }
 }

@@ -73,6 +73,10 @@ pub fn describe(analysis: &PhotoAnalysis) -> String {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| analysis.source.clone());
+    let name = match analysis.place {
+        Some(place) => format!("{name} {}", place.label()),
+        None => name,
+    };
     let line = format!(
         "{name}: {} {} (confidence {:.2}), {} patches sampled",
         shown_chart_name(&analysis.chart),

@@ -18,7 +18,9 @@ use anyhow::{bail, Result};
 use clap::Args;
 use features::run_features;
 use photos::{estimate_from_photos, PhotoEstimates};
-use print::{print_estimates, report_item, verdicts_to_stderr, with_bands, write_report};
+use print::{
+    print_estimates, print_places, report_item, verdicts_to_stderr, with_bands, write_report,
+};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
 use spdcam_core::light_families::LightKind;
@@ -156,7 +158,17 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         );
     }
     let photo_refs: Vec<&Path> = photos.iter().map(PathBuf::as_path).collect();
-    let truths = truths(args.truth.as_deref(), &photo_refs, estimates.len(), &grid)?;
+    let places: Vec<_> = estimates
+        .iter()
+        .map(|e| e.photo.as_ref().and_then(|p| p.place))
+        .collect();
+    let truths = truths(
+        args.truth.as_deref(),
+        &photo_refs,
+        &places,
+        estimates.len(),
+        &grid,
+    )?;
     for (e, truth) in estimates.iter_mut().zip(&truths) {
         if let Some(t) = truth {
             e.score_against(t)?;
@@ -218,6 +230,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         verdicts_to_stderr(&estimates);
     } else {
         print_estimates(&estimates, &args)?;
+        print_places(&estimates)?;
     }
     if failed > 0 {
         bail!(

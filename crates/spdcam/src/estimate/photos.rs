@@ -21,8 +21,9 @@ pub(super) struct PhotoEstimates {
     pub(super) failed: usize,
 }
 
-/// Estimates from the photos, one per photo that could be used; the photos that could not
-/// (no chart found, no model for its chart, unreadable) are reported on stderr and counted.
+/// Estimates from the photos, one per chart found (a photo may show several); the photos
+/// that could not be used (no chart found, no model for its chart, unreadable) are reported
+/// on stderr and counted.
 pub(super) fn estimate_from_photos(
     args: &EstimateArgs,
     estimator: &Estimator,
@@ -45,15 +46,20 @@ pub(super) fn estimate_from_photos(
         overlays: Vec::with_capacity(done.len()),
         failed: 0,
     };
-    for (path, photo) in args.photos.iter().zip(done) {
+    for photo in done {
+        let path = &args.photos[photo.photo];
         match (photo.analysed, photo.estimate) {
             (Ok(analysed), Some(Ok(estimate))) => {
                 out.estimates.push(estimate);
                 out.photos.push(path.clone());
                 out.overlays.push(analysed.overlay);
             }
-            (Ok(_), Some(Err(e))) => {
-                eprintln!("error: no estimate for {}: {e}", path.display());
+            (Ok(analysed), Some(Err(e))) => {
+                let place = analysed
+                    .analysis
+                    .place
+                    .map_or_else(String::new, |p| format!(" place {}", p.number));
+                eprintln!("error: no estimate for {}{place}: {e}", path.display());
                 out.failed += 1;
             }
             // Reported when the photos were analysed.
@@ -67,7 +73,8 @@ pub(super) fn estimate_from_photos(
 /// it cannot be used printed, and with `--features-out` the features of those that can.
 fn analysed(args: &EstimateArgs, photos: &[PhotoEstimate]) -> Result<()> {
     let mut analyses: Vec<PhotoAnalysis> = Vec::new();
-    for (path, photo) in args.photos.iter().zip(photos) {
+    for photo in photos {
+        let path = &args.photos[photo.photo];
         if let Some(written) = &photo.debug {
             let factor = photo.analysed.as_ref().map_or(1, |a| {
                 photo::debug_factor(a.analysis.width, a.analysis.height)

@@ -112,6 +112,29 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Re
     Ok(())
 }
 
+/// For each photo that shows several charts, how the light compares across its places.
+pub(super) fn print_places(estimates: &[Estimate]) -> Result<()> {
+    let mut shown: Vec<&str> = Vec::new();
+    for e in estimates {
+        let (Some(across), Some(photo)) = (&e.across_places, &e.photo) else {
+            continue;
+        };
+        if shown.contains(&photo.source.as_str()) {
+            continue;
+        }
+        shown.push(&photo.source);
+        outln!(
+            "the light across the {} places of {}:",
+            across.places.len(),
+            photo.source
+        )?;
+        for line in across.lines() {
+            outln!("  {line}")?;
+        }
+    }
+    Ok(())
+}
+
 /// What each number means, printed with `--explain`: the detection's confidence, the metrics'
 /// abbreviations, the verdict and the GFC, for those the estimates carry.
 fn explain(estimates: &[Estimate], detailed: bool) -> Result<()> {

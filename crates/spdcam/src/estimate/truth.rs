@@ -3,6 +3,7 @@
 use anyhow::{bail, Context, Result};
 use spdcam_core::error::short_number;
 use spdcam_core::named_light::SPD_NEGATIVE_TOLERANCE;
+use spdcam_core::photo::Place;
 use spdcam_core::spectral::{Extrapolation, Grid, Interpolation, Spd, SpectralSet};
 use std::path::Path;
 
@@ -78,11 +79,13 @@ fn check_coverage(path: &Path, wavelengths: &[f64], grid: &Grid) -> Result<()> {
 }
 
 /// The truth for each estimate: from `--truth` (one column for all, or one per estimate),
-/// else from `<stem>.truth.csv` beside each photo (`photos`, one per estimate); resampled
-/// to `grid`.
+/// else from `<stem>.truth.csv` beside each photo (`photos`, one per estimate, with its
+/// place among several charts in `places`: one column for the photo, or one per place in
+/// their numbered order); resampled to `grid`.
 pub(super) fn truths(
     truth: Option<&Path>,
     photos: &[&Path],
+    places: &[Option<Place>],
     count: usize,
     grid: &Grid,
 ) -> Result<Vec<Option<Spd>>> {
@@ -103,7 +106,8 @@ pub(super) fn truths(
     }
     photos
         .iter()
-        .map(|photo| {
+        .zip(places)
+        .map(|(photo, place)| {
             let Some(stem) = photo.file_stem() else {
                 return Ok(None);
             };
@@ -112,14 +116,17 @@ pub(super) fn truths(
                 return Ok(None);
             }
             let set = read_truths(&path, grid)?;
-            if set.len() != 1 {
-                bail!(
-                    "{}: one true SPD expected, found {}",
+            match (set.len(), place) {
+                (1, _) => Ok(Some(item(&set, 0)?)),
+                (n, Some(place)) if n == place.of => Ok(Some(item(&set, place.number - 1)?)),
+                (n, Some(place)) => bail!(
+                    "{}: {n} true SPDs for a photo of {} charts; give one, or one per chart \
+                     from left to right",
                     path.display(),
-                    set.len()
-                );
+                    place.of
+                ),
+                (n, None) => bail!("{}: one true SPD expected, found {n}", path.display()),
             }
-            Ok(Some(item(&set, 0)?))
         })
         .collect()
 }

@@ -2,6 +2,7 @@
 
 mod camera_args;
 mod parse;
+mod places_photo;
 mod scene_photo;
 
 pub use camera_args::CameraArgs;
@@ -10,6 +11,7 @@ use crate::messages::Messages;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use parse::parse_pair;
+use places_photo::render_places;
 use scene_photo::render_scene;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::imageio;
@@ -109,6 +111,21 @@ pub struct RenderArgs {
     /// photos of the scene joined at the chart's middle).
     #[arg(long, requires = "right_light")]
     balance_halves: bool,
+    /// With --scene: one chart of several in the scene instead of the one chart, as
+    /// space-separated KEY=VALUE: centre=X,Y (shares of the photo; required), chart=NAME
+    /// (default --chart), width=SHARE (of the photo's width, default 0.2), light=SPD (as
+    /// --spd; default --spd), level=L (the light's level, default 1; 0.5: half as bright, as
+    /// in a shadow), rotation=DEG, tilt=DEG, tilt-axis=horizontal|vertical. Once per chart
+    /// (up to 8); the photo is exposed for the first; the charts are numbered from left to
+    /// right as `estimate` numbers them, and --spd-out writes one column per chart in that
+    /// order.
+    #[arg(
+        long = "place",
+        value_name = "KEY=VALUE …",
+        requires = "scene",
+        conflicts_with_all = ["chart_width", "chart_centre", "chart_rotation", "tilt", "shadow", "right_light"]
+    )]
+    places: Vec<String>,
     /// Also write the light's SPD (normalised to a maximum of 1) as spectral CSV (`-`: to
     /// standard output), e.g. as the truth beside a scene photo.
     #[arg(long, value_name = "FILE.csv")]
@@ -199,6 +216,16 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         eprintln!(
             "warning: {}",
             report.describe(&format!("light {}", spd.name), &grid)
+        );
+    }
+    if let (Some((width, height)), false) = (scene, args.places.is_empty()) {
+        return render_places(
+            &args,
+            &spd.spd,
+            &spd.name,
+            (width, height),
+            data_dir,
+            messages,
         );
     }
     if let Some(path) = &args.spd_out {

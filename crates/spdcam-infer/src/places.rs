@@ -1,0 +1,283 @@
+//! The light at several places of one photo: where a photo shows several charts, each
+//! gives its own estimate, and this module compares them as a person checking a room
+//! would: do the lights match in colour (the largest Δu′v′ between two places, CIE 1976
+//! UCS, the colour-matching question a meter answers), how far their CCT and Duv spread,
+//! how bright each place is against the brightest (the photo's exposure is shared, so the
+//! charts' linear levels compare: [`crate::absolute::chart_level`]), and which place differs
+//! most.
+//!
+//! "The lights differ" is said when the largest Δu′v′ between places exceeds
+//! [`LIGHTS_DIFFER_DUV`]: two charts under one light read alike to well within it (their
+//! errors share the camera, its white balance and the light), while lights that differ by
+//! 0.01 or more (a just-noticeable colour difference is about 0.004) are told apart.
+
+use crate::chromaticity::xy_to_uv_prime;
+use crate::estimate::Estimate;
+use serde::Serialize;
+
+/// The largest Δu′v′ between two places' estimates above which the photo's lights are said
+/// to differ. Chosen on validation scenes (`spdcam experiment places`, docs/places.md):
+/// charts under one light read within it, lights 0.01 apart beyond it.
+pub const LIGHTS_DIFFER_DUV: f64 = 0.005;
+
+/// One place's light, as the comparison shows it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlaceLight {
+    /// The place's number (1-based, left to right).
+    pub number: usize,
+    /// The chart's centre, photo pixels.
+    pub centre: [f64; 2],
+    /// The light's CIE 1976 u′v′.
+    pub uv_prime: [f64; 2],
+    /// CCT, K (`None` far from the Planckian locus).
+    pub cct: Option<f64>,
+    /// Duv.
+    pub duv: Option<f64>,
+    /// The light's level here against the brightest place's (1 there); `None` when the
+    /// chart's level could not be read (no usable grey patch, reflectances not at hand).
+    pub relative_illuminance: Option<f64>,
+}
+
+/// How the light compares across the places of one photo.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LightAcrossPlaces {
+    /// Every place, in number order.
+    pub places: Vec<PlaceLight>,
+    /// The two places whose lights differ most in colour, and their Δu′v′.
+    pub largest_delta_uv: (usize, usize, f64),
+    /// The place whose light differs most from the others' (the largest mean Δu′v′ to the
+    /// rest).
+    pub most_different: usize,
+    /// Highest less lowest CCT among the places that have one, K.
+    pub cct_spread_k: Option<f64>,
+    /// Highest less lowest Duv.
+    pub duv_spread: Option<f64>,
+    /// Whether the lights differ in colour: the largest Δu′v′ above [`LIGHTS_DIFFER_DUV`].
+    pub lights_differ: bool,
+}
+
+impl LightAcrossPlaces {
+    /// The comparison of `estimates`, the estimates of one photo's places (each carrying
+    /// its photo analysis with its place); `None` for fewer than two.
+    pub fn of(estimates: &[&Estimate]) -> Option<LightAcrossPlaces> {
+        let mut placed: Vec<(&Estimate, usize, [f64; 2])> = estimates
+            .iter()
+            .filter_map(|e| {
+                let place = e.photo.as_ref()?.place?;
+                Some((*e, place.number, place.centre))
+            })
+            .collect();
+        if placed.len() < 2 {
+            return None;
+        }
+        placed.sort_by_key(|p| p.1);
+        let brightest = placed
+            .iter()
+            .filter_map(|p| p.0.light_level)
+            .fold(f64::NAN, f64::max);
+        let places: Vec<PlaceLight> = placed
+            .iter()
+            .map(|&(e, number, centre)| PlaceLight {
+                number,
+                centre,
+                uv_prime: xy_to_uv_prime(e.colorimetry.xy),
+                cct: e.colorimetry.cct,
+                duv: e.colorimetry.duv,
+                relative_illuminance: e
+                    .light_level
+                    .filter(|_| brightest > 0.0)
+                    .map(|l| l / brightest),
+            })
+            .collect();
+        let distance = |a: &PlaceLight, b: &PlaceLight| {
+            (a.uv_prime[0] - b.uv_prime[0]).hypot(a.uv_prime[1] - b.uv_prime[1])
+        };
+        let mut largest = (places[0].number, places[1].number, 0.0);
+        for (i, a) in places.iter().enumerate() {
+            for b in &places[i + 1..] {
+                let d = distance(a, b);
+                if d > largest.2 {
+                    largest = (a.number, b.number, d);
+                }
+            }
+        }
+        let most_different = places
+            .iter()
+            .map(|a| {
+                let mean =
+                    places.iter().map(|b| distance(a, b)).sum::<f64>() / (places.len() - 1) as f64;
+                (a.number, mean)
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(places[0].number, |m| m.0);
+        let spread = |values: Vec<f64>| {
+            (values.len() >= 2).then(|| {
+                values.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
+                    - values.iter().fold(f64::INFINITY, |m, &v| m.min(v))
+            })
+        };
+        Some(LightAcrossPlaces {
+            cct_spread_k: spread(places.iter().filter_map(|p| p.cct).collect()),
+            duv_spread: spread(places.iter().filter_map(|p| p.duv).collect()),
+            lights_differ: largest.2 > LIGHTS_DIFFER_DUV,
+            largest_delta_uv: largest,
+            most_different,
+            places,
+        })
+    }
+
+    /// The comparison as lines for a person: the verdict on the colours, the spreads, each
+    /// place's level.
+    pub fn lines(&self) -> Vec<String> {
+        let (a, b, d) = self.largest_delta_uv;
+        let mut out = vec![if self.lights_differ {
+            format!(
+                "the lights differ: places {a} and {b} are Δu′v′ {d:.4} apart (above \
+                 {LIGHTS_DIFFER_DUV}); place {} differs most",
+                self.most_different
+            )
+        } else {
+            format!(
+                "one light in colour: the places are at most Δu′v′ {d:.4} apart (places {a} \
+                 and {b}; within {LIGHTS_DIFFER_DUV})"
+            )
+        }];
+        let mut spreads = Vec::new();
+        if let Some(s) = self.cct_spread_k {
+            spreads.push(format!("CCT spread {s:.0} K"));
+        }
+        if let Some(s) = self.duv_spread {
+            spreads.push(format!("Duv spread {s:.4}"));
+        }
+        if !spreads.is_empty() {
+            out.push(spreads.join(", "));
+        }
+        let levels: Vec<String> = self
+            .places
+            .iter()
+            .map(|p| match p.relative_illuminance {
+                Some(r) => format!("place {} {:.0} %", p.number, 100.0 * r),
+                None => format!("place {} —", p.number),
+            })
+            .collect();
+        out.push(format!(
+            "light level against the brightest place: {}",
+            levels.join(", ")
+        ));
+        out
+    }
+}
+
+/// Sets [`Estimate::across_places`] on every estimate of a photo with several places:
+/// `estimates` grouped by their photo's source.
+pub fn compare_places(estimates: &mut [Estimate]) {
+    let mut sources: Vec<String> = estimates
+        .iter()
+        .filter_map(|e| {
+            let photo = e.photo.as_ref()?;
+            photo.place.map(|_| photo.source.clone())
+        })
+        .collect();
+    sources.sort();
+    sources.dedup();
+    for source in sources {
+        let of_photo = |e: &Estimate| {
+            e.photo
+                .as_ref()
+                .is_some_and(|p| p.source == source && p.place.is_some())
+        };
+        let group: Vec<&Estimate> = estimates.iter().filter(|e| of_photo(e)).collect();
+        let across = LightAcrossPlaces::of(&group);
+        for e in estimates.iter_mut().filter(|e| of_photo(e)) {
+            e.across_places = across.clone();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::estimate_of;
+    use spdcam_core::cie_illuminant::StandardIlluminant;
+    use spdcam_core::photo::{PhotoAnalysis, Place};
+    use spdcam_core::spectral::Grid;
+
+    fn placed(light: StandardIlluminant, number: usize, level: f64) -> Estimate {
+        let mut e = estimate_of(light.spd(&Grid::ESTIMATION).unwrap(), &[]);
+        e.photo = Some(PhotoAnalysis {
+            source: "room.jpg".into(),
+            width: 100,
+            height: 100,
+            method: "detected",
+            chart: "colorchecker24".into(),
+            confidence: 1.0,
+            corners: [[0.0; 2]; 4],
+            homography: [[0.0; 3]; 3],
+            feature_names: Vec::new(),
+            features: Vec::new(),
+            patches: Vec::new(),
+            warnings: Vec::new(),
+            exposure: None,
+            raw: None,
+            place: Some(Place {
+                number,
+                of: 3,
+                centre: [10.0 * number as f64, 5.0],
+            }),
+        });
+        e.light_level = Some(level);
+        e
+    }
+
+    #[test]
+    fn a_warm_place_among_daylight_ones_differs_most() {
+        let mut estimates = vec![
+            placed(StandardIlluminant::D65, 1, 0.8),
+            placed(StandardIlluminant::A, 2, 0.4),
+            placed(StandardIlluminant::D65, 3, 0.8),
+        ];
+        compare_places(&mut estimates);
+        let across = estimates[0].across_places.clone().unwrap();
+        assert_eq!(estimates[2].across_places.as_ref(), Some(&across));
+        assert!(across.lights_differ);
+        assert_eq!(across.most_different, 2);
+        // D65 u′v′ (0.1978, 0.4683), A (0.2560, 0.5243): Δu′v′ 0.0808 (CIE 015:2018).
+        assert_eq!(
+            (across.largest_delta_uv.0, across.largest_delta_uv.1),
+            (1, 2)
+        );
+        assert!((across.largest_delta_uv.2 - 0.0808).abs() < 0.001);
+        assert!((across.cct_spread_k.unwrap() - (6504.0 - 2856.0)).abs() < 20.0);
+        let levels: Vec<Option<f64>> = across
+            .places
+            .iter()
+            .map(|p| p.relative_illuminance)
+            .collect();
+        assert_eq!(levels, vec![Some(1.0), Some(0.5), Some(1.0)]);
+        assert!(across.lines()[0].starts_with("the lights differ"));
+    }
+
+    #[test]
+    fn one_light_at_every_place_is_one_light() {
+        let mut estimates = vec![
+            placed(StandardIlluminant::D65, 1, 0.8),
+            placed(StandardIlluminant::D65, 2, 0.2),
+        ];
+        compare_places(&mut estimates);
+        let across = estimates[1].across_places.clone().unwrap();
+        assert!(!across.lights_differ);
+        assert!(across.largest_delta_uv.2 < 1e-12);
+        assert!(across.lines()[0].starts_with("one light in colour"));
+        assert_eq!(across.places[1].relative_illuminance, Some(0.25));
+    }
+
+    #[test]
+    fn a_photo_of_one_chart_has_no_comparison() {
+        let mut estimates = vec![estimate_of(
+            StandardIlluminant::D65.spd(&Grid::ESTIMATION).unwrap(),
+            &[],
+        )];
+        compare_places(&mut estimates);
+        assert_eq!(estimates[0].across_places, None);
+    }
+}
