@@ -19,6 +19,8 @@
 //! - [`colour`]: every model judged on the light's colour as a colour meter reads it
 //!   (Δu′v′, CCT) on scene and patch-level photos by held-out cameras
 //!   ([`colour::ColourReport`]).
+//! - [`places`]: the light at several places of one photo, on rendered scenes of two to
+//!   four charts ([`places::PlacesReport`]).
 //! - [`light_kinds`]: a model's priors for each kind of light a person can name
 //!   ([`light_kinds::KindFit`]).
 //! - [`coverage`]: how well lighting recipes reach measured SPDs, per lamp type
@@ -43,6 +45,7 @@ pub mod error;
 pub mod held_out;
 pub mod lamp_validation;
 pub mod light_kinds;
+pub mod places;
 pub mod real_cameras;
 pub mod reliability;
 pub mod trust;

@@ -14,12 +14,14 @@
 //! its tone curve and the lens's vignetting, so it is approximate (tens of per cent): every
 //! output says so.
 
+use crate::chromaticity::xy_to_uv_prime;
 use crate::error::Result;
 use serde::Serialize;
 use spdcam_core::chart::Chart;
-use spdcam_core::colorimetry::srgb_decode;
 use spdcam_core::colorimetry::Observer;
+use spdcam_core::colorimetry::{linear_srgb_to_xyz, srgb_decode};
 use spdcam_core::photo::{Exposure, PhotoAnalysis};
+use spdcam_core::quality::uv::xyz_to_uv1976;
 use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::Spd;
 
@@ -123,12 +125,16 @@ pub fn absolute_level(
     }))
 }
 
-/// The light's level on a chart in the photo's linear units, and the patches it was read
-/// from.
+/// The light on a chart as the photo shows it, read on its grey patches: its level in the
+/// photo's linear units, the greys' colour, and the patches it was read from.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ChartLevel {
     /// The median over the patches used of y / ρ_Y (see [`chart_level`]).
     pub level: f64,
+    /// The CIE 1976 u′v′ of the grey patches used as the photo renders them (their mean
+    /// linear sRGB); for a raw photo, the light's chromaticity through the file's matrices.
+    /// Under one light every chart's greys share it, whatever the model reads of them.
+    pub grey_uv_prime: [f64; 2],
     /// The neutral feature patches used (1-based feature numbers), each with its y / ρ_Y.
     pub patches: Vec<(usize, f64)>,
 }
@@ -160,6 +166,7 @@ pub fn chart_level(
         )));
     }
     let raw = analysis.raw.is_some();
+    let mut grey_sum = [0.0f64; 3];
     let mut found: Vec<(usize, f64)> = chart
         .neutral_features()
         .into_iter()
@@ -169,15 +176,16 @@ pub fn chart_level(
             let y = if raw {
                 f64::from(analysis.patches.get(patch)?.camera_rgb?[1])
             } else {
-                let rgb = &analysis.features[3 * k..3 * k + 3];
-                let y: f64 = [0.2126, 0.7152, 0.0722]
-                    .iter()
-                    .zip(rgb)
-                    .map(|(w, &v)| w * srgb_decode(f64::from(v) / 255.0))
-                    .sum();
-                (USABLE_VALUES.0..=USABLE_VALUES.1)
-                    .contains(&y)
-                    .then_some(y)?
+                let rgb: [f64; 3] = std::array::from_fn(|c| {
+                    srgb_decode(f64::from(analysis.features[3 * k + c]) / 255.0)
+                });
+                let y = linear_srgb_to_xyz(rgb)[1];
+                if !(USABLE_VALUES.0..=USABLE_VALUES.1).contains(&y) {
+                    return None;
+                }
+                // The greys' colour, each grey weighed alike whatever its lightness.
+                (0..3).for_each(|c| grey_sum[c] += rgb[c] / y);
+                y
             };
             let factor = observer.reflectance_to_xyz(chart.reflectances.item(patch), spd)[1];
             (factor > 0.0 && factor.is_finite() && y > 0.0).then(|| (k + 1, y / factor))
@@ -203,8 +211,13 @@ pub fn chart_level(
         0.5 * (values[n / 2 - 1] + values[n / 2])
     };
     found.sort_by_key(|p| p.0);
+    let grey_uv_prime = match &analysis.raw {
+        Some(reading) => xy_to_uv_prime(reading.light_xy),
+        None => xyz_to_uv1976(linear_srgb_to_xyz(grey_sum)),
+    };
     Ok(Ok(ChartLevel {
         level,
+        grey_uv_prime,
         patches: found,
     }))
 }

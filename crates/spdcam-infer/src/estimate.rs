@@ -8,7 +8,7 @@
 //!     the chart ─► SPD ─► judged ─► Estimate (SPD, colorimetry, metrics, verdict, bands)
 //! ```
 
-use crate::absolute::Absolute;
+use crate::absolute::{Absolute, ChartLevel};
 use crate::error::{InferError, Result};
 use crate::places::LightAcrossPlaces;
 use crate::trust::Trust;
@@ -150,10 +150,10 @@ pub struct Estimate {
     /// For photos: the approximate absolute levels from the EXIF exposure, or why there are
     /// none.
     pub absolute: Option<Absolute>,
-    /// For photos: the light's level on the chart in the photo's linear units
-    /// ([`crate::absolute::chart_level`]), comparable between the charts of one photo;
-    /// `None` when it could not be read.
-    pub light_level: Option<f64>,
+    /// For photos: the light on the chart read on its grey patches, its level in the
+    /// photo's linear units and the greys' colour ([`crate::absolute::chart_level`]),
+    /// comparable between the charts of one photo; `None` when it could not be read.
+    pub light_level: Option<ChartLevel>,
     /// For one of several charts in a photo: how the light compares across its places
     /// ([`crate::places`]), the same on each of them.
     pub across_places: Option<LightAcrossPlaces>,
@@ -172,7 +172,7 @@ impl Estimate {
     /// `absolute` (approximate illuminance, PPFD, melanopic EDI and spectral irradiance from
     /// the EXIF exposure, see [`crate::absolute`]) or, when there is none, `absolute: null`
     /// and `absolute_reason`, and `light_level` (the chart's level in the photo's linear
-    /// units, or null); one of several charts in a photo has `photo.place` ({number, of,
+    /// units and its greys' u′v′, or null); one of several charts in a photo has `photo.place` ({number, of,
     /// centre}) and `across_places` (see [`crate::places::LightAcrossPlaces`]).
     pub fn to_json(&self) -> Result<serde_json::Value> {
         let mut v = serde_json::json!({

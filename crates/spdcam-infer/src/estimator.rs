@@ -463,10 +463,7 @@ impl Estimator {
         for photo in &mut photos {
             if let Ok(analysed) = &photo.analysed {
                 progress(PhotoProgress::Estimating(&analysed.analysis))?;
-                let label = match analysed.analysis.place {
-                    Some(place) => format!("{} place {}", labels[photo.photo], place.number),
-                    None => labels[photo.photo].clone(),
-                };
+                let label = place_label(&labels[photo.photo], &analysed.analysis);
                 self.estimate_analysed(photo, label);
             }
         }
@@ -513,6 +510,36 @@ impl Estimator {
         };
         self.estimate_analysed(&mut photo, name.into());
         photo
+    }
+
+    /// A photo held in memory the whole way, every chart it shows: one [`PhotoEstimate`] per
+    /// chart (as [`Estimator::estimate_photos`] gives them, labelled `name`, or `name place
+    /// K` where there are several, and compared across places), or one with why the photo
+    /// could not be used.
+    pub fn photo_bytes_places(
+        &self,
+        bytes: &[u8],
+        name: &str,
+        options: &PhotoOptions,
+    ) -> Vec<PhotoEstimate> {
+        let decoded = match photo::decode_photo(bytes, name) {
+            Ok(decoded) => decoded,
+            Err(e) => return vec![PhotoEstimate::unusable(e.into())],
+        };
+        let mut photos = match self.templates(options.chart.as_deref()) {
+            Ok(templates) => {
+                self.analyse_places_with(&decoded, options, templates, options.debug.clone())
+            }
+            Err(e) => vec![PhotoEstimate::unusable(e)],
+        };
+        for photo in &mut photos {
+            if let Ok(analysed) = &photo.analysed {
+                let label = place_label(name, &analysed.analysis);
+                self.estimate_analysed(photo, label);
+            }
+        }
+        compare_photo_places(&mut photos);
+        photos
     }
 
     /// The estimate for a photo already decoded (from bytes, or a pixel array in Python),
@@ -1070,9 +1097,7 @@ impl Estimator {
         };
         let light_level = match (&photo, chart_name, reflectances) {
             (Some(analysis), Some(name), Some(chart)) => {
-                chart_level(analysis, name, chart, &full, &unusable)?
-                    .ok()
-                    .map(|l| l.level)
+                chart_level(analysis, name, chart, &full, &unusable)?.ok()
             }
             _ => None,
         };
@@ -1175,6 +1200,14 @@ fn overlay_of(
         &analysis.patches,
         width,
     )?)
+}
+
+/// An estimate's label: the photo's, with the place where the photo shows several charts.
+fn place_label(photo: &str, analysis: &PhotoAnalysis) -> String {
+    match analysis.place {
+        Some(place) => format!("{photo} place {}", place.number),
+        None => photo.to_string(),
+    }
 }
 
 /// Sets the comparison across places ([`crate::places::compare_places`]) on every estimate

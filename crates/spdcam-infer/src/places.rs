@@ -6,18 +6,26 @@
 //! charts' linear levels compare: [`crate::absolute::chart_level`]), and which place differs
 //! most.
 //!
-//! "The lights differ" is said when the largest Δu′v′ between places exceeds
-//! [`LIGHTS_DIFFER_DUV`]: two charts under one light read alike to well within it (their
-//! errors share the camera, its white balance and the light), while lights that differ by
-//! 0.01 or more (a just-noticeable colour difference is about 0.004) are told apart.
+//! Whether the lights differ is read on the charts' grey patches, not on the estimates:
+//! under one light every chart's greys show one colour in the photo (one camera, one white
+//! balance), whatever chart they belong to and whatever a model makes of its coloured
+//! patches, while each estimate carries its own error (several thousandths of Δu′v′,
+//! `docs/colour.md`), too much to tell lights 0.01 apart from one light. "The lights differ"
+//! is said when two places' greys lie more than [`LIGHTS_DIFFER_DUV`] apart in u′v′ (a
+//! just-noticeable colour difference is about 0.004); where a place's greys cannot be read,
+//! the estimates are compared instead. (Comparing two charts' greys level for level, against
+//! a tone curve that might shift a grey's colour with its level, told the lights apart no
+//! better on the validation scenes: the greys' mean colours are compared.)
 
+use crate::absolute::ChartLevel;
 use crate::chromaticity::xy_to_uv_prime;
 use crate::estimate::Estimate;
 use serde::Serialize;
 
-/// The largest Δu′v′ between two places' estimates above which the photo's lights are said
-/// to differ. Chosen on validation scenes (`spdcam experiment places`, docs/places.md):
-/// charts under one light read within it, lights 0.01 apart beyond it.
+/// The largest Δu′v′ between two places' greys (or, where a place's greys cannot be read,
+/// their estimates) above which the photo's lights are said to differ. Chosen on validation
+/// scenes (`spdcam experiment places`, docs/places.md): charts under one light within it,
+/// lights 0.01 apart beyond it.
 pub const LIGHTS_DIFFER_DUV: f64 = 0.005;
 
 /// One place's light, as the comparison shows it.
@@ -27,8 +35,10 @@ pub struct PlaceLight {
     pub number: usize,
     /// The chart's centre, photo pixels.
     pub centre: [f64; 2],
-    /// The light's CIE 1976 u′v′.
+    /// The estimated light's CIE 1976 u′v′.
     pub uv_prime: [f64; 2],
+    /// The chart's greys' u′v′ as the photo shows them; `None` when none could be read.
+    pub grey_uv_prime: Option<[f64; 2]>,
     /// CCT, K (`None` far from the Planckian locus).
     pub cct: Option<f64>,
     /// Duv.
@@ -43,16 +53,20 @@ pub struct PlaceLight {
 pub struct LightAcrossPlaces {
     /// Every place, in number order.
     pub places: Vec<PlaceLight>,
-    /// The two places whose lights differ most in colour, and their Δu′v′.
+    /// The two places whose estimated lights differ most in colour, and their Δu′v′.
     pub largest_delta_uv: (usize, usize, f64),
+    /// The two places whose greys differ most in colour, and their Δu′v′; `None` when a
+    /// place's greys could not be read.
+    pub greys_largest_delta_uv: Option<(usize, usize, f64)>,
     /// The place whose light differs most from the others' (the largest mean Δu′v′ to the
-    /// rest).
+    /// rest, of the greys where every place's were read, else of the estimates).
     pub most_different: usize,
     /// Highest less lowest CCT among the places that have one, K.
     pub cct_spread_k: Option<f64>,
     /// Highest less lowest Duv.
     pub duv_spread: Option<f64>,
-    /// Whether the lights differ in colour: the largest Δu′v′ above [`LIGHTS_DIFFER_DUV`].
+    /// Whether the lights differ in colour: the largest Δu′v′ between the greys (else the
+    /// estimates) above [`LIGHTS_DIFFER_DUV`].
     pub lights_differ: bool,
 }
 
@@ -73,7 +87,7 @@ impl LightAcrossPlaces {
         placed.sort_by_key(|p| p.1);
         let brightest = placed
             .iter()
-            .filter_map(|p| p.0.light_level)
+            .filter_map(|p| p.0.light_level.as_ref().map(|l| l.level))
             .fold(f64::NAN, f64::max);
         let places: Vec<PlaceLight> = placed
             .iter()
@@ -81,35 +95,44 @@ impl LightAcrossPlaces {
                 number,
                 centre,
                 uv_prime: xy_to_uv_prime(e.colorimetry.xy),
+                grey_uv_prime: e.light_level.as_ref().map(|l| l.grey_uv_prime),
                 cct: e.colorimetry.cct,
                 duv: e.colorimetry.duv,
                 relative_illuminance: e
                     .light_level
+                    .as_ref()
                     .filter(|_| brightest > 0.0)
-                    .map(|l| l / brightest),
+                    .map(|l| l.level / brightest),
             })
             .collect();
-        let distance = |a: &PlaceLight, b: &PlaceLight| {
-            (a.uv_prime[0] - b.uv_prime[0]).hypot(a.uv_prime[1] - b.uv_prime[1])
-        };
-        let mut largest = (places[0].number, places[1].number, 0.0);
-        for (i, a) in places.iter().enumerate() {
-            for b in &places[i + 1..] {
-                let d = distance(a, b);
-                if d > largest.2 {
-                    largest = (a.number, b.number, d);
-                }
-            }
-        }
-        let most_different = places
-            .iter()
-            .map(|a| {
-                let mean =
-                    places.iter().map(|b| distance(a, b)).sum::<f64>() / (places.len() - 1) as f64;
-                (a.number, mean)
+        let estimates: Vec<[f64; 2]> = places.iter().map(|p| p.uv_prime).collect();
+        let levels: Option<Vec<&ChartLevel>> =
+            placed.iter().map(|p| p.0.light_level.as_ref()).collect();
+        let numbers: Vec<usize> = places.iter().map(|p| p.number).collect();
+        let n = places.len();
+        let estimate_distances: Vec<Vec<f64>> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| distance(estimates[i], estimates[j]))
+                    .collect()
             })
+            .collect();
+        let grey_distances: Option<Vec<Vec<f64>>> = levels.as_ref().map(|levels| {
+            (0..n)
+                .map(|i| {
+                    (0..n)
+                        .map(|j| greys_distance(levels[i], levels[j]))
+                        .collect()
+                })
+                .collect()
+        });
+        let largest = largest_pair(&estimate_distances, &numbers);
+        let greys_largest = grey_distances.as_ref().map(|d| largest_pair(d, &numbers));
+        let judged = grey_distances.as_ref().unwrap_or(&estimate_distances);
+        let most_different = (0..n)
+            .map(|i| (numbers[i], judged[i].iter().sum::<f64>() / (n - 1) as f64))
             .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map_or(places[0].number, |m| m.0);
+            .map_or(numbers[0], |m| m.0);
         let spread = |values: Vec<f64>| {
             (values.len() >= 2).then(|| {
                 values.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
@@ -119,8 +142,9 @@ impl LightAcrossPlaces {
         Some(LightAcrossPlaces {
             cct_spread_k: spread(places.iter().filter_map(|p| p.cct).collect()),
             duv_spread: spread(places.iter().filter_map(|p| p.duv).collect()),
-            lights_differ: largest.2 > LIGHTS_DIFFER_DUV,
+            lights_differ: greys_largest.unwrap_or(largest).2 > LIGHTS_DIFFER_DUV,
             largest_delta_uv: largest,
+            greys_largest_delta_uv: greys_largest,
             most_different,
             places,
         })
@@ -130,17 +154,27 @@ impl LightAcrossPlaces {
     /// place's level.
     pub fn lines(&self) -> Vec<String> {
         let (a, b, d) = self.largest_delta_uv;
-        let mut out = vec![if self.lights_differ {
-            format!(
-                "the lights differ: places {a} and {b} are Δu′v′ {d:.4} apart (above \
-                 {LIGHTS_DIFFER_DUV}); place {} differs most",
+        let estimates = format!("the estimates differ by up to Δu′v′ {d:.4} (places {a} and {b})");
+        let mut out = vec![match (self.lights_differ, self.greys_largest_delta_uv) {
+            (true, Some((ga, gb, gd))) => format!(
+                "the lights differ: the greys of places {ga} and {gb} are Δu′v′ {gd:.4} apart \
+                 (above {LIGHTS_DIFFER_DUV}); place {} differs most; {estimates}",
                 self.most_different
-            )
-        } else {
-            format!(
-                "one light in colour: the places are at most Δu′v′ {d:.4} apart (places {a} \
-                 and {b}; within {LIGHTS_DIFFER_DUV})"
-            )
+            ),
+            (false, Some((ga, gb, gd))) => format!(
+                "one light in colour: the greys agree within Δu′v′ {gd:.4} (places {ga} and \
+                 {gb}; within {LIGHTS_DIFFER_DUV}); {estimates}, which is the estimates' own \
+                 error"
+            ),
+            (true, None) => format!(
+                "the lights differ: {estimates} (above {LIGHTS_DIFFER_DUV}; a place's greys \
+                 could not be read); place {} differs most",
+                self.most_different
+            ),
+            (false, None) => format!(
+                "one light in colour as far as the estimates tell: {estimates} (within \
+                 {LIGHTS_DIFFER_DUV}; a place's greys could not be read)"
+            ),
         }];
         let mut spreads = Vec::new();
         if let Some(s) = self.cct_spread_k {
@@ -166,6 +200,30 @@ impl LightAcrossPlaces {
         ));
         out
     }
+}
+
+/// The Δu′v′ between two u′v′ points.
+fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// The pair of places farthest apart by `distances` (a symmetric table), by their
+/// `numbers`, and their distance.
+fn largest_pair(distances: &[Vec<f64>], numbers: &[usize]) -> (usize, usize, f64) {
+    let mut largest = (numbers[0], numbers[1.min(numbers.len() - 1)], 0.0);
+    for i in 0..distances.len() {
+        for j in i + 1..distances.len() {
+            if distances[i][j] > largest.2 {
+                largest = (numbers[i], numbers[j], distances[i][j]);
+            }
+        }
+    }
+    largest
+}
+
+/// How far apart two charts' greys are in u′v′: the distance of their mean colours.
+fn greys_distance(a: &ChartLevel, b: &ChartLevel) -> f64 {
+    distance(a.grey_uv_prime, b.grey_uv_prime)
 }
 
 /// Sets [`Estimate::across_places`] on every estimate of a photo with several places:
@@ -225,7 +283,11 @@ mod tests {
                 centre: [10.0 * number as f64, 5.0],
             }),
         });
-        e.light_level = Some(level);
+        e.light_level = Some(ChartLevel {
+            level,
+            grey_uv_prime: xy_to_uv_prime(e.colorimetry.xy),
+            patches: Vec::new(),
+        });
         e
     }
 

@@ -194,8 +194,9 @@ impl Fringes {
 /// Finds every chart of `templates` in `photo` that no better placement overlaps, numbered
 /// from left to right by their centres; empty when none reaches [`MIN_CONFIDENCE`]. The
 /// levels are searched as [`detect_traced`] searches them, coarsest first; once charts are
-/// found, a finer level is searched only while a lattice of patches lies outside them (a
-/// smaller chart may be there), so a photo of one chart costs about what [`detect`] costs.
+/// found, a finer level is searched only while two or more charts are found (a photo of
+/// several charts may hold smaller ones) or a lattice of patches lies outside them, so a
+/// photo of one chart costs about what [`detect`] costs.
 /// A placement found only by its support in the photo joins where no chart found by its
 /// patches lies.
 pub fn detect_all(
@@ -330,18 +331,18 @@ fn search_all(
         .chain(placed.iter().map(|p| &p.0))
         .map(|d| d.corners)
         .collect();
-    let outside = |p: [f64; 2]| {
-        let p = [p[0] * scale, p[1] * scale];
-        !charts.iter().any(|q| quads_near(q, &[p, p, p, p], 0.0))
-    };
-    let more = lattices.iter().any(|l| {
-        let out = l
-            .members
-            .iter()
-            .filter(|m| outside(blobs[m.0].centre))
-            .count();
-        out >= MIN_LATTICE && 2 * out > l.members.len()
-    });
+    let outside: Vec<Blob> = blobs
+        .iter()
+        .filter(|b| {
+            let p = [b.centre[0] * scale, b.centre[1] * scale];
+            !charts.iter().any(|q| quads_near(q, &[p, p, p, p], 0.0))
+        })
+        .cloned()
+        .collect();
+    // A photo that shows several charts may hold smaller ones still, whose patches a coarse
+    // level does not resolve (a Digital SG a tenth of the photo wide has patches of five
+    // level pixels): it is searched finer.
+    let more = charts.len() >= 2 || !find_lattices(&outside, MIN_LATTICE).is_empty();
     (placed, more)
 }
 

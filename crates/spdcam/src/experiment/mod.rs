@@ -1,7 +1,9 @@
 //! `spdcam experiment`: the thesis's model-selection experiment on its virtual datasets,
-//! the real-camera study, and the light's colour as a colour meter reads it.
+//! the real-camera study, the light's colour as a colour meter reads it, and the light at
+//! several places of one photo.
 
 mod colour;
+mod places;
 mod real_cameras;
 mod thesis;
 
@@ -27,6 +29,10 @@ enum ExperimentCommand {
     /// patch-level photos of the split's lamps and white references by held-out cameras,
     /// beside the constant (`docs/colour.md`).
     Colour(colour::ColourArgs),
+    /// The light at several places: rendered scenes of two to four charts under the split's
+    /// lamps through its held-out cameras, each chart against itself alone, the lights told
+    /// apart, the light levels between places (`docs/places.md`).
+    Places(places::PlacesArgs),
 }
 
 /// Runs `spdcam experiment`.
@@ -35,5 +41,6 @@ pub fn run(args: ExperimentArgs, data_dir: &spdcam_core::builtin::DataDir) -> Re
         ExperimentCommand::Thesis(a) => thesis::run(a, data_dir),
         ExperimentCommand::RealCameras(a) => real_cameras::run(a, data_dir),
         ExperimentCommand::Colour(a) => colour::run(a, data_dir),
+        ExperimentCommand::Places(a) => places::run(a, data_dir),
     }
 }
