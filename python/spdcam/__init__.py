@@ -33,6 +33,7 @@ __all__ = [
     "shipped_model",
     "read_photo",
     "estimate",
+    "estimate_places",
     "estimate_features",
     "LIGHT_KINDS",
     "Rendering",
@@ -147,6 +148,10 @@ class Detection:
     #: through the file's own colour matrices; ``neutral_patches``; ``colour``, how the
     #: matrices were used); ``None`` for a JPEG, PNG or TIFF.
     raw: Optional[dict[str, Any]] = None
+    #: For one of several charts in a photo (:func:`estimate_places`): its place,
+    #: ``{"number": 1-based from left to right, "of": how many, "centre": [x, y] px}``;
+    #: ``None`` for a photo of one chart.
+    place: Optional[dict[str, Any]] = None
 
     @staticmethod
     def _from_json(p: dict[str, Any]) -> "Detection":
@@ -167,6 +172,7 @@ class Detection:
             warnings=list(p["warnings"]),
             size=(int(p["width"]), int(p["height"])),
             raw=p.get("raw"),
+            place=p.get("place"),
         )
 
 
@@ -225,6 +231,12 @@ class Estimate:
     absolute: Optional[dict[str, Any]] = None
     #: The kind of light the estimate was told of (``light=``; ``"unknown"`` when none).
     light: str = "unknown"
+    #: For one of several charts in a photo (:func:`estimate_places`): how the light
+    #: compares across the photo's places (``places``, each with ``uv_prime``,
+    #: ``grey_uv_prime``, ``cct``, ``duv``, ``relative_illuminance``; ``largest_delta_uv``,
+    #: ``greys_largest_delta_uv``, ``most_different``, ``cct_spread_k``, ``duv_spread``,
+    #: ``lights_differ``), the same on each of them; ``None`` otherwise.
+    across_places: Optional[dict[str, Any]] = None
     #: The library's JSON of the estimate (as ``spdcam estimate --json`` prints it).
     json: dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -250,6 +262,7 @@ class Estimate:
             metric_uncertainty=dict(v.get("metric_uncertainty") or {}),
             absolute=v.get("absolute"),
             light=v.get("light", "unknown"),
+            across_places=v.get("across_places"),
             json=v,
         )
 
@@ -468,7 +481,9 @@ def estimate(
     ``progress`` is a callback ``(done, total)``, or ``True`` for a tqdm bar (when tqdm is
     installed; it is told after each batch of photos, estimated several at once on every
     core). The work runs without the GIL. Raises :class:`SpdcamError` (a
-    ``ValueError``) with the command line's message when the photo cannot be used.
+    ``ValueError``) with the command line's message when the photo cannot be used. Where a
+    photo shows several charts, this reads the one found best; :func:`estimate_places`
+    reads every one.
     """
     models = _models(model)
     points = _corners(corners)
@@ -480,6 +495,30 @@ def estimate(
             if isinstance(report, _Bar):
                 report.close()
     return _estimate_all([photo], models, chart, points, range, source, light)[0]
+
+
+def estimate_places(
+    photo: PhotoLike,
+    *,
+    chart: Optional[str] = None,
+    range: str = DEFAULT_RANGE,
+    model: Union[Model, str, "os.PathLike[str]", None] = None,
+    source: Optional[str] = None,
+    light: str = "unknown",
+) -> list[Estimate]:
+    """The light at every chart one photo shows, as ``spdcam estimate PHOTO`` gives it for a
+    photo of several charts: one :class:`Estimate` per chart, numbered from left to right
+    (``detection.place``), each carrying the comparison across the photo's places
+    (``across_places``: do the lights differ in colour, their CCT and Duv spread, each
+    place's light level against the brightest). A photo of one chart gives a list of one,
+    the estimate :func:`estimate` gives. ``photo`` and the other arguments are as for
+    :func:`estimate`; a chart whose patches are refused is left out, and a photo that gives
+    no estimate raises :class:`SpdcamError`.
+    """
+    models = _models(model)
+    native, name = _native_photo(photo, source)
+    values = _native.estimate_places(native, name, models, chart, range, light)
+    return [Estimate._from_dict(v) for v in values]
 
 
 class _Bar:

@@ -34,6 +34,16 @@ def estimate_photos(
 ) -> list[dict]:
     """Estimates the light from photos, several at once; each estimate as a dict."""
 
+def estimate_places(
+    photo: PhotoInput,
+    source: str,
+    models: Models,
+    chart: Optional[str] = None,
+    range: str = "400-700:5",
+    light: str = "unknown",
+) -> list[dict]:
+    """Estimates the light at every chart one photo shows; each estimate as a dict."""
+
 def estimate_rows(
     values: bytes,
     rows: int,

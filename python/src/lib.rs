@@ -160,20 +160,30 @@ fn estimate_one(
             .estimate_photo_bytes(data, source, options)
             .map_err(|e| e.to_string()),
         PhotoData::Pixels(pixels, width, height, bits) => {
-            let photo = if *bits == 16 {
-                let values = pixels
-                    .chunks_exact(2)
-                    .map(|c| u16::from_ne_bytes([c[0], c[1]]))
-                    .collect();
-                Photo::from_rgb16(source, *width, *height, values)
-            } else {
-                Photo::from_rgb8(source, *width, *height, pixels.to_vec())
-            };
-            photo
+            pixels_photo(source, pixels, *width, *height, *bits)
                 .map_err(spdcam_infer::InferError::from)
                 .and_then(|p| estimator.estimate_decoded(&p, options))
                 .map_err(|e| e.to_string())
         }
+    }
+}
+
+/// A photo of interleaved RGB pixels: `u8` values, or native-endian `u16` when `bits` is 16.
+fn pixels_photo(
+    source: &str,
+    pixels: &[u8],
+    width: usize,
+    height: usize,
+    bits: u32,
+) -> spdcam_core::error::Result<Photo> {
+    if bits == 16 {
+        let values = pixels
+            .chunks_exact(2)
+            .map(|c| u16::from_ne_bytes([c[0], c[1]]))
+            .collect();
+        Photo::from_rgb16(source, width, height, values)
+    } else {
+        Photo::from_rgb8(source, width, height, pixels.to_vec())
     }
 }
 
@@ -229,6 +239,70 @@ fn estimate_photos<'py>(
         }
     }
     Ok(out)
+}
+
+/// Estimates the light at every chart one photo shows (a file path, an encoded photo's
+/// bytes, or `(pixels, width, height, bits)`, named in messages by `source`): one dict per
+/// chart, numbered from left to right, each with its place and the comparison across
+/// places (`photo.place`, `across_places`, as `spdcam estimate --json` writes them). A chart
+/// whose patches are refused is left out; a photo that gives no estimate raises its
+/// message.
+#[pyfunction]
+#[pyo3(signature = (photo, source, models, chart=None, range="400-700:5", light="unknown"))]
+fn estimate_places<'py>(
+    py: Python<'py>,
+    photo: PhotoInput<'py>,
+    source: String,
+    models: &Models,
+    chart: Option<String>,
+    range: &str,
+    light: &str,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let estimator = models.on(range, light)?;
+    let options = PhotoOptions {
+        chart,
+        ..PhotoOptions::default()
+    };
+    let data = photo.data();
+    let results: Result<Vec<Estimate>, String> = py.allow_threads(|| {
+        let decoded = match &data {
+            PhotoData::Path(path) => {
+                spdcam_core::photo::load_photo(path).map_err(|e| unusable_photo(path, &e))
+            }
+            PhotoData::Encoded(bytes) => {
+                spdcam_core::photo::decode_photo(bytes, &source).map_err(|e| e.to_string())
+            }
+            PhotoData::Pixels(pixels, width, height, bits) => {
+                pixels_photo(&source, pixels, *width, *height, *bits).map_err(|e| e.to_string())
+            }
+        }?;
+        // A file's estimates are labelled with its name, as `estimate` labels them.
+        let label = match &data {
+            PhotoData::Path(path) => path
+                .file_name()
+                .map_or_else(|| source.clone(), |n| n.to_string_lossy().into_owned()),
+            _ => source.clone(),
+        };
+        let mut made = Vec::new();
+        let mut first_error = None;
+        for place in estimator.photo_places(&decoded, &label, &options) {
+            match place.into_estimate() {
+                Ok(e) => made.push(e),
+                Err(e) => {
+                    first_error.get_or_insert(e.to_string());
+                }
+            }
+        }
+        match (made.is_empty(), first_error) {
+            (true, Some(e)) => Err(e),
+            _ => Ok(made),
+        }
+    });
+    results
+        .map_err(py_err)?
+        .iter()
+        .map(|e| estimate_dict(py, e))
+        .collect()
 }
 
 /// Native-endian `f64` bytes as numbers.
@@ -624,6 +698,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<Models>()?;
     m.add_function(wrap_pyfunction!(estimate_photos, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate_places, m)?)?;
     m.add_function(wrap_pyfunction!(estimate_rows, m)?)?;
     m.add_function(wrap_pyfunction!(read_photo, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;

@@ -522,20 +522,30 @@ impl Estimator {
         name: &str,
         options: &PhotoOptions,
     ) -> Vec<PhotoEstimate> {
-        let decoded = match photo::decode_photo(bytes, name) {
-            Ok(decoded) => decoded,
-            Err(e) => return vec![PhotoEstimate::unusable(e.into())],
-        };
+        match photo::decode_photo(bytes, name) {
+            Ok(decoded) => self.photo_places(&decoded, name, options),
+            Err(e) => vec![PhotoEstimate::unusable(e.into())],
+        }
+    }
+
+    /// [`Estimator::photo_bytes_places`] for a photo already decoded (a file read, or a
+    /// pixel array in Python).
+    pub fn photo_places(
+        &self,
+        photo: &Photo,
+        name: &str,
+        options: &PhotoOptions,
+    ) -> Vec<PhotoEstimate> {
         let mut photos = match self.templates(options.chart.as_deref()) {
             Ok(templates) => {
-                self.analyse_places_with(&decoded, options, templates, options.debug.clone())
+                self.analyse_places_with(photo, options, templates, options.debug.clone())
             }
             Err(e) => vec![PhotoEstimate::unusable(e)],
         };
-        for photo in &mut photos {
-            if let Ok(analysed) = &photo.analysed {
+        for one in &mut photos {
+            if let Ok(analysed) = &one.analysed {
                 let label = place_label(name, &analysed.analysis);
-                self.estimate_analysed(photo, label);
+                self.estimate_analysed(one, label);
             }
         }
         compare_photo_places(&mut photos);
