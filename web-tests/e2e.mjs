@@ -327,6 +327,22 @@ await test('several photos share one plot', async () => {
   check(await page.locator('#uv-plot circle.estimate-point').count() >= 1, 'no point on the u′v′ diagram');
 });
 
+await test('a photo of three charts gives an entry per place and says how the places compare', async () => {
+  const tab = await context.newPage();
+  await tab.goto(url);
+  await tab.setInputFiles('#files', join(dirname(photoPath), 'cc24-two-lights.jpg'));
+  await tab.waitForFunction(() => document.querySelectorAll('#list li').length === 3 && !document.querySelector('#list li .status')?.textContent.includes('…'), null, { timeout: 60000 });
+  const names = await tab.locator('#list li .name').allInnerTexts();
+  check(JSON.stringify(names) === JSON.stringify([1, 2, 3].map((k) => `cc24-two-lights.jpg place ${k}`)), `entries ${names}`);
+  await tab.waitForSelector('#across-places');
+  const across = await text(tab, '#across-places');
+  check(/The light across the 3 places/.test(across) && /the lights differ/.test(across), `comparison '${across}'`);
+  check(/light level against the brightest place: place 1 \d+ %, place 2 100 %, place 3 \d+ %/.test(across), `levels '${across}'`);
+  await tab.locator('#list li').nth(2).click();
+  check((await text(tab, '#photo-title')) === 'cc24-two-lights.jpg place 3', 'the third place is not shown when chosen');
+  await tab.close();
+});
+
 await test('the summary says in plain words what the light is and how good the estimate is', async () => {
   const tab = await context.newPage();
   await tab.goto(url);

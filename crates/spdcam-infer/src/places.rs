@@ -26,7 +26,7 @@ use serde::Serialize;
 /// their estimates) above which the photo's lights are said to differ. Chosen on validation
 /// scenes (`spdcam experiment places`, docs/places.md): charts under one light within it,
 /// lights 0.01 apart beyond it.
-pub const LIGHTS_DIFFER_DUV: f64 = 0.005;
+pub const LIGHTS_DIFFER_DUV: f64 = 0.0085;
 
 /// One place's light, as the comparison shows it.
 #[derive(Debug, Clone, PartialEq, Serialize)]

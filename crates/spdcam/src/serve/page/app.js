@@ -90,7 +90,7 @@ async function run(entry, corners, chart) {
   render();
   try {
     const id = await submit(entry, corners, chart);
-    entry.result = await poll(entry, id);
+    entry.result = placed(entry, await poll(entry, id));
     entry.jobId = id;
     entry.placing = null;
     entry.corners = entry.result.photo ? entry.result.photo.corners.map((p) => p.slice()) : null;
@@ -108,6 +108,27 @@ async function run(entry, corners, chart) {
   entry.busy = false;
   entry.status = '';
   render();
+}
+
+/** A photo of several charts: the entry keeps its place's estimate (the first, or the place
+ *  it already stands for) and each other place becomes an entry of its own beside it, sharing
+ *  the photo; its estimate is the result the entry shows. */
+function placed(entry, result) {
+  const places = result.places;
+  if (!places || places.length < 2) return result;
+  if (entry.place) return places.find((p) => p.photo.place.number === entry.place) || places[0];
+  entry.place = places[0].photo.place.number;
+  entry.shown = places[0].name;
+  let at = state.entries.indexOf(entry);
+  for (const r of places.slice(1)) {
+    const sibling = {
+      ...entry, id: state.nextId++, color: COLORS[state.entries.length % COLORS.length],
+      result: r, place: r.photo.place.number, shown: r.name,
+      corners: r.photo.corners.map((p) => p.slice()), busy: false, status: '',
+    };
+    state.entries.splice(++at, 0, sibling);
+  }
+  return places[0];
 }
 
 function setStatus(entry, text) {
@@ -265,7 +286,7 @@ function renderList() {
     li.addEventListener('click', () => { state.selected = e.id; render(); });
     const top = html('div', {}, li);
     html('span', { class: 'swatch', style: `background:${e.color}` }, top);
-    html('span', { class: 'name' }, top, e.name);
+    html('span', { class: 'name' }, top, e.shown || e.name);
     let status = e.status;
     if (!e.busy && e.result) status = listStatus(e.result);
     html('div', { class: 'status' }, li, status);
@@ -297,7 +318,7 @@ function renderStage() {
   const e = selected();
   const view = $('photo-view');
   view.classList.toggle('wide', Boolean(e && e.placing));
-  $('photo-title').textContent = e ? e.name : 'Photo';
+  $('photo-title').textContent = e ? e.shown || e.name : 'Photo';
   stage.replaceChildren();
   $('stage-tools').replaceChildren();
   if (!e) { html('p', { class: 'placeholder' }, stage, 'No photo yet.'); return; }
@@ -662,6 +683,13 @@ function renderOverview() {
     if (p.verdict.glare) html('p', { class: 'glare', id: 'glare' }, v, p.verdict.glare);
   }
   html('p', { class: 'note', id: 'gfc-words' }, box, p.gfc);
+  const lines = e.result.across_places_lines;
+  if (lines) {
+    const across = html('div', { class: 'across', id: 'across-places' }, box);
+    html('strong', {}, across, `The light across the ${e.result.across_places.places.length} places of this photo`);
+    const ul = html('ul', {}, across);
+    lines.forEach((t) => html('li', {}, ul, t));
+  }
 }
 
 /** What a colour meter's screen leads with: CCT and Δuv, or the dominant wavelength, purity
