@@ -58,6 +58,7 @@ const OUTPUTS: &[(&str, &str, Output)] = &[
     ("experiment real-cameras", "output", Output::File),
     ("experiment colour", "output", Output::File),
     ("experiment colour", "photos_csv", Output::File),
+    ("experiment places", "output", Output::File),
     ("fit-in-camera", "output", Output::File),
     ("sim2real", "output", Output::File),
     ("coverage", "output", Output::File),

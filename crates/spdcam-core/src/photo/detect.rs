@@ -272,20 +272,7 @@ fn search_all(
                 .collect::<Vec<_>>()
         })
         .collect();
-    if trace.blobs.is_empty() || !candidates.is_empty() {
-        trace.blobs = blobs
-            .iter()
-            .map(|b| ([b.centre[0] * scale, b.centre[1] * scale], b.side() * scale))
-            .collect();
-    }
-    for c in &mut candidates {
-        if c.confidence() < MIN_CONFIDENCE {
-            let t = &templates[c.template];
-            c.support = grid_support(level, &t.patch_squares(), &c.map);
-            let ring = grid_support(level, &ring_squares(t), &c.map);
-            c.ring = c.ring.max((ring / FULL_SUPPORT).clamp(0.0, 1.0));
-        }
-    }
+    weigh(level, scale, templates, &blobs, &mut candidates, trace);
     candidates.sort_by(|a, b| b.score().total_cmp(&a.score()));
     let outline = |c: &Candidate| {
         let map = c.map.scaled_output(scale);
@@ -375,22 +362,7 @@ fn search_traced(
     trace: &mut SearchTrace,
 ) -> Option<(Detection, Start)> {
     let (mut candidates, blobs) = search_level(level, templates);
-    if trace.blobs.is_empty() || !candidates.is_empty() {
-        trace.blobs = blobs
-            .iter()
-            .map(|b| ([b.centre[0] * scale, b.centre[1] * scale], b.side() * scale))
-            .collect();
-    }
-    for c in &mut candidates {
-        if c.confidence() < MIN_CONFIDENCE {
-            // Too few patches segmented (a small or steep chart): let the photo itself say
-            // whether the grid sits on patches, and whether patches go on outside it.
-            let t = &templates[c.template];
-            c.support = grid_support(level, &t.patch_squares(), &c.map);
-            let ring = grid_support(level, &ring_squares(t), &c.map);
-            c.ring = c.ring.max((ring / FULL_SUPPORT).clamp(0.0, 1.0));
-        }
-    }
+    weigh(level, scale, templates, &blobs, &mut candidates, trace);
     // The confident placement that scores best, else the most confident one (for the trace).
     let confident = candidates
         .iter()
@@ -423,6 +395,34 @@ fn search_traced(
         };
         (found, start)
     })
+}
+
+/// Notes a level's blobs (in photo pixels; the level's pixels are `scale` wide) in `trace`
+/// when it placed candidates or nothing was noted yet; and for each candidate below
+/// [`MIN_CONFIDENCE`] (too few patches segmented: a small or steep chart) lets the photo
+/// itself say whether the grid sits on patches, and whether patches go on outside it.
+fn weigh(
+    level: &Level,
+    scale: f64,
+    templates: &[ChartTemplate],
+    blobs: &[Blob],
+    candidates: &mut [Candidate],
+    trace: &mut SearchTrace,
+) {
+    if trace.blobs.is_empty() || !candidates.is_empty() {
+        trace.blobs = blobs
+            .iter()
+            .map(|b| ([b.centre[0] * scale, b.centre[1] * scale], b.side() * scale))
+            .collect();
+    }
+    for c in candidates.iter_mut() {
+        if c.confidence() < MIN_CONFIDENCE {
+            let t = &templates[c.template];
+            c.support = grid_support(level, &t.patch_squares(), &c.map);
+            let ring = grid_support(level, &ring_squares(t), &c.map);
+            c.ring = c.ring.max((ring / FULL_SUPPORT).clamp(0.0, 1.0));
+        }
+    }
 }
 
 /// The smallest reduction factor the search goes down to: the level that keeps at most

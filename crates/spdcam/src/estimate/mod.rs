@@ -39,7 +39,8 @@ const DETAILED_MAX: usize = 20;
 pub struct EstimateArgs {
     /// Photos of a colour chart (JPEG, PNG, TIFF, or camera raw: DNG, CR2, CR3, NEF, ARW, RAF,
     /// ORF, RW2, PEF, …), or chart images from `spdcam render`;
-    /// one estimate each.
+    /// one estimate per chart found (a photo of several charts gives one per chart, labelled
+    /// by its place and compared across places).
     #[arg(value_name = "PHOTO", required_unless_present = "features")]
     photos: Vec<PathBuf>,
     /// The model file (.spdm); default: the models shipped inside spdcam, one per chart
@@ -213,9 +214,21 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             .zip(truths)
             .map(|((e, overlay), truth)| report_item(e, overlay, truth.map(Spd::into_values)))
             .collect::<Result<Vec<_>>>()?;
-        let title = match estimates.as_slice() {
-            [one] => format!("The light in {}", one.name),
-            all => format!("The light in {} photos", all.len()),
+        let mut distinct = photos.clone();
+        distinct.dedup();
+        let title = match (estimates.as_slice(), distinct.as_slice()) {
+            ([one], _) => format!("The light in {}", one.name),
+            (all, [photo]) => format!(
+                "The light at {} places of {}",
+                all.len(),
+                photo
+                    .file_name()
+                    .map_or_else(|| photo.display().to_string(), |n| n.to_string_lossy().into())
+            ),
+            (all, many) if all.len() == many.len() => {
+                format!("The light in {} photos", all.len())
+            }
+            (all, many) => format!("The light at {} places in {} photos", all.len(), many.len()),
         };
         write_report(path, &title, &items)?;
     }
