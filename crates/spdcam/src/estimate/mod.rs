@@ -221,9 +221,10 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             (all, [photo]) => format!(
                 "The light at {} places of {}",
                 all.len(),
-                photo
-                    .file_name()
-                    .map_or_else(|| photo.display().to_string(), |n| n.to_string_lossy().into())
+                photo.file_name().map_or_else(
+                    || photo.display().to_string(),
+                    |n| n.to_string_lossy().into()
+                )
             ),
             (all, many) if all.len() == many.len() => {
                 format!("The light in {} photos", all.len())
