@@ -14,14 +14,13 @@
 //! its tone curve and the lens's vignetting, so it is approximate (tens of per cent): every
 //! output says so.
 
-use crate::chromaticity::xy_to_uv_prime;
 use crate::error::Result;
 use serde::Serialize;
 use spdcam_core::chart::Chart;
 use spdcam_core::colorimetry::Observer;
 use spdcam_core::colorimetry::{linear_srgb_to_xyz, srgb_decode};
 use spdcam_core::photo::{Exposure, PhotoAnalysis};
-use spdcam_core::quality::uv::xyz_to_uv1976;
+use spdcam_core::quality::uv::{xy_to_uv1976, xyz_to_uv1976};
 use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::Spd;
 
@@ -212,7 +211,7 @@ pub fn chart_level(
     };
     found.sort_by_key(|p| p.0);
     let grey_uv_prime = match &analysis.raw {
-        Some(reading) => xy_to_uv_prime(reading.light_xy),
+        Some(reading) => xy_to_uv1976(reading.light_xy),
         None => xyz_to_uv1976(linear_srgb_to_xyz(grey_sum)),
     };
     Ok(Ok(ChartLevel {

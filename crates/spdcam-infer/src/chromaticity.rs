@@ -16,7 +16,7 @@
 
 use crate::estimate::Estimate;
 use spdcam_core::colorimetry::{cct_duv_to_uv, cct_to_uv_planck, Observer};
-use spdcam_core::quality::uv::uv1960_to_uv1976;
+use spdcam_core::quality::uv::{uv1960_to_uv1976, xy_to_uv1976};
 use spdcam_core::spectral::Grid;
 use std::fmt::Write as _;
 
@@ -83,12 +83,6 @@ impl View {
     }
 }
 
-/// CIE 1931 xy → CIE 1976 u′v′.
-pub fn xy_to_uv_prime(xy: [f64; 2]) -> [f64; 2] {
-    let d = -2.0 * xy[0] + 12.0 * xy[1] + 3.0;
-    [4.0 * xy[0] / d, 9.0 * xy[1] / d]
-}
-
 /// The spectral locus in u′v′ with its wavelengths, 360–700 nm every 5 nm.
 fn spectral_locus() -> Vec<(f64, [f64; 2])> {
     let Ok(grid) = Grid::new(360.0, 700.0, 5.0) else {
@@ -142,8 +136,8 @@ pub fn region95(e: &Estimate) -> Option<Vec<[f64; 2]>> {
 /// The u′v′ diagram of estimate `e` (and of its truth's chromaticity `truth_xy` when known)
 /// as a self-contained SVG element.
 pub fn uv_diagram_svg(e: &Estimate, truth_xy: Option<[f64; 2]>) -> String {
-    let point = xy_to_uv_prime(e.colorimetry.xy);
-    let truth = truth_xy.map(xy_to_uv_prime);
+    let point = xy_to_uv1976(e.colorimetry.xy);
+    let truth = truth_xy.map(xy_to_uv1976);
     let region = region95(e);
     let mut s = String::new();
     let _ = write!(
@@ -333,7 +327,7 @@ mod tests {
     #[test]
     fn d65_sits_at_its_published_u_v_and_the_locus_passes_520_nm() {
         // D65: x 0.31271, y 0.32902 → u′ 0.1978, v′ 0.4683 (CIE 015:2018 Table T.3).
-        let uv = xy_to_uv_prime([0.31271, 0.32902]);
+        let uv = xy_to_uv1976([0.31271, 0.32902]);
         assert!(
             (uv[0] - 0.1978).abs() < 1e-4 && (uv[1] - 0.4683).abs() < 1e-4,
             "{uv:?}"
@@ -355,7 +349,7 @@ mod tests {
         assert!((attr(&svg, "estimate-point", "data-u")[0] - 0.1978).abs() < 5e-4);
         assert!((attr(&svg, "estimate-point", "data-v")[0] - 0.4683).abs() < 5e-4);
         // The spectral locus passes 520 nm at x 0.0743, y 0.8338 (CIE 1931 table).
-        let at520 = MAIN.at(xy_to_uv_prime([0.0743, 0.8338]));
+        let at520 = MAIN.at(xy_to_uv1976([0.0743, 0.8338]));
         let polygon = svg
             .split("class=\"spectral-locus\" points=\"")
             .nth(1)

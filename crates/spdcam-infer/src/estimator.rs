@@ -1233,7 +1233,7 @@ fn compare_photo_places(photos: &mut [PhotoEstimate]) {
             }
         })
         .collect();
-    places::compare_places(&mut made);
+    set_across_places(&mut made);
     let mut made = made.into_iter();
     for p in photos
         .iter_mut()
@@ -1241,6 +1241,48 @@ fn compare_photo_places(photos: &mut [PhotoEstimate]) {
     {
         p.estimate = made.next().map(Ok);
     }
+}
+
+/// Sets [`Estimate::across_places`] on every estimate of a photo with several places,
+/// `estimates` grouped by their photo's source.
+fn set_across_places(estimates: &mut [Estimate]) {
+    let mut sources: Vec<String> = estimates
+        .iter()
+        .filter_map(|e| {
+            let photo = e.photo.as_ref()?;
+            photo.place.map(|_| photo.source.clone())
+        })
+        .collect();
+    sources.sort();
+    sources.dedup();
+    for source in sources {
+        let readings: Vec<places::PlaceReading> = estimates
+            .iter()
+            .filter_map(|e| place_reading(e, &source))
+            .collect();
+        let across = places::LightAcrossPlaces::of(&readings);
+        for e in estimates
+            .iter_mut()
+            .filter(|e| place_reading(e, &source).is_some())
+        {
+            e.across_places = across.clone();
+        }
+    }
+}
+
+/// What `estimate` gave at its place, when it is one of several charts in the photo
+/// `source`.
+fn place_reading<'a>(estimate: &'a Estimate, source: &str) -> Option<places::PlaceReading<'a>> {
+    let photo = estimate.photo.as_ref().filter(|p| p.source == source)?;
+    let place = photo.place?;
+    Some(places::PlaceReading {
+        number: place.number,
+        centre: place.centre,
+        xy: estimate.colorimetry.xy,
+        cct: estimate.colorimetry.cct,
+        duv: estimate.colorimetry.duv,
+        level: estimate.light_level.as_ref(),
+    })
 }
 
 /// Where the patches of `analysis` came from: corners placed by hand, or detection.

@@ -18,9 +18,8 @@
 //! better on the validation scenes: the greys' mean colours are compared.)
 
 use crate::absolute::ChartLevel;
-use crate::chromaticity::xy_to_uv_prime;
-use crate::estimate::Estimate;
 use serde::Serialize;
+use spdcam_core::quality::uv::xy_to_uv1976;
 
 /// The largest Δu′v′ between two places' greys (or, where a place's greys cannot be read,
 /// their estimates) above which the photo's lights are said to differ. Chosen on validation
@@ -70,44 +69,53 @@ pub struct LightAcrossPlaces {
     pub lights_differ: bool,
 }
 
+/// What one place of a photo gave: its place, its estimate's colour and the light read on
+/// its grey patches.
+#[derive(Debug, Clone, Copy)]
+pub struct PlaceReading<'a> {
+    /// The place's number (1-based, left to right).
+    pub number: usize,
+    /// The chart's centre, photo pixels.
+    pub centre: [f64; 2],
+    /// The estimate's CIE 1931 xy.
+    pub xy: [f64; 2],
+    /// The estimate's CCT, K.
+    pub cct: Option<f64>,
+    /// The estimate's Duv.
+    pub duv: Option<f64>,
+    /// The light on the chart read on its greys ([`crate::absolute::chart_level`]).
+    pub level: Option<&'a ChartLevel>,
+}
+
 impl LightAcrossPlaces {
-    /// The comparison of `estimates`, the estimates of one photo's places (each carrying
-    /// its photo analysis with its place); `None` for fewer than two.
-    pub fn of(estimates: &[&Estimate]) -> Option<LightAcrossPlaces> {
-        let mut placed: Vec<(&Estimate, usize, [f64; 2])> = estimates
-            .iter()
-            .filter_map(|e| {
-                let place = e.photo.as_ref()?.place?;
-                Some((*e, place.number, place.centre))
-            })
-            .collect();
+    /// The comparison of one photo's places; `None` for fewer than two.
+    pub fn of(readings: &[PlaceReading<'_>]) -> Option<LightAcrossPlaces> {
+        let mut placed = readings.to_vec();
         if placed.len() < 2 {
             return None;
         }
-        placed.sort_by_key(|p| p.1);
+        placed.sort_by_key(|p| p.number);
         let brightest = placed
             .iter()
-            .filter_map(|p| p.0.light_level.as_ref().map(|l| l.level))
+            .filter_map(|p| p.level.map(|l| l.level))
             .fold(f64::NAN, f64::max);
         let places: Vec<PlaceLight> = placed
             .iter()
-            .map(|&(e, number, centre)| PlaceLight {
-                number,
-                centre,
-                uv_prime: xy_to_uv_prime(e.colorimetry.xy),
-                grey_uv_prime: e.light_level.as_ref().map(|l| l.grey_uv_prime),
-                cct: e.colorimetry.cct,
-                duv: e.colorimetry.duv,
-                relative_illuminance: e
-                    .light_level
-                    .as_ref()
+            .map(|p| PlaceLight {
+                number: p.number,
+                centre: p.centre,
+                uv_prime: xy_to_uv1976(p.xy),
+                grey_uv_prime: p.level.map(|l| l.grey_uv_prime),
+                cct: p.cct,
+                duv: p.duv,
+                relative_illuminance: p
+                    .level
                     .filter(|_| brightest > 0.0)
                     .map(|l| l.level / brightest),
             })
             .collect();
         let estimates: Vec<[f64; 2]> = places.iter().map(|p| p.uv_prime).collect();
-        let levels: Option<Vec<&ChartLevel>> =
-            placed.iter().map(|p| p.0.light_level.as_ref()).collect();
+        let levels: Option<Vec<&ChartLevel>> = placed.iter().map(|p| p.level).collect();
         let numbers: Vec<usize> = places.iter().map(|p| p.number).collect();
         let n = places.len();
         let estimate_distances: Vec<Vec<f64>> = (0..n)
@@ -226,89 +234,69 @@ fn greys_distance(a: &ChartLevel, b: &ChartLevel) -> f64 {
     distance(a.grey_uv_prime, b.grey_uv_prime)
 }
 
-/// Sets [`Estimate::across_places`] on every estimate of a photo with several places:
-/// `estimates` grouped by their photo's source.
-pub fn compare_places(estimates: &mut [Estimate]) {
-    let mut sources: Vec<String> = estimates
-        .iter()
-        .filter_map(|e| {
-            let photo = e.photo.as_ref()?;
-            photo.place.map(|_| photo.source.clone())
-        })
-        .collect();
-    sources.sort();
-    sources.dedup();
-    for source in sources {
-        let of_photo = |e: &Estimate| {
-            e.photo
-                .as_ref()
-                .is_some_and(|p| p.source == source && p.place.is_some())
-        };
-        let group: Vec<&Estimate> = estimates.iter().filter(|e| of_photo(e)).collect();
-        let across = LightAcrossPlaces::of(&group);
-        for e in estimates.iter_mut().filter(|e| of_photo(e)) {
-            e.across_places = across.clone();
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_support::estimate_of;
     use spdcam_core::cie_illuminant::StandardIlluminant;
-    use spdcam_core::photo::{PhotoAnalysis, Place};
+    use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
     use spdcam_core::spectral::Grid;
 
-    fn placed(light: StandardIlluminant, number: usize, level: f64) -> Estimate {
-        let mut e = estimate_of(light.spd(&Grid::ESTIMATION).unwrap(), &[]);
-        e.photo = Some(PhotoAnalysis {
-            source: "room.jpg".into(),
-            width: 100,
-            height: 100,
-            method: "detected",
-            chart: "colorchecker24".into(),
-            confidence: 1.0,
-            corners: [[0.0; 2]; 4],
-            homography: [[0.0; 3]; 3],
-            feature_names: Vec::new(),
-            features: Vec::new(),
-            patches: Vec::new(),
-            warnings: Vec::new(),
-            exposure: None,
-            raw: None,
-            place: Some(Place {
-                number,
-                of: 3,
-                centre: [10.0 * number as f64, 5.0],
-            }),
-        });
-        e.light_level = Some(ChartLevel {
+    /// A place under `light` whose greys show the light's own colour, at `level`.
+    fn reading(
+        light: StandardIlluminant,
+        number: usize,
+        level: f64,
+    ) -> (PlaceReading<'static>, ChartLevel) {
+        let grid = Grid::ESTIMATION;
+        let spd = light.spd(&grid).unwrap();
+        let xy = Observer::cie1931(&grid).unwrap().spd_to_xy(spd.values());
+        let (cct, duv) = uv_to_cct_duv(xy_to_uv1960(xy)).unwrap();
+        let chart = ChartLevel {
             level,
-            grey_uv_prime: xy_to_uv_prime(e.colorimetry.xy),
+            grey_uv_prime: xy_to_uv1976(xy),
             patches: Vec::new(),
-        });
-        e
+        };
+        let place = PlaceReading {
+            number,
+            centre: [10.0 * number as f64, 5.0],
+            xy,
+            cct: Some(cct),
+            duv: Some(duv),
+            level: None,
+        };
+        (place, chart)
+    }
+
+    fn compare(lights: &[(StandardIlluminant, f64)]) -> Option<LightAcrossPlaces> {
+        let made: Vec<(PlaceReading, ChartLevel)> = lights
+            .iter()
+            .enumerate()
+            .map(|(k, &(light, level))| reading(light, k + 1, level))
+            .collect();
+        let readings: Vec<PlaceReading> = made
+            .iter()
+            .map(|(p, chart)| PlaceReading {
+                level: Some(chart),
+                ..*p
+            })
+            .collect();
+        LightAcrossPlaces::of(&readings)
     }
 
     #[test]
     fn a_warm_place_among_daylight_ones_differs_most() {
-        let mut estimates = vec![
-            placed(StandardIlluminant::D65, 1, 0.8),
-            placed(StandardIlluminant::A, 2, 0.4),
-            placed(StandardIlluminant::D65, 3, 0.8),
-        ];
-        compare_places(&mut estimates);
-        let across = estimates[0].across_places.clone().unwrap();
-        assert_eq!(estimates[2].across_places.as_ref(), Some(&across));
+        use StandardIlluminant::{A, D65};
+        let across = compare(&[(D65, 0.8), (A, 0.4), (D65, 0.8)]).unwrap();
         assert!(across.lights_differ);
         assert_eq!(across.most_different, 2);
         // D65 u′v′ (0.1978, 0.4683), A (0.2560, 0.5243): Δu′v′ 0.0808 (CIE 015:2018).
+        let (a, b, d) = across.largest_delta_uv;
+        assert_eq!((a, b), (1, 2));
+        assert!((d - 0.0808).abs() < 0.001, "{d}");
         assert_eq!(
-            (across.largest_delta_uv.0, across.largest_delta_uv.1),
-            (1, 2)
+            across.greys_largest_delta_uv.map(|g| (g.0, g.1)),
+            Some((1, 2))
         );
-        assert!((across.largest_delta_uv.2 - 0.0808).abs() < 0.001);
         assert!((across.cct_spread_k.unwrap() - (6504.0 - 2856.0)).abs() < 20.0);
         let levels: Vec<Option<f64>> = across
             .places
@@ -321,12 +309,8 @@ mod tests {
 
     #[test]
     fn one_light_at_every_place_is_one_light() {
-        let mut estimates = vec![
-            placed(StandardIlluminant::D65, 1, 0.8),
-            placed(StandardIlluminant::D65, 2, 0.2),
-        ];
-        compare_places(&mut estimates);
-        let across = estimates[1].across_places.clone().unwrap();
+        let d65 = StandardIlluminant::D65;
+        let across = compare(&[(d65, 0.8), (d65, 0.2)]).unwrap();
         assert!(!across.lights_differ);
         assert!(across.largest_delta_uv.2 < 1e-12);
         assert!(across.lines()[0].starts_with("one light in colour"));
@@ -334,12 +318,16 @@ mod tests {
     }
 
     #[test]
-    fn a_photo_of_one_chart_has_no_comparison() {
-        let mut estimates = vec![estimate_of(
-            StandardIlluminant::D65.spd(&Grid::ESTIMATION).unwrap(),
-            &[],
-        )];
-        compare_places(&mut estimates);
-        assert_eq!(estimates[0].across_places, None);
+    fn without_greys_the_estimates_decide_and_one_place_is_no_comparison() {
+        let (a, _) = reading(StandardIlluminant::A, 1, 1.0);
+        let (d65, _) = reading(StandardIlluminant::D65, 2, 1.0);
+        let across = LightAcrossPlaces::of(&[a, d65]).unwrap();
+        assert!(across.lights_differ && across.greys_largest_delta_uv.is_none());
+        assert!(across
+            .places
+            .iter()
+            .all(|p| p.relative_illuminance.is_none()));
+        assert!(across.lines()[0].contains("a place's greys could not be read"));
+        assert_eq!(LightAcrossPlaces::of(&[a]), None);
     }
 }

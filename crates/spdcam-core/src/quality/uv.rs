@@ -14,6 +14,13 @@ pub fn xyz_to_uv1976(xyz: [f64; 3]) -> [f64; 2] {
     [4.0 * xyz[0] / d, 9.0 * xyz[1] / d]
 }
 
+/// CIE 1931 (x, y) → CIE 1976 UCS (u′, v′): u′ = 4x/(−2x+12y+3), v′ = 9y/(−2x+12y+3)
+/// (CIE 015:2018 §8.1).
+pub fn xy_to_uv1976(xy: [f64; 2]) -> [f64; 2] {
+    let d = -2.0 * xy[0] + 12.0 * xy[1] + 3.0;
+    [4.0 * xy[0] / d, 9.0 * xy[1] / d]
+}
+
 /// CIE 1960 (u, v) → CIE 1976 (u′, v′): u′ = u, v′ = 1.5 v (CIE 015:2018 §8.1).
 pub fn uv1960_to_uv1976(uv: [f64; 2]) -> [f64; 2] {
     [uv[0], 1.5 * uv[1]]
@@ -47,5 +54,8 @@ mod tests {
         assert_eq!(uv1960_to_uv1976(e), e76);
         let back = uv1976_to_uv1960(d65);
         assert!((back[0] - direct[0]).abs() < 1e-15 && (back[1] - direct[1]).abs() < 1e-15);
+        // From xy directly, as from its XYZ.
+        let from_xy = xy_to_uv1976([0.31271, 0.32902]);
+        assert!((from_xy[0] - d65[0]).abs() < 1e-15 && (from_xy[1] - d65[1]).abs() < 1e-15);
     }
 }
