@@ -118,31 +118,24 @@ fn render_places_charts_writes_one_truth_per_place_and_refuses_overlaps() {
         .and_then(|t| t.parse::<f64>().ok())
         .expect(&estimated);
     assert!((level - 50.0).abs() <= 2.5, "{estimated}");
-    let e = fails(&[
-        "render",
-        "--spd",
-        "D50",
-        "--scene",
-        "1200x800",
-        "--place",
-        "centre=0.45,0.5 width=0.3",
-        "--place",
-        "centre=0.55,0.5 width=0.3",
-        "-o",
-        &s(&dir.join("overlap.jpg")),
-    ]);
+    // Refusals, each naming what is wrong, with no photo written.
+    let refused = |places: &[&str], name: &str| {
+        let out = dir.join(name);
+        let out_text = s(&out);
+        let mut args = vec!["render", "--spd", "D50", "--scene", "1200x800"];
+        for &p in places {
+            args.extend(["--place", p]);
+        }
+        args.extend(["-o", out_text.as_str()]);
+        let e = fails(&args);
+        assert!(!out.exists(), "{name} was written");
+        e
+    };
+    let e = refused(
+        &["centre=0.45,0.5 width=0.3", "centre=0.55,0.5 width=0.3"],
+        "overlap.jpg",
+    );
     assert!(e.contains("charts 1 and 2 of the scene overlap"), "{e}");
-    assert!(!dir.join("overlap.jpg").exists());
-    let e = fails(&[
-        "render",
-        "--spd",
-        "D50",
-        "--scene",
-        "1200x800",
-        "--place",
-        "width=0.3",
-        "-o",
-        &s(&dir.join("bad.jpg")),
-    ]);
+    let e = refused(&["width=0.3"], "bad.jpg");
     assert!(e.contains("needs centre=X,Y"), "{e}");
 }

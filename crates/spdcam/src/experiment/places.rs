@@ -2,7 +2,7 @@
 //! two to four charts (`spdcam_eval::places`); this parses its options and writes its
 //! report.
 
-use crate::args::held_out::LibraryArgs;
+use crate::args::held_out::{flags, LibraryArgs};
 use anyhow::Result;
 use clap::Args;
 use spdcam_core::builtin::DataDir;
@@ -47,16 +47,13 @@ pub(super) fn run(args: PlacesArgs, data_dir: &DataDir) -> Result<()> {
     let report = PlacesReport::measure(&options, data_dir, &mut |what| {
         eprintln!("{what} ({:.0} s)", started.elapsed().as_secs_f64())
     })?;
-    let mut command = format!(
-        "spdcam --data-dir DATA experiment places --split {} --scenes {} --seed {}",
-        args.split.display(),
+    let command = format!(
+        "spdcam --data-dir DATA experiment places{} --scenes {} --seed {} -o {}",
+        flags(&[], &args.split, &args.library, args.cameras.as_deref()),
         args.scenes,
-        args.seed
+        args.seed,
+        args.output.display()
     );
-    if let Some(c) = &args.cameras {
-        command += &format!(" --cameras {}", c.display());
-    }
-    command += &format!(" -o {}", args.output.display());
     let md = report.markdown(&command);
     write_atomic(&args.output, md.as_bytes())?;
     print!("{md}");
