@@ -1220,7 +1220,7 @@ fn place_label(photo: &str, analysis: &PhotoAnalysis) -> String {
     }
 }
 
-/// Sets the comparison across places ([`crate::places::compare_places`]) on every estimate
+/// Sets the comparison across places ([`set_across_places`]) on every estimate
 /// made of a photo with several charts.
 fn compare_photo_places(photos: &mut [PhotoEstimate]) {
     let mut made: Vec<Estimate> = photos
