@@ -508,29 +508,23 @@ impl PlacesReport {
                 v.sort_by(f64::total_cmp);
                 v
             };
-            let ends = |v: Vec<f64>, largest: bool| {
-                let end = if largest { v.last() } else { v.first() }.copied();
-                format!(
-                    "{:.4} · {:.4}",
-                    if largest {
-                        median(v.clone())
-                    } else {
-                        end.unwrap_or(f64::NAN)
-                    },
-                    if largest {
-                        end.unwrap_or(f64::NAN)
-                    } else {
-                        median(v)
-                    }
-                )
+            // Under one light the median and the largest spread; apart the smallest and
+            // the median (each list sorted).
+            let median_largest = |v: Vec<f64>| {
+                let largest = v.last().copied().unwrap_or(f64::NAN);
+                format!("{:.4} · {largest:.4}", median(v))
+            };
+            let smallest_median = |v: Vec<f64>| {
+                let smallest = v.first().copied().unwrap_or(f64::NAN);
+                format!("{smallest:.4} · {:.4}", median(v))
             };
             out += &format!(
                 "| {} | {} | {} | {} | {} |\n",
                 part.label,
-                ends(spread(true, |s| s.grey_spread), true),
-                ends(spread(true, |s| s.estimated_spread), true),
-                ends(spread(false, |s| s.grey_spread), false),
-                ends(spread(false, |s| s.estimated_spread), false),
+                median_largest(spread(true, |s| s.grey_spread)),
+                median_largest(spread(true, |s| s.estimated_spread)),
+                smallest_median(spread(false, |s| s.grey_spread)),
+                smallest_median(spread(false, |s| s.estimated_spread)),
             );
         }
         out += "\nBy chart size (both parts): found, and median Δu′v′ in the scene · alone.\n\n";

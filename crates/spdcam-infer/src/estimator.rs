@@ -1220,54 +1220,37 @@ fn place_label(photo: &str, analysis: &PhotoAnalysis) -> String {
     }
 }
 
-/// Sets the comparison across places ([`set_across_places`]) on every estimate
-/// made of a photo with several charts.
+/// Sets [`Estimate::across_places`] on every estimate made of a photo with several charts,
+/// the estimates grouped by their photo's source.
 fn compare_photo_places(photos: &mut [PhotoEstimate]) {
-    let mut made: Vec<Estimate> = photos
-        .iter_mut()
-        .filter_map(|p| match p.estimate.take() {
-            Some(Ok(e)) => Some(e),
-            other => {
-                p.estimate = other;
-                None
-            }
-        })
-        .collect();
-    set_across_places(&mut made);
-    let mut made = made.into_iter();
-    for p in photos
-        .iter_mut()
-        .filter(|p| p.estimate.is_none() && p.analysed.is_ok())
-    {
-        p.estimate = made.next().map(Ok);
-    }
-}
-
-/// Sets [`Estimate::across_places`] on every estimate of a photo with several places,
-/// `estimates` grouped by their photo's source.
-fn set_across_places(estimates: &mut [Estimate]) {
-    let mut sources: Vec<String> = estimates
+    let mut sources: Vec<String> = photos
         .iter()
-        .filter_map(|e| {
-            let photo = e.photo.as_ref()?;
-            photo.place.map(|_| photo.source.clone())
-        })
+        .filter_map(made)
+        .filter_map(|e| e.photo.as_ref().filter(|p| p.place.is_some()))
+        .map(|p| p.source.clone())
         .collect();
     sources.sort();
     sources.dedup();
     for source in sources {
-        let readings: Vec<places::PlaceReading> = estimates
+        let readings: Vec<places::PlaceReading> = photos
             .iter()
+            .filter_map(made)
             .filter_map(|e| place_reading(e, &source))
             .collect();
         let across = places::LightAcrossPlaces::of(&readings);
-        for e in estimates
-            .iter_mut()
-            .filter(|e| place_reading(e, &source).is_some())
-        {
-            e.across_places = across.clone();
+        for p in photos.iter_mut() {
+            if let Some(Ok(e)) = &mut p.estimate {
+                if place_reading(e, &source).is_some() {
+                    e.across_places = across.clone();
+                }
+            }
         }
     }
+}
+
+/// The estimate made of `photo`, when one was.
+fn made(photo: &PhotoEstimate) -> Option<&Estimate> {
+    photo.estimate.as_ref().and_then(|e| e.as_ref().ok())
 }
 
 /// What `estimate` gave at its place, when it is one of several charts in the photo

@@ -218,17 +218,8 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
             report.describe(&format!("light {}", spd.name), &grid)
         );
     }
-    if let (Some((width, height)), false) = (scene, args.places.is_empty()) {
-        return render_places(
-            &args,
-            &spd.spd,
-            &spd.name,
-            (width, height),
-            data_dir,
-            messages,
-        );
-    }
-    if let Some(path) = &args.spd_out {
+    let several = !args.places.is_empty();
+    if let (Some(path), false) = (&args.spd_out, several) {
         let values = spd.spd.normalised_by_max().into_values();
         let set = SpectralSet::on_grid(&grid, vec![spd.name.clone()], vec![values])?;
         fsio::write_output(path, set.to_csv_string().as_bytes())?;
@@ -236,15 +227,10 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
             messages.say(format_args!("light SPD: {}", path.display()))?;
         }
     }
-    if let Some((width, height)) = scene {
-        return render_scene(
-            &args,
-            &spd.spd,
-            &spd.name,
-            (width, height),
-            data_dir,
-            messages,
-        );
+    if let Some(size) = scene {
+        // Several charts write their own truths, one per place.
+        let photograph = if several { render_places } else { render_scene };
+        return photograph(&args, &spd.spd, &spd.name, size, data_dir, messages);
     }
     let camera = args.camera.camera(data_dir, &grid)?;
     let rendering = camera.render(&spd.spd, args.seed, args.stages.is_some() || dng)?;

@@ -2,16 +2,16 @@
 //! own light (or one light at different levels), the truth of each written beside.
 
 use super::parse::{parse_numbers, parse_share};
+use super::scene_photo::{scene_camera, write_scene};
 use super::RenderArgs;
 use crate::messages::Messages;
 use anyhow::{bail, Context, Result};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::Camera;
 use spdcam_core::chart::Chart;
-use spdcam_core::photo::raw::dng::virtual_camera_dng;
-use spdcam_core::photo::scene::{self, SceneOptions, Tilt, TiltAxis};
+use spdcam_core::photo::quad_centre;
+use spdcam_core::photo::scene::{SceneOptions, Tilt, TiltAxis};
 use spdcam_core::photo::scene_places::{photograph_places, ScenePlace, MAX_PLACES};
-use spdcam_core::photo::{quad_centre, ChartTemplate};
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_core::{fsio, named_light};
 
@@ -116,9 +116,7 @@ pub(super) fn render_places(
     for spec in &specs {
         let name = spec.chart.as_deref().unwrap_or(&args.camera.chart);
         let chart = Chart::resolve(name, None, data_dir, &grid)?;
-        let template = ChartTemplate::from_chart(&chart)?;
-        let chart = chart.with_layout(scene::scene_layout(&template))?;
-        cameras.push(args.camera.camera_for(chart, data_dir, &grid)?);
+        cameras.push(scene_camera(args, chart, data_dir)?);
         lights.push(match &spec.light {
             Some(text) => {
                 let resolved = named_light::resolve_spd(text, data_dir, &grid)?;
@@ -154,21 +152,13 @@ pub(super) fn render_places(
         ..SceneOptions::default()
     };
     let shot = photograph_places(&places, args.seed, &options)?;
-    let dng = args
-        .output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("dng"));
-    if dng {
-        let mosaic = shot.mosaic.as_ref().ok_or_else(|| {
-            anyhow::anyhow!("this scene has no mosaic to write as a DNG (a three-sensor camera)")
-        })?;
-        fsio::write_output(
-            &args.output,
-            &virtual_camera_dng(&cameras[0], &lights[0].1, mosaic, None)?,
-        )?;
-    } else {
-        fsio::write_output(&args.output, &shot.jpeg)?;
-    }
+    write_scene(
+        args,
+        (&cameras[0], &lights[0].1),
+        &shot.jpeg,
+        shot.mosaic.as_ref(),
+        "a three-sensor camera",
+    )?;
     // Left to right, as `estimate` numbers the charts it finds.
     let mut order: Vec<usize> = (0..places.len()).collect();
     order.sort_by(|&a, &b| {

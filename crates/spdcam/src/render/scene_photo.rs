@@ -6,9 +6,12 @@ use super::{RenderArgs, TiltAxisArg};
 use crate::messages::Messages;
 use anyhow::{bail, Result};
 use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::Camera;
+use spdcam_core::chart::Chart;
 use spdcam_core::photo::raw::dng::virtual_camera_dng;
 use spdcam_core::photo::scene::{self, SceneLight, SceneOptions, Shadow, Tilt, TiltAxis};
 use spdcam_core::photo::ChartTemplate;
+use spdcam_core::raster::Mosaic;
 use spdcam_core::spectral::{Grid, Spd};
 use spdcam_core::{fsio, named_light};
 
@@ -64,10 +67,7 @@ pub(super) fn render_scene(
     messages: Messages,
 ) -> Result<()> {
     let grid = Grid::SIMULATION;
-    let chart = args.camera.chart(data_dir, &grid)?;
-    let template = ChartTemplate::from_chart(&chart)?;
-    let chart = chart.with_layout(scene::scene_layout(&template))?;
-    let camera = args.camera.camera_for(chart, data_dir, &grid)?;
+    let camera = scene_camera(args, args.camera.chart(data_dir, &grid)?, data_dir)?;
     let options = args.scene_options(width, height)?;
     let right = args
         .right_light
@@ -83,24 +83,13 @@ pub(super) fn render_scene(
     };
     let shot = scene::photograph(&camera, light, args.seed, &options)?;
     let chart = camera.chart();
-    let dng = args
-        .output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("dng"));
-    if dng {
-        let mosaic = shot.mosaic.as_ref().ok_or_else(|| {
-            anyhow::anyhow!(
-                "this scene has no single mosaic to write as a DNG (a three-sensor camera, or \
-                 two halves developed apart)"
-            )
-        })?;
-        fsio::write_output(
-            &args.output,
-            &virtual_camera_dng(&camera, spd, mosaic, None)?,
-        )?;
-    } else {
-        fsio::write_output(&args.output, &shot.jpeg)?;
-    }
+    write_scene(
+        args,
+        (&camera, spd),
+        &shot.jpeg,
+        shot.mosaic.as_ref(),
+        "a three-sensor camera, or two halves developed apart",
+    )?;
     if fsio::is_stdout(&args.output) {
         return Ok(());
     }
@@ -121,4 +110,37 @@ pub(super) fn render_scene(
         corners.join(",")
     ))?;
     Ok(())
+}
+
+/// The camera of the render's options photographing `chart` laid out for a scene
+/// ([`scene::scene_layout`]).
+pub(super) fn scene_camera(args: &RenderArgs, chart: Chart, data_dir: &DataDir) -> Result<Camera> {
+    let template = ChartTemplate::from_chart(&chart)?;
+    let chart = chart.with_layout(scene::scene_layout(&template))?;
+    args.camera.camera_for(chart, data_dir, &Grid::SIMULATION)
+}
+
+/// Writes a scene photo to `--output`: its JPEG, or for FILE.dng the sensor's `mosaic` as
+/// `camera` under `light` would write it (`no_mosaic` says why a scene has none).
+pub(super) fn write_scene(
+    args: &RenderArgs,
+    (camera, light): (&Camera, &Spd),
+    jpeg: &[u8],
+    mosaic: Option<&Mosaic>,
+    no_mosaic: &str,
+) -> Result<()> {
+    let dng = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("dng"));
+    if !dng {
+        return Ok(fsio::write_output(&args.output, jpeg)?);
+    }
+    let mosaic = mosaic.ok_or_else(|| {
+        anyhow::anyhow!("this scene has no single mosaic to write as a DNG ({no_mosaic})")
+    })?;
+    Ok(fsio::write_output(
+        &args.output,
+        &virtual_camera_dng(camera, light, mosaic, None)?,
+    )?)
 }
