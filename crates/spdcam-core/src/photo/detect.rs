@@ -545,6 +545,10 @@ fn place(
                 if slot.as_ref().is_some_and(|s| c.score() <= s.score()) {
                     continue;
                 }
+                let cells = rotated.iter().map(|p| (p[0] + tc, p[1] + tr));
+                if lattice_goes_on(cells, cols, rows) {
+                    continue;
+                }
                 c.ring = ring_share(blobs, t, &map);
                 if slot.as_ref().is_none_or(|s| c.score() > s.score()) {
                     *slot = Some(c);
@@ -595,6 +599,32 @@ fn ring_share(blobs: &[Blob], t: &ChartTemplate, map: &Homography) -> f64 {
     }
     hit.len() as f64 / (2 * (cols + rows) + 4) as f64
 }
+
+/// Whether the lattice a placement came from goes on past one of the chart's sides: of
+/// the lattice's cells along that side inside the chart (`cells`: every lattice member's
+/// cell, in the template's columns and rows), at least [`CONTINUED_SIDE`] (and three) have a
+/// member one step beyond them. A chart's own lattice never does (its border lies there);
+/// a part of a larger grid does, such as six by four patches of the ColorChecker
+/// Passport's other page beside its ColorChecker 24, which otherwise reads as a second one.
+fn lattice_goes_on(cells: impl Iterator<Item = (i32, i32)>, cols: i32, rows: i32) -> bool {
+    let cells: std::collections::HashSet<(i32, i32)> = cells.collect();
+    let side = |edge: &dyn Fn(i32) -> (i32, i32), (dc, dr): (i32, i32), n: i32| {
+        let along: Vec<(i32, i32)> = (0..n).map(edge).filter(|p| cells.contains(p)).collect();
+        let beyond = along
+            .iter()
+            .filter(|&&(c, r)| cells.contains(&(c + dc, r + dr)))
+            .count();
+        beyond >= 3 && beyond as f64 >= CONTINUED_SIDE * along.len() as f64
+    };
+    side(&|r| (0, r), (-1, 0), rows)
+        || side(&|r| (cols - 1, r), (1, 0), rows)
+        || side(&|c| (c, 0), (0, -1), cols)
+        || side(&|c| (c, rows - 1), (0, 1), cols)
+}
+
+/// The share of a side's lattice cells with a member beyond them that says the lattice goes
+/// on there.
+const CONTINUED_SIDE: f64 = 0.75;
 
 /// Largest distance (in patch pitches) from a ring point to a blob that counts as a patch
 /// continuing the grid there.
@@ -955,6 +985,26 @@ mod tests {
             .collect();
         let share = ring_share(&corner, &t, &map);
         assert!((share - 11.0 / 24.0).abs() < 1e-12, "{share}");
+    }
+
+    #[test]
+    fn a_lattice_going_on_past_a_side_is_part_of_a_larger_grid() {
+        let grid = |cols: std::ops::Range<i32>, rows: std::ops::Range<i32>| {
+            rows.flat_map(move |r| cols.clone().map(move |c| (c, r)))
+                .collect::<Vec<_>>()
+        };
+        // The chart's own lattice, some patches missed: it stops at its sides.
+        let own: Vec<(i32, i32)> = grid(0..6, 0..4)
+            .into_iter()
+            .filter(|&(c, r)| (c + r) % 5 != 0)
+            .collect();
+        assert!(!lattice_goes_on(own.iter().copied(), 6, 4));
+        // Six by four of a grid eight wide (the Passport's other page), at either end.
+        assert!(lattice_goes_on(grid(0..8, 0..4).into_iter(), 6, 4));
+        assert!(lattice_goes_on(grid(-2..6, 0..4).into_iter(), 6, 4));
+        // One stray member beside a side is no grid going on.
+        let stray = grid(0..6, 0..4).into_iter().chain([(6, 1), (2, -1)]);
+        assert!(!lattice_goes_on(stray, 6, 4));
     }
 
     #[test]
