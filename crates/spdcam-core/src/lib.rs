@@ -24,7 +24,8 @@
 //!   feature row, from encoded pixels or, for camera raw files ([`photo::raw`]), from the
 //!   sensor's mosaic with the light's colour read through the file's own matrices; every
 //!   chart of a photo that shows several, each with its place; synthetic scenes of one chart
-//!   ([`photo::scene`]) or of several ([`photo::scene_places`]) to test and measure it;
+//!   ([`photo::scene`]) or of several ([`photo::scene_places`]), a ColorChecker Passport in
+//!   its case among them ([`photo::pocket`]), to test and measure it;
 //!   [`feature_check`] rejects rows that cannot say anything about the light.
 //! - [`spectral_error`] (RMSE, GFC, SAM, SID between spectra), [`colorimetry`] (XYZ, CCT/Duv,
 //!   sRGB, CIELAB) and [`quality`] (CRI, TM-30, α-opic and other metrics of a light).

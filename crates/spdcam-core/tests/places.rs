@@ -95,12 +95,14 @@ fn two_charts_under_two_lights_are_both_found() {
             light: &warm,
             level: 1.0,
             placing: placing(0.3, [0.25, 0.5], 10.0, None),
+            case: None,
         },
         ScenePlace {
             camera: cc.camera(),
             light: &cool,
             level: 0.8,
             placing: placing(0.25, [0.72, 0.45], -20.0, None),
+            case: None,
         },
     ];
     let (shot, photo) = shoot(&places, 1);
@@ -118,12 +120,14 @@ fn small_and_tilted_charts_are_found_beside_a_large_one() {
             light: &d50,
             level: 1.0,
             placing: placing(0.35, [0.3, 0.5], 0.0, None),
+            case: None,
         },
         ScenePlace {
             camera: cc.camera(),
             light: &d50,
             level: 0.5,
             placing: placing(0.1, [0.72, 0.25], 30.0, None),
+            case: None,
         },
         ScenePlace {
             camera: cc.camera(),
@@ -138,6 +142,7 @@ fn small_and_tilted_charts_are_found_beside_a_large_one() {
                     axis: TiltAxis::Vertical,
                 }),
             ),
+            case: None,
         },
     ];
     let (shot, photo) = shoot(&places, 2);
@@ -156,6 +161,7 @@ fn one_chart_is_found_as_the_single_search_finds_it() {
         light: &d65,
         level: 1.0,
         placing: placing(0.4, [0.45, 0.55], 15.0, None),
+        case: None,
     }];
     let (_, photo) = shoot(&places, 3);
     let templates = [cc.template.clone()];
@@ -183,6 +189,7 @@ fn each_chart_of_several_is_analysed_with_its_place() {
             light: &d65,
             level: 1.0,
             placing: placing(0.2, centre, 0.0, None),
+            case: None,
         })
         .collect();
     let (shot, photo) = shoot(&places, 4);
@@ -211,6 +218,7 @@ fn charts_placed_over_each_other_are_refused() {
             light: &d65,
             level: 1.0,
             placing: placing(0.3, centre, 0.0, None),
+            case: None,
         })
         .collect();
     let e = photograph_places(&places, 5, &photo_options()).unwrap_err();

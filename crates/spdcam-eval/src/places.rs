@@ -317,6 +317,7 @@ fn scene_places<'a>(
                 perspective: 0.05,
                 ..SceneOptions::default()
             },
+            case: None,
         })
         .collect()
 }

@@ -22,6 +22,7 @@ mod lateral_ca;
 mod lattice;
 mod load;
 mod overlay;
+pub mod pocket;
 mod pyramid;
 pub mod raw;
 mod refine;

@@ -340,9 +340,21 @@ pub(super) struct Laid {
     pub(super) patch_px: f64,
     /// The canvas's width and height in its own pixels.
     pub(super) canvas: (usize, usize),
+    /// The outer outline of what is laid in the photo (the canvas, or the case holding
+    /// it): TL, TR, BR, BL.
+    pub(super) outline: [[f64; 2]; 4],
 }
 
 impl Laid {
+    /// The outline of a `canvas` (width, height) mapped by `homography`: TL, TR, BR, BL.
+    pub(super) fn canvas_outline(
+        homography: &Homography,
+        (cw, ch): (usize, usize),
+    ) -> [[f64; 2]; 4] {
+        let (cw, ch) = (cw as f64, ch as f64);
+        [[0.0, 0.0], [cw, 0.0], [cw, ch], [0.0, ch]].map(|p| homography.apply(p))
+    }
+
     /// The patch grid's top side in photo pixels.
     pub(super) fn grid_width_px(&self) -> f64 {
         let [a, b, ..] = self.corners;
@@ -408,6 +420,7 @@ pub(super) fn lay(camera: &Camera, rng: &mut SmallRng, options: &SceneOptions) -
         corners,
         patch_px,
         canvas: (cw, ch),
+        outline: Laid::canvas_outline(&homography, (cw, ch)),
     })
 }
 
@@ -481,9 +494,7 @@ impl Laid {
         w: usize,
         h: usize,
     ) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
-        let (cw, ch) = (self.canvas.0 as f64, self.canvas.1 as f64);
-        let outline =
-            [[0.0, 0.0], [cw, 0.0], [cw, ch], [0.0, ch]].map(|p| self.homography.apply(p));
+        let outline = Laid::canvas_outline(&self.homography, self.canvas);
         let span = |axis: usize, size: usize| {
             let lo = outline
                 .iter()

@@ -5,6 +5,7 @@
 //! balance, as a camera takes one photo, so the charts' levels compare as the lights'.
 
 use super::geometry::quads_near;
+use super::pocket::{case_dark, check_case_shadow, Case};
 use super::scene::{
     chart_white, check_placement, check_scene_size, check_width_share, develop_whole, lay, paint,
     quad_area, Laid, SceneOptions, Seen,
@@ -38,6 +39,10 @@ pub struct ScenePlace<'a> {
     /// the width, centre, rotation, tilt or perspective, shadow); the photo's fields are
     /// those given to [`photograph_places`].
     pub placing: SceneOptions,
+    /// The chart held in a ColorChecker Passport's case, open flat beside its other page:
+    /// the camera photographing that page (its chart from
+    /// [`PassportPage::chart`](super::pocket::PassportPage::chart)); `None`: the chart alone.
+    pub case: Option<&'a Camera>,
 }
 
 /// What is true about one chart of a scene of several.
@@ -90,6 +95,9 @@ pub fn photograph_places(
     for (k, place) in places.iter().enumerate() {
         check_width_share(place.placing.width_share)?;
         check_placement(&place.placing)?;
+        if place.case.is_some() {
+            check_case_shadow(place.placing.shadow, k + 1)?;
+        }
         if !(place.level.is_finite() && place.level > 0.0) {
             return Err(Error::invalid(format!(
                 "chart {}: the light's level {} must be above 0",
@@ -99,9 +107,10 @@ pub fn photograph_places(
         }
     }
     let mut rng = SmallRng::seed_from_u64(seed);
-    let laid = lay_apart(places, &mut rng, options)?;
+    let (laid, cases) = lay_apart(places, &mut rng, options)?;
     let mut scale = None;
     let mut exposed = Vec::with_capacity(places.len());
+    let mut pages = Vec::with_capacity(places.len());
     for place in places {
         let lit = Spd::new(
             *place.light.grid(),
@@ -110,11 +119,20 @@ pub fn photograph_places(
         let (one, s) = place.camera.exposed_chart_at(&[&lit], scale)?;
         scale = Some(s);
         exposed.push(one);
+        pages.push(match place.case {
+            Some(page) => Some(page.exposed_chart_at(&[&lit], scale)?.0),
+            None => None,
+        });
     }
     let mut scene = RgbImage::new(w, h);
     scene.planes =
         super::scene::background(&mut rng, w, h, chart_white(first.camera, &exposed[0][0]));
-    for ((place, laid), exposed) in places.iter().zip(&laid).zip(&exposed) {
+    for (k, (place, laid)) in places.iter().zip(&laid).enumerate() {
+        if let (Some(page), Some(case), Some(page_exposed)) = (place.case, &cases[k], &pages[k]) {
+            case.paint_frame(&mut scene, case_dark(page, &page_exposed[0]));
+            paint(&mut scene, page, &case.page, page_exposed, None);
+        }
+        let exposed = &exposed[k];
         paint(
             &mut scene,
             place.camera,
@@ -164,15 +182,17 @@ fn luminance(spd: &Spd) -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// Every place's chart laid in the photo, none overlapping another (with a gap of a tenth
-/// of the smaller chart's patch grid): random placements are drawn again; fixed ones that
-/// overlap are an error naming them.
+/// Every place's chart laid in the photo (with its case, if held in one), none overlapping
+/// another (with a gap of a tenth of the smaller one's size): random placements are drawn
+/// again; fixed ones that overlap, or a case that does not fit the photo, are an error
+/// naming them.
 fn lay_apart(
     places: &[ScenePlace],
     rng: &mut SmallRng,
     options: &SceneOptions,
-) -> Result<Vec<Laid>> {
+) -> Result<(Vec<Laid>, Vec<Option<Case>>)> {
     let mut laid: Vec<Laid> = Vec::with_capacity(places.len());
+    let mut cases: Vec<Option<Case>> = Vec::with_capacity(places.len());
     for (k, place) in places.iter().enumerate() {
         let placing = SceneOptions {
             width: options.width,
@@ -182,10 +202,28 @@ fn lay_apart(
         let fixed = placing.centre.is_some();
         let mut tries = 0;
         loop {
-            let candidate = lay(place.camera, rng, &placing)?;
+            let mut candidate = lay(place.camera, rng, &placing)?;
+            let case = place
+                .case
+                .map(|page| Case::around(&candidate, page.chart()));
+            if let Some(case) = &case {
+                candidate.outline = case.outline;
+                if !inside(&case.outline, options) {
+                    if fixed || tries >= PLACEMENT_TRIES {
+                        return Err(Error::invalid(format!(
+                            "chart {}: its Passport case does not fit the photo; place it \
+                             further in or make it smaller",
+                            k + 1
+                        )));
+                    }
+                    tries += 1;
+                    continue;
+                }
+            }
             match laid.iter().position(|other| overlap(other, &candidate)) {
                 None => {
                     laid.push(candidate);
+                    cases.push(case);
                     break;
                 }
                 Some(j) if fixed || tries >= PLACEMENT_TRIES => {
@@ -200,17 +238,21 @@ fn lay_apart(
             }
         }
     }
-    Ok(laid)
+    Ok((laid, cases))
 }
 
-/// Whether two laid charts' outlines (their canvases, border included) come nearer than a
-/// tenth of the smaller one's size.
+/// Whether `outline` lies inside the photo of `options`' size, 4 px from its edges.
+fn inside(outline: &[[f64; 2]; 4], options: &SceneOptions) -> bool {
+    let (w, h) = (options.width as f64, options.height as f64);
+    outline
+        .iter()
+        .all(|p| p[0] > 4.0 && p[1] > 4.0 && p[0] < w - 4.0 && p[1] < h - 4.0)
+}
+
+/// Whether two laid charts' outlines (their canvases, border included, or their cases) come
+/// nearer than a tenth of the smaller one's size.
 fn overlap(a: &Laid, b: &Laid) -> bool {
-    let outline = |l: &Laid| {
-        let (cw, ch) = (l.canvas.0 as f64, l.canvas.1 as f64);
-        [[0.0, 0.0], [cw, 0.0], [cw, ch], [0.0, ch]].map(|p| l.homography.apply(p))
-    };
-    let (pa, pb) = (outline(a), outline(b));
+    let (pa, pb) = (a.outline, b.outline);
     let gap = 0.1 * quad_area(&pa).min(quad_area(&pb)).sqrt();
     quads_near(&pa, &pb, gap)
 }

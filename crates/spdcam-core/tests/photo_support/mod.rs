@@ -112,7 +112,7 @@ pub struct SceneSize {
 }
 
 /// A random light: a colour temperature, or one to three narrow bands (strongly coloured).
-fn random_light(rng: &mut SmallRng) -> (String, Spd) {
+pub fn random_light(rng: &mut SmallRng) -> (String, Spd) {
     if rng.random_bool(0.5) {
         let cct = rng.random_range(2500.0..10000.0f64).round();
         let spec = format!("cct:{cct}");

@@ -7,8 +7,10 @@ use super::RenderArgs;
 use crate::messages::Messages;
 use anyhow::{bail, Context, Result};
 use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::Camera;
-use spdcam_core::chart::Chart;
+use spdcam_core::chart::{shown_chart_name, Chart, KnownChart};
+use spdcam_core::photo::pocket::{page_camera, PassportPage};
 use spdcam_core::photo::quad_centre;
 use spdcam_core::photo::scene::{SceneOptions, Tilt, TiltAxis};
 use spdcam_core::photo::scene_places::{photograph_places, ScenePlace, MAX_PLACES};
@@ -25,6 +27,7 @@ struct PlaceSpec {
     level: f64,
     rotation: f64,
     tilt: Option<Tilt>,
+    passport: Option<PassportPage>,
 }
 
 /// Reads one `--place` value: space-separated KEY=VALUE (see `RenderArgs::places`).
@@ -37,6 +40,7 @@ fn parse_place(text: &str) -> Result<PlaceSpec> {
         level: 1.0,
         rotation: 0.0,
         tilt: None,
+        passport: None,
     };
     let mut axis = TiltAxis::Vertical;
     let mut tilt = None;
@@ -68,9 +72,20 @@ fn parse_place(text: &str) -> Result<PlaceSpec> {
                     _ => bail!("--place '{text}': tilt-axis is horizontal or vertical"),
                 }
             }
+            "passport" => {
+                spec.passport = Some(PassportPage::from_name(value).with_context(|| {
+                    format!(
+                        "--place '{text}': passport={value} names no page of the Passport; \
+                         give passport={}",
+                        PassportPage::ALL
+                            .map(PassportPage::name)
+                            .join(" or passport=")
+                    )
+                })?)
+            }
             _ => bail!(
                 "--place '{text}': unknown key '{key}' (the keys: chart, centre, width, light, \
-                 level, rotation, tilt, tilt-axis)"
+                 level, rotation, tilt, tilt-axis, passport)"
             ),
         }
     }
@@ -112,11 +127,29 @@ pub(super) fn render_places(
         .map(|t| parse_place(t))
         .collect::<Result<Vec<_>>>()?;
     let mut cameras: Vec<Camera> = Vec::with_capacity(specs.len());
+    let mut pages: Vec<Option<Camera>> = Vec::with_capacity(specs.len());
     let mut lights: Vec<(String, Spd)> = Vec::with_capacity(specs.len());
     for spec in &specs {
         let name = spec.chart.as_deref().unwrap_or(&args.camera.chart);
         let chart = Chart::resolve(name, None, data_dir, &grid)?;
-        cameras.push(scene_camera(args, chart, data_dir)?);
+        let camera = scene_camera(args, chart, data_dir)?;
+        pages.push(match spec.passport {
+            Some(page) => {
+                let chart = &camera.chart().name;
+                if KnownChart::from_name(chart) != Some(KnownChart::ColorChecker24) {
+                    bail!(
+                        "--place passport={}: a ColorChecker Passport holds the ColorChecker \
+                         24, not {}",
+                        page.name(),
+                        shown_chart_name(chart)
+                    );
+                }
+                let sensitivities = Sensitivities::resolve(&args.camera.camera, data_dir, &grid)?;
+                Some(page_camera(page, &sensitivities, &camera)?)
+            }
+            None => None,
+        });
+        cameras.push(camera);
         lights.push(match &spec.light {
             Some(text) => {
                 let resolved = named_light::resolve_spd(text, data_dir, &grid)?;
@@ -132,7 +165,8 @@ pub(super) fn render_places(
         .iter()
         .zip(&cameras)
         .zip(&lights)
-        .map(|((spec, camera), (_, light))| ScenePlace {
+        .zip(&pages)
+        .map(|(((spec, camera), (_, light)), page)| ScenePlace {
             camera,
             light,
             level: spec.level,
@@ -144,6 +178,7 @@ pub(super) fn render_places(
                 perspective: 0.0,
                 ..SceneOptions::default()
             },
+            case: page.as_ref(),
         })
         .collect();
     let options = SceneOptions {
