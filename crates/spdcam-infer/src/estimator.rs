@@ -603,8 +603,9 @@ impl Estimator {
     }
 
     /// [`Estimator::analyse_with`] for every chart the photo shows (`options.corners`: the
-    /// one they hold): one [`PhotoEstimate`] per chart, the debug image (drawing them all)
-    /// on the first. A chart whose patches are refused as not the chart keeps its refusal.
+    /// one or several they hold, four corners each): one [`PhotoEstimate`] per chart, the
+    /// debug image (drawing them all) on the first. A chart whose patches are refused as not
+    /// the chart keeps its refusal.
     fn analyse_places_with(
         &self,
         photo: &Photo,
@@ -612,12 +613,12 @@ impl Estimator {
         templates: Vec<ChartTemplate>,
         debug: Option<PathBuf>,
     ) -> Vec<PhotoEstimate> {
-        if options.corners.is_some() {
+        if options.corners.as_ref().is_some_and(|c| c.len() <= 4) {
             return vec![self.analyse_with(photo, options, templates, debug)];
         }
         let analyse = AnalyseOptions {
             templates,
-            corners: None,
+            corners: options.corners.clone(),
             debug,
         };
         let (analyses, debug) = photo::analyse_places_telling_debug(photo, &analyse);

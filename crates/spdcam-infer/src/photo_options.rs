@@ -15,7 +15,8 @@ pub struct PhotoOptions {
     /// Look only for this chart (a name or a reflectance CSV); default: every chart a model
     /// of the set was trained for.
     pub chart: Option<String>,
-    /// The chart's four outer corners in pixels, any order (one photo only).
+    /// The chart's four outer corners in pixels, any order (one photo only); four for each
+    /// chart of several, chart after chart, where every chart is estimated.
     pub corners: Option<Vec<[f64; 2]>>,
     /// Where to write a debug image of each photo (see `spdcam_core::photo::debug_path`).
     pub debug: Option<PathBuf>,

@@ -30,7 +30,8 @@ pub struct AnalyseOptions {
     /// The charts to look for; with [`AnalyseOptions::corners`], the one whose patches fit
     /// the photo inside those corners best.
     pub templates: Vec<ChartTemplate>,
-    /// The chart's four outer corners in photo pixels, any order; `None` to detect.
+    /// The chart's four outer corners in photo pixels, any order; `None` to detect. For
+    /// [`analyse_places_telling_debug`], four for each chart of several, chart after chart.
     pub corners: Option<Vec<[f64; 2]>>,
     /// Where to write the debug image (written also when no chart is found). With several
     /// photos, each gets its own file, see [`debug_path`].
@@ -161,21 +162,27 @@ fn analyse_places(
     options: &AnalyseOptions,
     written: &mut Option<PathBuf>,
 ) -> Result<Vec<PhotoAnalysis>> {
-    if options.corners.is_some() {
-        return Ok(vec![analyse_decoded(photo, options, written)?]);
-    }
     let templates = &options.templates;
     if templates.is_empty() {
         return Err(Error::invalid("no chart to look for"));
     }
-    let (detections, trace) = detect_all(photo, templates)?;
-    if detections.is_empty() {
-        if let Some(path) = &options.debug {
-            write_overlay(path, &debug_overlay_full(photo, &[], Some(&trace)))?;
-            *written = Some(path.clone());
+    let (detections, method) = match &options.corners {
+        Some(corners) if corners.len() <= 4 => {
+            return Ok(vec![analyse_decoded(photo, options, written)?])
         }
-        return Err(no_chart(photo, templates));
-    }
+        Some(corners) => (placed_by_corners(photo, templates, corners)?, "corners"),
+        None => {
+            let (detections, trace) = detect_all(photo, templates)?;
+            if detections.is_empty() {
+                if let Some(path) = &options.debug {
+                    write_overlay(path, &debug_overlay_full(photo, &[], Some(&trace)))?;
+                    *written = Some(path.clone());
+                }
+                return Err(no_chart(photo, templates));
+            }
+            (detections, "detected")
+        }
+    };
     let mut sampled = Vec::with_capacity(detections.len());
     for detection in detections {
         let template = template_of(templates, &detection)?;
@@ -200,11 +207,39 @@ fn analyse_places(
                 of,
                 centre: quad_centre(&detection.corners),
             });
-            let mut analysis = assemble(photo, template, detection, "detected", patches, raw);
+            let mut analysis = assemble(photo, template, detection, method, patches, raw);
             analysis.place = place;
             analysis
         })
         .collect())
+}
+
+/// The charts placed by `corners`, four for each (chart after chart), numbered from left
+/// to right as detection numbers the charts it finds.
+fn placed_by_corners(
+    photo: &Photo,
+    templates: &[ChartTemplate],
+    corners: &[[f64; 2]],
+) -> Result<Vec<Detection>> {
+    if !corners.len().is_multiple_of(4) {
+        return Err(Error::invalid(format!(
+            "corners come four for each chart (eight numbers x1,y1,…,x4,y4 per --corners); \
+             {} points were given",
+            corners.len()
+        )));
+    }
+    let mut placed = corners
+        .chunks(4)
+        .map(|one| match templates {
+            [only] => from_corners(photo, only, one),
+            _ => Ok(from_corners_any(photo, templates, one)?.0),
+        })
+        .collect::<Result<Vec<Detection>>>()?;
+    placed.sort_by(|a, b| {
+        let (ca, cb) = (quad_centre(&a.corners), quad_centre(&b.corners));
+        ca[0].total_cmp(&cb[0]).then(ca[1].total_cmp(&cb[1]))
+    });
+    Ok(placed)
 }
 
 /// The template of the chart `detection` found.
@@ -228,6 +263,13 @@ fn analyse_decoded(
         return Err(Error::invalid("no chart to look for"));
     }
     let (detection, trace, method) = match &options.corners {
+        Some(corners) if corners.len() > 4 => {
+            return Err(Error::invalid(format!(
+                "corners of {} charts were given: several charts are read one estimate per \
+                 chart (each photo's places), not as one",
+                corners.len().div_ceil(4)
+            )))
+        }
         Some(corners) => {
             let detection = match templates.as_slice() {
                 [only] => from_corners(photo, only, corners)?,

@@ -12,9 +12,10 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Args, Clone, Default)]
 pub struct PhotoArgs {
     /// The chart's four outer corners in pixels, any order: x1,y1,x2,y2,x3,y3,x4,y4
-    /// (one photo only); without it the chart is detected.
+    /// (one photo only); once per chart for a photo of several, each then estimated and
+    /// numbered from left to right; without it the charts are detected.
     #[arg(long, value_name = "X1,Y1,…,X4,Y4", allow_hyphen_values = true)]
-    pub corners: Option<String>,
+    pub corners: Vec<String>,
     /// Look only for this chart: colorchecker24, colorchecker_sg140 (or another chart
     /// name or reflectance CSV); default: every chart a model is for (with the shipped
     /// models the ColorChecker 24 and the ColorChecker Digital SG).
@@ -60,7 +61,16 @@ impl PhotoArgs {
     pub fn options(&self) -> Result<PhotoOptions> {
         Ok(PhotoOptions {
             chart: self.chart.clone(),
-            corners: self.corners.as_deref().map(parse_corners).transpose()?,
+            corners: match self.corners.as_slice() {
+                [] => None,
+                texts => Some(
+                    texts
+                        .iter()
+                        .map(|t| parse_corners(t))
+                        .collect::<Result<Vec<_>>>()?
+                        .concat(),
+                ),
+            },
             debug: self.debug.clone(),
             overlay_width: None,
         })
