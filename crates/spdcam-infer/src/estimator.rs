@@ -588,7 +588,7 @@ impl Estimator {
             let (analysis, found) = self.the_chart_placed(photo, &analyse, analysis)?;
             identified = found.map(Carried);
             let overlay = match options.overlay_width {
-                Some(width) => Some(overlay_of(photo, &analyse.templates, &analysis, width)?),
+                Some(width) => Some(overlay_of(photo, &analyse.templates, &[&analysis], width)?),
                 None => None,
             };
             Ok(AnalysedPhoto { analysis, overlay })
@@ -630,6 +630,14 @@ impl Estimator {
                 return vec![unusable];
             }
         };
+        // One drawing of every place, numbered, shared by their reports.
+        let overlay = match options.overlay_width {
+            Some(width) => {
+                let all: Vec<&PhotoAnalysis> = analyses.iter().collect();
+                Some(overlay_of(photo, &analyse.templates, &all, width).map_err(|e| e.to_string()))
+            }
+            None => None,
+        };
         let mut debug = debug;
         analyses
             .into_iter()
@@ -637,12 +645,7 @@ impl Estimator {
                 let mut identified = None;
                 let analysed = self.refuse_not_the_chart(&analysis).and_then(|found| {
                     identified = found.map(Carried);
-                    let overlay = match options.overlay_width {
-                        Some(width) => {
-                            Some(overlay_of(photo, &analyse.templates, &analysis, width)?)
-                        }
-                        None => None,
-                    };
+                    let overlay = overlay.clone().transpose().map_err(InferError::invalid)?;
                     Ok(AnalysedPhoto { analysis, overlay })
                 });
                 PhotoEstimate {
@@ -1192,25 +1195,27 @@ fn kind_names(priors: Option<&KindPriors>) -> String {
 fn overlay_of(
     photo: &Photo,
     templates: &[ChartTemplate],
-    analysis: &PhotoAnalysis,
+    analyses: &[&PhotoAnalysis],
     width: u32,
 ) -> Result<Vec<u8>> {
-    let template = templates
+    let detections: Vec<_> = analyses.iter().map(|a| a.detection()).collect();
+    let found = analyses
         .iter()
-        .find(|t| t.name == analysis.chart)
-        .ok_or_else(|| {
-            InferError::invalid(format!(
-                "{}: no template of chart {}",
-                analysis.source, analysis.chart
-            ))
-        })?;
-    Ok(analysis_overlay_jpeg(
-        photo,
-        template,
-        &analysis.detection(),
-        &analysis.patches,
-        width,
-    )?)
+        .zip(&detections)
+        .map(|(analysis, detection)| {
+            let template = templates
+                .iter()
+                .find(|t| t.name == analysis.chart)
+                .ok_or_else(|| {
+                    InferError::invalid(format!(
+                        "{}: no template of chart {}",
+                        analysis.source, analysis.chart
+                    ))
+                })?;
+            Ok((template, detection, analysis.patches.as_slice()))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(analysis_overlay_jpeg(photo, &found, width)?)
 }
 
 /// An estimate's label: the photo's, with the place where the photo shows several charts.

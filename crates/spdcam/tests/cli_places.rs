@@ -35,6 +35,18 @@ fn every_chart_of_the_example_is_estimated_and_the_lights_are_told_apart() {
         "{out}"
     );
     assert!(out.contains("place 1 differs most"), "{out}");
+    // The report shows each place on one drawing of the photo with every place numbered.
+    let dir = scratch("places-report");
+    let report = dir.join("places.html");
+    ok(&["estimate", EXAMPLE, "--report", &s(&report)]);
+    let html = std::fs::read_to_string(&report).unwrap();
+    let photos: Vec<&str> = html
+        .split("data:image/jpeg;base64,")
+        .skip(1)
+        .map(|t| t.split('"').next().unwrap())
+        .collect();
+    assert_eq!(photos.len(), 3, "one photo per place");
+    assert!(photos.iter().all(|p| *p == photos[0]), "one drawing of every place");
 }
 
 #[test]
@@ -138,4 +150,107 @@ fn render_places_charts_writes_one_truth_per_place_and_refuses_overlaps() {
     assert!(e.contains("charts 1 and 2 of the scene overlap"), "{e}");
     let e = refused(&["width=0.3"], "bad.jpg");
     assert!(e.contains("needs centre=X,Y"), "{e}");
+}
+
+#[test]
+fn a_passport_in_its_case_is_one_chart_and_its_other_page_none() {
+    let dir = scratch("passport");
+    for (page, rotation) in [("creative", "8"), ("white-balance", "190")] {
+        let photo = dir.join(format!("passport-{page}.jpg"));
+        let truth = dir.join(format!("passport-{page}.truth.csv"));
+        let centre = if rotation == "8" {
+            "0.3,0.5"
+        } else {
+            "0.7,0.5"
+        };
+        ok(&[
+            "render",
+            "--spd",
+            "cct:4000",
+            "--scene",
+            "1600x1000",
+            "--place",
+            &format!("centre={centre} width=0.28 rotation={rotation} passport={page}"),
+            "-o",
+            &s(&photo),
+            "--spd-out",
+            &s(&truth),
+        ]);
+        let out = ok(&["estimate", &s(&photo)]);
+        // One chart: no place numbers, no comparison across places, scored as good.
+        assert!(out.contains("ColorChecker 24 detected"), "{page}: {out}");
+        assert!(!out.contains(" place "), "{page}: {out}");
+        let gfc: f64 = out
+            .split("against the true SPD: GFC ")
+            .nth(1)
+            .and_then(|t| t.split(',').next())
+            .and_then(|t| t.parse().ok())
+            .expect(&out);
+        assert!(gfc > 0.95, "{page}: GFC {gfc}");
+    }
+    let e = fails(&[
+        "render",
+        "--spd",
+        "D50",
+        "--scene",
+        "1200x800",
+        "--place",
+        "centre=0.3,0.5 width=0.25 passport=cover",
+        "-o",
+        &s(&dir.join("cover.jpg")),
+    ]);
+    assert!(
+        e.contains("passport=creative or passport=white-balance"),
+        "{e}"
+    );
+}
+
+#[test]
+fn corners_given_once_per_chart_place_each_chart() {
+    // The example's three charts: their corners from the detection, given back by hand.
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", EXAMPLE, "--json"])).unwrap();
+    let corners: Vec<String> = json
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| {
+            e["photo"]["corners"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|p| p.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
+                .map(|v| format!("{v:.1}"))
+                .collect::<Vec<_>>()
+                .join(",")
+        })
+        .collect();
+    assert_eq!(corners.len(), 3);
+    // Given right to left, numbered left to right all the same.
+    let mut args = vec!["estimate", EXAMPLE, "--json"];
+    for c in corners.iter().rev() {
+        args.extend(["--corners", c.as_str()]);
+    }
+    let placed: serde_json::Value = serde_json::from_str(&ok(&args)).unwrap();
+    let placed = placed.as_array().unwrap();
+    assert_eq!(placed.len(), 3);
+    for (k, (by_hand, found)) in placed.iter().zip(json.as_array().unwrap()).enumerate() {
+        assert_eq!(by_hand["photo"]["place"]["number"], k + 1);
+        assert_eq!(by_hand["photo"]["method"], "corners");
+        let (a, b) = (&by_hand["colorimetry"]["xy"], &found["colorimetry"]["xy"]);
+        let d = (a[0].as_f64().unwrap() - b[0].as_f64().unwrap())
+            .hypot(a[1].as_f64().unwrap() - b[1].as_f64().unwrap());
+        assert!(d < 0.005, "place {}: {a} against {b}", k + 1);
+    }
+    assert_eq!(placed[0]["across_places"]["lights_differ"], true);
+    // A set of corners short of four points is refused, naming the option.
+    let e = fails(&[
+        "estimate",
+        EXAMPLE,
+        "--corners",
+        &corners[0],
+        "--corners",
+        "1,2,3,4",
+    ]);
+    assert!(e.contains("--corners needs eight numbers"), "{e}");
 }

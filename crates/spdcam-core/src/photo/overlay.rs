@@ -213,17 +213,15 @@ fn draw_overlay(
         .unwrap_or_default()
 }
 
-/// The debug image of an analysed photo (the chart found, `detection`, and its sampled
-/// `patches`, as [`debug_overlay`] draws them), reduced to at most `max_width` px wide and
-/// encoded as JPEG: small enough to embed in a report.
+/// The debug image of an analysed photo (the charts `found` with their sampled patches, as
+/// [`debug_overlay`] draws them, numbered by place when there are several), reduced to at
+/// most `max_width` px wide and encoded as JPEG: small enough to embed in a report.
 pub fn analysis_overlay_jpeg(
     photo: &Photo,
-    template: &ChartTemplate,
-    detection: &Detection,
-    patches: &[PatchSample],
+    found: &[Found<'_>],
     max_width: u32,
 ) -> Result<Vec<u8>> {
-    let mut image = debug_overlay(photo, &[(template, detection, patches)], None);
+    let mut image = debug_overlay(photo, found, None);
     if image.width() > max_width && max_width > 0 {
         let height = (u64::from(image.height()) * u64::from(max_width) / u64::from(image.width()))
             .max(1) as u32;
