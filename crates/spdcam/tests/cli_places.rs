@@ -46,7 +46,10 @@ fn every_chart_of_the_example_is_estimated_and_the_lights_are_told_apart() {
         .map(|t| t.split('"').next().unwrap())
         .collect();
     assert_eq!(photos.len(), 3, "one photo per place");
-    assert!(photos.iter().all(|p| *p == photos[0]), "one drawing of every place");
+    assert!(
+        photos.iter().all(|p| *p == photos[0]),
+        "one drawing of every place"
+    );
 }
 
 #[test]

@@ -600,31 +600,24 @@ fn ring_share(blobs: &[Blob], t: &ChartTemplate, map: &Homography) -> f64 {
     hit.len() as f64 / (2 * (cols + rows) + 4) as f64
 }
 
-/// Whether the lattice a placement came from goes on past one of the chart's sides: of
-/// the lattice's cells along that side inside the chart (`cells`: every lattice member's
-/// cell, in the template's columns and rows), at least [`CONTINUED_SIDE`] (and three) have a
-/// member one step beyond them. A chart's own lattice never does (its border lies there);
-/// a part of a larger grid does, such as six by four patches of the ColorChecker
-/// Passport's other page beside its ColorChecker 24, which otherwise reads as a second one.
+/// Whether the lattice a placement came from goes on past one of the chart's sides: the
+/// line of cells one step beyond that side holds lattice members (`cells`: every member's
+/// cell, in the template's columns and rows) in at least half its length, and two. A
+/// chart's own lattice never does (its border lies there); a part of a larger grid does,
+/// such as six by four patches of the ColorChecker Passport's other page beside its
+/// ColorChecker 24, which otherwise reads as a second one. The members need not continue
+/// patches found along the side: a page's dark patches are often missed.
 fn lattice_goes_on(cells: impl Iterator<Item = (i32, i32)>, cols: i32, rows: i32) -> bool {
     let cells: std::collections::HashSet<(i32, i32)> = cells.collect();
-    let side = |edge: &dyn Fn(i32) -> (i32, i32), (dc, dr): (i32, i32), n: i32| {
-        let along: Vec<(i32, i32)> = (0..n).map(edge).filter(|p| cells.contains(p)).collect();
-        let beyond = along
-            .iter()
-            .filter(|&&(c, r)| cells.contains(&(c + dc, r + dr)))
-            .count();
-        beyond >= 3 && beyond as f64 >= CONTINUED_SIDE * along.len() as f64
+    let beyond = |line: &dyn Fn(i32) -> (i32, i32), n: i32| {
+        let members = (0..n).filter(|&k| cells.contains(&line(k))).count();
+        members >= 2 && 2 * members >= n as usize
     };
-    side(&|r| (0, r), (-1, 0), rows)
-        || side(&|r| (cols - 1, r), (1, 0), rows)
-        || side(&|c| (c, 0), (0, -1), cols)
-        || side(&|c| (c, rows - 1), (0, 1), cols)
+    beyond(&|r| (-1, r), rows)
+        || beyond(&|r| (cols, r), rows)
+        || beyond(&|c| (c, -1), cols)
+        || beyond(&|c| (c, rows), cols)
 }
-
-/// The share of a side's lattice cells with a member beyond them that says the lattice goes
-/// on there.
-const CONTINUED_SIDE: f64 = 0.75;
 
 /// Largest distance (in patch pitches) from a ring point to a blob that counts as a patch
 /// continuing the grid there.
@@ -1002,6 +995,11 @@ mod tests {
         // Six by four of a grid eight wide (the Passport's other page), at either end.
         assert!(lattice_goes_on(grid(0..8, 0..4).into_iter(), 6, 4));
         assert!(lattice_goes_on(grid(-2..6, 0..4).into_iter(), 6, 4));
+        // Along a side whose own patches were partly missed, as a page's dark ones are.
+        let missed = grid(0..8, 0..4)
+            .into_iter()
+            .filter(|&(c, r)| !(c == 5 && r != 1) && (c, r) != (7, 3));
+        assert!(lattice_goes_on(missed, 6, 4));
         // One stray member beside a side is no grid going on.
         let stray = grid(0..6, 0..4).into_iter().chain([(6, 1), (2, -1)]);
         assert!(!lattice_goes_on(stray, 6, 4));
