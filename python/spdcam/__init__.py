@@ -501,6 +501,7 @@ def estimate_places(
     photo: PhotoLike,
     *,
     chart: Optional[str] = None,
+    corners: Optional[Iterable[Iterable[Sequence[float]]]] = None,
     range: str = DEFAULT_RANGE,
     model: Union[Model, str, "os.PathLike[str]", None] = None,
     source: Optional[str] = None,
@@ -511,13 +512,20 @@ def estimate_places(
     (``detection.place``), each carrying the comparison across the photo's places
     (``across_places``: do the lights differ in colour, their CCT and Duv spread, each
     place's light level against the brightest). A photo of one chart gives a list of one,
-    the estimate :func:`estimate` gives. ``photo`` and the other arguments are as for
+    the estimate :func:`estimate` gives. ``corners``, when given, places the charts instead
+    of detecting them: one set of four outer corners (x, y) per chart, in any order (as
+    ``--corners`` given once per chart). ``photo`` and the other arguments are as for
     :func:`estimate`; a chart whose patches are refused is left out, and a photo that gives
     no estimate raises :class:`SpdcamError`.
     """
     models = _models(model)
     native, name = _native_photo(photo, source)
-    values = _native.estimate_places(native, name, models, chart, range, light)
+    points = None
+    if corners is not None:
+        points = [point for one in corners for point in (_corners(one) or [])]
+        if not points:
+            raise SpdcamError("corners needs one set of four points (x, y) per chart")
+    values = _native.estimate_places(native, name, models, chart, points, range, light)
     return [Estimate._from_dict(v) for v in values]
 
 

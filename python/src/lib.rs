@@ -244,23 +244,26 @@ fn estimate_photos<'py>(
 /// Estimates the light at every chart one photo shows (a file path, an encoded photo's
 /// bytes, or `(pixels, width, height, bits)`, named in messages by `source`): one dict per
 /// chart, numbered from left to right, each with its place and the comparison across
-/// places (`photo.place`, `across_places`, as `spdcam estimate --json` writes them). A chart
-/// whose patches are refused is left out; a photo that gives no estimate raises its
-/// message.
+/// places (`photo.place`, `across_places`, as `spdcam estimate --json` writes them);
+/// `corners`, four per chart, place the charts instead of detecting them. A chart whose
+/// patches are refused is left out; a photo that gives no estimate raises its message.
 #[pyfunction]
-#[pyo3(signature = (photo, source, models, chart=None, range="400-700:5", light="unknown"))]
+#[pyo3(signature = (photo, source, models, chart=None, corners=None, range="400-700:5", light="unknown"))]
+#[allow(clippy::too_many_arguments)]
 fn estimate_places<'py>(
     py: Python<'py>,
     photo: PhotoInput<'py>,
     source: String,
     models: &Models,
     chart: Option<String>,
+    corners: Option<Vec<[f64; 2]>>,
     range: &str,
     light: &str,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let estimator = models.on(range, light)?;
     let options = PhotoOptions {
         chart,
+        corners,
         ..PhotoOptions::default()
     };
     let data = photo.data();

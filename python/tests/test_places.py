@@ -56,3 +56,14 @@ def test_a_photo_of_one_chart_is_a_list_of_one(example):
 def test_a_photo_without_a_chart_raises():
     with pytest.raises(spdcam.SpdcamError, match="no chart found"):
         spdcam.estimate_places(np.full((200, 300, 3), 128, dtype=np.uint8))
+
+
+def test_corners_given_per_chart_place_the_same_charts(places):
+    corners = [e.detection.corners.tolist() for e in places]
+    placed = spdcam.estimate_places(PLACES, corners=corners[::-1])
+    assert [e.detection.place["number"] for e in placed] == [1, 2, 3]
+    assert all(e.detection.method == "corners" for e in placed)
+    for a, b in zip(places, placed):
+        assert abs(a.cct - b.cct) / a.cct < 0.02
+    with pytest.raises(spdcam.SpdcamError, match="four points"):
+        spdcam.estimate_places(PLACES, corners=[corners[0], corners[1][:3]])
