@@ -6,7 +6,10 @@
 //! and tilt); "the lights differ" said when the lamps differ and not when one lamp lights
 //! every chart (at levels from a quarter to the full light, as shadows give); and the light
 //! level between places against the true ratio. Validation lamps choose the threshold of
-//! "the lights differ"; test lamps are only reported.
+//! "the lights differ"; test lamps are only reported. Beside them, scenes whose first
+//! chart is a ColorChecker 24 held in a ColorChecker Passport's open case
+//! ([`spdcam_core::photo::pocket`]): the chart found, its other page never taken for a
+//! chart, and the chart read as well as alone.
 
 use crate::colour::lights::{lights, Light, LightSet};
 use crate::colour::score::{ColourScore, LightColour};
@@ -20,13 +23,14 @@ use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::light_families::ValidationSplit;
+use spdcam_core::photo::pocket::{page_camera, PassportPage};
 use spdcam_core::photo::scene::{scene_layout, SceneOptions, Tilt, TiltAxis};
 use spdcam_core::photo::scene_places::{photograph_places, PlaceTruth, ScenePlace};
 use spdcam_core::photo::{quad_centre, quads_near, ChartTemplate};
 use spdcam_core::seed;
 use spdcam_core::spectral_error;
 use spdcam_infer::places::LIGHTS_DIFFER_DUV;
-use spdcam_infer::{Estimate, Estimator, PhotoOptions};
+use spdcam_infer::{Estimate, Estimator, InferError, PhotoOptions};
 use std::path::PathBuf;
 
 /// The photos' size: a phone photo reduced, the scale the trust scenes are judged at.
@@ -34,6 +38,8 @@ pub const PHOTO_SIZE: (usize, usize) = (1600, 1000);
 
 /// The charts a scene is made of, as photos show them.
 const CHARTS: [&str; 2] = ["colorchecker24", "colorchecker_sg140"];
+/// The ColorChecker 24's index in [`CHARTS`], the chart a Passport holds.
+const COLORCHECKER24: usize = 0;
 
 /// Lights this far apart in Δu′v′ or more must be told apart; one light must not be.
 pub const MUST_DIFFER_DUV: f64 = 0.01;
@@ -98,6 +104,22 @@ pub struct SceneOutcome {
     pub grey_spread: Option<f64>,
 }
 
+/// One scene with a ColorChecker Passport, scored.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PocketOutcome {
+    /// Places the photo gave that lie on no chart of the scene (the Passport's other page,
+    /// or anything else taken for a chart) and were refused as not the chart: no estimate
+    /// is made of them, but the user reads the refusal.
+    pub refused: usize,
+    /// Estimates that lie on no chart of the scene: invented.
+    pub invented: usize,
+    /// The Passport's chart in its case (`None`: not found or no estimate).
+    pub in_case: Option<Scored>,
+    /// The same chart in the same scene (seed, charts, lights, background) without the
+    /// case.
+    pub alone: Option<Scored>,
+}
+
 /// The outcomes of one part of the split.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PartOutcome {
@@ -105,6 +127,8 @@ pub struct PartOutcome {
     pub label: &'static str,
     /// Every scene.
     pub scenes: Vec<SceneOutcome>,
+    /// Every scene with a Passport.
+    pub pockets: Vec<PocketOutcome>,
 }
 
 /// The whole measurement.
@@ -160,9 +184,17 @@ impl PlacesReport {
                     score_scene(&estimator, &cameras, &charts, &lamps, scene_seed)
                 })
                 .collect::<Result<Vec<_>>>()?;
+            let pockets = (0..options.scenes.div_ceil(2))
+                .into_par_iter()
+                .map(|s| {
+                    let scene_seed = seed::derive(part_seed, options.scenes + s);
+                    score_pocket(&estimator, &cameras, &charts, &lamps, scene_seed)
+                })
+                .collect::<Result<Vec<_>>>()?;
             parts.push(PartOutcome {
                 label: set.label(),
                 scenes,
+                pockets,
             });
         }
         let chosen_threshold = choose_threshold(&parts[0].scenes);
@@ -259,6 +291,78 @@ fn score_scene(
             .and_then(|e| e.across_places.as_ref())
             .and_then(|a| a.greys_largest_delta_uv)
             .map(|g| g.2),
+    })
+}
+
+/// One scene drawn from `seed` as [`score_scene`] draws one, its first chart a
+/// ColorChecker 24 (10–22 % of the width) held in a Passport's case, open beside one of
+/// its other pages (drawn); scored for the Passport's chart against the same scene without
+/// the case, and for the places the photo gives.
+fn score_pocket(
+    estimator: &Estimator,
+    cameras: &[Sensitivities],
+    charts: &[Chart],
+    lamps: &[Light],
+    seed: u64,
+) -> Result<PocketOutcome> {
+    let mut rng = SmallRng::seed_from_u64(seed);
+    let sensitivities = &cameras[rng.random_range(0..cameras.len())];
+    let cameras: Vec<Camera> = charts
+        .iter()
+        .map(|c| Camera::new(sensitivities, c.clone(), CameraConfig::default(), &GRID))
+        .collect::<std::result::Result<_, _>>()?;
+    let page = PassportPage::ALL[rng.random_range(0..PassportPage::ALL.len())];
+    let page = page_camera(page, sensitivities, &cameras[COLORCHECKER24])?;
+    let options = SceneOptions {
+        width: PHOTO_SIZE.0,
+        height: PHOTO_SIZE.1,
+        ..SceneOptions::default()
+    };
+    let mut attempt = 0;
+    let (drawn, shot) = loop {
+        let (mut drawn, _) = draw_charts(&mut rng, charts.len(), lamps.len());
+        drawn[0].0 = COLORCHECKER24;
+        drawn[0].3 = rng.random_range(0.1..0.22);
+        let mut places = scene_places(&drawn, &cameras, lamps);
+        places[0].case = Some(&page);
+        match photograph_places(&places, seed, &options) {
+            Ok(shot) => break (drawn, shot),
+            Err(_) if attempt < 40 => attempt += 1,
+            Err(e) => return Err(e.into()),
+        }
+    };
+    let photos = estimator.photo_bytes_places(&shot.jpeg, "scene.jpg", &PhotoOptions::default());
+    // A refusal lies on no chart when the places found outnumber the charts found.
+    let refusals = photos
+        .iter()
+        .filter(|p| matches!(&p.analysed, Err(InferError::NotTheChart(_))))
+        .count();
+    let estimates: Vec<Estimate> = photos
+        .into_iter()
+        .filter_map(|p| p.estimate.and_then(|e| e.ok()))
+        .collect();
+    let on_some_chart = |e: &Estimate| shot.places.iter().any(|t| on_chart(e, t));
+    let invented = estimates.iter().filter(|e| !on_some_chart(e)).count();
+    let estimated_charts = estimates.len() - invented;
+    let refused = (estimated_charts + refusals).saturating_sub(drawn.len()).min(refusals);
+    let light = &lamps[drawn[0].1];
+    let in_case = estimates
+        .iter()
+        .find(|e| on_chart(e, &shot.places[0]))
+        .map(|e| score(e, light))
+        .transpose()?;
+    // The same scene (same seed, charts, lights and background) without the case.
+    let uncased = photograph_places(&scene_places(&drawn, &cameras, lamps), seed, &options)?;
+    let alone = found(estimator, &uncased.jpeg)
+        .iter()
+        .find(|e| on_chart(e, &uncased.places[0]))
+        .map(|e| score(e, light))
+        .transpose()?;
+    Ok(PocketOutcome {
+        refused,
+        invented,
+        in_case,
+        alone,
     })
 }
 
@@ -526,6 +630,35 @@ impl PlacesReport {
                 median_largest(spread(true, |s| s.estimated_spread)),
                 smallest_median(spread(false, |s| s.grey_spread)),
                 smallest_median(spread(false, |s| s.estimated_spread)),
+            );
+        }
+        out += "\nA ColorChecker 24 held in a ColorChecker Passport's open case, beside its other \
+                page (the creative enhancement page or the white balance grey, drawn), as the \
+                first chart of a scene drawn as above (10–22 % of the width): the Passport's \
+                chart found; places beyond the scene's charts (the other page or anything \
+                else taken for a chart) refused as not the chart (no estimate is made of \
+                them, but the refusal is printed) and estimated (invented); and the chart \
+                in its case against the same chart in the same scene without the case.\n\n";
+        out += "| lamps | scenes | Passports found | places beyond the charts: refused · estimated | median GFC in the case · without | median Δu′v′ in the case · without |\n|---|---|---|---|---|---|\n";
+        for part in &self.parts {
+            let pockets = &part.pockets;
+            let found = pockets.iter().filter(|p| p.in_case.is_some()).count();
+            let refused: usize = pockets.iter().map(|p| p.refused).sum();
+            let invented: usize = pockets.iter().map(|p| p.invented).sum();
+            let both: Vec<(Scored, Scored)> = pockets
+                .iter()
+                .filter_map(|p| Some((p.in_case?, p.alone?)))
+                .collect();
+            let med = |pick: fn(&(Scored, Scored)) -> f64| median(both.iter().map(pick).collect());
+            out += &format!(
+                "| {} | {} | {found} of {} | {refused} · {invented} | {:.4} · {:.4} | {:.4} · {:.4} |\n",
+                part.label,
+                pockets.len(),
+                pockets.len(),
+                med(|p| p.0.gfc),
+                med(|p| p.1.gfc),
+                med(|p| p.0.delta_uv),
+                med(|p| p.1.delta_uv),
             );
         }
         out += "\nBy chart size (both parts): found, and median Δu′v′ in the scene · alone.\n\n";
