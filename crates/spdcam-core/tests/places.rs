@@ -4,7 +4,7 @@
 
 mod photo_support;
 
-use photo_support::{colorchecker24, ChartSetup};
+use photo_support::{colorchecker24, wide_photo_options, ChartSetup};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::named_light;
 use spdcam_core::photo::scene::{SceneOptions, Tilt, TiltAxis};
@@ -29,18 +29,6 @@ fn placing(share: f64, centre: [f64; 2], rotation: f64, tilt: Option<Tilt>) -> S
         rotation_deg: Some(rotation),
         tilt,
         perspective: 0.0,
-        ..SceneOptions::default()
-    }
-}
-
-fn photo_options() -> SceneOptions {
-    SceneOptions {
-        width: 1600,
-        height: 1000,
-        // A little blur and vignetting, as a lens gives; the seed draws them.
-        blur_sigma: (0.3, 0.8),
-        vignetting: (0.0, 0.15),
-        jpeg_quality: (88, 92),
         ..SceneOptions::default()
     }
 }
@@ -80,7 +68,7 @@ fn assert_found(found: &[Detection], shot: &PlacesPhoto, what: &str) {
 }
 
 fn shoot(places: &[ScenePlace], seed: u64) -> (PlacesPhoto, spdcam_core::photo::Photo) {
-    let shot = photograph_places(places, seed, &photo_options()).unwrap();
+    let shot = photograph_places(places, seed, &wide_photo_options()).unwrap();
     let photo = decode_photo(&shot.jpeg, &format!("places-{seed}.jpg")).unwrap();
     (shot, photo)
 }
@@ -221,6 +209,6 @@ fn charts_placed_over_each_other_are_refused() {
             case: None,
         })
         .collect();
-    let e = photograph_places(&places, 5, &photo_options()).unwrap_err();
+    let e = photograph_places(&places, 5, &wide_photo_options()).unwrap_err();
     assert!(e.to_string().contains("charts 1 and 2"), "{e}");
 }

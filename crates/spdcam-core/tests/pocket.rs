@@ -5,7 +5,7 @@
 
 mod photo_support;
 
-use photo_support::random_light;
+use photo_support::{random_light, wide_photo_options};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use spdcam_core::builtin;
@@ -44,17 +44,6 @@ fn pocket() -> Pocket {
         classic,
         template,
         pages,
-    }
-}
-
-fn photo_options() -> SceneOptions {
-    SceneOptions {
-        width: 1600,
-        height: 1000,
-        blur_sigma: (0.3, 0.8),
-        vignetting: (0.0, 0.15),
-        jpeg_quality: (85, 92),
-        ..SceneOptions::default()
     }
 }
 
@@ -103,7 +92,7 @@ fn the_passport_is_one_chart_beside_its_other_page() {
             },
             case: Some(&pocket.pages[page]),
         }];
-        let shot = photograph_places(&places, seed, &photo_options()).unwrap();
+        let shot = photograph_places(&places, seed, &wide_photo_options()).unwrap();
         let photo = decode_photo(&shot.jpeg, "passport.jpg").unwrap();
         let (found, _) = detect_all(&photo, std::slice::from_ref(&pocket.template)).unwrap();
         let what = format!(
@@ -134,7 +123,7 @@ fn the_mini_and_nano_sizes_are_found_as_a_colorchecker_24() {
             },
             case: None,
         }];
-        let shot = photograph_places(&places, 100 + seed, &photo_options()).unwrap();
+        let shot = photograph_places(&places, 100 + seed, &wide_photo_options()).unwrap();
         let photo = decode_photo(&shot.jpeg, "small.jpg").unwrap();
         let (found, _) = detect_all(&photo, std::slice::from_ref(&pocket.template)).unwrap();
         assert_one_chart(
@@ -162,6 +151,6 @@ fn a_passport_whose_case_does_not_fit_is_refused() {
         },
         case: Some(&pocket.pages[0]),
     }];
-    let e = photograph_places(&places, 1, &photo_options()).unwrap_err();
+    let e = photograph_places(&places, 1, &wide_photo_options()).unwrap_err();
     assert!(e.to_string().contains("Passport case does not fit"), "{e}");
 }

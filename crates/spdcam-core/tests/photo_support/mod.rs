@@ -111,6 +111,19 @@ pub struct SceneSize {
     pub height: usize,
 }
 
+/// A 1600 × 1000 photo through a lens with a little blur and vignetting, at a good JPEG
+/// quality (the seed draws them within these ranges): the photos of several charts.
+pub fn wide_photo_options() -> SceneOptions {
+    SceneOptions {
+        width: 1600,
+        height: 1000,
+        blur_sigma: (0.3, 0.8),
+        vignetting: (0.0, 0.15),
+        jpeg_quality: (88, 92),
+        ..SceneOptions::default()
+    }
+}
+
 /// A random light: a colour temperature, or one to three narrow bands (strongly coloured).
 pub fn random_light(rng: &mut SmallRng) -> (String, Spd) {
     if rng.random_bool(0.5) {
