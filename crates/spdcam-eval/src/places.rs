@@ -344,7 +344,9 @@ fn score_pocket(
     let on_some_chart = |e: &Estimate| shot.places.iter().any(|t| on_chart(e, t));
     let invented = estimates.iter().filter(|e| !on_some_chart(e)).count();
     let estimated_charts = estimates.len() - invented;
-    let refused = (estimated_charts + refusals).saturating_sub(drawn.len()).min(refusals);
+    let refused = (estimated_charts + refusals)
+        .saturating_sub(drawn.len())
+        .min(refusals);
     let light = &lamps[drawn[0].1];
     let in_case = estimates
         .iter()
