@@ -216,16 +216,8 @@ fn score_scene(
     seed: u64,
 ) -> Result<SceneOutcome> {
     let mut rng = SmallRng::seed_from_u64(seed);
-    let sensitivities = &cameras[rng.random_range(0..cameras.len())];
-    let cameras: Vec<Camera> = charts
-        .iter()
-        .map(|c| Camera::new(sensitivities, c.clone(), CameraConfig::default(), &GRID))
-        .collect::<std::result::Result<_, _>>()?;
-    let options = SceneOptions {
-        width: PHOTO_SIZE.0,
-        height: PHOTO_SIZE.1,
-        ..SceneOptions::default()
-    };
+    let (_, cameras) = scene_cameras(&mut rng, cameras, charts)?;
+    let options = photo_options();
     // Charts that cannot all be laid apart in the photo are drawn again.
     let mut attempt = 0;
     let (drawn, one_light, shot) = loop {
@@ -306,18 +298,10 @@ fn score_pocket(
     seed: u64,
 ) -> Result<PocketOutcome> {
     let mut rng = SmallRng::seed_from_u64(seed);
-    let sensitivities = &cameras[rng.random_range(0..cameras.len())];
-    let cameras: Vec<Camera> = charts
-        .iter()
-        .map(|c| Camera::new(sensitivities, c.clone(), CameraConfig::default(), &GRID))
-        .collect::<std::result::Result<_, _>>()?;
+    let (sensitivities, cameras) = scene_cameras(&mut rng, cameras, charts)?;
     let page = PassportPage::ALL[rng.random_range(0..PassportPage::ALL.len())];
     let page = page_camera(page, sensitivities, &cameras[COLORCHECKER24])?;
-    let options = SceneOptions {
-        width: PHOTO_SIZE.0,
-        height: PHOTO_SIZE.1,
-        ..SceneOptions::default()
-    };
+    let options = photo_options();
     let mut attempt = 0;
     let (drawn, shot) = loop {
         let (mut drawn, _) = draw_charts(&mut rng, charts.len(), lamps.len());
@@ -366,6 +350,30 @@ fn score_pocket(
         in_case,
         alone,
     })
+}
+
+/// One of the held-out `cameras`, drawn, and it photographing each of `charts` with the
+/// full camera chain.
+fn scene_cameras<'a>(
+    rng: &mut SmallRng,
+    cameras: &'a [Sensitivities],
+    charts: &[Chart],
+) -> Result<(&'a Sensitivities, Vec<Camera>)> {
+    let sensitivities = &cameras[rng.random_range(0..cameras.len())];
+    let cameras = charts
+        .iter()
+        .map(|c| Camera::new(sensitivities, c.clone(), CameraConfig::default(), &GRID))
+        .collect::<std::result::Result<_, _>>()?;
+    Ok((sensitivities, cameras))
+}
+
+/// A scene photo's size; its lens and JPEG as [`SceneOptions`] draws them.
+fn photo_options() -> SceneOptions {
+    SceneOptions {
+        width: PHOTO_SIZE.0,
+        height: PHOTO_SIZE.1,
+        ..SceneOptions::default()
+    }
 }
 
 /// One chart drawn for a scene: its chart (index into the charts), lamp, level, share of the

@@ -20,7 +20,7 @@
 //! orange and blue hue patches: modelled surfaces, not measurements of the printed page.
 
 use super::geometry::Homography;
-use super::scene::{Laid, Shadow};
+use super::scene::{pixel_bounds, Laid, Shadow};
 use crate::builtin;
 use crate::camera::colour::ColourConfig;
 use crate::camera::sensor::Sensitivities;
@@ -254,23 +254,10 @@ impl Case {
     /// the light) into `scene`; the pages are painted over it afterwards.
     pub(super) fn paint_frame(&self, scene: &mut RgbImage, dark: [f32; 3]) {
         let (w, h) = (scene.width, scene.height);
-        let span = |axis: usize, size: usize| {
-            let lo = self
-                .outline
-                .iter()
-                .map(|p| p[axis])
-                .fold(f64::INFINITY, f64::min);
-            let hi = self
-                .outline
-                .iter()
-                .map(|p| p[axis])
-                .fold(f64::NEG_INFINITY, f64::max);
-            (lo.floor().clamp(0.0, size as f64) as usize)
-                ..(hi.ceil().clamp(0.0, size as f64) as usize)
-        };
+        let (xs, ys) = pixel_bounds(&self.outline, w, h);
         let [x0, y0, x1, y1] = self.extent;
-        for y in span(1, h) {
-            for x in span(0, w) {
+        for y in ys {
+            for x in xs.clone() {
                 let [u, v] = self.inverse.apply([x as f64 + 0.5, y as f64 + 0.5]);
                 if u >= x0 && u <= x1 && v >= y0 && v <= y1 {
                     for (plane, value) in scene.planes.iter_mut().zip(dark) {

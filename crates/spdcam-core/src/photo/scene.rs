@@ -456,7 +456,7 @@ pub(super) fn paint(
     let shade =
         |u: f64, v: f64| shadow.map_or(1.0, |sh| sh.light_at(u / cw as f64, v / ch as f64) as f32);
     // Only the photo pixels inside the canvas's outline are visited.
-    let xs = laid.homography_bounds(w, h);
+    let xs = pixel_bounds(&Laid::canvas_outline(&laid.homography, laid.canvas), w, h);
     for y in xs.1.clone() {
         for x in xs.0.clone() {
             let q = laid.inverse.apply([x as f64 + 0.5, y as f64 + 0.5]);
@@ -486,30 +486,27 @@ pub(super) fn paint(
     }
 }
 
-impl Laid {
-    /// The photo's pixel columns and rows the canvas's outline covers (clipped to the
-    /// photo).
-    fn homography_bounds(
-        &self,
-        w: usize,
-        h: usize,
-    ) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
-        let outline = Laid::canvas_outline(&self.homography, self.canvas);
-        let span = |axis: usize, size: usize| {
-            let lo = outline
-                .iter()
-                .map(|p| p[axis])
-                .fold(f64::INFINITY, f64::min);
-            let hi = outline
-                .iter()
-                .map(|p| p[axis])
-                .fold(f64::NEG_INFINITY, f64::max);
-            let lo = (lo.floor() - 1.0).clamp(0.0, size as f64) as usize;
-            let hi = (hi.ceil() + 1.0).clamp(0.0, size as f64) as usize;
-            lo..hi
-        };
-        (span(0, w), span(1, h))
-    }
+/// The photo's pixel columns and rows an `outline` (photo pixels) covers, a pixel of margin
+/// around it, clipped to a `w × h` photo.
+pub(super) fn pixel_bounds(
+    outline: &[[f64; 2]; 4],
+    w: usize,
+    h: usize,
+) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+    let span = |axis: usize, size: usize| {
+        let lo = outline
+            .iter()
+            .map(|p| p[axis])
+            .fold(f64::INFINITY, f64::min);
+        let hi = outline
+            .iter()
+            .map(|p| p[axis])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let lo = (lo.floor() - 1.0).clamp(0.0, size as f64) as usize;
+        let hi = (hi.ceil() + 1.0).clamp(0.0, size as f64) as usize;
+        lo..hi
+    };
+    (span(0, w), span(1, h))
 }
 
 /// The lens and the camera over the painted scene: the glow (if any), blur and vignetting

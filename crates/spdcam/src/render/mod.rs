@@ -116,11 +116,9 @@ pub struct RenderArgs {
     /// (default --chart), width=SHARE (of the photo's width, default 0.2), light=SPD (as
     /// --spd; default --spd), level=L (the light's level, default 1; 0.5: half as bright, as
     /// in a shadow), rotation=DEG, tilt=DEG, tilt-axis=horizontal|vertical,
-    /// passport=creative|white-balance (the ColorChecker 24 held in a ColorChecker Passport's
-    /// case, open flat beside that page, which is not a chart). Once per chart (up to 8); the
-    /// photo is exposed for the first; the charts are numbered from left to
-    /// right as `estimate` numbers them, and --spd-out writes one column per chart in that
-    /// order.
+    /// passport=creative|white-balance (held in a Passport's case beside that page). Once
+    /// per chart (up to 8), exposed for the first, numbered left to right as `estimate`
+    /// numbers them; --spd-out writes one column per chart in that order.
     #[arg(
         long = "place",
         value_name = "KEY=VALUE …",
