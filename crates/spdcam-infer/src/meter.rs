@@ -9,17 +9,16 @@
 use crate::estimate::Estimate;
 use crate::estimate::MAX_CCT_DUV;
 use crate::meaningful::{cct_meaningful, cri_meaningful};
-use crate::rounding::{round_sig, shown, shown_with_unit, undetermined_words, NOT_DETERMINABLE};
+use crate::rounding::{
+    round_sig, shown, shown_with_unit, undetermined_words, NOT_DETERMINABLE, UNCALIBRATED,
+};
 use serde::Serialize;
 use spdcam_core::quality::dominant::{dominant_wavelength, peak_wavelength_nm, ILLUMINANT_E_XY};
 use spdcam_core::quality::film_tv::{
     cct_correction, special_rendering_indices_r1_r15, spectral_similarity_index, SsiReference,
     DAYLIGHT_K, TUNGSTEN_K,
 };
-use spdcam_core::quality::LightSpectrum;
-
-/// What an SSI carries in place of an interval: the trust calibration has none for it.
-pub const SSI_UNCALIBRATED: &str = "uncalibrated: no interval";
+use spdcam_core::quality::{registry, LightSpectrum};
 
 /// One number of the meter's screen.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -52,6 +51,11 @@ pub struct Meter {
     pub r9_note: Option<String>,
     /// SSI and the filter corrections to 3200 K and 5600 K, for white light.
     pub film_tv: Vec<Reading>,
+}
+
+/// The name of metric `key` in the registry ([`registry::Metric::label`]).
+fn label(key: &'static str) -> &'static str {
+    registry::metric(key).map_or(key, |m| m.label)
 }
 
 /// The 95 % half-width of metric `key`, when calibrated.
@@ -187,29 +191,21 @@ fn film_tv(
     let cct_undetermined = shown("cct_k", cct, cct_half).is_err();
     let calibrated = e.trust.as_ref().is_some_and(|t| t.uncertainty.is_some());
     let mut out = Vec::new();
-    for (key, label, reference) in [
-        ("ssi", "SSI (own CCT)", SsiReference::CctMatched),
-        (
-            "ssi_3200",
-            "SSI (3200 K tungsten)",
-            SsiReference::Planckian(TUNGSTEN_K),
-        ),
-        (
-            "ssi_5600",
-            "SSI (5600 K daylight)",
-            SsiReference::Daylight(DAYLIGHT_K),
-        ),
+    for (key, reference) in [
+        ("ssi", SsiReference::CctMatched),
+        ("ssi_3200", SsiReference::Planckian(TUNGSTEN_K)),
+        ("ssi_5600", SsiReference::Daylight(DAYLIGHT_K)),
     ] {
+        let label = label(key);
         if let Ok(v) = spectral_similarity_index(light, &reference) {
             let value = if key == "ssi" && cct_undetermined {
                 // Its reference is a light of the estimate's own CCT, which the photo does not
                 // determine.
                 format!("{NOT_DETERMINABLE} (its reference needs the CCT)")
             } else if calibrated {
-                // SSI has no calibrated interval (the calibration covers the metrics of
-                // `spdcam_core::quality::SCALAR_KEYS`): say so rather than print a bare number
-                // beside numbers that carry theirs.
-                format!("{v:.0} ({SSI_UNCALIBRATED})")
+                // SSI has no calibrated interval (`registry::Metric::calibrated`): say so
+                // rather than print a bare number beside numbers that carry theirs.
+                format!("{v:.0} ({UNCALIBRATED})")
             } else {
                 format!("{v:.0}")
             };
@@ -218,10 +214,8 @@ fn film_tv(
     }
     // The mired shift's 95 % half-width from the CCT's: d(10⁶/T) = 10⁶·dT/T² (first order).
     let mired_half = cct_half.map(|h| 1e6 * h / (cct * cct));
-    for (key, label, target) in [
-        ("mired_3200", "To 3200 K", TUNGSTEN_K),
-        ("mired_5600", "To 5600 K", DAYLIGHT_K),
-    ] {
+    for (key, target) in [("mired_3200", TUNGSTEN_K), ("mired_5600", DAYLIGHT_K)] {
+        let label = label(key);
         let Ok(c) = cct_correction(cct, duv, target) else {
             continue;
         };
@@ -457,7 +451,7 @@ mod tests {
         let mut e = estimate_of_d65();
         let m = Meter::of(&e);
         let ssi = m.film_tv.iter().find(|r| r.key == "ssi").unwrap();
-        assert!(ssi.value.contains(SSI_UNCALIBRATED), "{ssi:?}");
+        assert!(ssi.value.contains(UNCALIBRATED), "{ssi:?}");
         // A CCT the photo does not determine leaves the SSI against the light's own CCT
         // undetermined too, and the filter corrections give their intervals.
         let u = e.trust.as_mut().unwrap().uncertainty.as_mut().unwrap();

@@ -16,10 +16,11 @@ use crate::estimate::{Estimate, MAX_CCT_DUV};
 use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::meter::Meter;
 pub use crate::rounding::{round_sig, round_with_uncertainty};
-use crate::rounding::{shown, undetermined_words};
+use crate::rounding::{shown, undetermined_words, UNCALIBRATED};
 use crate::trust::{Veil, Verdict};
 use serde::Serialize;
 use spdcam_core::light_families::LightKind;
+use spdcam_core::quality::registry::{self, Group, MeaningfulFor};
 
 /// Within this |Duv| a light reads as white without a tint (ANSI C78.377-2017 puts its
 /// nominal white quadrangles about ±0.006 around the locus).
@@ -102,97 +103,26 @@ pub struct MetricLine {
     pub not_meaningful: Option<String>,
 }
 
-/// A metric shown: key, label, explanation (its unit is [`crate::rounding::unit`]).
-type MetricSpec = (&'static str, &'static str, &'static str);
-
-/// The metrics shown, by group.
-const GROUPS: [(&str, &[MetricSpec]); 4] = [
-    (
-        "Colour",
-        &[
-            (
-                "cct_k",
-                "CCT",
-                "How warm (low) or cool (high) a white light looks.",
-            ),
-            (
-                "duv",
-                "Duv",
-                "How far from white the colour is: above 0 greenish, below 0 pinkish.",
-            ),
-        ],
-    ),
-    (
-        "Colour rendering",
-        &[
-            (
-                "cri_ra",
-                "CRI Ra",
-                "How true eight pastel colours look (100 = like daylight or a bulb).",
-            ),
-            (
-                "cri_r9",
-                "CRI R9",
-                "How true a saturated red looks (skin, food, wood).",
-            ),
-            (
-                "tm30_rf",
-                "TM-30 Rf",
-                "Colour fidelity over 99 samples (100 = like the reference light).",
-            ),
-            (
-                "tm30_rg",
-                "TM-30 Rg",
-                "Colour gamut: above 100 colours look more saturated, below 100 duller.",
-            ),
-        ],
-    ),
-    (
-        "Circadian and eye",
-        &[
-            (
-                "mel_der",
-                "Melanopic DER",
-                "Effect on the body clock per lux, relative to daylight D65 (1 = same).",
-            ),
-            (
-                "sp_ratio",
-                "S/P ratio",
-                "Night (rod) vision per lux relative to day vision; higher looks brighter at dusk.",
-            ),
-            (
-                "blh_efficacy_w_per_lm",
-                "Blue-light hazard",
-                "Retinal blue-light hazard per lumen (IEC TR 62778); lower is gentler.",
-            ),
-        ],
-    ),
-    (
-        "Plants",
-        &[(
-            "ppf_per_lux",
-            "PPF per 1000 lx",
-            "Photosynthetic photons (400–700 nm) per 1000 lux of light.",
-        )],
-    ),
-];
-
 impl Presentation {
     /// The presentation of `estimate`.
     pub fn of(estimate: &Estimate) -> Presentation {
         let light = describe_light(estimate);
         let uncertainty = estimate.trust.as_ref().and_then(|t| t.uncertainty.as_ref());
-        let groups = GROUPS
+        let groups = Group::PRESENTED
             .iter()
-            .map(|(title, metrics)| {
-                let mut lines: Vec<MetricLine> = metrics
-                    .iter()
-                    .map(|&(key, label, explanation)| {
+            .map(|&group| {
+                let mut lines: Vec<MetricLine> = registry::in_group(group)
+                    .map(|metric| {
+                        let key = metric.key;
                         let half95 = uncertainty
                             .and_then(|u| u.metrics.get(key))
                             .map(|i| i.half95);
                         let (value, not_meaningful) = match meaningful_value(estimate, key) {
                             Ok(v) => match shown(key, v, half95) {
+                                // A calibrated estimate without this metric's interval.
+                                Ok(text) if half95.is_none() && uncertainty.is_some() => {
+                                    (Some(format!("{text} ({UNCALIBRATED})")), None)
+                                }
                                 Ok(text) => (Some(text), None),
                                 Err(_) => (None, Some(undetermined_words(key, v, half95))),
                             },
@@ -200,9 +130,9 @@ impl Presentation {
                         };
                         MetricLine {
                             key,
-                            label,
-                            unit: crate::rounding::unit(key),
-                            explanation,
+                            label: metric.label,
+                            unit: metric.unit,
+                            explanation: metric.explanation,
                             value,
                             not_meaningful,
                         }
@@ -211,7 +141,7 @@ impl Presentation {
                 // Stable: the meaningful ones first, each part in its own order.
                 lines.sort_by_key(|l| l.value.is_none());
                 MetricGroup {
-                    title,
+                    title: group.title(),
                     metrics: lines,
                 }
             })
@@ -393,24 +323,24 @@ fn gfc_words(expected: Option<f64>) -> String {
 }
 
 /// The value of metric `key` when it is meaningful for this light, else why not (CCT and
-/// TM-30 far from white, CRI farther than CIE 13.3 allows, or undefined).
+/// TM-30 far from white, CRI farther than CIE 13.3 allows, or undefined), by the metric's
+/// row of the registry ([`registry::Metric::meaningful_for`]).
 pub fn meaningful_value(estimate: &Estimate, key: &str) -> Result<f64, String> {
     let m = &estimate.metrics;
-    let undefined = || {
-        let reason_key = if key == "cri_r9" { "cri_r" } else { key };
-        Err(m
+    let Some(metric) = registry::metric(key) else {
+        return Err(format!("{key} is not a metric"));
+    };
+    let Some(value) = metric.value(m) else {
+        return Err(m
             .reasons
-            .get(reason_key)
+            .get(metric.reason_key)
             .cloned()
-            .unwrap_or_else(|| "not defined for this light".into()))
+            .unwrap_or_else(|| "not defined for this light".into()));
     };
-    let Some(value) = m.scalar(key) else {
-        return undefined();
-    };
-    match key {
-        "cct_k" | "tm30_rf" | "tm30_rg" => cct_meaningful(estimate)?,
-        "cri_ra" | "cri_r9" => cri_meaningful(estimate)?,
-        _ => {}
+    match metric.meaningful_for {
+        MeaningfulFor::WhiteLight => cct_meaningful(estimate)?,
+        MeaningfulFor::Cri => cri_meaningful(estimate)?,
+        MeaningfulFor::AnyLight => {}
     }
     Ok(value)
 }

@@ -21,45 +21,67 @@
 //!   mired shift beyond 25 mired (about an eighth CTO, the smallest correction gel). In
 //!   place of the number, the interval itself ([`undetermined_words`]).
 //! - One unit per quantity: PPF per lux in µmol s⁻¹ m⁻² per 1000 lx ([`scale`]).
+//!
+//! Each metric's unit, scale, precision, limit and range are columns of its row in the
+//! metric registry ([`registry::METRICS`]); the rules above are what those columns hold.
+
+use spdcam_core::quality::registry::{self, Determined, Metric, Precision};
+
+/// What follows a number that has no interval beside numbers that carry theirs: the trust
+/// calibration gives it none ([`registry::Metric::calibrated`]), or none for this model.
+pub const UNCALIBRATED: &str = "uncalibrated: no interval";
 
 /// The words that stand in place of a number its photo does not determine.
 pub const NOT_DETERMINABLE: &str = "not determinable from this photo";
 
+/// The registry's row of `key` ([`registry::METRICS`]); a key it does not hold is written
+/// as a plain number of three significant digits, determined within ±25.
+fn row(key: &str) -> Metric {
+    registry::metric(key).copied().unwrap_or(Metric {
+        key: "",
+        reason_key: "",
+        symbol: "",
+        label: "",
+        explanation: "",
+        unit: "",
+        shown_scale: 1.0,
+        group: registry::Group::FilmTv,
+        precision: Precision::Significant3,
+        lab_decimals: 3,
+        determined: Determined::Within(25.0),
+        at_most_100: false,
+        may_be_negative: true,
+        meaningful_for: registry::MeaningfulFor::AnyLight,
+        calibrated: false,
+        interval_in_per_cent: false,
+        source: registry::Source::Meter,
+    })
+}
+
 /// What the metric of `key` is multiplied by before it is shown: PPF per lux (stored per
-/// lux) is shown per 1000 lx, all else as stored.
+/// lux) is shown per 1000 lx, all else as stored ([`Metric::shown_scale`]).
 pub fn scale(key: &str) -> f64 {
-    if key == "ppf_per_lux" {
-        1000.0
-    } else {
-        1.0
-    }
+    row(key).shown_scale
 }
 
 /// The unit shown after the metric of `key` (empty for none): one unit per quantity
-/// everywhere.
+/// everywhere ([`Metric::unit`]).
 pub fn unit(key: &str) -> &'static str {
-    match key {
-        "cct_k" => "K",
-        "ppf_per_lux" => "µmol s⁻¹ m⁻² per 1000 lx",
-        "blh_efficacy_w_per_lm" => "W/lm",
-        k if k.starts_with("mired") => "mired",
-        _ => "",
-    }
+    row(key).unit
 }
 
 /// Whether a value `value` with 95 % half-width `half` (both as shown, after [`scale`]) is
-/// determined by the photo, by the rules of the module's documentation.
+/// determined by the photo, by the rules of the module's documentation
+/// ([`Metric::determined`]).
 pub fn determinable(key: &str, value: f64, half: f64) -> bool {
-    match key {
-        "cct_k" => half <= 0.15 * value.abs(),
+    match row(key).determined {
+        Determined::WithinShare(share) => half <= share * value.abs(),
+        Determined::Within(limit) => half <= limit,
         // Or, far from white, an interval wholly beyond the ±0.05 within which a CCT means
         // anything: the photo then shows the light is coloured, and by about how much.
-        "duv" => half <= 0.0125 || value.abs() - half > crate::estimate::MAX_CCT_DUV,
-        "mel_der" | "sp_ratio" | "ppf_per_lux" | "blh_efficacy_w_per_lm" => {
-            half <= 0.5 * value.abs()
+        Determined::WithinOrColoured(limit) => {
+            half <= limit || value.abs() - half > crate::estimate::MAX_CCT_DUV
         }
-        k if k.starts_with("mired") => half <= 25.0,
-        _ => half <= 25.0,
     }
 }
 
@@ -68,22 +90,25 @@ pub fn determinable(key: &str, value: f64, half: f64) -> bool {
 /// [`NOT_DETERMINABLE`] when the interval is too wide ([`determinable`]). `value` and
 /// `half95` are as stored; [`scale`] is applied here.
 pub fn shown(key: &str, value: f64, half95: Option<f64>) -> Result<String, &'static str> {
-    let k = scale(key);
+    let metric = row(key);
+    let k = metric.shown_scale;
     let value = k * value;
-    let signed = key == "duv" || key.starts_with("mired");
-    let sign = if signed && value >= 0.0 { "+" } else { "" };
+    let sign = if metric.precision.signed() && value >= 0.0 {
+        "+"
+    } else {
+        ""
+    };
     match half95.map(|h| k * h).filter(|h| *h > 0.0 && h.is_finite()) {
         Some(half) if !determinable(key, value, half) => Err(NOT_DETERMINABLE),
         Some(half) => {
             let (v, h) = round_with_uncertainty(value, half);
             Ok(format!("{sign}{v} ± {h}"))
         }
-        None => Ok(match key {
-            "duv" => format!("{value:+.4}"),
-            k if k.starts_with("mired") => format!("{value:+.0}"),
-            "cct_k" | "cri_ra" | "tm30_rf" | "tm30_rg" | "ssi" => format!("{value:.0}"),
-            k if k.starts_with("cri_r") => format!("{value:.0}"),
-            _ => round_sig(value, 3),
+        None => Ok(match metric.precision {
+            Precision::Signed4 => format!("{value:+.4}"),
+            Precision::SignedWhole => format!("{value:+.0}"),
+            Precision::Whole => format!("{value:.0}"),
+            Precision::Significant3 => round_sig(value, 3),
         }),
     }
 }
@@ -99,18 +124,18 @@ pub fn shown_with_unit(key: &str, value: f64, half95: Option<f64>) -> String {
 }
 
 /// The 95 % interval `value ± half95` of the metric of `key` (both as stored), cut to the
-/// values the quantity can take: indices on the 0–100 scale (CIE 13.3 Ra and R1–R15, TM-30
-/// Rf, SSI) never exceed 100, and quantities that cannot be negative (CCT, TM-30 Rg, the
-/// ratios and efficacies) never fall below 0.
+/// values the quantity can take ([`Metric::at_most_100`], [`Metric::may_be_negative`]):
+/// indices on the 0–100 scale (CIE 13.3 Ra and R1–R15, TM-30 Rf, SSI) never exceed 100, and
+/// quantities that cannot be negative (CCT, TM-30 Rg, the ratios and efficacies) never fall
+/// below 0.
 pub fn interval_bounds(key: &str, value: f64, half95: f64) -> (f64, f64) {
+    let metric = row(key);
     let (mut lo, mut hi) = (value - half95, value + half95);
-    let at_most_100 = key.starts_with("cri_r") || key == "tm30_rf" || key.starts_with("ssi");
-    let signed = key == "duv" || key.starts_with("mired") || key.starts_with("cri_r");
-    if at_most_100 {
+    if metric.at_most_100 {
         hi = hi.min(100.0);
         lo = lo.min(hi);
     }
-    if !signed {
+    if !metric.may_be_negative {
         lo = lo.max(0.0);
         hi = hi.max(lo);
     }

@@ -8,6 +8,7 @@ use serde::Serialize;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
 use spdcam_core::named_light::resolve_spd;
+use spdcam_core::quality::registry::{Metric, Source, METRICS};
 use spdcam_core::quality::{LightSpectrum, LightingMetrics, QUALITY_GRID};
 use spdcam_core::spectral::SpectralSet;
 use std::path::Path;
@@ -70,11 +71,15 @@ fn lights(spec: &str, data_dir: &DataDir) -> Result<Vec<Row>> {
     }])
 }
 
-fn fixed(v: Option<f64>, decimals: usize) -> String {
-    v.map_or_else(|| "—".into(), |v| format!("{v:.decimals$}"))
+/// The metrics of the table: every registry row read from a light's metrics.
+fn table_metrics() -> impl Iterator<Item = &'static Metric> {
+    METRICS
+        .iter()
+        .filter(|m| matches!(m.source, Source::Lighting(_)))
 }
 
-/// The main numbers, one light per line, then the reasons and warnings.
+/// The main numbers ([`METRICS`] read from the light), one light per line, each to its
+/// `lab_decimals`; then the reasons and warnings.
 fn print_table(rows: &[Row]) -> Result<()> {
     let width = rows
         .iter()
@@ -82,42 +87,32 @@ fn print_table(rows: &[Row]) -> Result<()> {
         .max()
         .unwrap_or(4)
         .max(4);
-    outln!(
-        "{:<width$}  {:>7} {:>8} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>7} {:>9}",
-        "name",
-        "CCT K",
-        "Duv",
-        "Ra",
-        "R9",
-        "Rf",
-        "Rg",
-        "M-EDER",
-        "S/P",
-        "PPF/lx",
-        "BLH mW/lm"
-    )?;
-    for r in rows {
-        let m = &r.metrics;
-        let pad = width - r.name.chars().count();
-        outln!(
-            "{}{:pad$}  {:>7} {:>8} {:>6} {:>6} {:>6} {:>6} {:>6} {:>5} {:>7} {:>9}",
-            r.name,
-            "",
-            fixed(m.cct_k, 0),
-            fixed(m.duv, 4),
-            fixed(m.cri_ra, 1),
-            fixed(m.cri_r.map(|r| r[8]), 1),
-            fixed(m.tm30_rf, 1),
-            fixed(m.tm30_rg, 1),
-            fixed(m.mel_der, 3),
-            fixed(m.sp_ratio, 2),
-            fixed(m.ppf_per_lux.map(|v| 1000.0 * v), 2),
-            fixed(m.blh_efficacy_w_per_lm.map(|v| 1000.0 * v), 3),
-        )?;
+    let column = |m: &Metric| m.symbol.chars().count().max(7);
+    let mut header = format!("{:<width$} ", "name");
+    for m in table_metrics() {
+        header += &format!(" {:>w$}", m.symbol, w = column(m));
     }
+    outln!("{header}")?;
+    for r in rows {
+        let pad = width - r.name.chars().count();
+        let mut line = format!("{}{:pad$} ", r.name, "");
+        for m in table_metrics() {
+            let value = m.value(&r.metrics).map_or_else(
+                || "—".into(),
+                |v| format!("{:.d$}", m.shown_scale * v, d = m.lab_decimals),
+            );
+            line += &format!(" {value:>w$}", w = column(m));
+        }
+        outln!("{line}")?;
+    }
+    let units: Vec<String> = table_metrics()
+        .filter(|m| !m.unit.is_empty())
+        .map(|m| format!("{} in {}", m.symbol, m.unit))
+        .collect();
     outln!(
-        "(PPF/lx in µmol·s⁻¹·klm⁻¹, i.e. µmol·m⁻²·s⁻¹ per 1000 lx; `--json` gives every number: \
-         R1–R14, TM-30 hue bins, all five α-opic ratios, chromaticities)"
+        "({}; `--json` gives every number: R1–R14, TM-30 hue bins, all five α-opic ratios, \
+         chromaticities)",
+        units.join(", ")
     )?;
     for r in rows {
         let mut seen = Vec::new();

@@ -19,7 +19,8 @@
 //!   ([`film_tv`]).
 //!
 //! [`LightingMetrics`] gathers every number; a value that is not defined for a light is `None`
-//! with the reason in [`LightingMetrics::reasons`]. The results match colour-science 0.4.7
+//! with the reason in [`LightingMetrics::reasons`]. The single numbers a person reads, with
+//! their names, units, rounding and groups, are the rows of one table, [`registry::METRICS`]. The results match colour-science 0.4.7
 //! (CRI, CIE 2017/TM-30, CCT) and luxpy 1.12.5 (α-opic) on 221 measured lamps
 //! (`tests/quality_reference.rs`).
 
@@ -30,6 +31,7 @@ pub mod dominant;
 pub mod film_tv;
 pub mod photobiology;
 pub mod reference;
+pub mod registry;
 mod spectrum;
 pub mod tm30;
 pub mod uv;
@@ -121,21 +123,6 @@ pub const METRIC_KEYS: [&str; 18] = [
     "ppf_per_lux",
     "blh_efficacy_w_per_lm",
     "reasons",
-];
-
-/// The single-number metrics a person quotes, by key: each has an uncertainty when an
-/// estimate has one (`cri_r9` is R9, saturated red, from `cri_r`).
-pub const SCALAR_KEYS: [&str; 10] = [
-    "cct_k",
-    "duv",
-    "cri_ra",
-    "cri_r9",
-    "tm30_rf",
-    "tm30_rg",
-    "mel_der",
-    "sp_ratio",
-    "ppf_per_lux",
-    "blh_efficacy_w_per_lm",
 ];
 
 /// The CCT-dependent keys.
@@ -309,22 +296,10 @@ impl LightingMetrics {
         );
     }
 
-    /// The value of the single-number metric `key` (one of [`SCALAR_KEYS`]), `None` when it
-    /// is undefined or `key` is not one of them.
+    /// The value of the single-number metric `key` (a row of [`registry::METRICS`] read from
+    /// these metrics), `None` when it is undefined or `key` is not one of them.
     pub fn scalar(&self, key: &str) -> Option<f64> {
-        match key {
-            "cct_k" => self.cct_k,
-            "duv" => self.duv,
-            "cri_ra" => self.cri_ra,
-            "cri_r9" => self.cri_r.map(|r| r[8]),
-            "tm30_rf" => self.tm30_rf,
-            "tm30_rg" => self.tm30_rg,
-            "mel_der" => self.mel_der,
-            "sp_ratio" => self.sp_ratio,
-            "ppf_per_lux" => self.ppf_per_lux,
-            "blh_efficacy_w_per_lm" => self.blh_efficacy_w_per_lm,
-            _ => None,
-        }
+        registry::metric(key)?.value(self)
     }
 
     fn set_reason(&mut self, keys: &[&str], reason: &str) {
@@ -350,8 +325,12 @@ mod tests {
         assert!((m.mel_der.unwrap() - 1.0).abs() < 1e-12);
         assert!(m.cri_ra.unwrap() > 99.0 && m.tm30_rf.unwrap() > 99.0);
         assert!(m.warnings.is_empty(), "{:?}", m.warnings);
-        for key in SCALAR_KEYS {
-            assert!(m.scalar(key).is_some_and(f64::is_finite), "{key}");
+        for metric in registry::calibrated() {
+            assert!(
+                m.scalar(metric.key).is_some_and(f64::is_finite),
+                "{}",
+                metric.key
+            );
         }
         assert_eq!(m.scalar("cri_r9"), Some(m.cri_r.unwrap()[8]));
         assert_eq!(m.scalar("cri_ra"), m.cri_ra);
@@ -370,6 +349,13 @@ mod tests {
         let json = serde_json::to_value(&m).unwrap();
         for key in METRIC_KEYS {
             assert!(json.get(key).is_some(), "missing key {key}");
+        }
+        // And the other way: every field but the warnings is a key of the list.
+        for key in json.as_object().unwrap().keys() {
+            assert!(
+                key == "warnings" || METRIC_KEYS.contains(&key.as_str()),
+                "{key} is not in METRIC_KEYS"
+            );
         }
         assert!(json["cri_ra"].is_null());
         // A deep red line has a CCT below 1000 K: CCT, CRI and TM-30 are undefined, the

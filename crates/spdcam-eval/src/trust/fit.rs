@@ -14,7 +14,7 @@ use crate::trust::scenes::scene_rows;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::light_families::validation_split::LampPart;
-use spdcam_core::quality::SCALAR_KEYS;
+use spdcam_core::quality::registry;
 use spdcam_infer::pca::{Components, Pca};
 use spdcam_infer::ridge::{Gram, Ridge};
 use spdcam_infer::trust::{
@@ -151,9 +151,9 @@ pub fn fit_calibration(
         .iter()
         .map(|j| 1.0 - gfc_model.expected(&j.spd, difficulty(j)))
         .collect();
-    let metric_calibrations = SCALAR_KEYS
-        .iter()
-        .filter_map(|&key| {
+    let metric_calibrations = registry::calibrated()
+        .filter_map(|metric| {
+            let key = metric.key;
             let photos: Vec<MetricPhoto> = judged
                 .iter()
                 .zip(&widenings)
@@ -204,9 +204,6 @@ pub fn fit_calibration(
     })
 }
 
-/// Metrics whose intervals are judged by their width as a share of the estimate when the
-/// calibration chooses among them ([`fit_metric`]): CCT, whose goal is one in per cent.
-const WIDTH_AS_SHARE: [&str; 1] = ["cct_k"];
 /// Powers of the expected 1 − GFC in a metric's floor that the calibration chooses among
 /// ([`MetricCalibration::gap_power`]); 0 is one floor for every photo.
 const GAP_POWERS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
@@ -231,11 +228,11 @@ struct MetricPhoto {
 /// power of the expected 1 − GFC in the floor ([`GAP_POWERS`]), the floor (median of |error|
 /// / (widening · gap factor)) and the group-conditional conformal scales; the power whose 95 %
 /// intervals are narrowest in the median over the photos is kept (for CCT as a share of the
-/// estimate, [`WIDTH_AS_SHARE`]). The conformal quantile holds for any power fixed
+/// estimate, [`registry::Metric::interval_in_per_cent`]). The conformal quantile holds for any power fixed
 /// beforehand; choosing among five on the same photos costs little coverage, which the
 /// report measures on held-out photos.
 fn fit_metric(key: &str, photos: &[MetricPhoto]) -> Option<MetricCalibration> {
-    let as_share = WIDTH_AS_SHARE.contains(&key);
+    let as_share = registry::metric(key).is_some_and(|m| m.interval_in_per_cent);
     // A width as a share needs the estimate's value; photos without one are left out.
     let photos: Vec<&MetricPhoto> = photos
         .iter()

@@ -3,7 +3,7 @@
 //! take of them.
 
 use crate::error::Result;
-use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
+use spdcam_core::quality::{registry, LightingMetrics};
 use spdcam_core::spectral_error;
 use spdcam_infer::trust::{self, ChartCheck, Perturbed, SelfCheck};
 use spdcam_infer::Model;
@@ -60,11 +60,10 @@ pub fn judge_rows(
                         LightingMetrics::from_samples(&wavelengths, &spd),
                         LightingMetrics::from_samples(&wavelengths, t),
                     );
-                    SCALAR_KEYS
-                        .iter()
-                        .filter_map(|&k| {
-                            let value = e.scalar(k)?;
-                            let error = (value - t.scalar(k)?).abs();
+                    registry::calibrated()
+                        .filter_map(|metric| {
+                            let (k, value) = (metric.key, metric.value(&e)?);
+                            let error = (value - metric.value(&t)?).abs();
                             Some(((k.to_string(), error), (k.to_string(), value)))
                         })
                         .unzip()

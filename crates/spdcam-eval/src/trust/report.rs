@@ -15,7 +15,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::chart_lighting::{Corrections, UnevenLight};
 use spdcam_core::light_families::validation_split::LampPart;
-use spdcam_core::quality::SCALAR_KEYS;
+use spdcam_core::quality::registry;
 use spdcam_core::spectral_error;
 use spdcam_infer::trust::{
     self, assess, weigh, ChartCheck, PhotoFlags, TrustCalibration, Verdict, DOUBTFUL_GFC, POOR_GFC,
@@ -145,9 +145,11 @@ struct MetricCoverage {
     share95: Vec<f64>,
 }
 
-/// Metrics whose median 95 % half-width the report also gives as a share of the estimate
-/// (the goal for CCT is one in per cent).
-const SHARE_SHOWN: [&str; 1] = ["cct_k"];
+/// Whether the report also gives the median 95 % half-width of metric `key` as a share of
+/// the estimate ([`registry::Metric::interval_in_per_cent`]).
+fn share_shown(key: &str) -> bool {
+    registry::metric(key).is_some_and(|m| m.interval_in_per_cent)
+}
 
 /// Scene photos of each test lamp the report measures (the whole camera chain).
 pub const REPORT_SCENES_PER_LAMP: usize = 2;
@@ -270,7 +272,7 @@ fn measure_row(
                 if let Some(value) = j
                     .metric_value
                     .get(key)
-                    .filter(|v| SHARE_SHOWN.contains(&key.as_str()) && **v != 0.0)
+                    .filter(|v| share_shown(key) && **v != 0.0)
                 {
                     c.share95.push(interval.half95 / value.abs());
                 }
@@ -395,7 +397,7 @@ fn metric_table(name: &str, sets: &[(String, BTreeMap<String, MetricCoverage>)])
             .collect::<String>(),
         "---:|".repeat(sets.len())
     );
-    for key in SCALAR_KEYS {
+    for key in registry::calibrated().map(|m| m.key) {
         t += &format!("| `{key}` |");
         for (_, coverage) in sets {
             t += &match coverage.get(key) {
@@ -404,7 +406,7 @@ fn metric_table(name: &str, sets: &[(String, BTreeMap<String, MetricCoverage>)])
                     100.0 * c.in68 as f64 / c.total as f64,
                     100.0 * c.in95 as f64 / c.total as f64,
                     significant(median(&mut c.half95.clone())),
-                    if SHARE_SHOWN.contains(&key) && !c.share95.is_empty() {
+                    if share_shown(key) && !c.share95.is_empty() {
                         format!(", ± {:.1} %", 100.0 * median(&mut c.share95.clone()))
                     } else {
                         String::new()

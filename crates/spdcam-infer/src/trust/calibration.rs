@@ -44,7 +44,7 @@ pub struct Uncertainty {
     /// ([`TrustCalibration::widening`]); 1 when it explains it as well or better.
     pub widening: f64,
     /// Half-widths of the 68 % and 95 % intervals of the single-number metrics, by key
-    /// ([`SCALAR_KEYS`](spdcam_core::quality::SCALAR_KEYS)): "Ra 82 ± 4" is `cri_ra` ± `half95`. Only metrics the calibration
+    /// ([`registry::calibrated`](spdcam_core::quality::registry::calibrated)): "Ra 82 ± 4" is `cri_ra` ± `half95`. Only metrics the calibration
     /// measured and the perturbed copies define.
     pub metrics: BTreeMap<String, MetricInterval>,
 }
@@ -63,7 +63,7 @@ pub struct MetricInterval {
 /// follows the expected GFC, as the scale ([`MetricCalibration::unit`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MetricCalibration {
-    /// The metric's key ([`SCALAR_KEYS`](spdcam_core::quality::SCALAR_KEYS)).
+    /// The metric's key ([`registry::METRICS`](spdcam_core::quality::registry::METRICS)).
     pub key: String,
     /// The median of |error| / (widening · gap factor) on the calibration photos
     /// ([`MetricCalibration::gap_factor`]; the median absolute error where the factor is 1).

@@ -7,7 +7,7 @@ use crate::model::Model;
 use rand::rngs::SmallRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use spdcam_core::quality::{LightingMetrics, SCALAR_KEYS};
+use spdcam_core::quality::{registry, LightingMetrics};
 use std::collections::BTreeMap;
 
 /// Perturbed copies of the features whose estimates measure the spread.
@@ -75,7 +75,7 @@ impl Perturbed {
             .collect()
     }
 
-    /// Per single-number metric ([`SCALAR_KEYS`]), the standard deviation of its values
+    /// Per calibrated metric ([`registry::calibrated`]), the standard deviation of its values
     /// over the copies (on `wavelengths`, the model's grid); a metric undefined for more than
     /// a quarter of the copies has none.
     pub fn metric_spread(&self, wavelengths: &[f64]) -> BTreeMap<String, f64> {
@@ -84,12 +84,11 @@ impl Perturbed {
             .iter()
             .map(|s| LightingMetrics::from_samples(wavelengths, s))
             .collect();
-        SCALAR_KEYS
-            .iter()
-            .filter_map(|&key| {
-                let values: Vec<f64> = all.iter().filter_map(|m| m.scalar(key)).collect();
+        registry::calibrated()
+            .filter_map(|metric| {
+                let values: Vec<f64> = all.iter().filter_map(|m| metric.value(m)).collect();
                 (4 * values.len() >= 3 * all.len() && values.len() > 1)
-                    .then(|| (key.to_string(), sample_std(values.into_iter())))
+                    .then(|| (metric.key.to_string(), sample_std(values.into_iter())))
             })
             .collect()
     }

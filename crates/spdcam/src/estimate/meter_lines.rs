@@ -3,9 +3,10 @@
 //! and TV numbers, every number written by the library's one rule
 //! ([`spdcam_infer::rounding`]), as the report and the web page write it.
 
+use spdcam_core::quality::registry::{self, Group};
 use spdcam_infer::meter::Meter;
 use spdcam_infer::presentation::meaningful_value;
-use spdcam_infer::rounding::shown_with_unit;
+use spdcam_infer::rounding::{shown_with_unit, UNCALIBRATED};
 use spdcam_infer::Estimate;
 
 /// `xy (0.3127, 0.3290); CCT 6500 ± 300 K, Δuv +0.0031 ± 0.0012`, or for coloured light
@@ -27,32 +28,37 @@ pub(super) fn headline_line(e: &Estimate, meter: &Meter) -> String {
     )
 }
 
-/// The main lighting-quality numbers on one line, `—` where undefined or not meaningful for
-/// this light (CRI and TM-30 far from white), each with its 95 % interval when the estimate
-/// has one: `Ra 82 ± 4, R9 20 ± 15, …, PPF 30 ± 8 µmol s⁻¹ m⁻² per 1000 lx`.
+/// The main lighting-quality numbers on one line (the registry's metrics past the colour
+/// group, which the headline gives), `—` where undefined or not meaningful for this light
+/// (CRI and TM-30 far from white), each with its 95 % interval when the estimate has one:
+/// `Ra 82 ± 4, R9 20 ± 15, …, PPF 30 ± 8 µmol s⁻¹ m⁻² per 1000 lx`.
 pub(super) fn metrics_line(e: &Estimate) -> String {
     let intervals = e
         .trust
         .as_ref()
         .and_then(|t| t.uncertainty.as_ref())
         .map(|u| &u.metrics);
-    let f = |key: &str| {
-        let Ok(v) = meaningful_value(e, key) else {
-            return "—".to_string();
-        };
-        shown_with_unit(key, v, intervals.and_then(|i| i.get(key)).map(|i| i.half95))
-    };
-    format!(
-        "Ra {}, R9 {}, Rf {}, Rg {}, M-EDER {}, S/P {}, blue-light hazard {}, PPF {}",
-        f("cri_ra"),
-        f("cri_r9"),
-        f("tm30_rf"),
-        f("tm30_rg"),
-        f("mel_der"),
-        f("sp_ratio"),
-        f("blh_efficacy_w_per_lm"),
-        f("ppf_per_lux"),
-    )
+    Group::PRESENTED
+        .iter()
+        .filter(|&&g| g != Group::Colour)
+        .flat_map(|&g| registry::in_group(g))
+        .map(|m| {
+            let value = match meaningful_value(e, m.key) {
+                Err(_) => "—".to_string(),
+                Ok(v) => {
+                    let half95 = intervals.and_then(|i| i.get(m.key)).map(|i| i.half95);
+                    let text = shown_with_unit(m.key, v, half95);
+                    if intervals.is_some() && half95.is_none() {
+                        format!("{text} ({UNCALIBRATED})")
+                    } else {
+                        text
+                    }
+                }
+            };
+            format!("{} {value}", m.symbol)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The film and TV numbers on one line, `None` for a light without a meaningful CCT:
