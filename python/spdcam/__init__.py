@@ -36,6 +36,7 @@ __all__ = [
     "estimate_places",
     "estimate_features",
     "LIGHT_KINDS",
+    "METRICS",
     "Rendering",
     "render",
     "Dataset",
@@ -51,17 +52,14 @@ PathLike = Union[str, "os.PathLike[str]"]
 Progress = Callable[[int, int], None]
 
 DEFAULT_RANGE = "400-700:5"
-#: The kinds of light ``estimate(light=…)`` takes (``spdcam light-kinds list``).
-LIGHT_KINDS = (
-    "unknown",
-    "daylight",
-    "incandescent",
-    "fluorescent",
-    "white-led",
-    "hid",
-    "rgb-led",
-    "luminaire",
-)
+#: The kinds of light ``estimate(light=…)`` takes (``spdcam light-kinds list``), from the
+#: library's one classification of light.
+LIGHT_KINDS: tuple[str, ...] = tuple(_native.light_kinds())
+#: The single-number metrics, from the library's metric registry: one dict per metric with
+#: its ``key`` (as in :attr:`Estimate.metrics` and :attr:`Estimate.metric_uncertainty`),
+#: ``symbol``, ``label``, ``unit``, ``group``, ``explanation`` and whether it has a
+#: ``calibrated`` interval.
+METRICS: tuple[dict[str, Any], ...] = tuple(_native.metric_registry())
 
 
 class Model:

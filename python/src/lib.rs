@@ -22,6 +22,7 @@ use spdcam_core::dataset::{GenerateEvent, GenerateOptions, GenerateRequest, Pipe
 use spdcam_core::light_families::LightKind;
 use spdcam_core::named_light;
 use spdcam_core::photo::{load_photo, Photo};
+use spdcam_core::quality::registry::METRICS;
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral::{Extrapolation, Interpolation, SpectralSet};
 use spdcam_infer::error::unusable_photo;
@@ -694,6 +695,34 @@ fn library_seconds_rows(
     .map_err(|e: spdcam_infer::InferError| py_err(e))
 }
 
+/// The metric registry (`spdcam_core::quality::registry::METRICS`) as a list of dicts: each
+/// metric's `key` (as in an estimate's `metrics` and `metric_uncertainty`), `symbol`,
+/// `label`, `unit`, `group`, `explanation` and whether it has a `calibrated` interval.
+#[pyfunction]
+fn metric_registry(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    let rows: Vec<serde_json::Value> = METRICS
+        .iter()
+        .map(|m| {
+            serde_json::json!({
+                "key": m.key,
+                "symbol": m.symbol,
+                "label": m.label,
+                "unit": m.unit,
+                "group": m.group.title(),
+                "explanation": m.explanation,
+                "calibrated": m.calibrated,
+            })
+        })
+        .collect();
+    pythonize::pythonize(py, &rows).map_err(py_err)
+}
+
+/// The names of the kinds of light `estimate(light=…)` takes, `unknown` first.
+#[pyfunction]
+fn light_kinds() -> Vec<&'static str> {
+    LightKind::ALL.iter().map(|k| k.name()).collect()
+}
+
 /// The compiled part of the `spdcam` package.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -706,6 +735,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_photo, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(generate, m)?)?;
+    m.add_function(wrap_pyfunction!(metric_registry, m)?)?;
+    m.add_function(wrap_pyfunction!(light_kinds, m)?)?;
     #[cfg(feature = "train")]
     train::register(m)?;
     m.add_function(wrap_pyfunction!(library_seconds_photo, m)?)?;

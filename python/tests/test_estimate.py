@@ -42,6 +42,14 @@ def test_the_example_photo_round_trip(example):
     assert e.verdict in ("ok", "doubtful", "unusable") and isinstance(e.reasons, list)
     assert 0.0 < e.expected_gfc <= 1.0
     assert e.band_widening >= 1.0
+    # Every interval is of a registry metric that the calibration covers, and the
+    # presentation names each metric as the registry does.
+    registry = {m["key"]: m for m in spdcam.METRICS}
+    assert set(e.metric_uncertainty) <= {k for k, m in registry.items() if m["calibrated"]}
+    for group in e.json["presentation"]["groups"]:
+        for m in group["metrics"]:
+            assert (m["label"], m["unit"]) == (registry[m["key"]]["label"], registry[m["key"]]["unit"])
+            assert group["title"] == registry[m["key"]]["group"]
     ra = e.metric_uncertainty["cri_ra"]
     assert 0.0 < ra["half68"] < ra["half95"] == e.json["metric_uncertainty"]["cri_ra"]["half95"]
     for lower, upper in (e.band, e.band68):
