@@ -10,7 +10,7 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::light_families::coverage::best_gfc;
 use spdcam_core::light_families::lamp_families::fit_lamp;
 use spdcam_core::light_families::validation_split::LampPart;
-use spdcam_core::light_families::{LampFamily, LampLibrary, LampType, Lighting, ValidationSplit};
+use spdcam_core::light_families::{LampLibrary, LampType, Lighting, ValidationSplit};
 use spdcam_core::spectral::Grid;
 use std::path::PathBuf;
 
@@ -125,8 +125,9 @@ impl Coverage {
                 .iter()
                 .enumerate()
                 .map(|(i, spd)| {
-                    LampFamily::for_type(library.types[i])
-                        .and_then(|f| fit_lamp(f, &library.names[i], spd, &grid).ok())
+                    Some(library.types[i])
+                        .filter(|t| t.has_model())
+                        .and_then(|t| fit_lamp(t, &library.names[i], spd, &grid).ok())
                         .map(|l| l.gfc)
                 })
                 .collect()

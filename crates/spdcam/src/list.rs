@@ -67,11 +67,11 @@ pub fn run(args: ListArgs, data_dir: &DataDir) -> Result<()> {
             outln!("  {form:<28} {what}")?;
         }
         outln!("lamp families (lamp:NAME), fitted to measured lamps:")?;
-        for family in light_families::LampFamily::ALL {
+        for family in light_families::LampType::MODELLED {
             outln!(
                 "  {:<28} {}",
                 format!("lamp:{}", family.name()),
-                family.describe()
+                family.describe_model()
             )?;
         }
     }

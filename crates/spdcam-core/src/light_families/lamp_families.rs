@@ -71,81 +71,34 @@ const fn p(name: &'static str, lower: f64, upper: f64, scale: Scale) -> Param {
     }
 }
 
-/// A family of lamps with a physical model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LampFamily {
-    /// Phosphor-converted white LED: a blue or violet pump (Ohno LED, 400–475 nm) and two
-    /// phosphor bands.
-    PhosphorLed,
-    /// A phosphor white with a direct red LED added.
-    HybridLed,
-    /// Four coloured LEDs (RGB, RGBA, RGBW…; an unused one gets height 0).
-    MixedLed,
-    /// Mercury lines, rare-earth phosphor lines and three broad phosphor bands
-    /// (halophosphate, BAM blue, deluxe reds).
-    Fluorescent,
-    /// Discharge lines (Hg, Na, Tl, In, Li) and four broad bands (pressure-broadened sodium,
-    /// the quasi-continuum of metal halides).
-    Hid,
-    /// A filament (Planck's law) through a smooth filter: dimmed, halogen, coated.
-    Incandescent,
-}
-
-impl LampFamily {
-    /// Every family.
-    pub const ALL: [LampFamily; 6] = [
-        LampFamily::PhosphorLed,
-        LampFamily::HybridLed,
-        LampFamily::MixedLed,
-        LampFamily::Fluorescent,
-        LampFamily::Hid,
-        LampFamily::Incandescent,
+impl LampType {
+    /// The lamp types with a physical model, fitted to measured lamps of the type: every
+    /// type but [`LampType::Other`] and [`LampType::Daylight`] (daylight has its own CIE
+    /// recipe).
+    pub const MODELLED: [LampType; 6] = [
+        LampType::PhosphorLed,
+        LampType::HybridLed,
+        LampType::MixedLed,
+        LampType::Fluorescent,
+        LampType::Hid,
+        LampType::Incandescent,
     ];
 
-    /// The recipe name (`lamp:NAME`).
-    pub fn name(self) -> &'static str {
+    /// Whether the type has a physical model ([`LampType::MODELLED`]).
+    pub fn has_model(self) -> bool {
+        LampType::MODELLED.contains(&self)
+    }
+
+    /// One line on the type's model, for `spdcam list lighting`.
+    pub fn describe_model(self) -> &'static str {
         match self {
-            LampFamily::PhosphorLed => "phosphor-led",
-            LampFamily::HybridLed => "hybrid-led",
-            LampFamily::MixedLed => "mixed-led",
-            LampFamily::Fluorescent => "fluorescent",
-            LampFamily::Hid => "hid",
-            LampFamily::Incandescent => "incandescent",
-        }
-    }
-
-    /// The family named `name`.
-    pub fn parse(name: &str) -> Option<LampFamily> {
-        LampFamily::ALL.into_iter().find(|f| f.name() == name)
-    }
-
-    /// The lamp type the family is fitted to.
-    pub fn lamp_type(self) -> LampType {
-        match self {
-            LampFamily::PhosphorLed => LampType::PhosphorLed,
-            LampFamily::HybridLed => LampType::HybridLed,
-            LampFamily::MixedLed => LampType::MixedLed,
-            LampFamily::Fluorescent => LampType::Fluorescent,
-            LampFamily::Hid => LampType::Hid,
-            LampFamily::Incandescent => LampType::Incandescent,
-        }
-    }
-
-    /// The family fitted to lamps of `kind`, if any.
-    pub fn for_type(kind: LampType) -> Option<LampFamily> {
-        LampFamily::ALL.into_iter().find(|f| f.lamp_type() == kind)
-    }
-
-    /// One line on the model, for `spdcam list lighting`.
-    pub fn describe(self) -> &'static str {
-        match self {
-            LampFamily::PhosphorLed => "phosphor-converted white LEDs: a blue/violet pump (Ohno 2005 LED, 400–475 nm) and two phosphor bands (Gaussian in energy)",
-            LampFamily::HybridLed => "hybrid white LEDs: pump, two phosphor bands and a direct red LED (590–670 nm)",
-            LampFamily::MixedLed => "mixed-colour LEDs (RGB, RGBA…): four Ohno 2005 LEDs anywhere in 400–700 nm",
-            LampFamily::Fluorescent => "fluorescent tubes: Hg lines, Tb³⁺/Eu³⁺ phosphor lines and three broad phosphor bands",
-            LampFamily::Hid => "high-intensity discharge (sodium, mercury, metal halide): Hg/Na/Tl/In/Li lines and four broad bands",
-            LampFamily::Incandescent => "incandescent and halogen filaments: Planck's law through a smooth filter",
+            LampType::PhosphorLed => "phosphor-converted white LEDs: a blue/violet pump (Ohno 2005 LED, 400–475 nm) and two phosphor bands (Gaussian in energy)",
+            LampType::HybridLed => "hybrid white LEDs: pump, two phosphor bands and a direct red LED (590–670 nm)",
+            LampType::MixedLed => "mixed-colour LEDs (RGB, RGBA…): four Ohno 2005 LEDs anywhere in 400–700 nm",
+            LampType::Fluorescent => "fluorescent tubes: Hg lines, Tb³⁺/Eu³⁺ phosphor lines and three broad phosphor bands",
+            LampType::Hid => "high-intensity discharge (sodium, mercury, metal halide): Hg/Na/Tl/In/Li lines and four broad bands",
+            LampType::Incandescent => "incandescent and halogen filaments: Planck's law through a smooth filter",
+            LampType::Other | LampType::Daylight => "no physical model",
         }
     }
 
@@ -172,8 +125,8 @@ impl LampFamily {
             p("line_sigma_nm", 1.0, 10.0, Log),
         ];
         match self {
-            LampFamily::PhosphorLed => [pump, phosphor(0, 470.0), phosphor(1, 470.0)].concat(),
-            LampFamily::HybridLed => [
+            LampType::PhosphorLed => [pump, phosphor(0, 470.0), phosphor(1, 470.0)].concat(),
+            LampType::HybridLed => [
                 &pump[..],
                 &phosphor(0, 470.0),
                 &phosphor(1, 470.0),
@@ -183,7 +136,7 @@ impl LampFamily {
                 ],
             ]
             .concat(),
-            LampFamily::MixedLed => {
+            LampType::MixedLed => {
                 let names = [
                     ("led1_nm", "led1_half_width_nm"),
                     ("led2_nm", "led2_half_width_nm"),
@@ -195,14 +148,14 @@ impl LampFamily {
                     .flat_map(|&(c, w)| [p(c, 400.0, 700.0, Linear), p(w, 5.0, 60.0, Log)])
                     .collect()
             }
-            LampFamily::Fluorescent => [
+            LampType::Fluorescent => [
                 &lines[..],
                 &phosphor(0, 400.0),
                 &phosphor(1, 400.0),
                 &phosphor(2, 400.0),
             ]
             .concat(),
-            LampFamily::Hid => {
+            LampType::Hid => {
                 let band = |c: &'static str, w: &'static str| {
                     [p(c, 380.0, 780.0, Linear), p(w, 0.02, 0.8, Log)]
                 };
@@ -215,7 +168,8 @@ impl LampFamily {
                 ]
                 .concat()
             }
-            LampFamily::Incandescent => vec![
+            LampType::Other | LampType::Daylight => Vec::new(),
+            LampType::Incandescent => vec![
                 p("cct_k", 1500.0, 6500.0, Log),
                 p("filter_tilt", -3.0, 3.0, Linear),
                 p("filter_curve", -3.0, 3.0, Linear),
@@ -226,38 +180,39 @@ impl LampFamily {
     /// Starting points of the fit (several, as the fit has local minima).
     fn starts(self) -> Vec<Vec<f64>> {
         match self {
-            LampFamily::PhosphorLed => vec![
+            LampType::PhosphorLed => vec![
                 vec![450.0, 12.0, 540.0, 0.15, 610.0, 0.12],
                 vec![450.0, 12.0, 560.0, 0.2, 640.0, 0.1],
                 vec![410.0, 10.0, 520.0, 0.15, 620.0, 0.12],
                 vec![445.0, 12.0, 500.0, 0.2, 590.0, 0.15],
             ],
-            LampFamily::HybridLed => vec![
+            LampType::HybridLed => vec![
                 vec![450.0, 12.0, 530.0, 0.15, 580.0, 0.15, 620.0, 10.0],
                 vec![410.0, 10.0, 540.0, 0.15, 600.0, 0.15, 630.0, 10.0],
                 vec![450.0, 12.0, 560.0, 0.15, 600.0, 0.2, 650.0, 10.0],
             ],
-            LampFamily::MixedLed => vec![
+            LampType::MixedLed => vec![
                 vec![450.0, 12.0, 530.0, 15.0, 590.0, 10.0, 625.0, 10.0],
                 vec![460.0, 12.0, 520.0, 15.0, 560.0, 20.0, 640.0, 10.0],
                 vec![445.0, 12.0, 505.0, 15.0, 595.0, 10.0, 640.0, 10.0],
             ],
-            LampFamily::Fluorescent => vec![
+            LampType::Fluorescent => vec![
                 vec![0.0, 3.0, 450.0, 0.15, 480.0, 0.15, 580.0, 0.15],
                 vec![0.0, 3.0, 450.0, 0.15, 580.0, 0.15, 630.0, 0.15],
                 vec![0.0, 3.0, 480.0, 0.15, 580.0, 0.15, 650.0, 0.15],
                 vec![-8.0, 3.0, 450.0, 0.15, 580.0, 0.15, 630.0, 0.15],
             ],
-            LampFamily::Hid => vec![
+            LampType::Hid => vec![
                 vec![0.0, 3.0, 450.0, 0.15, 530.0, 0.15, 590.0, 0.15, 640.0, 0.15],
                 vec![0.0, 3.0, 420.0, 0.15, 500.0, 0.15, 570.0, 0.15, 620.0, 0.15],
                 vec![0.0, 3.0, 480.0, 0.15, 560.0, 0.15, 600.0, 0.15, 680.0, 0.15],
             ],
-            LampFamily::Incandescent => vec![
+            LampType::Incandescent => vec![
                 vec![2800.0, 0.0, 0.0],
                 vec![2000.0, 0.0, 0.0],
                 vec![3500.0, 0.0, 0.0],
             ],
+            LampType::Other | LampType::Daylight => Vec::new(),
         }
     }
 
@@ -282,25 +237,26 @@ impl LampFamily {
         };
         let t = theta;
         match self {
-            LampFamily::PhosphorLed => vec![led(t[0], t[1]), band(t[2], t[3]), band(t[4], t[5])],
-            LampFamily::HybridLed => vec![
+            LampType::PhosphorLed => vec![led(t[0], t[1]), band(t[2], t[3]), band(t[4], t[5])],
+            LampType::HybridLed => vec![
                 led(t[0], t[1]),
                 band(t[2], t[3]),
                 band(t[4], t[5]),
                 led(t[6], t[7]),
             ],
-            LampFamily::MixedLed => (0..4).map(|k| led(t[2 * k], t[2 * k + 1])).collect(),
-            LampFamily::Fluorescent => {
+            LampType::MixedLed => (0..4).map(|k| led(t[2 * k], t[2 * k + 1])).collect(),
+            LampType::Fluorescent => {
                 let mut s = lines(&FLUORESCENT_LINES, t[0], t[1]);
                 s.extend((0..3).map(|k| band(t[2 + 2 * k], t[3 + 2 * k])));
                 s
             }
-            LampFamily::Hid => {
+            LampType::Hid => {
                 let mut s = lines(&DISCHARGE_LINES, t[0], t[1]);
                 s.extend((0..4).map(|k| band(t[2 + 2 * k], t[3 + 2 * k])));
                 s
             }
-            LampFamily::Incandescent => vec![Shape::Filament {
+            LampType::Other | LampType::Daylight => Vec::new(),
+            LampType::Incandescent => vec![Shape::Filament {
                 cct_k: t[0],
                 tilt: t[1],
                 curve: t[2],
@@ -317,11 +273,11 @@ impl LampFamily {
     /// wavelength), so that the same slot means the same kind of band across lamps.
     fn canonical(self, theta: &mut [f64], heights: &mut [f64]) {
         let (start, count, first_height) = match self {
-            LampFamily::PhosphorLed | LampFamily::HybridLed => (2, 2, 1),
-            LampFamily::MixedLed => (0, 4, 0),
-            LampFamily::Fluorescent => (2, 3, FLUORESCENT_LINES.len()),
-            LampFamily::Hid => (2, 4, DISCHARGE_LINES.len()),
-            LampFamily::Incandescent => return,
+            LampType::PhosphorLed | LampType::HybridLed => (2, 2, 1),
+            LampType::MixedLed => (0, 4, 0),
+            LampType::Fluorescent => (2, 3, FLUORESCENT_LINES.len()),
+            LampType::Hid => (2, 4, DISCHARGE_LINES.len()),
+            LampType::Incandescent | LampType::Other | LampType::Daylight => return,
         };
         let mut slots: Vec<([f64; 2], f64)> = (0..count)
             .map(|k| {
@@ -342,7 +298,7 @@ impl LampFamily {
 
 /// The spectrum of `family` at `theta` with shape heights `heights`, on `wavelengths`.
 pub fn model_spectrum(
-    family: LampFamily,
+    family: LampType,
     theta: &[f64],
     heights: &[f64],
     wavelengths: &[f64],
@@ -363,7 +319,7 @@ pub fn model_spectrum(
 pub struct FittedLamp {
     /// The lamp's name in the library.
     pub name: String,
-    /// The non-linear parameters ([`LampFamily::parameter_names`] order).
+    /// The non-linear parameters ([`LampType::parameter_names`] order).
     pub theta: Vec<f64>,
     /// The shapes' heights, scaled so the model spectrum's maximum is 1.
     pub heights: Vec<f64>,
@@ -375,7 +331,7 @@ pub struct FittedLamp {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FamilyFit {
     /// The spectral model the lamps were fitted with.
-    pub family: LampFamily,
+    pub family: LampType,
     /// The names of its non-linear parameters, in [`FittedLamp::theta`] order.
     pub parameter_names: Vec<String>,
     /// Every lamp fitted, with its parameters.
@@ -402,6 +358,12 @@ impl LampFits {
         let fits: LampFits = serde_json::from_str(text)
             .map_err(|e| Error::parse(source, format!("not lamp fits: {e}")))?;
         for f in &fits.families {
+            if !f.family.has_model() {
+                return Err(Error::parse(
+                    source,
+                    format!("{} lamps have no physical model", f.family.name()),
+                ));
+            }
             let d = f.family.params().len();
             let k = f.family.shapes(&vec![500.0; d]).len();
             if let Some(bad) = f
@@ -425,14 +387,20 @@ impl LampFits {
     }
 
     /// The fit of one family.
-    pub fn family(&self, family: LampFamily) -> Option<&FamilyFit> {
+    pub fn family(&self, family: LampType) -> Option<&FamilyFit> {
         self.families.iter().find(|f| f.family == family)
     }
 }
 
 /// Fits `family`'s model to one measured SPD on `grid` (least squares over the whole grid,
 /// the best of several starts); the GFC is measured on 400–700 nm.
-pub fn fit_lamp(family: LampFamily, name: &str, spd: &[f64], grid: &Grid) -> Result<FittedLamp> {
+pub fn fit_lamp(family: LampType, name: &str, spd: &[f64], grid: &Grid) -> Result<FittedLamp> {
+    if !family.has_model() {
+        return Err(Error::invalid(format!(
+            "lamp '{name}': {} lamps have no physical model to fit",
+            family.label()
+        )));
+    }
     let wavelengths = grid.wavelengths();
     if spd.len() != wavelengths.len() {
         return Err(Error::invalid(format!(
@@ -493,18 +461,18 @@ pub fn fit_lamp(family: LampFamily, name: &str, spd: &[f64], grid: &Grid) -> Res
 /// Fits every family to the lamps `lamps` (positions in `library`) of its type, in parallel.
 /// A family with no lamp of its type is an error.
 pub fn fit_families(library: &LampLibrary, lamps: &[usize]) -> Result<Vec<FamilyFit>> {
-    LampFamily::ALL
+    LampType::MODELLED
         .iter()
         .map(|&family| {
             let own: Vec<usize> = lamps
                 .iter()
                 .copied()
-                .filter(|&i| library.types[i] == family.lamp_type())
+                .filter(|&i| library.types[i] == family)
                 .collect();
             if own.is_empty() {
                 return Err(Error::invalid(format!(
                     "no lamps of type {} to fit the {} family to",
-                    family.lamp_type().label(),
+                    family.label(),
                     family.name()
                 )));
             }
@@ -539,7 +507,7 @@ pub fn visible_gfc(a: &[f64], b: &[f64], grid: &Grid) -> f64 {
 /// Draws lamps of one family around its fitted lamps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LampDraws {
-    family: LampFamily,
+    family: LampType,
     lamps: Vec<FittedLamp>,
     /// Per non-linear parameter: the kernel bandwidth (in the parameter's scale) and the
     /// range draws stay in.
@@ -561,7 +529,7 @@ struct Kernel {
 impl LampDraws {
     /// Draws for `family` from `fits`, on `grid`, with the kernel bandwidths multiplied by
     /// `spread` (1 = Scott's rule; 0 = the fitted lamps themselves).
-    pub fn new(fits: &LampFits, family: LampFamily, grid: &Grid, spread: f64) -> Result<Self> {
+    pub fn new(fits: &LampFits, family: LampType, grid: &Grid, spread: f64) -> Result<Self> {
         let fit = fits
             .family(family)
             .filter(|f| !f.lamps.is_empty())
@@ -628,7 +596,7 @@ impl LampDraws {
     }
 
     /// The family drawn from.
-    pub fn family(&self) -> LampFamily {
+    pub fn family(&self) -> LampType {
         self.family
     }
 
@@ -695,20 +663,20 @@ mod tests {
     /// Each family's fit recovers a spectrum made by its own model.
     #[test]
     fn fits_recover_their_own_model() {
-        let cases: [(LampFamily, Vec<f64>, Vec<f64>); 4] = [
+        let cases: [(LampType, Vec<f64>, Vec<f64>); 4] = [
             (
-                LampFamily::PhosphorLed,
+                LampType::PhosphorLed,
                 vec![452.0, 11.0, 545.0, 0.17, 615.0, 0.11],
                 vec![0.8, 0.9, 0.5],
             ),
             (
-                LampFamily::MixedLed,
+                LampType::MixedLed,
                 vec![455.0, 11.0, 530.0, 17.0, 590.0, 9.0, 632.0, 10.0],
                 vec![0.5, 0.9, 0.4, 0.7],
             ),
-            (LampFamily::Incandescent, vec![2900.0, 0.4, -0.3], vec![1.0]),
+            (LampType::Incandescent, vec![2900.0, 0.4, -0.3], vec![1.0]),
             (
-                LampFamily::Fluorescent,
+                LampType::Fluorescent,
                 vec![0.0, 2.5, 450.0, 0.2, 490.0, 0.25, 600.0, 0.12],
                 [
                     vec![0.2, 0.5, 0.9, 0.2],
@@ -728,6 +696,23 @@ mod tests {
     }
 
     #[test]
+    fn a_type_without_a_model_is_refused() {
+        let spd = vec![1.0; grid().count];
+        for t in [LampType::Other, LampType::Daylight] {
+            assert!(!t.has_model());
+            let err = fit_lamp(t, "x", &spd, &grid()).unwrap_err().to_string();
+            assert!(err.contains("no physical model"), "{err}");
+        }
+        let text =
+            r#"{"method":"m","families":[{"family":"other","parameter_names":[],"lamps":[]}]}"#;
+        let err = LampFits::from_json(text, "fits.json")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("no physical model"), "{err}");
+        assert_eq!(LampType::MODELLED.len(), LampType::ALL.len() - 2);
+    }
+
+    #[test]
     fn draws_stay_near_the_fitted_lamps_and_spread_zero_repeats_them() {
         let wl = grid().wavelengths();
         let lamps: Vec<FittedLamp> = [440.0, 450.0, 460.0]
@@ -735,7 +720,7 @@ mod tests {
             .map(|&pump| {
                 let theta = vec![pump, 11.0, 550.0, 0.17, 615.0, 0.11];
                 let heights = vec![0.5, 0.9, 0.4];
-                let spd = model_spectrum(LampFamily::PhosphorLed, &theta, &heights, &wl);
+                let spd = model_spectrum(LampType::PhosphorLed, &theta, &heights, &wl);
                 let max = spd.iter().cloned().fold(0.0, f64::max);
                 FittedLamp {
                     name: format!("pump {pump}"),
@@ -748,25 +733,25 @@ mod tests {
         let fits = LampFits {
             method: "test".into(),
             families: vec![FamilyFit {
-                family: LampFamily::PhosphorLed,
+                family: LampType::PhosphorLed,
                 parameter_names: vec![],
                 lamps: lamps.clone(),
             }],
         };
         let mut rng = SmallRng::seed_from_u64(5);
-        let exact = LampDraws::new(&fits, LampFamily::PhosphorLed, &grid(), 0.0).unwrap();
+        let exact = LampDraws::new(&fits, LampType::PhosphorLed, &grid(), 0.0).unwrap();
         for _ in 0..10 {
             let spd = exact.draw(&mut rng);
             let best = lamps
                 .iter()
                 .map(|l| {
-                    let m = model_spectrum(LampFamily::PhosphorLed, &l.theta, &l.heights, &wl);
+                    let m = model_spectrum(LampType::PhosphorLed, &l.theta, &l.heights, &wl);
                     visible_gfc(&spd, &m, &grid())
                 })
                 .fold(0.0, f64::max);
             assert!(best > 1.0 - 1e-12);
         }
-        let draws = LampDraws::new(&fits, LampFamily::PhosphorLed, &grid(), 1.0).unwrap();
+        let draws = LampDraws::new(&fits, LampType::PhosphorLed, &grid(), 1.0).unwrap();
         let peaks: Vec<f64> = (0..200)
             .map(|_| {
                 let spd = draws.draw(&mut rng);
@@ -785,7 +770,7 @@ mod tests {
             "{peaks:?}"
         );
         // A family without fitted lamps is an error that says what to run.
-        let err = LampDraws::new(&fits, LampFamily::Hid, &grid(), 1.0).unwrap_err();
+        let err = LampDraws::new(&fits, LampType::Hid, &grid(), 1.0).unwrap_err();
         assert!(err.to_string().contains("spdcam lamps fit"));
     }
 

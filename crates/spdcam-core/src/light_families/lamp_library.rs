@@ -26,11 +26,13 @@ pub enum LampType {
     Incandescent,
     /// Anything else (e.g. plasma).
     Other,
+    /// Daylight: sun and sky (the CIE daylight recipes and references; no library lamp).
+    Daylight,
 }
 
 impl LampType {
     /// Every type, in report order.
-    pub const ALL: [LampType; 7] = [
+    pub const ALL: [LampType; 8] = [
         LampType::PhosphorLed,
         LampType::MixedLed,
         LampType::HybridLed,
@@ -38,7 +40,27 @@ impl LampType {
         LampType::Hid,
         LampType::Incandescent,
         LampType::Other,
+        LampType::Daylight,
     ];
+
+    /// The name in recipes (`lamp:NAME`) and JSON: `phosphor-led`, `hid`, ….
+    pub fn name(self) -> &'static str {
+        match self {
+            LampType::PhosphorLed => "phosphor-led",
+            LampType::MixedLed => "mixed-led",
+            LampType::HybridLed => "hybrid-led",
+            LampType::Fluorescent => "fluorescent",
+            LampType::Hid => "hid",
+            LampType::Incandescent => "incandescent",
+            LampType::Other => "other",
+            LampType::Daylight => "daylight",
+        }
+    }
+
+    /// The type named `name` ([`LampType::name`]).
+    pub fn from_name(name: &str) -> Option<LampType> {
+        LampType::ALL.into_iter().find(|t| t.name() == name)
+    }
 
     /// The type of an info-table entry (`LED Phosphor`, `Fluorescent Narrowband`, …).
     pub fn from_info(text: &str) -> LampType {
@@ -70,6 +92,7 @@ impl LampType {
             LampType::Hid => "HID",
             LampType::Incandescent => "incandescent/halogen",
             LampType::Other => "other",
+            LampType::Daylight => "daylight",
         }
     }
 }

@@ -142,6 +142,7 @@ impl LightKind {
             LampType::Fluorescent => LightKind::Fluorescent,
             LampType::Hid => LightKind::Hid,
             LampType::Incandescent => LightKind::Incandescent,
+            LampType::Daylight => LightKind::Daylight,
             LampType::Other => return None,
         })
     }

@@ -15,7 +15,7 @@ mod parametric;
 pub mod validation_split;
 
 pub use channels::{Channels, WeightRule};
-pub use lamp_families::{LampDraws, LampFamily, LampFits};
+pub use lamp_families::{LampDraws, LampFits};
 pub use lamp_library::{LampLibrary, LampType};
 pub use light_kind::LightKind;
 pub use luminaire::{Luminaire, PowerBudget, TELELUMEN_BUDGET, TELELUMEN_FILE};
@@ -266,7 +266,7 @@ impl Lighting {
             Family::Measured(m) => m.describe(),
             Family::Lamp(d) => format!(
                 "{} ({} fitted lamps)",
-                d.family().describe(),
+                d.family().describe_model(),
                 d.lamp_count()
             ),
             Family::Blend(b) => format!(
@@ -398,15 +398,17 @@ impl Lighting {
 fn parse_lamp(rest: &str, spec: &str, grid: &Grid) -> Result<LampDraws> {
     let mut parts = rest.split(':');
     let name = parts.next().unwrap_or_default();
-    let family = LampFamily::parse(name).ok_or_else(|| Error::UnknownName {
-        kind: "lamp family",
-        name: name.to_string(),
-        valid: LampFamily::ALL
-            .iter()
-            .map(|f| f.name())
-            .collect::<Vec<_>>()
-            .join(", "),
-    })?;
+    let family = LampType::from_name(name)
+        .filter(|t| t.has_model())
+        .ok_or_else(|| Error::UnknownName {
+            kind: "lamp family",
+            name: name.to_string(),
+            valid: LampType::MODELLED
+                .iter()
+                .map(|f| f.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })?;
     let mut spread = 1.0;
     let mut fits = None;
     for option in parts {

@@ -40,12 +40,18 @@ pub struct Light {
     pub name: String,
     /// The set it belongs to.
     pub set: LightSet,
-    /// The lamp's type; `None` for a reference.
-    pub kind: Option<LampType>,
-    /// The kind of light a person who knows it would name.
-    pub light_kind: LightKind,
+    /// The light's type: the library's for a lamp; incandescent or daylight for a
+    /// reference.
+    pub kind: LampType,
     /// The SPD on the simulation grid, peak 1: what the camera sees and what the truth is.
     pub spd: Spd,
+}
+
+impl Light {
+    /// The kind of light a person who knows it would name ([`LightKind::of_lamp_type`]).
+    pub fn light_kind(&self) -> LightKind {
+        LightKind::of_lamp_type(self.kind).unwrap_or_default()
+    }
 }
 
 /// The white references, on [`GRID`], peak 1: CIE A, D50 and D65 (the CIE 015 tables),
@@ -55,9 +61,9 @@ pub struct Light {
 pub fn references() -> Result<Vec<Light>> {
     let mut out = Vec::new();
     for (s, kind) in [
-        (StandardIlluminant::A, LightKind::Incandescent),
-        (StandardIlluminant::D50, LightKind::Daylight),
-        (StandardIlluminant::D65, LightKind::Daylight),
+        (StandardIlluminant::A, LampType::Incandescent),
+        (StandardIlluminant::D50, LampType::Daylight),
+        (StandardIlluminant::D65, LampType::Daylight),
     ] {
         out.push((format!("CIE {}", s.name()), s.spd(&GRID)?, kind));
     }
@@ -65,23 +71,22 @@ pub fn references() -> Result<Vec<Light>> {
         out.push((
             format!("Planckian {t} K"),
             planck(t, &GRID)?,
-            LightKind::Incandescent,
+            LampType::Incandescent,
         ));
     }
     for t in [5000.0, 6500.0] {
         out.push((
             format!("CIE daylight {t} K"),
             daylight(t, &GRID)?,
-            LightKind::Daylight,
+            LampType::Daylight,
         ));
     }
     Ok(out
         .into_iter()
-        .map(|(name, spd, light_kind)| Light {
+        .map(|(name, spd, kind)| Light {
             name,
             set: LightSet::References,
-            kind: None,
-            light_kind,
+            kind,
             spd: spd.normalised_by_max(),
         })
         .collect())
@@ -100,8 +105,7 @@ pub fn lights(library: &LampLibrary, split: &ValidationSplit, set: LightSet) -> 
         .map(|i| Light {
             name: library.names[i].clone(),
             set,
-            kind: Some(library.types[i]),
-            light_kind: LightKind::of_lamp_type(library.types[i]).unwrap_or_default(),
+            kind: library.types[i],
             spd: library.spds[i].normalised_by_max(),
         })
         .collect())

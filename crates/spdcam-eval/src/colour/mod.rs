@@ -75,7 +75,7 @@ impl Group {
     /// Whether `light` belongs to the group.
     fn holds(&self, light: &Light) -> bool {
         match self {
-            Group::Type(t) => light.kind == Some(*t),
+            Group::Type(t) => light.kind == *t,
             Group::Light(name) => light.name == *name,
             Group::All => true,
         }
@@ -155,7 +155,7 @@ fn groups(lights: &[Light]) -> Vec<(LightSet, Group)> {
             out.extend(
                 LampType::ALL
                     .into_iter()
-                    .filter(|t| members.iter().any(|l| l.kind == Some(*t)))
+                    .filter(|t| members.iter().any(|l| l.kind == *t))
                     .map(|t| (set, Group::Type(t))),
             );
         }
@@ -268,7 +268,7 @@ impl ColourReport {
                     .collect(),
             )?;
             let same = |_: &Light| Ok(estimator.clone());
-            let told = |l: &Light| Ok(estimator.for_light(l.light_kind)?);
+            let told = |l: &Light| Ok(estimator.for_light(l.light_kind())?);
             let ways: [(&EstimatorFor<'_>, bool); 2] = [(&same, false), (&told, true)];
             for (estimator_for, light_named) in ways {
                 if light_named && !options.light_named {

@@ -129,7 +129,7 @@ impl ColourReport {
                         ["scene", "patch"][k].to_string(),
                         light.set.label().to_string(),
                         light.name.clone(),
-                        light.kind.map_or(String::new(), |t| t.label().to_string()),
+                        light.kind.label().to_string(),
                         p.camera
                             .and_then(|i| self.camera_names.get(i))
                             .cloned()
@@ -244,7 +244,12 @@ impl ColourReport {
     /// The protocol in words.
     fn protocol(&self) -> String {
         let [lamp, reference, patch] = self.photos;
-        let types = LampType::ALL.map(LampType::label).join(", ");
+        let types = LampType::ALL
+            .into_iter()
+            .filter(|&t| t != LampType::Daylight)
+            .map(LampType::label)
+            .collect::<Vec<_>>()
+            .join(", ");
         format!(
             "## Protocol\n\n\
              Lights: the validation split's validation lamps (choose on these) and test lamps \
@@ -367,12 +372,10 @@ mod tests {
         use crate::colour::photos::Scored;
         use crate::colour::score::ColourScore;
         use spdcam_core::cie_illuminant::planck;
-        use spdcam_core::light_families::LightKind;
         let light = Light {
             name: "Lamp, \"warm\"".into(),
             set: LightSet::Test,
-            kind: Some(LampType::ALL[0]),
-            light_kind: LightKind::Incandescent,
+            kind: LampType::ALL[0],
             spd: planck(3000.0, &Grid::ESTIMATION).unwrap(),
         };
         let scored = Scored {
