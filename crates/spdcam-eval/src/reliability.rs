@@ -7,7 +7,7 @@
 
 use crate::error::Result;
 use plotters::prelude::*;
-use spdcam_infer::plot::{plot_error, svg};
+use spdcam_present::plot::{plot_error, svg};
 
 /// The nominal levels of the bands the diagram measures.
 pub const LEVELS: [f64; 11] = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.68, 0.8, 0.9, 0.95, 0.99];

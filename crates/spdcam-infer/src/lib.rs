@@ -31,12 +31,8 @@
 //!   chart's linear level they rest on); [`places`]: the light compared across the charts
 //!   of one photo.
 //! - [`trust`]: how far an estimate can be trusted (self-check with the glare read on the
-//!   chart, uncertainty bands, verdict); [`presentation`]: what an estimate means in words and rounded numbers
-//!   ([`meaningful`]: which metrics mean anything for the light);
-//!   [`rounding`]: the one rule every front end writes numbers by; [`meter`]: what a
-//!   colour meter's screen shows; [`plot`] and [`report`]: SVG plots (with the CIE 1976
-//!   u′v′ diagram of [`chromaticity`]) and the HTML report (its meter parts in
-//!   `report_meter`, its escaping in `html`).
+//!   chart, uncertainty bands, verdict). What an estimate means for a person (rounded
+//!   numbers, the meter's screen, plots, the HTML report) is the `spdcam-present` crate's.
 //! - [`ridge`]: closed-form ridge regression, the `linear` model's fit and the simple
 //!   learner every protocol compares against (here, so that it runs without burn).
 //! - [`error`]: the crate's error type.
@@ -74,36 +70,25 @@
 #![deny(missing_docs)]
 
 pub mod absolute;
-pub mod chromaticity;
 pub mod colour_head;
 pub mod colour_map;
 pub mod error;
 pub mod estimate;
 pub mod estimator;
 pub mod feature_rows;
-mod html;
 pub mod kind_prior;
-pub mod meaningful;
 pub mod measured_colour;
-pub mod meter;
 pub mod model;
 pub mod network;
 pub mod pca;
 pub mod photo_options;
 pub mod places;
-pub mod plot;
-pub mod presentation;
 pub mod record;
-pub mod report;
-mod report_meter;
 pub mod ridge;
-pub mod rounding;
 pub mod scale;
 pub mod shipped;
 pub mod stream;
 pub mod target;
-#[cfg(test)]
-mod test_support;
 pub mod trust;
 
 pub use error::{InferError, Result};

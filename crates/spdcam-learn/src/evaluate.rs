@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use spdcam_core::spectral::Grid;
 use spdcam_core::spectral_error::{compare, summarise, SpectralMetrics, Summary};
 use spdcam_infer::model::Model;
-use spdcam_infer::plot::{plot_error, spds_svg, svg};
+use spdcam_present::plot::{plot_error, spds_svg, svg};
 
 /// Summaries of the four metrics over a set.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -79,7 +79,7 @@ fn the_report_of_the_example_photo_shows_its_numbers_as_json_gives_them() {
     let json: Value = serde_json::from_str(&ok(&["estimate", EXAMPLE, "--json"])).unwrap();
     let e = &json[0];
     // Every metric as the presentation gives it: rounded with its interval, or '—' and why.
-    let presentation = spdcam_infer::presentation::Presentation::of(&example_estimate());
+    let presentation = spdcam_present::presentation::Presentation::of(&example_estimate());
     let mut greyed = 0;
     for line in presentation.groups.iter().flat_map(|g| &g.metrics) {
         match &line.value {

@@ -7,7 +7,7 @@
 //! Every list of metrics in the program is read from [`METRICS`]: the command line's lines
 //! and `spdcam metrics` table, the report's and the web page's groups, the meter's film and
 //! TV numbers, Python's view, the trust calibration's intervals and its report. Adding a
-//! metric is its own module, its field in [`LightingMetrics`](super::LightingMetrics)
+//! metric is its own module, its field in [`LightingMetrics`]
 //! (`quality/mod.rs`) and its row here.
 //!
 //! The rules of each column (why 15 % for CCT, 25 for an index …) are those of the rounding

@@ -11,12 +11,12 @@ use spdcam_core::fsio;
 use spdcam_core::spectral::{Grid, SpectralSet};
 use spdcam_infer::estimate::Score;
 use spdcam_infer::estimator::EstimatedBlock;
-use spdcam_infer::plot::spds_band_svg;
 use spdcam_infer::stream::{
     long_header, long_rows, row_name, FeatureStream, Layout, WIDE_LAYOUT_MAX_ROWS,
 };
 use spdcam_infer::trust::Uncertainty;
 use spdcam_infer::{Estimate, Estimator, RowStream};
+use spdcam_present::plot::spds_band_svg;
 use std::io::Write;
 use std::path::Path;
 

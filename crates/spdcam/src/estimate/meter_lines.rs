@@ -1,13 +1,13 @@
 //! What `spdcam estimate` prints of one estimate's numbers, as a colour meter shows them:
 //! the headline (CCT and Δuv, or the dominant wavelength), the lighting metrics and the film
 //! and TV numbers, every number written by the library's one rule
-//! ([`spdcam_infer::rounding`]), as the report and the web page write it.
+//! ([`spdcam_present::rounding`]), as the report and the web page write it.
 
 use spdcam_core::quality::registry::{self, Group};
-use spdcam_infer::meter::Meter;
-use spdcam_infer::presentation::meaningful_value;
-use spdcam_infer::rounding::{shown_with_unit, UNCALIBRATED};
 use spdcam_infer::Estimate;
+use spdcam_present::meter::Meter;
+use spdcam_present::presentation::meaningful_value;
+use spdcam_present::rounding::{shown_with_unit, UNCALIBRATED};
 
 /// `xy (0.3127, 0.3290); CCT 6500 ± 300 K, Δuv +0.0031 ± 0.0012`, or for coloured light
 /// the dominant wavelength, purity and peak; and the illuminance when known.
@@ -87,11 +87,11 @@ mod tests {
     use super::*;
     use spdcam_core::builtin::DataDir;
     use spdcam_core::spectral::Grid;
-    use spdcam_infer::presentation::Presentation;
-    use spdcam_infer::report::{report_html, ReportItem};
-    use spdcam_infer::rounding::NOT_DETERMINABLE;
     use spdcam_infer::trust::MetricInterval;
     use spdcam_infer::{Estimator, ModelSet, PhotoOptions};
+    use spdcam_present::presentation::Presentation;
+    use spdcam_present::report::{report_html, ReportItem};
+    use spdcam_present::rounding::NOT_DETERMINABLE;
 
     const EXAMPLE: &[u8] = include_bytes!("../../../../examples/sg-telelumen.jpg");
 

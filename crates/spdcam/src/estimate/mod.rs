@@ -25,9 +25,9 @@ use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
 use spdcam_core::light_families::LightKind;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
-use spdcam_infer::plot::spds_band_svg;
 use spdcam_infer::trust::Uncertainty;
 use spdcam_infer::{Estimate, Estimator, Model, ModelSet};
+use spdcam_present::plot::spds_band_svg;
 use std::path::{Path, PathBuf};
 use truth::truths;
 

@@ -8,8 +8,8 @@ use crate::outln;
 use anyhow::Result;
 use spdcam_core::photo::{self, PhotoAnalysis};
 use spdcam_infer::error::unusable_photo;
-use spdcam_infer::report::REPORT_IMAGE_WIDTH;
 use spdcam_infer::{Estimate, Estimator, PhotoEstimate, PhotoProgress};
+use spdcam_present::report::REPORT_IMAGE_WIDTH;
 use std::path::PathBuf;
 
 /// What [`estimate_from_photos`] gives: the estimates, their photos, with `--report` each

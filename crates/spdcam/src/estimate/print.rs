@@ -8,12 +8,12 @@ use anyhow::Result;
 use spdcam_core::fsio;
 use spdcam_core::light_families::LightKind;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
-use spdcam_infer::meter::Meter;
-use spdcam_infer::presentation::glare_words;
-use spdcam_infer::report::{report_html, ReportImage, ReportItem};
-use spdcam_infer::rounding::NOT_DETERMINABLE;
 use spdcam_infer::trust::{Trust, Verdict};
 use spdcam_infer::Estimate;
+use spdcam_present::meter::Meter;
+use spdcam_present::presentation::glare_words;
+use spdcam_present::report::{report_html, ReportImage, ReportItem};
+use spdcam_present::rounding::NOT_DETERMINABLE;
 use std::path::Path;
 
 /// The estimates as text: colorimetry and the SPD every 25 nm (for up to 20), the score

@@ -2,9 +2,9 @@
 //! report.
 
 use super::{Outcome, Upload};
-use spdcam_infer::presentation::Presentation;
-use spdcam_infer::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
 use spdcam_infer::{Estimator, PhotoOptions};
+use spdcam_present::presentation::Presentation;
+use spdcam_present::report::{report_html, ReportImage, ReportItem, REPORT_IMAGE_WIDTH};
 use std::sync::Arc;
 
 /// What estimates: the estimator of the models, built once for every upload.

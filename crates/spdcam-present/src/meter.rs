@@ -6,8 +6,6 @@
 //! Academy SSI and the filter correction to 3200 K and 5600 K
 //! ([`spdcam_core::quality::film_tv`]). Every number is written by [`crate::rounding`].
 
-use crate::estimate::Estimate;
-use crate::estimate::MAX_CCT_DUV;
 use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::rounding::{
     round_sig, shown, shown_with_unit, undetermined_words, NOT_DETERMINABLE, UNCALIBRATED,
@@ -19,6 +17,8 @@ use spdcam_core::quality::film_tv::{
     DAYLIGHT_K, TUNGSTEN_K,
 };
 use spdcam_core::quality::{registry, LightSpectrum};
+use spdcam_infer::estimate::Estimate;
+use spdcam_infer::estimate::MAX_CCT_DUV;
 
 /// One number of the meter's screen.
 #[derive(Debug, Clone, PartialEq, Serialize)]

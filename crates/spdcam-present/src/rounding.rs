@@ -80,7 +80,7 @@ pub fn determinable(key: &str, value: f64, half: f64) -> bool {
         // Or, far from white, an interval wholly beyond the ±0.05 within which a CCT means
         // anything: the photo then shows the light is coloured, and by about how much.
         Determined::WithinOrColoured(limit) => {
-            half <= limit || value.abs() - half > crate::estimate::MAX_CCT_DUV
+            half <= limit || value.abs() - half > spdcam_infer::estimate::MAX_CCT_DUV
         }
     }
 }

@@ -3,8 +3,8 @@
 //! colour rendering indices only nearer still. What the meter, the presentation and the
 //! chromaticity diagram all ask before they show such a number.
 
-use crate::estimate::{Estimate, MAX_CCT_DUV};
 use spdcam_core::quality::CRI_MAX_DUV;
+use spdcam_infer::estimate::{Estimate, MAX_CCT_DUV};
 
 /// Whether the CCT (and what is built on it, TM-30's reference) is meaningful.
 pub fn cct_meaningful(estimate: &Estimate) -> Result<(), String> {

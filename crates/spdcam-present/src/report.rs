@@ -8,15 +8,15 @@
 //! nothing. Each estimate prints on one A4 or Letter page.
 
 use crate::chromaticity::uv_diagram_svg;
-use crate::estimate::Colorimetry;
-use crate::estimate::Estimate;
 use crate::html::esc;
 use crate::meaningful::cct_meaningful;
 use crate::presentation::Presentation;
 use crate::report_meter::{film_tv_html, headline_html};
-use crate::trust::Band;
 use spdcam_core::quality::HueBin;
 use spdcam_core::spectral::Spd;
+use spdcam_infer::estimate::Colorimetry;
+use spdcam_infer::estimate::Estimate;
+use spdcam_infer::trust::Band;
 use std::fmt::Write as _;
 
 /// Widest photo embedded in a report, in pixels.

@@ -1,9 +1,9 @@
 //! Plots of spectra as SVG (plotters), shared by the estimate and the model evaluation.
 
-use crate::error::{InferError, Result};
-use crate::trust::Uncertainty;
 use plotters::prelude::*;
 use spdcam_core::spectral::Grid;
+use spdcam_infer::error::{InferError, Result};
+use spdcam_infer::trust::Uncertainty;
 
 /// The error of a failed drawing step.
 pub fn plot_error(e: impl std::fmt::Display) -> InferError {
@@ -176,7 +176,7 @@ pub fn spds_band_svg(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::trust::{Band, Uncertainty};
+    use spdcam_infer::trust::{Band, Uncertainty};
     use std::collections::BTreeMap;
 
     #[test]

@@ -12,15 +12,15 @@
 //! - The light is described by simple rules on its chromaticity and its spectrum's shape
 //!   ([`describe_light`]).
 
-use crate::estimate::{Estimate, MAX_CCT_DUV};
 use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::meter::Meter;
 pub use crate::rounding::{round_sig, round_with_uncertainty};
 use crate::rounding::{shown, undetermined_words, UNCALIBRATED};
-use crate::trust::{Veil, Verdict};
 use serde::Serialize;
 use spdcam_core::light_families::LightKind;
 use spdcam_core::quality::registry::{self, Group, MeaningfulFor};
+use spdcam_infer::estimate::{Estimate, MAX_CCT_DUV};
+use spdcam_infer::trust::{Veil, Verdict};
 
 /// Within this |Duv| a light reads as white without a tint (ANSI C78.377-2017 puts its
 /// nominal white quadrangles about ±0.006 around the locus).

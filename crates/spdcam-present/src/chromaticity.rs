@@ -14,10 +14,10 @@
 //!   point when known. An inset enlarges the neighbourhood of the estimate, where the region
 //!   is seen.
 
-use crate::estimate::Estimate;
 use spdcam_core::colorimetry::{cct_duv_to_uv, cct_to_uv_planck, Observer};
 use spdcam_core::quality::uv::{uv1960_to_uv1976, xy_to_uv1976};
 use spdcam_core::spectral::Grid;
+use spdcam_infer::estimate::Estimate;
 use std::fmt::Write as _;
 
 /// The isotemperature lines drawn, kelvin, and at which end each is labelled: `true` at

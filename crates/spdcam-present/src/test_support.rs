@@ -1,10 +1,10 @@
 //! Estimates of known spectra for the tests of what is shown of an estimate.
 
-use crate::estimate::{Colorimetry, Estimate};
-use crate::trust::{Band, MetricInterval, Trust, Uncertainty, Verdict};
 use spdcam_core::cie_illuminant::StandardIlluminant;
 use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Grid, Spd};
+use spdcam_infer::estimate::{Colorimetry, Estimate};
+use spdcam_infer::trust::{Band, MetricInterval, Trust, Uncertainty, Verdict};
 
 /// An `ok` estimate of `spd` whose metrics have the 95 % half-widths `halves`.
 pub(crate) fn estimate_of(spd: Spd, halves: &[(&str, f64)]) -> Estimate {
