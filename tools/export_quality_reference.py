@@ -35,6 +35,11 @@ colour-science to 360-780 nm at 1 nm and zero outside the data, called S1 below)
   S lambda / (h c N_A), over 683.002 sum S ybar (numpy).
 - blh_kbv: K_B,v in W/lm, sum S B / (683.002 sum S ybar) at 1 nm with B(lambda) of
   ICNIRP 2013 / IEC 62471 built here from its definition (numpy).
+- cqs_*: colour.colour_quality_scale(S1, additional_data=True, method="NIST CQS 9.0")
+  (W. Davis and Y. Ohno, Optical Engineering 49(3) 033602, 2010; NIST CQS 9.0; its own CCT by
+  Ohno 2013 picks the reference, Planckian below 5000 K, CIE daylight from 5000 K): qa, qf,
+  qg, and per VS sample q1..q15 (saturation-corrected, scaled 0-100). CQS 9.0 defines no Qp
+  and no Qd (colour-science returns None for them), so they have no columns.
 """
 
 from __future__ import annotations
@@ -83,6 +88,8 @@ COLUMNS = (
     + [f"elr_{a}" for a in ALPHA]
     + [f"der_{a}" for a in ALPHA]
     + ["sp_ratio", "ppf_per_lux", "blh_kbv"]
+    + ["cqs_qa", "cqs_qf", "cqs_qg"]
+    + [f"cqs_q{i}" for i in range(1, 16)]
 )
 
 
@@ -152,6 +159,12 @@ def metrics(wl: np.ndarray, values: np.ndarray, name: str) -> dict:
     par = (w1 >= 400) & (w1 <= 700)
     row["ppf_per_lux"] = np.sum(v1[par] * w1[par] * 1e-9 / (H * C * N_A) * 1e6) / lum
     row["blh_kbv"] = np.sum(v1 * blue_light_hazard(w1)) / lum
+
+    cqs = colour.colour_quality_scale(s1, additional_data=True, method="NIST CQS 9.0")
+    assert cqs.Q_p is None and cqs.Q_d is None, (name, cqs.Q_p, cqs.Q_d)
+    row["cqs_qa"], row["cqs_qf"], row["cqs_qg"] = cqs.Q_a, cqs.Q_f, cqs.Q_g
+    for i in range(1, 16):
+        row[f"cqs_q{i}"] = cqs.Q_as[i].Q_a
     for k, v in row.items():
         if k != "name":
             row[k] = float(v)

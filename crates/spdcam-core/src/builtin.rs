@@ -80,6 +80,14 @@ pub const CIE2024_TCS15: BuiltinTable = BuiltinTable {
     csv: include_str!("../../../data/cie_2024_tcs15.csv"),
 };
 
+/// The 15 Munsell reflectance samples VS1–VS15 of the NIST Colour Quality Scale 9.0 (Davis &
+/// Ohno 2010; 360–830 nm, 5 nm), as distributed by colour-science (BSD-3-Clause).
+pub const NIST_CQS90_VS15: BuiltinTable = BuiltinTable {
+    name: "nist_cqs90_vs15",
+    description: "NIST Colour Quality Scale 9.0 reflectance samples VS1–VS15",
+    csv: include_str!("../../../data/nist_cqs90_vs15.csv"),
+};
+
 /// The CIE 1951 scotopic spectral luminous efficiency V′(λ) (380–780 nm, 1 nm).
 pub const CIE1951_SCOTOPIC: BuiltinTable = BuiltinTable {
     name: "cie_1951_scotopic",
@@ -235,6 +243,7 @@ mod tests {
             &CIE1964_10DEG_CMF,
             &CIE1995_TCS14,
             &CIE2024_TCS15,
+            &NIST_CQS90_VS15,
             &CIE1951_SCOTOPIC,
             &CIE_S026_ALPHA_OPIC,
             &BLUE_LIGHT_HAZARD,
@@ -249,6 +258,7 @@ mod tests {
         }
         assert_eq!(CIE1995_TCS14.load().unwrap().len(), 14);
         assert_eq!(CIE2024_TCS15.load().unwrap().names(), ["tcs15"]);
+        assert_eq!(NIST_CQS90_VS15.load().unwrap().len(), 15);
         assert_eq!(
             CIE_S026_ALPHA_OPIC.load().unwrap().names(),
             ["sc", "mc", "lc", "rh", "mel"]

@@ -32,7 +32,7 @@ pub struct ColourRendering {
 }
 
 /// The CIE 13.3 reference illuminants on [`QUALITY_GRID`], prepared once.
-fn references() -> &'static ReferenceIlluminants {
+pub(crate) fn references() -> &'static ReferenceIlluminants {
     static R: OnceLock<ReferenceIlluminants> = OnceLock::new();
     R.get_or_init(|| {
         ReferenceIlluminants::on_grid(&QUALITY_GRID).expect("references on 360–780 nm")

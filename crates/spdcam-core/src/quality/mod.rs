@@ -26,6 +26,7 @@
 
 pub mod alpha_opic;
 pub mod cam02;
+pub mod cqs;
 pub mod cri;
 pub mod dominant;
 pub mod film_tv;
@@ -37,6 +38,7 @@ pub mod tm30;
 pub mod uv;
 
 pub use alpha_opic::{alpha_opic_cie_s026, AlphaOpic, AlphaValues};
+pub use cqs::{colour_quality_scale_nist_cqs90, ColourQualityScale};
 pub use cri::{colour_rendering_cie1995, ColourRendering};
 pub use dominant::{
     dominant_wavelength, dominant_wavelength_of, peak_wavelength_nm, DominantWavelength,
