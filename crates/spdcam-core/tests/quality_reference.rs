@@ -53,7 +53,10 @@ fn our_values(light: &LightSpectrum) -> BTreeMap<String, f64> {
     v.insert("sp_ratio".into(), m.sp_ratio.unwrap());
     v.insert("ppf_per_lux".into(), m.ppf_per_lux.unwrap());
     v.insert("blh_kbv".into(), m.blh_efficacy_w_per_lm.unwrap());
-    v.extend(cqs_values(light, m.cct_k.unwrap()));
+    let cqs = cqs_values(light, m.cct_k.unwrap());
+    // The metrics carry the CQS computed at their own CCT.
+    assert_eq!(m.cqs_qa, Some(cqs["cqs_qa"]));
+    v.extend(cqs);
     v
 }
 

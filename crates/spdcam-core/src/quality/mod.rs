@@ -8,7 +8,8 @@
 //!   ([`crate::colorimetry::uv_to_cct_duv`]);
 //! - colour rendering: CIE 13.3-1995 Ra and R1–R14 ([`cri`]);
 //! - colour fidelity and gamut: CIE 224:2017 / ANSI/IES TM-30-20 Rf, Rg and the 16 hue bins
-//!   ([`tm30`], with CIECAM02/CAM02-UCS in [`cam02`]);
+//!   ([`tm30`], with CIECAM02/CAM02-UCS in [`cam02`]); the NIST Colour Quality Scale 9.0
+//!   Qa ([`cqs`]);
 //! - CIE S 026:2018 α-opic efficacies and daylight efficacy ratios, M-EDER ([`alpha_opic`]);
 //! - S/P ratio, photosynthetic photon flux per lumen, blue-light hazard efficacy
 //!   ([`photobiology`]);
@@ -20,8 +21,9 @@
 //!
 //! [`LightingMetrics`] gathers every number; a value that is not defined for a light is `None`
 //! with the reason in [`LightingMetrics::reasons`]. The single numbers a person reads, with
-//! their names, units, rounding and groups, are the rows of one table, [`registry::METRICS`]. The results match colour-science 0.4.7
-//! (CRI, CIE 2017/TM-30, CCT) and luxpy 1.12.5 (α-opic) on 221 measured lamps
+//! their names, units, rounding and groups, are the rows of one table,
+//! [`registry::METRICS`]. The results match colour-science 0.4.7 (CRI, CIE 2017/TM-30, NIST
+//! CQS 9.0, CCT) and luxpy 1.12.5 (α-opic) on 221 measured lamps
 //! (`tests/quality_reference.rs`).
 
 pub mod alpha_opic;
@@ -87,6 +89,8 @@ pub struct LightingMetrics {
     pub tm30_bins: Option<Vec<HueBin>>,
     /// CIE 224:2017 fidelity of each of the 99 colour evaluation samples.
     pub tm30_rf_ces: Option<Vec<f64>>,
+    /// NIST Colour Quality Scale 9.0 general index Qa ([`cqs`]).
+    pub cqs_qa: Option<f64>,
     /// CIE S 026 α-opic efficacies of luminous radiation, mW/lm.
     pub alpha_opic_elr_mw_per_lm: Option<AlphaValues>,
     /// CIE S 026 α-opic daylight (D65) efficacy ratios.
@@ -106,7 +110,7 @@ pub struct LightingMetrics {
 }
 
 /// The keys of [`LightingMetrics`] that hold numbers, in output order.
-pub const METRIC_KEYS: [&str; 18] = [
+pub const METRIC_KEYS: [&str; 19] = [
     "xy",
     "uv_1960",
     "uv_prime_1976",
@@ -118,6 +122,7 @@ pub const METRIC_KEYS: [&str; 18] = [
     "tm30_rg",
     "tm30_bins",
     "tm30_rf_ces",
+    "cqs_qa",
     "alpha_opic_elr_mw_per_lm",
     "alpha_opic_der",
     "mel_der",
@@ -128,7 +133,7 @@ pub const METRIC_KEYS: [&str; 18] = [
 ];
 
 /// The CCT-dependent keys.
-const CCT_KEYS: [&str; 8] = [
+const CCT_KEYS: [&str; 9] = [
     "cct_k",
     "duv",
     "cri_ra",
@@ -137,6 +142,7 @@ const CCT_KEYS: [&str; 8] = [
     "tm30_rg",
     "tm30_bins",
     "tm30_rf_ces",
+    "cqs_qa",
 ];
 
 impl LightingMetrics {
@@ -161,6 +167,7 @@ impl LightingMetrics {
             tm30_rg: None,
             tm30_bins: None,
             tm30_rf_ces: None,
+            cqs_qa: None,
             alpha_opic_elr_mw_per_lm: None,
             alpha_opic_der: None,
             mel_der: None,
@@ -245,6 +252,10 @@ impl LightingMetrics {
                         &e.to_string(),
                     ),
                 }
+                match colour_quality_scale_nist_cqs90(light, cct) {
+                    Ok(q) => m.cqs_qa = Some(q.qa),
+                    Err(e) => m.set_reason(&["cqs_qa"], &e.to_string()),
+                }
             }
             Err(e) => m.set_reason(&CCT_KEYS, &format!("no correlated colour temperature: {e}")),
         }
@@ -277,6 +288,7 @@ impl LightingMetrics {
             ("cri_ra", &mut self.cri_ra),
             ("tm30_rf", &mut self.tm30_rf),
             ("tm30_rg", &mut self.tm30_rg),
+            ("cqs_qa", &mut self.cqs_qa),
             ("mel_der", &mut self.mel_der),
             ("sp_ratio", &mut self.sp_ratio),
             ("ppf_per_lux", &mut self.ppf_per_lux),

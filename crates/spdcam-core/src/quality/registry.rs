@@ -207,7 +207,7 @@ const fn index(mut m: Metric, meaningful_for: MeaningfulFor, may_be_negative: bo
 }
 
 /// Every single-number metric, in the order the front ends show them.
-pub const METRICS: [Metric; 15] = [
+pub const METRICS: [Metric; 16] = [
     Metric {
         unit: "K",
         lab_decimals: 0,
@@ -287,6 +287,18 @@ pub const METRICS: [Metric; 15] = [
             Source::Lighting(|m| m.tm30_rg),
         )
     },
+    index(
+        row(
+            "cqs_qa",
+            "Qa",
+            "CQS Qa",
+            "How good 15 saturated colours look, more saturation not counted against the light (NIST CQS 9.0).",
+            Group::ColourRendering,
+            Source::Lighting(|m| m.cqs_qa),
+        ),
+        MeaningfulFor::WhiteLight,
+        false,
+    ),
     ratio(row(
         "mel_der",
         "M-EDER",
