@@ -13,7 +13,6 @@ use crate::error::{InferError, Result};
 use crate::places::LightAcrossPlaces;
 use crate::trust::Trust;
 use serde::Serialize;
-use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
 use spdcam_core::light_families::LightKind;
 use spdcam_core::photo::PhotoAnalysis;
 use spdcam_core::quality::LightingMetrics;
@@ -49,9 +48,25 @@ impl Colorimetry {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn of(spd: &Spd) -> Result<Colorimetry> {
-        let xy = Observer::cie1931(spd.grid())?.spd_to_xy(spd);
-        let (cct, duv) = match uv_to_cct_duv(xy_to_uv1960(xy)) {
-            Ok((cct, duv)) if duv.abs() <= MAX_CCT_DUV => (Some(cct), Some(duv)),
+        Colorimetry::of_metrics(&LightingMetrics::of_spd(spd))
+    }
+
+    /// The colorimetry read from a light's `metrics`, which hold its xy, CCT and Duv
+    /// computed once (at 1 nm, [`LightingMetrics::of`]); the CCT and Duv only within
+    /// [`MAX_CCT_DUV`] of the Planckian locus. An error when the light has no chromaticity
+    /// (no visible light).
+    pub fn of_metrics(metrics: &LightingMetrics) -> Result<Colorimetry> {
+        let xy = metrics.xy.ok_or_else(|| {
+            InferError::invalid(format!(
+                "the spectrum has no chromaticity: {}",
+                metrics
+                    .reasons
+                    .get("xy")
+                    .map_or("no visible light", String::as_str)
+            ))
+        })?;
+        let (cct, duv) = match (metrics.cct_k, metrics.duv) {
+            (Some(cct), Some(duv)) if duv.abs() <= MAX_CCT_DUV => (Some(cct), Some(duv)),
             _ => (None, None),
         };
         Ok(Colorimetry { xy, cct, duv })

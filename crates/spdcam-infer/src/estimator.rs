@@ -1089,7 +1089,7 @@ impl Estimator {
         let full = Spd::new(chosen.model.grid(), model_spd.clone())?;
         let spd = Spd::new(self.grid, map.apply(model_spd))?;
         let metrics = LightingMetrics::of_spd(&full);
-        let colorimetry = Colorimetry::of(&full)?;
+        let colorimetry = Colorimetry::of_metrics(&metrics)?;
         if photo.as_ref().is_some_and(|a| a.raw.is_some()) {
             if let (Some(u), Some(cct)) = (&mut trust.uncertainty, colorimetry.cct) {
                 measured_colour::set_intervals(&mut u.metrics, cct);

@@ -51,8 +51,19 @@ impl ReportItem {
         image: Option<ReportImage>,
         truth_spd: Option<Vec<f64>>,
     ) -> ReportItem {
+        ReportItem::presented(Presentation::of(&estimate), estimate, image, truth_spd)
+    }
+
+    /// [`ReportItem::new`] with the estimate's presentation made already (for the page's
+    /// JSON, say): not made again.
+    pub fn presented(
+        presentation: Presentation,
+        estimate: Estimate,
+        image: Option<ReportImage>,
+        truth_spd: Option<Vec<f64>>,
+    ) -> ReportItem {
         ReportItem {
-            presentation: Presentation::of(&estimate),
+            presentation,
             estimate,
             image,
             truth_spd,

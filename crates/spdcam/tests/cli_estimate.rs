@@ -66,7 +66,7 @@ fn the_example_photo_is_estimated_with_the_shipped_model() {
         "{out}"
     );
     assert!(
-        out.contains("  Ra —, R9 —, Rf —, Rg —, M-EDER ")
+        out.contains("  Ra —, R9 —, Rf —, Rg —, Qa —, M-EDER ")
             && out.contains("PPF ")
             && out.contains("µmol s⁻¹ m⁻² per 1000 lx"),
         "{out}"

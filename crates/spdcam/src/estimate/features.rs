@@ -257,7 +257,7 @@ pub(super) fn run_features(args: &EstimateArgs, path: &Path, estimator: &Estimat
         return Ok(());
     }
     if detailed {
-        print_estimates(&run.first, args)?;
+        print_estimates(&run.first, args, None)?;
         return Ok(());
     }
     outln!("{} estimates with {}", run.rows, run.model)?;

@@ -207,6 +207,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             &spds_band_svg(&title, &grid, &series, &bands, &plotted_truths)?,
         )?;
     }
+    let mut reported = None;
     if let Some(path) = &args.report {
         let items = estimates
             .iter()
@@ -232,6 +233,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
             (all, many) => format!("The light at {} places in {} photos", all.len(), many.len()),
         };
         write_report(path, &title, &items)?;
+        reported = Some(items);
     }
     if args.photo.json {
         let json = estimates
@@ -243,7 +245,7 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
     if quiet(&args) {
         verdicts_to_stderr(&estimates);
     } else {
-        print_estimates(&estimates, &args)?;
+        print_estimates(&estimates, &args, reported.as_deref())?;
         print_places(&estimates)?;
     }
     if failed > 0 {

@@ -18,7 +18,13 @@ use std::path::Path;
 
 /// The estimates as text: colorimetry and the SPD every 25 nm (for up to 20), the score
 /// against the truth, with `--explain` what each number means, and where the files went.
-pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Result<()> {
+/// `reported`: the report's items of the same estimates, when a report was written, whose
+/// meters are printed rather than made again.
+pub(super) fn print_estimates(
+    estimates: &[Estimate],
+    args: &EstimateArgs,
+    reported: Option<&[ReportItem]>,
+) -> Result<()> {
     let mut models: Vec<&str> = estimates.iter().map(|e| e.model.as_str()).collect();
     models.dedup();
     let told = match estimates.first().map(|e| e.light) {
@@ -33,7 +39,7 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Re
         models.join(", ")
     )?;
     let detailed = estimates.len() <= DETAILED_MAX;
-    for e in estimates {
+    for (i, e) in estimates.iter().enumerate() {
         let unusable = e
             .trust
             .as_ref()
@@ -41,11 +47,18 @@ pub(super) fn print_estimates(estimates: &[Estimate], args: &EstimateArgs) -> Re
         if unusable {
             outln!("{}: UNUSABLE, no estimate to rely on", e.name)?;
         } else if detailed {
-            let meter = Meter::of(e);
-            outln!("{}: {}", e.name, headline_line(e, &meter))?;
+            let made;
+            let meter = match reported.and_then(|items| items.get(i)) {
+                Some(item) => &item.presentation.meter,
+                None => {
+                    made = Meter::of(e);
+                    &made
+                }
+            };
+            outln!("{}: {}", e.name, headline_line(e, meter))?;
             outln!("  relative SPD: {}", spd_line(&e.spd))?;
             outln!("  {}", metrics_line(e))?;
-            if let Some(line) = film_tv_line(&meter) {
+            if let Some(line) = film_tv_line(meter) {
                 outln!("  {line}")?;
             }
             match (&e.absolute, e.photo.as_ref().and_then(|p| p.exposure)) {

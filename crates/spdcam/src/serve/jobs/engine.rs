@@ -73,15 +73,19 @@ impl Engine {
             return failed(status, message);
         }
         let mut jsons = Vec::with_capacity(made.len());
+        // Each estimate's presentation, made once for the JSON and the report.
+        let mut presentations = Vec::with_capacity(made.len());
         for (estimate, _) in &made {
             let mut json = match estimate.to_json() {
                 Ok(json) => json,
                 Err(e) => return failed(500, e.to_string()),
             };
-            match serde_json::to_value(Presentation::of(estimate)) {
+            let presentation = Presentation::of(estimate);
+            match serde_json::to_value(&presentation) {
                 Ok(p) => json["presentation"] = p,
                 Err(e) => return failed(500, e.to_string()),
             }
+            presentations.push(presentation);
             if let Some(across) = &estimate.across_places {
                 json["across_places_lines"] = serde_json::json!(across.lines());
             }
@@ -98,12 +102,13 @@ impl Engine {
         };
         let items: Vec<ReportItem> = made
             .into_iter()
-            .map(|(estimate, overlay)| {
+            .zip(presentations)
+            .map(|((estimate, overlay), presentation)| {
                 let image = overlay.map(|bytes| ReportImage {
                     mime: "image/jpeg",
                     bytes,
                 });
-                ReportItem::new(estimate, image, None)
+                ReportItem::presented(presentation, estimate, image, None)
             })
             .collect();
         let report = report_html(&title, &items);
