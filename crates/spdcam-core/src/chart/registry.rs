@@ -380,6 +380,15 @@ impl KnownChart {
             .filter(|c| c.model_chart() == Some(*c))
             .collect()
     }
+
+    /// The physical charts a shipped model reads photos of, in [`KnownChart::ALL`]'s order:
+    /// the charts photos are searched for, one per chart a person owns.
+    pub fn photographed() -> Vec<KnownChart> {
+        KnownChart::ALL
+            .into_iter()
+            .filter(|c| c.physical() == Some(*c) && c.model_chart().is_some())
+            .collect()
+    }
 }
 
 #[cfg(test)]
@@ -407,6 +416,10 @@ mod tests {
         assert_eq!(
             KnownChart::with_shipped_model(),
             [KnownChart::ColorChecker24, KnownChart::Sg96]
+        );
+        assert_eq!(
+            KnownChart::photographed(),
+            [KnownChart::ColorChecker24, KnownChart::Sg140]
         );
         assert_eq!(KnownChart::Sg140.model_chart(), Some(KnownChart::Sg96));
         assert_eq!(
