@@ -703,7 +703,7 @@ const DEFAULT_CHART: KnownChart = KnownChart::ColorChecker24;
 /// description)` of each, the name as `chart` arguments and results give it, the shown name
 /// as people know the chart.
 #[pyfunction]
-fn charts() -> Vec<(&'static str, &'static str, &'static str)> {
+fn charts() -> Vec<(&'static str, &'static str, String)> {
     KnownChart::ALL
         .into_iter()
         .map(|c| (c.name(), c.shown_name(), c.description()))

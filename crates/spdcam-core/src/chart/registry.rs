@@ -174,22 +174,24 @@ impl KnownChart {
         }
     }
 
-    /// What the chart is and where its reflectances come from.
-    pub fn description(self) -> &'static str {
+    /// What the chart is and where its reflectances come from, the chart named by its
+    /// [`KnownChart::shown_name`].
+    pub fn description(self) -> String {
+        let shown = self.shown_name();
         match self {
-            KnownChart::ColorChecker24 => "ColorChecker Classic 24, 4×6, built in",
-            KnownChart::Sg96 => {
-                "ColorChecker Digital SG, the 96 centre patches (the thesis's i1Pro2 set) where \
-                 they sit on the chart, 8×12, features row by row as in photos; data directory"
-            }
-            KnownChart::Sg96Thesis => {
-                "the same 96 patches in file order, 12 per row, as the thesis rendered them; \
-                 data directory"
-            }
-            KnownChart::Sg140 => {
-                "ColorChecker Digital SG, all 140 patches, 10×14, the 96 centre patches are \
-                 features; data directory"
-            }
+            KnownChart::ColorChecker24 => format!("{shown} (Classic), 4×6, built in"),
+            KnownChart::Sg96 => format!(
+                "{shown}, the 96 centre patches (the thesis's i1Pro2 set) where they sit on \
+                 the chart, 8×12, features row by row as in photos; data directory"
+            ),
+            KnownChart::Sg96Thesis => format!(
+                "{shown}, the same 96 patches in file order, 12 per row, as the thesis \
+                 rendered them; data directory"
+            ),
+            KnownChart::Sg140 => format!(
+                "{shown}, all 140 patches, 10×14, the 96 centre patches are features; data \
+                 directory"
+            ),
         }
     }
 
