@@ -476,13 +476,14 @@ impl Estimator {
     ///
     /// ```
     /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::chart::KnownChart;
     /// use spdcam_core::spectral::Grid;
     /// use spdcam_infer::{Estimator, PhotoOptions};
     ///
     /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
     /// let jpeg = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/sg-telelumen.jpg"))?;
     /// let estimate = estimator.estimate_photo_bytes(&jpeg, "upload.jpg", &PhotoOptions::default())?;
-    /// assert_eq!(estimate.photo.unwrap().chart, "colorchecker_sg140");
+    /// assert_eq!(estimate.photo.unwrap().chart, KnownChart::Sg140.name());
     /// let err = estimator.estimate_photo_bytes(b"not a photo", "notes.txt", &PhotoOptions::default());
     /// assert!(err.unwrap_err().to_string().contains("notes.txt"));
     /// # Ok::<(), Box<dyn std::error::Error>>(())
