@@ -31,6 +31,7 @@ __all__ = [
     "Estimates",
     "load_model",
     "shipped_model",
+    "charts",
     "read_photo",
     "estimate",
     "estimate_places",
@@ -101,6 +102,13 @@ def load_model(path: Union[str, "os.PathLike[str]"]) -> Model:
     return Model(_native.Models.load(os.fspath(path)))
 
 
+def charts() -> dict[str, str]:
+    """The charts spdcam knows by name, from its chart registry: the name ``chart``
+    arguments take and results give (``colorchecker24``, ``colorchecker_sg140``, …) → the
+    name people know the chart by (``ColorChecker 24``, ``ColorChecker Digital SG``)."""
+    return {name: shown for name, shown, _ in _native.charts()}
+
+
 def _models(model: Union[Model, str, "os.PathLike[str]", None]) -> "_native.Models":
     if model is None:
         return shipped_model()._native
@@ -113,7 +121,8 @@ def _models(model: Union[Model, str, "os.PathLike[str]", None]) -> "_native.Mode
 class Detection:
     """Where the chart is in a photo and what its patches gave."""
 
-    #: The chart found (e.g. ``colorchecker_sg140``).
+    #: The chart found, by the name ``chart`` arguments take (e.g. ``colorchecker_sg140``);
+    #: :attr:`chart_name` is the name people know it by.
     chart: str
     #: ``"detected"`` or ``"corners"`` (given by the caller).
     method: str
@@ -150,6 +159,12 @@ class Detection:
     #: ``{"number": 1-based from left to right, "of": how many, "centre": [x, y] px}``;
     #: ``None`` for a photo of one chart.
     place: Optional[dict[str, Any]] = None
+
+    @property
+    def chart_name(self) -> str:
+        """The chart found as people know it, one name per physical chart (e.g.
+        ``ColorChecker Digital SG``), as the command line and the report name it."""
+        return _native.shown_chart_name(self.chart)
 
     @staticmethod
     def _from_json(p: dict[str, Any]) -> "Detection":
@@ -639,7 +654,7 @@ def render(
     wavelengths: Optional[Sequence[float]] = None,
     *,
     camera: str = "nikon_d5100_npl",
-    chart: str = "colorchecker24",
+    chart: Optional[str] = None,
     patch_px: int = 24,
     seed: int = 0,
 ) -> Rendering:
@@ -649,7 +664,8 @@ def render(
     ``spd`` names a light (``"D65"``, ``"A"``, ``"cct:4000"``, ``"daylight:5000"``,
     ``"planck:3000"``, a spectral CSV path), or is its values on ``wavelengths`` (nm), or a
     ``colour.SpectralDistribution``. ``camera`` and ``chart`` are built-in names (``spdcam
-    list``) or CSV files.
+    list``; :func:`charts`) or CSV files; ``chart`` by default the command line's,
+    ``_native.DEFAULT_CHART`` (the ColorChecker 24).
     """
     if hasattr(spd, "wavelengths") and hasattr(spd, "values") and wavelengths is None:
         wavelengths, spd = spd.wavelengths, spd.values
@@ -723,7 +739,7 @@ def generate(
     count: int,
     *,
     seed: int = 0,
-    chart: str = "colorchecker24",
+    chart: Optional[str] = None,
     camera: str = "nikon_d5100_npl",
     spd_grid: str = "380-780:5",
     fast: bool = False,
@@ -738,7 +754,8 @@ def generate(
 
     ``lighting`` is a lighting recipe (``spdcam list lighting`` shows the forms); sample
     ``i`` depends only on ``(seed, i)``. ``chart`` and ``camera`` are built-in names or CSV
-    files (the camera's other settings are the command line's defaults); ``spd_grid`` the
+    files (``chart`` by default the ColorChecker 24, as :func:`render`; the camera's other
+    settings are the command line's defaults); ``spd_grid`` the
     wavelengths the SPDs are stored at, ``START-END[:STEP]`` in nm; ``fast`` gives
     noise-free patch-level features without an image; ``randomise`` the domain
     randomisation groups (camera, exposure, wb, tone, jpeg, gradient) and ``cameras`` the

@@ -6,6 +6,14 @@ Progress = Optional[Callable[[int, int], None]]
 """A callback ``(done, total)``, called with the GIL held while long work runs."""
 
 __version__: str
+DEFAULT_CHART: str
+"""The chart ``render`` and ``generate`` draw when none is named."""
+
+def charts() -> list[tuple[str, str, str]]:
+    """``(name, shown name, description)`` of each chart spdcam knows by name."""
+
+def shown_chart_name(name: str) -> str:
+    """The name people know the chart called ``name`` by."""
 
 class SpdcamError(ValueError):
     """An input spdcam cannot use; the message is the command line's."""
@@ -63,7 +71,7 @@ def render(
     wavelengths: Optional[Sequence[float]] = None,
     values: Optional[Sequence[float]] = None,
     camera: str = "nikon_d5100_npl",
-    chart: str = "colorchecker24",
+    chart: Optional[str] = None,
     patch_px: int = 24,
     seed: int = 0,
 ) -> tuple[int, int, bytes, list[str], list[float]]: ...
@@ -72,7 +80,7 @@ def generate(
     lighting: str,
     count: int,
     seed: int = 0,
-    chart: str = "colorchecker24",
+    chart: Optional[str] = None,
     camera: str = "nikon_d5100_npl",
     spd_grid: str = "380-780:5",
     fast: bool = False,

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
-use spdcam_core::chart::{Chart, Layout, THESIS_PATCH_PX};
+use spdcam_core::chart::{Chart, KnownChart, Layout, THESIS_PATCH_PX};
 use spdcam_core::dataset::randomise::RandomiseRequest;
 use spdcam_core::dataset::{GenerateEvent, GenerateOptions, GenerateRequest, Pipeline};
 use spdcam_core::light_families::LightKind;
@@ -484,7 +484,7 @@ type RenderResult<'py> = (usize, usize, Bound<'py, PyBytes>, Vec<String>, Vec<f3
 /// `wavelengths`, is its values; `spdcam render` with the same light and seed gives the
 /// same image and features.
 #[pyfunction]
-#[pyo3(signature = (spd, wavelengths=None, values=None, camera="nikon_d5100_npl", chart="colorchecker24", patch_px=24, seed=0))]
+#[pyo3(signature = (spd, wavelengths=None, values=None, camera="nikon_d5100_npl", chart=None, patch_px=24, seed=0))]
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
@@ -492,10 +492,11 @@ fn render<'py>(
     wavelengths: Option<Vec<f64>>,
     values: Option<Vec<f64>>,
     camera: &str,
-    chart: &str,
+    chart: Option<&str>,
     patch_px: usize,
     seed: u64,
 ) -> PyResult<RenderResult<'py>> {
+    let chart = chart.unwrap_or(DEFAULT_CHART.name());
     let rendering = py
         .allow_threads(|| -> spdcam_core::Result<_> {
             let grid = Grid::SIMULATION;
@@ -598,7 +599,7 @@ impl Reporter {
 /// settings (same library run, same files): `count` samples under the `lighting` recipe,
 /// sample `i` depending only on `(seed, i)`. Returns the samples the directory holds.
 #[pyfunction]
-#[pyo3(signature = (output, lighting, count, seed=0, chart="colorchecker24", camera="nikon_d5100_npl", spd_grid="380-780:5", fast=false, randomise=Vec::new(), cameras=None, force=false, progress=None))]
+#[pyo3(signature = (output, lighting, count, seed=0, chart=None, camera="nikon_d5100_npl", spd_grid="380-780:5", fast=false, randomise=Vec::new(), cameras=None, force=false, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn generate(
     py: Python<'_>,
@@ -606,7 +607,7 @@ fn generate(
     lighting: String,
     count: u64,
     seed: u64,
-    chart: &str,
+    chart: Option<&str>,
     camera: &str,
     spd_grid: &str,
     fast: bool,
@@ -615,6 +616,7 @@ fn generate(
     force: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<u64> {
+    let chart = chart.unwrap_or(DEFAULT_CHART.name());
     let reporter = Reporter::new(progress);
     let manifest = py
         .allow_threads(|| -> spdcam_core::Result<_> {
@@ -723,6 +725,27 @@ fn light_kinds() -> Vec<&'static str> {
     LightKind::ALL.iter().map(|k| k.name()).collect()
 }
 
+/// The chart `render` and `generate` draw when none is named, as the command line's.
+const DEFAULT_CHART: KnownChart = KnownChart::ColorChecker24;
+
+/// The charts spdcam knows by name, from the chart registry: `(name, shown name,
+/// description)` of each, the name as `chart` arguments and results give it, the shown name
+/// as people know the chart.
+#[pyfunction]
+fn charts() -> Vec<(&'static str, &'static str, String)> {
+    KnownChart::ALL
+        .into_iter()
+        .map(|c| (c.name(), c.shown_name(), c.description()))
+        .collect()
+}
+
+/// The name people know the chart called `name` by (`ColorChecker Digital SG` for
+/// `colorchecker_sg140`); any other chart by its own name.
+#[pyfunction]
+fn shown_chart_name(name: &str) -> String {
+    spdcam_core::chart::shown_chart_name(name)
+}
+
 /// The compiled part of the `spdcam` package.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -737,6 +760,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(generate, m)?)?;
     m.add_function(wrap_pyfunction!(metric_registry, m)?)?;
     m.add_function(wrap_pyfunction!(light_kinds, m)?)?;
+    m.add_function(wrap_pyfunction!(charts, m)?)?;
+    m.add_function(wrap_pyfunction!(shown_chart_name, m)?)?;
+    m.add("DEFAULT_CHART", DEFAULT_CHART.name())?;
     #[cfg(feature = "train")]
     train::register(m)?;
     m.add_function(wrap_pyfunction!(library_seconds_photo, m)?)?;

@@ -30,6 +30,10 @@ def test_the_example_photo_round_trip(example):
     assert e.spd.shape == (61,) and e.spd.max() == pytest.approx(1.0)
     d = e.detection
     assert d.chart == "colorchecker_sg140" and d.method == "detected"
+    # One name for the chart in everything a person reads: the model's and the detection's.
+    assert d.chart_name == "ColorChecker Digital SG" and d.chart_name in e.model
+    assert spdcam.charts()[d.chart] == d.chart_name
+    assert spdcam.charts()["colorchecker24"] == "ColorChecker 24"
     assert d.confidence > 0.8
     assert d.corners.shape == (4, 2) and d.homography.shape == (3, 3)
     assert d.features.shape == (288,) and len(d.feature_names) == 288

@@ -14,6 +14,6 @@ def test_the_example_notebook_runs():
     ).execute()
     outputs = [o for c in notebook.cells if c.cell_type == "code" for o in c.get("outputs", [])]
     text = "".join(o.get("text", "") for o in outputs)
-    assert "colorchecker_sg140 detected" in text
+    assert "ColorChecker Digital SG detected" in text
     assert "GFC against the truth" in text and "CIE Ra" in text
     assert not [o for o in outputs if o.get("output_type") == "error"]

@@ -6,6 +6,7 @@
 //! named as the chart prints it ([`crate::chart::feature_patch_name`]), a chart as people
 //! know it ([`crate::chart::shown_chart_name`]).
 
+use crate::chart::KnownChart;
 use std::fmt;
 
 /// What a truncated JPEG is, for warnings and errors.
@@ -70,6 +71,9 @@ pub enum Advice {
     NoChartData {
         /// The chart as people know it.
         chart: String,
+        /// The measured data's file of its reflectances (`charts/…csv`,
+        /// [`crate::chart::KnownChart::data_file`]).
+        file: String,
     },
     /// No check against the chart: spdcam does not know its reflectances.
     UnknownChart {
@@ -168,6 +172,18 @@ impl Advice {
     }
 }
 
+/// The charts checked with nothing beside the program (their reflectances built in), as
+/// people know them: `ColorChecker 24`.
+fn built_in_charts() -> String {
+    let mut names: Vec<&str> = KnownChart::ALL
+        .into_iter()
+        .filter(|c| !c.needs_data_dir())
+        .map(KnownChart::shown_name)
+        .collect();
+    names.dedup();
+    names.join(" or a ")
+}
+
 impl fmt::Display for Advice {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -239,14 +255,15 @@ impl fmt::Display for Advice {
                 "the light found cannot be checked against the chart ({why}): retake the \
                  photo with the chart well exposed and evenly lit"
             ),
-            Advice::NoChartData { chart } => write!(
+            Advice::NoChartData { chart, file } => write!(
                 f,
                 "the light found is not checked against the chart: the {chart}'s measured \
                  reflectances are not shipped with spdcam, and it was started without the \
-                 folder that holds them (charts/colorchecker_sg.csv in the measured data). \
-                 To have the check, start spdcam with that data folder (its data-directory \
-                 option or the SPDCAM_DATA variable), or photograph a ColorChecker 24, \
-                 which is checked with nothing else"
+                 folder that holds them ({file} in the measured data). To have the check, \
+                 start spdcam with that data folder (its data-directory option or the \
+                 SPDCAM_DATA variable), or photograph a {}, which is checked with nothing \
+                 else",
+                built_in_charts()
             ),
             Advice::UnknownChart { chart } => write!(
                 f,
@@ -308,8 +325,8 @@ impl fmt::Display for Advice {
                 f,
                 "many lights give nearly this photo, or it is unlike the lights spdcam \
                  learned from: the spectrum's shape is uncertain (wide band), so take it as \
-                 a rough guide; the ColorChecker Digital SG, with more patches, tells such \
-                 lights apart better"
+                 a rough guide; the {}, with more patches, tells such lights apart better",
+                KnownChart::Sg140.shown_name()
             ),
             Advice::MayBePoor { at_least, level } => write!(
                 f,

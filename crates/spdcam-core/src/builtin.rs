@@ -43,12 +43,9 @@ pub const CAMERAS: &[BuiltinTable] = &[
     },
 ];
 
-/// The ColorChecker 24 reflectances (Ohta), p01 dark skin … p24 black.
-pub const COLORCHECKER24: BuiltinTable = BuiltinTable {
-    name: "colorchecker24",
-    description: "X-Rite ColorChecker Classic 24 (N. Ohta), 4×6",
-    csv: include_str!("../../../data/colorchecker24.csv"),
-};
+/// The ColorChecker 24 reflectances (Ohta), p01 dark skin … p24 black: the chart
+/// registry's table ([`crate::chart::registry`]).
+pub const COLORCHECKER24: BuiltinTable = crate::chart::registry::COLORCHECKER24_TABLE;
 
 /// The 99 colour evaluation samples of ANSI/IES TM-30 (CIE 2017).
 pub const TM30_CES99: BuiltinTable = BuiltinTable {

@@ -21,7 +21,7 @@ use rayon::prelude::*;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
-use spdcam_core::chart::Chart;
+use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::light_families::ValidationSplit;
 use spdcam_core::photo::pocket::{page_camera, PassportPage};
 use spdcam_core::photo::scene::{scene_layout, SceneOptions, Tilt, TiltAxis};
@@ -37,7 +37,7 @@ use std::path::PathBuf;
 pub const PHOTO_SIZE: (usize, usize) = (1600, 1000);
 
 /// The charts a scene is made of, as photos show them.
-const CHARTS: [&str; 2] = ["colorchecker24", "colorchecker_sg140"];
+const CHARTS: [KnownChart; 2] = [KnownChart::ColorChecker24, KnownChart::Sg140];
 /// The ColorChecker 24's index in [`CHARTS`], the chart a Passport holds.
 const COLORCHECKER24: usize = 0;
 
@@ -163,8 +163,8 @@ impl PlacesReport {
             Estimator::shipped(data_dir.clone(), spdcam_core::spectral::Grid::ESTIMATION)?;
         let charts = CHARTS
             .iter()
-            .map(|name| {
-                let chart = Chart::resolve(name, None, data_dir, &GRID)?;
+            .map(|known| {
+                let chart = known.chart(data_dir, &GRID)?;
                 let template = ChartTemplate::from_chart(&chart)?;
                 Ok(chart.with_layout(scene_layout(&template))?)
             })

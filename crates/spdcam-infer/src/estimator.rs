@@ -33,7 +33,7 @@ use crate::trust::{
 use rayon::prelude::*;
 use spdcam_core::advice::{Advice, Sampled};
 use spdcam_core::builtin::DataDir;
-use spdcam_core::chart::Chart;
+use spdcam_core::chart::{shown_chart_name, Chart};
 use spdcam_core::light_families::LightKind;
 use spdcam_core::photo::{
     self, analysis_overlay_jpeg, debug_paths, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis,
@@ -476,13 +476,14 @@ impl Estimator {
     ///
     /// ```
     /// use spdcam_core::builtin::DataDir;
+    /// use spdcam_core::chart::KnownChart;
     /// use spdcam_core::spectral::Grid;
     /// use spdcam_infer::{Estimator, PhotoOptions};
     ///
     /// let estimator = Estimator::shipped(DataDir::new(None), Grid::ESTIMATION)?;
     /// let jpeg = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/sg-telelumen.jpg"))?;
     /// let estimate = estimator.estimate_photo_bytes(&jpeg, "upload.jpg", &PhotoOptions::default())?;
-    /// assert_eq!(estimate.photo.unwrap().chart, "colorchecker_sg140");
+    /// assert_eq!(estimate.photo.unwrap().chart, KnownChart::Sg140.name());
     /// let err = estimator.estimate_photo_bytes(b"not a photo", "notes.txt", &PhotoOptions::default());
     /// assert!(err.unwrap_err().to_string().contains("notes.txt"));
     /// # Ok::<(), Box<dyn std::error::Error>>(())
@@ -778,7 +779,7 @@ impl Estimator {
             InferError::invalid(format!(
                 "{}: no model for chart {}; the models are for {}",
                 analysis.source,
-                analysis.chart,
+                shown_chart_name(&analysis.chart),
                 self.charts()
             ))
         })?;
@@ -1166,13 +1167,20 @@ impl Estimator {
         Ok(())
     }
 
-    /// `colorchecker_sg96, colorchecker24`: the charts the set's models read.
+    /// `ColorChecker Digital SG, ColorChecker 24`: the charts the set's models read, as
+    /// people know them.
     fn charts(&self) -> String {
         self.prepared
             .models
             .models()
             .iter()
-            .map(|m| m.model.header().chart.as_deref().unwrap_or("unknown"))
+            .map(|m| {
+                m.model
+                    .header()
+                    .chart
+                    .as_deref()
+                    .map_or_else(|| "unknown".to_string(), shown_chart_name)
+            })
             .collect::<Vec<_>>()
             .join(", ")
     }
@@ -1519,6 +1527,7 @@ impl RowStream<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use spdcam_core::chart::KnownChart;
     use spdcam_core::photo::decode_photo;
 
     fn example_photo() -> PathBuf {
@@ -1601,8 +1610,11 @@ mod tests {
     fn a_candidate_is_judged_by_the_calibration_given_and_refuses_another_models() {
         use spdcam_core::cie_illuminant::StandardIlluminant;
         let shipped_set = ModelSet::shipped().unwrap();
-        let cc24 = shipped_set.for_chart("colorchecker24").unwrap().clone();
-        let sg = shipped_set.for_chart("colorchecker_sg96").unwrap().clone();
+        let cc24 = shipped_set
+            .for_known(KnownChart::ColorChecker24)
+            .unwrap()
+            .clone();
+        let sg = shipped_set.for_known(KnownChart::Sg96).unwrap().clone();
         let own = trust::calibration_for(&cc24.model).unwrap().unwrap();
         let row = colorchecker24_row(&StandardIlluminant::D65.spd(&Grid::SIMULATION).unwrap());
         let judge = |cal: TrustCalibration| {

@@ -353,23 +353,13 @@ impl KindPriors {
     }
 }
 
-/// The priors built into the program, per shipped model.
-const SHIPPED_PRIORS: &[(&str, &str)] = &[
-    (
-        "the colorchecker_sg96 light-kind priors",
-        include_str!("../../../models/colorchecker_sg96.kinds.json"),
-    ),
-    (
-        "the colorchecker24 light-kind priors",
-        include_str!("../../../models/colorchecker24.kinds.json"),
-    ),
-];
-
-/// The built-in priors of `model` (matched by its fingerprint), if any.
+/// The priors built into the program per shipped model (`models/<chart>.kinds.json`): those of
+/// `model` (matched by its fingerprint), if any.
 pub fn priors_for(model: &Model) -> Result<Option<KindPriors>> {
     let fingerprint = model.fingerprint();
-    for (name, text) in SHIPPED_PRIORS {
-        let priors = KindPriors::from_json(text, name)?;
+    for shipped in &crate::shipped::SHIPPED {
+        let name = format!("{}'s light-kind priors", shipped.name());
+        let priors = KindPriors::from_json(shipped.kinds, &name)?;
         if priors.model == fingerprint {
             return Ok(Some(priors));
         }

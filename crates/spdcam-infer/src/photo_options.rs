@@ -28,8 +28,10 @@ pub struct PhotoOptions {
 
 /// The charts to look for in photos. With `chart`: that chart as photos show it (from a
 /// model's file when a model was trained for it) and as `spdcam render` draws it. Without:
-/// every model's chart, the same two ways; when no model carries its chart's template, the
-/// ColorChecker 24 and, when the data directory holds it, the Digital SG.
+/// every model's chart, the same two ways; when no model names its chart, the chart
+/// registry's charts that a shipped model reads, as photos show them (those whose
+/// reflectances are at hand: the ColorChecker 24 and, when the data directory holds it, the
+/// Digital SG).
 pub fn chart_templates(
     models: &ModelSet,
     chart: Option<&str>,
@@ -45,11 +47,10 @@ pub fn chart_templates(
             .collect(),
     };
     if names.is_empty() {
-        let mut out = vec![ChartTemplate::from_chart(&Chart::colorchecker24(&grid)?)?];
-        if let Ok(sg) = Chart::resolve(KnownChart::Sg140.name(), None, data_dir, &grid) {
-            out.push(ChartTemplate::from_chart(&sg)?);
-        }
-        return Ok(out);
+        return Ok(KnownChart::with_shipped_model()
+            .into_iter()
+            .filter_map(|c| c.template(data_dir, &grid))
+            .collect());
     }
     let mut out: Vec<ChartTemplate> = Vec::new();
     let mut push = |t: ChartTemplate| {

@@ -1,28 +1,57 @@
-//! The models shipped inside spdcam, one per chart people own, and the set of models an
-//! estimate chooses from: the model whose features a photo's chart gives.
+//! The models shipped inside spdcam, one per chart people own, with what was measured on
+//! each (its trust calibration and light-kind priors), keyed by the chart registry's
+//! [`KnownChart`]; and the set of models an estimate chooses from: the model whose features
+//! a photo's chart gives.
 
 use crate::error::{InferError, Result};
 use crate::model::Model;
 use spdcam_core::chart::{shown_chart_name, KnownChart};
 
-/// The shipped models: chart name and `.spdm` bytes (`models/<chart>.spdm`, each made by the
-/// seeded commands in the README).
-const SHIPPED: &[(&str, &[u8])] = &[
-    (
-        KnownChart::Sg96.name(),
-        include_bytes!("../../../models/colorchecker_sg96.spdm"),
-    ),
-    (
-        KnownChart::ColorChecker24.name(),
-        include_bytes!("../../../models/colorchecker24.spdm"),
-    ),
+/// A model shipped inside the program and what was measured on it: `models/<chart>.spdm`
+/// (made by the seeded commands in the README), `<chart>.trust.json` (`spdcam trust
+/// calibrate`) and `<chart>.kinds.json` (the light-kind priors).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Shipped {
+    /// The chart the model is trained on ([`KnownChart::model_chart`] of those it reads).
+    pub chart: KnownChart,
+    /// The model's `.spdm` bytes.
+    pub model: &'static [u8],
+    /// Its trust calibration's JSON.
+    pub calibration: &'static str,
+    /// Its light-kind priors' JSON.
+    pub kinds: &'static str,
+}
+
+/// The shipped model of `$chart`, its files named by the chart's machine name `$file`.
+macro_rules! shipped {
+    ($chart:expr, $file:literal) => {
+        Shipped {
+            chart: $chart,
+            model: include_bytes!(concat!("../../../models/", $file, ".spdm")),
+            calibration: include_str!(concat!("../../../models/", $file, ".trust.json")),
+            kinds: include_str!(concat!("../../../models/", $file, ".kinds.json")),
+        }
+    };
+}
+
+/// The shipped models, in the order an estimate tries them.
+pub(crate) const SHIPPED: [Shipped; 2] = [
+    shipped!(KnownChart::Sg96, "colorchecker_sg96"),
+    shipped!(KnownChart::ColorChecker24, "colorchecker24"),
 ];
+
+impl Shipped {
+    /// The model as messages name it: `the shipped ColorChecker 24 model`.
+    pub fn name(&self) -> String {
+        format!("the shipped {} model", self.chart.shown_name())
+    }
+}
 
 /// A model with the name messages use for it.
 #[derive(Debug, Clone)]
 pub struct NamedModel {
-    /// `the shipped ColorChecker 24 model` (the chart as people know it) or the model file's
-    /// path.
+    /// `the shipped ColorChecker 24 model` (the chart as people know it,
+    /// [`KnownChart::shown_name`]) or the model file's path.
     pub name: String,
     /// The model.
     pub model: Model,
@@ -40,8 +69,10 @@ impl ModelSet {
     /// ```
     /// use spdcam_infer::ModelSet;
     ///
+    /// use spdcam_core::chart::KnownChart;
+    ///
     /// let models = ModelSet::shipped()?;
-    /// let cc24 = models.for_chart("colorchecker24").unwrap();
+    /// let cc24 = models.for_known(KnownChart::ColorChecker24).unwrap();
     /// assert_eq!(cc24.name, "the shipped ColorChecker 24 model");
     /// assert_eq!(cc24.model.feature_names().len(), 72);
     /// # Ok::<(), spdcam_infer::InferError>(())
@@ -49,14 +80,11 @@ impl ModelSet {
     pub fn shipped() -> Result<ModelSet> {
         let models = SHIPPED
             .iter()
-            .map(|(chart, bytes)| {
-                let model = Model::from_bytes(bytes).map_err(|e| {
-                    InferError::invalid(format!("the shipped {chart} model is damaged: {e}"))
-                })?;
-                Ok(NamedModel {
-                    name: format!("the shipped {} model", shown_chart_name(chart)),
-                    model,
-                })
+            .map(|shipped| {
+                let name = shipped.name();
+                let model = Model::from_bytes(shipped.model)
+                    .map_err(|e| InferError::invalid(format!("{name} is damaged: {e}")))?;
+                Ok(NamedModel { name, model })
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(ModelSet { models })
@@ -91,14 +119,22 @@ impl ModelSet {
             .find(|m| m.model.header().chart.as_deref() == Some(chart))
     }
 
+    /// The model that reads a photo of `chart`: the one trained for its
+    /// [`KnownChart::model_chart`] (the Digital SG's 96-patch model for the whole SG).
+    pub fn for_known(&self, chart: KnownChart) -> Option<&NamedModel> {
+        self.for_chart(chart.model_chart()?.name())
+    }
+
     /// The model for feature columns `names` (from `source`), or an error that names the
     /// charts and column counts the set's models read.
     ///
     /// ```
     /// use spdcam_infer::ModelSet;
     ///
+    /// use spdcam_core::chart::KnownChart;
+    ///
     /// let models = ModelSet::shipped()?;
-    /// let sg = models.for_chart("colorchecker_sg96").unwrap();
+    /// let sg = models.for_known(KnownChart::Sg140).unwrap();
     /// let chosen = models.require(sg.model.feature_names(), "photo.csv")?;
     /// assert_eq!(chosen.name, sg.name);
     /// let err = models.require(&["red".to_string()], "other.csv").unwrap_err();
@@ -125,15 +161,20 @@ impl ModelSet {
         )))
     }
 
-    /// The models' charts and how many features each reads (`colorchecker24 (72 features),
-    /// …`), the one list every "no model reads these columns" message names.
+    /// The models' charts as people know them and how many features each reads
+    /// (`ColorChecker 24 (72 features), …`), the one list every "no model reads these
+    /// columns" message names.
     pub fn known(&self) -> String {
         self.models
             .iter()
             .map(|m| {
                 format!(
                     "{} ({} features)",
-                    m.model.header().chart.as_deref().unwrap_or("unknown chart"),
+                    m.model
+                        .header()
+                        .chart
+                        .as_deref()
+                        .map_or_else(|| "unknown chart".to_string(), shown_chart_name),
                     m.model.feature_names().len()
                 )
             })
@@ -150,9 +191,11 @@ mod tests {
     fn shipped_models_load_and_each_names_its_chart() {
         let set = ModelSet::shipped().unwrap();
         assert_eq!(set.models().len(), SHIPPED.len());
-        for (chart, _) in SHIPPED {
-            let m = set.for_chart(chart).unwrap();
-            assert_eq!(m.model.header().chart.as_deref(), Some(*chart));
+        for shipped in SHIPPED {
+            let chart = shipped.chart.name();
+            assert_eq!(shipped.chart.model_chart(), Some(shipped.chart));
+            let m = set.for_known(shipped.chart).unwrap();
+            assert_eq!(m.model.header().chart.as_deref(), Some(chart));
             assert!(
                 m.model.photo_chart().is_some(),
                 "{chart}: no photo template"
@@ -166,7 +209,7 @@ mod tests {
     fn features_of_a_known_count_in_another_order_name_the_column() {
         let set = ModelSet::shipped().unwrap();
         let mut names = set
-            .for_chart("colorchecker24")
+            .for_known(KnownChart::ColorChecker24)
             .unwrap()
             .model
             .feature_names()
@@ -184,9 +227,12 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            err.contains("f.csv") && err.contains("colorchecker24"),
+            err.contains("f.csv") && err.contains("ColorChecker 24 (72 features)"),
             "{err}"
         );
-        assert!(err.contains("colorchecker_sg96 (288 features)"), "{err}");
+        assert!(
+            err.contains("ColorChecker Digital SG (288 features)"),
+            "{err}"
+        );
     }
 }

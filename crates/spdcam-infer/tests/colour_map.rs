@@ -1,12 +1,13 @@
 //! The shipped Digital SG model's colour map: it moves white estimates to the colour the map
 //! gives, is part of the model's identity, survives the file, and keeps averages honest.
 
+use spdcam_core::chart::KnownChart;
 use spdcam_infer::colour_head::ColourHead;
 use spdcam_infer::{Model, ModelSet};
 
 fn shipped_sg() -> Model {
     let set = ModelSet::shipped().unwrap();
-    set.for_chart("colorchecker_sg96").unwrap().model.clone()
+    set.for_known(KnownChart::Sg140).unwrap().model.clone()
 }
 
 /// A plausible feature row: a grey chart with a warm cast rising along the patches.

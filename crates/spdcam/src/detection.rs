@@ -7,7 +7,7 @@ use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
-use spdcam_core::chart::Chart;
+use spdcam_core::chart::{Chart, KnownChart};
 use spdcam_core::fsio;
 use spdcam_core::limits;
 use spdcam_core::photo::detection_rate::{self, BucketRate};
@@ -33,7 +33,7 @@ pub struct DetectionArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "colorchecker24,colorchecker_sg140"
+        default_values_t = KnownChart::photographed().iter().map(|c| c.name().to_string())
     )]
     charts: Vec<String>,
     /// Photograph only these of --charts (each photo is still searched for all of them);

@@ -265,7 +265,7 @@ fn a_colorchecker24_photo_is_estimated_with_its_own_model() {
         "-o",
         &s(&never),
     ]);
-    assert!(err.contains("no model for chart colorchecker24"), "{err}");
+    assert!(err.contains("no model for chart ColorChecker 24"), "{err}");
     assert!(!never.exists(), "no SPD file without an estimate");
     let text = std::fs::read_to_string(&features).unwrap();
     let mut lines = text.lines();

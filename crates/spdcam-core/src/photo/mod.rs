@@ -76,10 +76,7 @@ pub struct ChartTemplate {
     pub neutrals: Vec<(usize, f64)>,
 }
 
-/// Patch side over patch pitch of a physical ColorChecker Classic 24.
-pub const COLORCHECKER24_PATCH_FRACTION: f64 = 0.84;
-/// Patch side over patch pitch of a physical ColorChecker Digital SG.
-pub const COLORCHECKER_SG_PATCH_FRACTION: f64 = 0.88;
+pub use crate::chart::registry::{COLORCHECKER24_PATCH_FRACTION, COLORCHECKER_SG_PATCH_FRACTION};
 /// Patch fraction of other charts whose layout has no gap.
 pub const DEFAULT_PATCH_FRACTION: f64 = 0.85;
 
@@ -89,20 +86,24 @@ const NEUTRAL_RANGE_NM: (f64, f64) = (420.0, 680.0);
 const NEUTRAL_MAX_REL_STD: f64 = 0.1;
 
 impl ChartTemplate {
-    /// The template of `chart`: its grid and features; the patch fraction of the physical
-    /// chart for the ColorCheckers, else of the chart's layout (or
+    /// The template of `chart`: its grid and features; the patch fraction of the chart as
+    /// printed for a known printed chart ([`KnownChart::patch_fraction`]), else of the
+    /// chart's layout (or
     /// [`DEFAULT_PATCH_FRACTION`] when its layout has no gap); its neutral patches found
     /// from the reflectances. Fails when fewer than three neutral patches of clearly
     /// different lightness exist, since then nothing fixes the orientation.
     pub fn from_chart(chart: &Chart) -> Result<ChartTemplate> {
         let layout = &chart.layout;
-        let patch_fraction = match KnownChart::from_name(&chart.name) {
-            Some(KnownChart::ColorChecker24) => COLORCHECKER24_PATCH_FRACTION,
-            Some(KnownChart::Sg140) => COLORCHECKER_SG_PATCH_FRACTION,
-            _ if layout.gap_px > 0 => {
+        // A chart as printed has its own patch fraction; its features alone, no photo's.
+        let printed = KnownChart::from_name(&chart.name)
+            .filter(|known| known.physical() == Some(*known))
+            .and_then(KnownChart::patch_fraction);
+        let patch_fraction = match printed {
+            Some(fraction) => fraction,
+            None if layout.gap_px > 0 => {
                 layout.patch_px as f64 / (layout.patch_px + layout.gap_px) as f64
             }
-            _ => DEFAULT_PATCH_FRACTION,
+            None => DEFAULT_PATCH_FRACTION,
         };
         let wavelengths = chart.reflectances.wavelengths();
         let band: Vec<usize> = (0..wavelengths.len())
@@ -139,16 +140,14 @@ impl ChartTemplate {
     }
 
     /// The physical chart to look for in photos when features come from the chart named
-    /// `chart`: the ColorChecker 24 for `colorchecker24`; the full Digital SG (whose 96
-    /// centre patches, row by row, are the features) for `colorchecker_sg96` and
-    /// `colorchecker_sg140`; any other chart as itself. `None` for a chart no photo shows
-    /// in that order (`colorchecker_sg96_thesis`, the file order) or that has no template.
+    /// `chart`: a [`KnownChart`]'s physical chart ([`KnownChart::template`]: the full
+    /// Digital SG for its 96 centre patches), any other chart as itself. `None` for a chart
+    /// no photo shows in that order (the thesis's file order) or that has no template.
     pub fn for_chart(chart: &str, data_dir: &DataDir, grid: &Grid) -> Option<ChartTemplate> {
-        let physical = match KnownChart::from_name(chart) {
-            Some(known) => known.physical()?.name(),
-            None => chart,
-        };
-        let chart = Chart::resolve(physical, None, data_dir, grid).ok()?;
+        if let Some(known) = KnownChart::from_name(chart) {
+            return known.template(data_dir, grid);
+        }
+        let chart = Chart::resolve(chart, None, data_dir, grid).ok()?;
         ChartTemplate::from_chart(&chart).ok()
     }
 

@@ -418,24 +418,13 @@ impl TrustCalibration {
     }
 }
 
-/// The calibrations shipped with the models (`models/<chart>.trust.json`, made by
-/// `spdcam trust calibrate`); each names the model it was measured on.
-const SHIPPED_CALIBRATIONS: &[(&str, &str)] = &[
-    (
-        "the colorchecker_sg96 calibration",
-        include_str!("../../../../models/colorchecker_sg96.trust.json"),
-    ),
-    (
-        "the colorchecker24 calibration",
-        include_str!("../../../../models/colorchecker24.trust.json"),
-    ),
-];
-
-/// The shipped calibration measured on `model`, if any.
+/// The shipped calibration measured on `model` (`models/<chart>.trust.json`, made by
+/// `spdcam trust calibrate`), if any.
 pub fn calibration_for(model: &Model) -> Result<Option<TrustCalibration>> {
     let fingerprint = model.fingerprint();
-    for (name, text) in SHIPPED_CALIBRATIONS {
-        let c = TrustCalibration::from_json(text, name)?;
+    for shipped in &crate::shipped::SHIPPED {
+        let name = format!("{}'s calibration", shipped.name());
+        let c = TrustCalibration::from_json(shipped.calibration, &name)?;
         if c.model == fingerprint {
             return Ok(Some(c));
         }

@@ -349,6 +349,7 @@ fn no_check(chart: &str) -> Advice {
     match KnownChart::from_name(chart) {
         Some(known) if known.needs_data_dir() => Advice::NoChartData {
             chart: known.shown_name().into(),
+            file: known.data_file().unwrap_or_default(),
         },
         _ => Advice::UnknownChart {
             chart: shown_chart_name(chart),
@@ -401,14 +402,18 @@ mod tests {
     /// The shipped models and the ColorChecker 24's self-check on their model's grid.
     fn cc24_setup() -> (ModelSet, ChartCheck) {
         let models = ModelSet::shipped().unwrap();
-        let grid = models.for_chart("colorchecker24").unwrap().model.grid();
+        let grid = models
+            .for_known(KnownChart::ColorChecker24)
+            .unwrap()
+            .model
+            .grid();
         (models, cc24_check(&grid))
     }
 
     #[test]
     fn a_wrong_charts_features_are_not_ok_and_bands_hold_the_estimate() {
         let (models, check) = cc24_setup();
-        let model = &models.for_chart("colorchecker24").unwrap().model;
+        let model = &models.for_known(KnownChart::ColorChecker24).unwrap().model;
         let grid = model.grid();
         let row = features_of(&check, &StandardIlluminant::D65.spd(&grid).unwrap());
         let mut wrong = Vec::new();
@@ -495,8 +500,8 @@ mod tests {
     #[test]
     fn every_reason_says_what_went_wrong_and_what_to_do_in_plain_words() {
         let models = ModelSet::shipped().unwrap();
-        let cc24 = &models.for_chart("colorchecker24").unwrap().model;
-        let sg = &models.for_chart("colorchecker_sg96").unwrap().model;
+        let cc24 = &models.for_known(KnownChart::ColorChecker24).unwrap().model;
+        let sg = &models.for_known(KnownChart::Sg96).unwrap().model;
         let check = cc24_check(&cc24.grid());
         // A calibration whose every level is crossed by any estimate.
         let mut strict = crate::trust::calibration_for(cc24).unwrap().unwrap();
@@ -635,14 +640,18 @@ mod tests {
         assert!(said("(dark skin)") && said("(magenta, cyan"), "{all:?}");
         assert!(said("place them again") && said("place the corners by hand"));
         assert!(said("not shipped with spdcam"));
-        assert!(said("charts/colorchecker_sg.csv") && said("photograph a ColorChecker 24"));
+        let sg_file = KnownChart::Sg96.data_file().unwrap();
+        assert!(
+            said(&sg_file) && said("photograph a ColorChecker 24"),
+            "{all:?}"
+        );
         assert!(!plain("worst at p07") && !plain("use --data-dir") && !plain("features 1, 2"));
     }
 
     #[test]
     fn a_chart_lit_by_two_lights_each_half_balanced_says_so() {
         let (models, check) = cc24_setup();
-        let model = &models.for_chart("colorchecker24").unwrap().model;
+        let model = &models.for_known(KnownChart::ColorChecker24).unwrap().model;
         let grid = model.grid();
         let daylight = features_of(&check, &StandardIlluminant::D65.spd(&grid).unwrap());
         let bulb = features_of(&check, &StandardIlluminant::A.spd(&grid).unwrap());

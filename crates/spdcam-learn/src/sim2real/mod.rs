@@ -221,7 +221,7 @@ impl Ablation {
             };
         fixed_row(
             "thesis camera (5D II + BW486, file patch order)",
-            &cameras.camera(THESIS_CAMERA, "colorchecker_sg96_thesis", None)?,
+            &cameras.camera(THESIS_CAMERA, KnownChart::Sg96Thesis.name(), None)?,
             None,
         )?;
         fixed_row(

@@ -3,7 +3,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use spdcam_core::chart::shown_chart_name;
+use spdcam_core::chart::{shown_chart_name, KnownChart};
 use spdcam_core::photo::PhotoAnalysis;
 use spdcam_infer::PhotoOptions;
 use std::path::{Path, PathBuf};
@@ -16,10 +16,8 @@ pub struct PhotoArgs {
     /// numbered from left to right; without it the charts are detected.
     #[arg(long, value_name = "X1,Y1,…,X4,Y4", allow_hyphen_values = true)]
     pub corners: Vec<String>,
-    /// Look only for this chart: colorchecker24, colorchecker_sg140 (or another chart
-    /// name or reflectance CSV); default: every chart a model is for (with the shipped
-    /// models the ColorChecker 24 and the ColorChecker Digital SG).
-    #[arg(long, value_name = "NAME")]
+    /// Look only for this chart (its help, from the chart registry, names the known ones).
+    #[arg(long, value_name = "NAME", help = chart_help())]
     pub chart: Option<String>,
     /// Write a debug image (PNG) with the chart's outline and every sampled region; with
     /// several photos, one per photo (`NAME-<photo>.png`). Written also when no chart is found.
@@ -33,6 +31,24 @@ pub struct PhotoArgs {
     /// (JSON Lines), written as each row is estimated.
     #[arg(long)]
     pub json: bool,
+}
+
+/// The help of `--chart`, its charts from the chart registry: `Look only for this chart:
+/// colorchecker24, colorchecker_sg140 (…); default: … the ColorChecker 24 and the
+/// ColorChecker Digital SG`.
+fn chart_help() -> String {
+    let charts = KnownChart::photographed();
+    let names: Vec<&str> = charts.iter().map(|c| c.name()).collect();
+    let shown: Vec<String> = charts
+        .iter()
+        .map(|c| format!("the {}", c.shown_name()))
+        .collect();
+    format!(
+        "Look only for this chart: {} (or another chart name or reflectance CSV); default: \
+         every chart a model is for (with the shipped models {})",
+        names.join(", "),
+        shown.join(" and ")
+    )
 }
 
 /// Parses `x1,y1,…,x4,y4` (commas and/or spaces) into four points.

@@ -13,9 +13,16 @@ use spdcam_core::camera::white_balance::WhiteBalance;
 use spdcam_core::camera::{
     too_low_exposure, Camera, CameraConfig, WhiteBalanceStatistics, MAX_EXPOSURE, MIN_EXPOSURE,
 };
-use spdcam_core::chart::{Chart, Layout};
+use spdcam_core::chart::{Chart, KnownChart, Layout};
 use spdcam_core::error::short_number;
 use spdcam_core::spectral::Grid;
+
+/// The help of `--chart`, every known chart's name from the chart registry:
+/// `Chart: colorchecker24, …, or a reflectance CSV`.
+fn chart_help() -> String {
+    let names: Vec<&str> = KnownChart::ALL.iter().map(|c| c.name()).collect();
+    format!("Chart: {}, or a reflectance CSV", names.join(", "))
+}
 
 /// Camera and chart options shared by every command that renders.
 #[derive(Debug, Args, Clone)]
@@ -23,8 +30,8 @@ pub struct CameraArgs {
     /// Camera sensitivities: a built-in name, a data-directory name or FILE.csv (r,g,b).
     #[arg(long, default_value = "nikon_d5100_npl")]
     pub camera: String,
-    /// Chart: colorchecker24, colorchecker_sg96, colorchecker_sg140, or a reflectance CSV.
-    #[arg(long, default_value = "colorchecker24")]
+    /// Chart: a known chart's name or a reflectance CSV (its help names the known ones).
+    #[arg(long, default_value = KnownChart::ColorChecker24.name(), help = chart_help())]
     pub chart: String,
     /// Layout ROWSxCOLS of a chart given as a reflectance CSV.
     #[arg(long, value_name = "ROWSxCOLS")]

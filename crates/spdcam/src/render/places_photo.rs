@@ -138,9 +138,9 @@ pub(super) fn render_places(
                 let chart = &camera.chart().name;
                 if KnownChart::from_name(chart) != Some(KnownChart::ColorChecker24) {
                     bail!(
-                        "--place passport={}: a ColorChecker Passport holds the ColorChecker \
-                         24, not {}",
+                        "--place passport={}: a ColorChecker Passport holds the {}, not {}",
                         page.name(),
+                        KnownChart::ColorChecker24.shown_name(),
                         shown_chart_name(chart)
                     );
                 }

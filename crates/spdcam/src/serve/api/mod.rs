@@ -9,7 +9,7 @@ mod plain_error;
 mod upload;
 
 use super::body::{Budget, Pace};
-use super::jobs::{Jobs, CHARTS};
+use super::jobs::{self, Jobs};
 use answer::Answer;
 use anyhow::Result;
 use axum::body::Body;
@@ -17,9 +17,11 @@ use axum::routing::{get, post};
 use axum::Router;
 use chromaticity::locus_json;
 use handlers::{charts, estimate, job, locus, not_allowed, not_found, report, submit};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 const INDEX_HTML: &str = include_str!("../page/index.html");
+/// Where the page names the charts it reads ([`index_html`]).
+const CHARTS_MARK: &str = "<!--charts-->";
 const APP_JS: &str = include_str!("../page/app.js");
 const STYLE_CSS: &str = include_str!("../page/style.css");
 /// The example photo "Try the example photo" loads: the ColorChecker 24 one, whose
@@ -29,11 +31,22 @@ const EXAMPLE_JPG: &[u8] = include_bytes!("../../../../../examples/cc24-led.jpg"
 /// field other than the photo.
 const FORM_OVERHEAD: usize = 64 * 1024;
 
-/// The charts a person can name for placed corners ([`CHARTS`]), each with its name and
+/// The page, the charts it reads named where it marks them ([`CHARTS_MARK`]) from the
+/// chart registry: ` (ColorChecker 24 or ColorChecker Digital SG)`.
+fn index_html() -> &'static [u8] {
+    static PAGE: OnceLock<String> = OnceLock::new();
+    PAGE.get_or_init(|| {
+        let names: Vec<&str> = jobs::charts().iter().map(|c| c.shown_name()).collect();
+        INDEX_HTML.replace(CHARTS_MARK, &format!(" ({})", names.join(" or ")))
+    })
+    .as_bytes()
+}
+
+/// The charts a person can name for placed corners ([`jobs::charts`]), each with its name and
 /// a label that tells it apart: `{"name": "colorchecker24", "label": "ColorChecker 24
 /// (4 × 6 patches)"}`.
 fn charts_json() -> serde_json::Value {
-    CHARTS
+    jobs::charts()
         .iter()
         .map(|c| {
             let label = match c.printed_layout() {
@@ -80,10 +93,10 @@ impl Api {
             get(move || async move { Answer(200, kind, Body::from(body)) })
         };
         Router::new()
-            .route("/", page("text/html; charset=utf-8", INDEX_HTML.as_bytes()))
+            .route("/", page("text/html; charset=utf-8", index_html()))
             .route(
                 "/index.html",
-                page("text/html; charset=utf-8", INDEX_HTML.as_bytes()),
+                page("text/html; charset=utf-8", index_html()),
             )
             .route(
                 "/app.js",

@@ -24,11 +24,16 @@ pub(super) fn plain_error(status: u16, error: &str) -> (&'static str, String) {
                 .to_string(),
         )
     } else if error.contains("no model for chart") {
+        let charts: Vec<String> = crate::serve::jobs::charts()
+            .iter()
+            .map(|c| format!("a {}", c.shown_name()))
+            .collect();
         (
             "unknown_chart",
-            "The chart in this photo is not one spdcam reads: use a ColorChecker 24 or a \
-             ColorChecker Digital SG."
-                .to_string(),
+            format!(
+                "The chart in this photo is not one spdcam reads: use {}.",
+                charts.join(" or ")
+            ),
         )
     } else if error.contains("corners") {
         (
@@ -119,7 +124,7 @@ mod tests {
         let cases = [
             (
                 400,
-                "room.jpg: no chart found (looked for colorchecker24); give its corners with --corners x1,y1,…,x4,y4",
+                "room.jpg: no chart found (looked for ColorChecker 24); give its corners with --corners x1,y1,…,x4,y4",
                 "no_chart",
             ),
             (400, "notes.txt: not an image (unknown format)", "bad_photo"),
@@ -186,5 +191,15 @@ mod tests {
             "{detected}"
         );
         assert!(for_http(cases[9].1).contains("in the form field `corners` (x1,y1,…,x4,y4)"));
+        let (code, unknown) = plain_error(
+            422,
+            "p.jpg: no model for chart my_chart; the models are for ColorChecker 24",
+        );
+        assert_eq!(code, "unknown_chart");
+        assert_eq!(
+            unknown,
+            "The chart in this photo is not one spdcam reads: use a ColorChecker 24 or a \
+             ColorChecker Digital SG."
+        );
     }
 }

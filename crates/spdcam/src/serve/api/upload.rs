@@ -4,7 +4,7 @@
 use super::answer::Answer;
 use super::{Api, FORM_OVERHEAD};
 use crate::serve::body::{self, BodyError, Held};
-use crate::serve::jobs::{Upload, CHARTS};
+use crate::serve::jobs::{charts, Upload};
 use crate::serve::multipart::{self, FormError, Limits};
 use axum::extract::Request;
 use axum::http::header;
@@ -98,7 +98,7 @@ impl Api {
         };
         let chart = match form.chart.as_deref().map(str::trim) {
             Some(name) if !name.is_empty() => Some(
-                CHARTS
+                charts()
                     .into_iter()
                     .find(|c| c.name() == name)
                     .ok_or_else(|| {
@@ -106,7 +106,11 @@ impl Api {
                             400,
                             format!(
                                 "unknown chart '{name}'; valid: {}",
-                                CHARTS.map(|c| c.name()).join(", ")
+                                charts()
+                                    .iter()
+                                    .map(|c| c.name())
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
                             ),
                         )
                     })?,

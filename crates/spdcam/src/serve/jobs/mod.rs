@@ -20,8 +20,11 @@ use tokio::sync::{Notify, OwnedSemaphorePermit};
 /// Reports (each with its photo, a few hundred kB) are kept for this many newest jobs.
 pub const KEEP_REPORTS: usize = 32;
 
-/// The charts a client may name for its corners: a name, never a path.
-pub const CHARTS: [KnownChart; 2] = [KnownChart::ColorChecker24, KnownChart::Sg96];
+/// The charts a client may name for its corners (a name, never a path): those a shipped
+/// model reads, from the chart registry ([`KnownChart::with_shipped_model`]).
+pub fn charts() -> Vec<KnownChart> {
+    KnownChart::with_shipped_model()
+}
 
 /// One uploaded photo to estimate, held in memory.
 #[derive(Debug)]
@@ -34,7 +37,7 @@ pub struct Upload {
     pub corners: Option<Vec<[f64; 2]>>,
     /// The share of the server's upload memory budget the bytes hold; released with them.
     pub memory: Option<OwnedSemaphorePermit>,
-    /// The chart, when the client named it (one of [`CHARTS`]).
+    /// The chart, when the client named it (one of [`charts`]).
     pub chart: Option<KnownChart>,
     /// The kind of light the client named (`Unknown` when none).
     pub light: LightKind,

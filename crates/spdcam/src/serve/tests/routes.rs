@@ -48,10 +48,17 @@ fn the_charts_to_name_come_from_the_server_with_labels_that_tell_them_apart() {
             ),
         ]
     );
-    // The page holds no list of its own.
+    // The page holds no list of its own: its script asks, the server names them in its text.
     let (_, page) = request(server.addr(), "GET", "/app.js", None);
     let page = String::from_utf8_lossy(&page);
     assert!(page.contains("api/charts") && !page.contains("ColorChecker"));
+    assert!(!include_str!("../page/index.html").contains("ColorChecker"));
+    let (_, page) = request(server.addr(), "GET", "/", None);
+    let page = String::from_utf8_lossy(&page);
+    assert!(
+        page.contains("a colour chart (ColorChecker 24 or ColorChecker Digital SG) in the light"),
+        "{page}"
+    );
     server.stop();
 }
 

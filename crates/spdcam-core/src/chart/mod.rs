@@ -1,5 +1,10 @@
 //! Colour charts: patch reflectances, their layout on the image, and which patches feed the
-//! features a model reads.
+//! features a model reads. The charts spdcam knows by name, and everything about each of
+//! them, are in [`registry`] ([`KnownChart`]); any other chart is a reflectance CSV.
+
+pub mod registry;
+
+pub use registry::{feature_patch_name, patch_name, shown_chart_name, KnownChart, Reflectances};
 
 use crate::builtin::{self, DataDir};
 use crate::error::{Error, Result};
@@ -191,216 +196,13 @@ pub const NEUTRAL_VARIATION: f64 = 0.1;
 /// Reflectance of a chart's matte black body, shown in gaps and borders.
 pub const DEFAULT_BACKGROUND: f64 = 0.04;
 
-/// The error for a known chart whose reflectances were not found in the data directory
-/// (`error` says they were not): it names the chart as the user did, the charts available
-/// without data, and how to set the data directory. Other errors (a damaged file) pass.
-fn needs_data(chart: KnownChart, error: Error, data_dir: &DataDir) -> Error {
-    if !matches!(error, Error::UnknownName { .. }) {
-        return error;
-    }
-    let without_data: Vec<&str> = KnownChart::ALL
-        .into_iter()
-        .filter(|c| !c.needs_data_dir())
-        .map(KnownChart::name)
-        .collect();
-    let place = match data_dir.root() {
-        Some(root) => format!("the data directory {} does not hold them", root.display()),
-        None => "no data directory is set".to_string(),
-    };
-    Error::invalid(format!(
-        "chart {} needs its measured reflectances from the data directory, and {place}; \
-         charts available without data: {} (or a reflectance CSV: {CSV_LAYOUT}); \
-         set the data directory with --data-dir DIR or {}",
-        chart.name(),
-        without_data.join(", "),
-        builtin::DATA_DIR_ENV
-    ))
-}
-
 /// How a chart given as a reflectance CSV gets its layout, in every message that offers one:
 /// `spdcam render` takes any as `--layout ROWSxCOLS`; `estimate` has no such option, so it
 /// reads only the layouts it can guess, with a model trained on that chart.
-const CSV_LAYOUT: &str = "24 patches are laid out 4×6 and 96 as 8×12; `spdcam render` takes \
+pub(crate) const CSV_LAYOUT: &str =
+    "24 patches are laid out 4×6 and 96 as 8×12; `spdcam render` takes \
      any other layout as --layout ROWSxCOLS; `spdcam estimate` reads a 24- or 96-patch chart \
      with a model trained on it (--model)";
-
-/// The official names of the ColorChecker Classic 24's patches (X-Rite, "ColorChecker
-/// Classic" product sheet), row by row from dark skin to black.
-pub const COLORCHECKER24_PATCH_NAMES: [&str; 24] = [
-    "dark skin",
-    "light skin",
-    "blue sky",
-    "foliage",
-    "blue flower",
-    "bluish green",
-    "orange",
-    "purplish blue",
-    "moderate red",
-    "purple",
-    "yellow green",
-    "orange yellow",
-    "blue",
-    "green",
-    "red",
-    "yellow",
-    "magenta",
-    "cyan",
-    "white 9.5",
-    "neutral 8",
-    "neutral 6.5",
-    "neutral 5",
-    "neutral 3.5",
-    "black 2",
-];
-
-/// The ColorChecker Digital SG's printed name of the patch in column `col` and row `row`
-/// (both 0-based): the column's letter A–N and the row's number 1–10, as X-Rite names them.
-fn sg_patch_name(col: usize, row: usize) -> String {
-    format!("{}{}", char::from(b'A' + col as u8), row + 1)
-}
-
-/// The name people know the chart called `name` by (see [`KnownChart::shown_name`]); any
-/// other chart by its own name.
-pub fn shown_chart_name(name: &str) -> String {
-    KnownChart::from_name(name).map_or_else(|| name.to_string(), |c| c.shown_name().to_string())
-}
-
-/// The name of feature patch `k` (0-based) of the chart called `name`
-/// ([`KnownChart::feature_patch_name`]); `patch N` (1-based) for other charts.
-pub fn feature_patch_name(name: &str, k: usize) -> String {
-    KnownChart::from_name(name)
-        .and_then(|c| c.feature_patch_name(k))
-        .unwrap_or_else(|| format!("patch {}", k + 1))
-}
-
-/// The name of patch `p` (0-based, row-major over the whole chart) of the chart called
-/// `name` ([`KnownChart::patch_name`]); `patch N` (1-based) for other charts.
-pub fn patch_name(name: &str, p: usize) -> String {
-    KnownChart::from_name(name)
-        .and_then(|c| c.patch_name(p))
-        .unwrap_or_else(|| format!("patch {}", p + 1))
-}
-
-/// The charts [`Chart::resolve`] knows by name; any other chart is a reflectance CSV.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum KnownChart {
-    /// The ColorChecker Classic 24 (built in).
-    ColorChecker24,
-    /// The Digital SG's 96 centre patches where they sit on the chart, row by row.
-    Sg96,
-    /// The same 96 patches in the thesis's file order.
-    Sg96Thesis,
-    /// The whole Digital SG, 140 patches.
-    Sg140,
-}
-
-impl KnownChart {
-    /// Every known chart.
-    pub const ALL: [KnownChart; 4] = [
-        KnownChart::ColorChecker24,
-        KnownChart::Sg96,
-        KnownChart::Sg96Thesis,
-        KnownChart::Sg140,
-    ];
-
-    /// The name on the command line, in model files and in [`Chart::name`].
-    pub const fn name(self) -> &'static str {
-        match self {
-            KnownChart::ColorChecker24 => "colorchecker24",
-            KnownChart::Sg96 => "colorchecker_sg96",
-            KnownChart::Sg96Thesis => "colorchecker_sg96_thesis",
-            KnownChart::Sg140 => "colorchecker_sg140",
-        }
-    }
-
-    /// Whether the chart's reflectances come from the data directory (all but the built-in
-    /// ColorChecker 24).
-    pub const fn needs_data_dir(self) -> bool {
-        !matches!(self, KnownChart::ColorChecker24)
-    }
-
-    /// What the chart is and where its reflectances come from.
-    pub fn description(self) -> &'static str {
-        match self {
-            KnownChart::ColorChecker24 => "ColorChecker Classic 24, 4×6, built in",
-            KnownChart::Sg96 => {
-                "ColorChecker Digital SG, the 96 centre patches (the thesis's i1Pro2 set) where \
-                 they sit on the chart, 8×12, features row by row as in photos; data directory"
-            }
-            KnownChart::Sg96Thesis => {
-                "the same 96 patches in file order, 12 per row, as the thesis rendered them; \
-                 data directory"
-            }
-            KnownChart::Sg140 => {
-                "ColorChecker Digital SG, all 140 patches, 10×14, the 96 centre patches are \
-                 features; data directory"
-            }
-        }
-    }
-
-    /// The known chart called `name` (exactly), if any.
-    pub fn from_name(name: &str) -> Option<KnownChart> {
-        KnownChart::ALL.into_iter().find(|c| c.name() == name)
-    }
-
-    /// The chart's name as people know it and as messages for them name it:
-    /// `ColorChecker 24` or `ColorChecker Digital SG`.
-    pub const fn shown_name(self) -> &'static str {
-        match self {
-            KnownChart::ColorChecker24 => "ColorChecker 24",
-            KnownChart::Sg96 | KnownChart::Sg96Thesis | KnownChart::Sg140 => {
-                "ColorChecker Digital SG"
-            }
-        }
-    }
-
-    /// The name of feature patch `k` (0-based, in this chart's feature order) as the chart
-    /// prints it or its maker names it: the ColorChecker 24's official names (`dark skin`,
-    /// `blue sky`), the Digital SG's column letter and row number (`E4`). `None` past the
-    /// last feature.
-    pub fn feature_patch_name(self, k: usize) -> Option<String> {
-        match self {
-            KnownChart::ColorChecker24 => COLORCHECKER24_PATCH_NAMES.get(k).map(|n| n.to_string()),
-            // Features run row by row over the 96 centre patches (B2…M9).
-            KnownChart::Sg96 | KnownChart::Sg140 => {
-                (k < 96).then(|| sg_patch_name(1 + k % 12, 1 + k / 12))
-            }
-            // The file order runs column by column, 8 patches down each column.
-            KnownChart::Sg96Thesis => (k < 96).then(|| sg_patch_name(1 + k / 8, 1 + k % 8)),
-        }
-    }
-
-    /// The name of patch `p` (row-major among all the physical chart's patches, as a photo
-    /// is sampled) as the chart prints it: for the ColorChecker 24 as
-    /// [`KnownChart::feature_patch_name`], for the whole Digital SG its column letter and
-    /// row number (`A1`…`N10`). `None` for a chart no photo shows, or past the last patch.
-    pub fn patch_name(self, p: usize) -> Option<String> {
-        match self {
-            KnownChart::ColorChecker24 => self.feature_patch_name(p),
-            KnownChart::Sg140 => (p < 140).then(|| sg_patch_name(p % 14, p / 14)),
-            KnownChart::Sg96 | KnownChart::Sg96Thesis => None,
-        }
-    }
-
-    /// The patches of the physical chart a photo shows ([`KnownChart::physical`]), rows ×
-    /// columns as printed: what a person counts to tell the charts apart.
-    pub fn printed_layout(self) -> Option<(usize, usize)> {
-        match self.physical()? {
-            KnownChart::ColorChecker24 => Some((4, 6)),
-            KnownChart::Sg96 | KnownChart::Sg96Thesis | KnownChart::Sg140 => Some((10, 14)),
-        }
-    }
-
-    /// The physical chart a photo shows when features come from this one: the whole SG for
-    /// its 96 centre patches; `None` for the thesis's file order, which no photo shows.
-    pub fn physical(self) -> Option<KnownChart> {
-        match self {
-            KnownChart::ColorChecker24 => Some(KnownChart::ColorChecker24),
-            KnownChart::Sg96 | KnownChart::Sg140 => Some(KnownChart::Sg140),
-            KnownChart::Sg96Thesis => None,
-        }
-    }
-}
 
 impl Chart {
     /// Centre of each feature patch on the chart, in chart widths and heights from the
@@ -494,98 +296,46 @@ impl Chart {
         })
     }
 
-    /// The built-in ColorChecker 24 on `grid`.
+    /// The built-in ColorChecker 24 on `grid` ([`KnownChart::ColorChecker24`]).
     pub fn colorchecker24(grid: &Grid) -> Result<Chart> {
-        Chart::from_reflectances(
-            KnownChart::ColorChecker24.name(),
-            &builtin::COLORCHECKER24.load()?,
-            4,
-            6,
-            grid,
-        )
+        KnownChart::ColorChecker24.chart(&DataDir::new(None), grid)
     }
 
-    /// The full 140-patch ColorChecker Digital SG from a set named in X-Rite style
-    /// (`A1`…`N10`: letter = column A–N, number = row 1–10); the 96 patches inside the outer
-    /// ring are the features, row-major.
+    /// The full 140-patch ColorChecker Digital SG ([`KnownChart::Sg140`]) from a set named
+    /// in X-Rite style (`A1`…`N10`: letter = column A–N, number = row 1–10); the 96 patches
+    /// inside the outer ring are the features, row-major.
     pub fn colorchecker_sg140(reflectances: &SpectralSet, grid: &Grid) -> Result<Chart> {
-        let mut order = Vec::with_capacity(140);
-        for row in 1..=10 {
-            for col in b'A'..=b'N' {
-                let name = format!("{}{row}", col as char);
-                order.push(reflectances.position(&name).ok_or_else(|| {
-                    Error::invalid(format!(
-                        "ColorChecker SG reflectances lack patch '{name}' (expected A1…N10)"
-                    ))
-                })?);
-            }
-        }
-        let mut chart = Chart::from_reflectances(
-            KnownChart::Sg140.name(),
-            &reflectances.select(&order),
-            10,
-            14,
-            grid,
-        )?;
-        chart.feature_patches = (1..9)
-            .flat_map(|r| (1..13).map(move |c| r * 14 + c))
-            .collect();
-        Ok(chart)
+        KnownChart::Sg140.arrange(reflectances, grid)
     }
 
-    /// Resolves a chart by name or file: a [`KnownChart`]'s name, or a reflectance CSV
-    /// (path or data-directory name) with `layout` rows × cols (needed unless the file has
-    /// 24, 96 or 140 patches, whose layouts are known).
+    /// Resolves a chart by name or file: a [`KnownChart`]'s name (with its own layout), or
+    /// a reflectance CSV (path or data-directory name) with `layout` rows × cols (needed
+    /// unless the file has 24, 96 or 140 patches, whose layouts are known).
     pub fn resolve(
         spec: &str,
         layout: Option<(usize, usize)>,
         data_dir: &DataDir,
         grid: &Grid,
     ) -> Result<Chart> {
-        let (name, set) = match KnownChart::from_name(spec) {
-            Some(KnownChart::ColorChecker24) => return Chart::colorchecker24(grid),
-            Some(known @ (KnownChart::Sg96 | KnownChart::Sg96Thesis)) => {
-                let (_, set) = builtin::resolve_table(
-                    "colorchecker_digital_sg_96_i1pro2",
-                    "chart",
-                    &[],
-                    data_dir,
-                    &["thesis"],
-                )
-                .map_err(|e| needs_data(known, e, data_dir))?;
-                if known == KnownChart::Sg96 {
-                    // The file lists the SG's centre patches column by column (B2…B9,
-                    // C2…C9, …, M2…M9): position (row r, column c) holds file patch c·8 + r.
-                    let order: Vec<usize> = (0..8)
-                        .flat_map(|r| (0..12).map(move |c| c * 8 + r))
-                        .collect();
-                    return Chart::from_reflectances(spec, &set.select(&order), 8, 12, grid);
-                }
-                (spec.to_string(), set)
-            }
-            Some(known @ KnownChart::Sg140) => (
-                spec.to_string(),
-                builtin::resolve_table("colorchecker_sg", "chart", &[], data_dir, &["charts"])
-                    .map_err(|e| needs_data(known, e, data_dir))?
-                    .1,
-            ),
-            None => builtin::resolve_table(
-                spec,
-                "chart",
-                &[builtin::COLORCHECKER24],
-                data_dir,
-                &["charts", "reflectances", "thesis"],
-            )
-            .map_err(|e| match e {
-                Error::UnknownName { name, .. } => Error::UnknownName {
-                    kind: "chart",
-                    name,
-                    valid: KnownChart::ALL.map(KnownChart::name).join(", ")
-                        + &format!(", or a reflectance CSV ({CSV_LAYOUT})"),
-                },
-                other => other,
-            })?,
-        };
+        if let Some(known) = KnownChart::from_name(spec) {
+            return known.chart(data_dir, grid);
+        }
+        let (name, set) = builtin::resolve_table(
+            spec,
+            "chart",
+            &[],
+            data_dir,
+            &["charts", "reflectances", "thesis"],
+        )
+        .map_err(|e| match e {
+            Error::UnknownName { name, .. } => Error::UnknownName {
+                kind: "chart",
+                name,
+                valid: KnownChart::ALL.map(KnownChart::name).join(", ")
+                    + &format!(", or a reflectance CSV ({CSV_LAYOUT})"),
+            },
+            other => other,
+        })?;
         let sg_named = set.position("A1").is_some() && set.position("N10").is_some();
         if set.len() == 140 && sg_named && layout.is_none() {
             return Chart::colorchecker_sg140(&set, grid);
