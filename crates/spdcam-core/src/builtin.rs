@@ -43,10 +43,6 @@ pub const CAMERAS: &[BuiltinTable] = &[
     },
 ];
 
-/// The ColorChecker 24 reflectances (Ohta), p01 dark skin … p24 black: the chart
-/// registry's table ([`crate::chart::registry`]).
-pub const COLORCHECKER24: BuiltinTable = crate::chart::registry::COLORCHECKER24_TABLE;
-
 /// The 99 colour evaluation samples of ANSI/IES TM-30 (CIE 2017).
 pub const TM30_CES99: BuiltinTable = BuiltinTable {
     name: "tm30_ces99",
@@ -245,11 +241,7 @@ mod tests {
             &CIE_S026_ALPHA_OPIC,
             &BLUE_LIGHT_HAZARD,
         ];
-        for t in CAMERAS
-            .iter()
-            .chain([&COLORCHECKER24, &TM30_CES99])
-            .chain(quality)
-        {
+        for t in CAMERAS.iter().chain([&TM30_CES99]).chain(quality) {
             let set = t.load().unwrap();
             assert!(!set.is_empty(), "{}", t.name);
         }
@@ -260,7 +252,6 @@ mod tests {
             CIE_S026_ALPHA_OPIC.load().unwrap().names(),
             ["sc", "mc", "lc", "rh", "mel"]
         );
-        assert_eq!(COLORCHECKER24.load().unwrap().len(), 24);
         assert_eq!(TM30_CES99.load().unwrap().len(), 99);
         for c in CAMERAS {
             assert_eq!(c.load().unwrap().names(), ["r", "g", "b"]);

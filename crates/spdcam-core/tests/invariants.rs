@@ -64,7 +64,7 @@ proptest! {
         let grid = Grid::SIMULATION;
         let measured = builtin::CAMERAS[0].load().unwrap();
         let sensitivities = Sensitivities::new(builtin::CAMERAS[0].name, &measured, &grid).unwrap();
-        let reflectances = builtin::COLORCHECKER24.load().unwrap();
+        let reflectances = spdcam_core::chart::registry::COLORCHECKER24_TABLE.load().unwrap();
         let features = |set: &spdcam_core::spectral::SpectralSet| {
             let chart = Chart::from_reflectances("shuffled", set, 4, 6, &grid).unwrap();
             let camera = Camera::new(&sensitivities, chart, CameraConfig::default(), &grid).unwrap();

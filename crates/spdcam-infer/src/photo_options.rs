@@ -49,7 +49,7 @@ pub fn chart_templates(
     if names.is_empty() {
         return Ok(KnownChart::with_shipped_model()
             .into_iter()
-            .filter_map(|c| c.template(data_dir, &grid))
+            .filter_map(|c| ChartTemplate::of_known(c, data_dir, &grid))
             .collect());
     }
     let mut out: Vec<ChartTemplate> = Vec::new();

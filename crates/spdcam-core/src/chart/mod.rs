@@ -507,7 +507,7 @@ mod tests {
     #[test]
     fn reflectances_in_percent_and_giant_layouts_are_refused() {
         // Issue 15: a chart in percent was accepted; `--patch-px 100000` aborted.
-        let set = builtin::COLORCHECKER24.load().unwrap();
+        let set = registry::COLORCHECKER24_TABLE.load().unwrap();
         let percent = SpectralSet::new(
             set.wavelengths().to_vec(),
             set.names().to_vec(),
@@ -534,7 +534,7 @@ mod tests {
 
     #[test]
     fn wrong_patch_count_is_an_error() {
-        let set = builtin::COLORCHECKER24.load().unwrap();
+        let set = registry::COLORCHECKER24_TABLE.load().unwrap();
         let e = Chart::from_reflectances("x", &set, 5, 5, &Grid::SIMULATION).unwrap_err();
         assert!(e.to_string().contains("5×5"), "{e}");
     }

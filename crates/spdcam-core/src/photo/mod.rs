@@ -139,13 +139,22 @@ impl ChartTemplate {
         })
     }
 
+    /// The detection template of the physical chart a photo of `known` shows
+    /// ([`KnownChart::physical`]: the full Digital SG for its 96 centre patches): what photos
+    /// are searched for. `None` for a chart no photo shows, or whose reflectances are not at
+    /// hand.
+    pub fn of_known(known: KnownChart, data_dir: &DataDir, grid: &Grid) -> Option<ChartTemplate> {
+        let chart = known.physical()?.chart(data_dir, grid).ok()?;
+        ChartTemplate::from_chart(&chart).ok()
+    }
+
     /// The physical chart to look for in photos when features come from the chart named
-    /// `chart`: a [`KnownChart`]'s physical chart ([`KnownChart::template`]: the full
-    /// Digital SG for its 96 centre patches), any other chart as itself. `None` for a chart
-    /// no photo shows in that order (the thesis's file order) or that has no template.
+    /// `chart`: a [`KnownChart`]'s ([`ChartTemplate::of_known`]), any other chart as itself.
+    /// `None` for a chart no photo shows in that order (the thesis's file order) or that has
+    /// no template.
     pub fn for_chart(chart: &str, data_dir: &DataDir, grid: &Grid) -> Option<ChartTemplate> {
         if let Some(known) = KnownChart::from_name(chart) {
-            return known.template(data_dir, grid);
+            return ChartTemplate::of_known(known, data_dir, grid);
         }
         let chart = Chart::resolve(chart, None, data_dir, grid).ok()?;
         ChartTemplate::from_chart(&chart).ok()

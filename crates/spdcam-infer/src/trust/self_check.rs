@@ -677,7 +677,9 @@ pub(super) mod tests {
         }
         // Two ColorChecker 24s side by side (6 × 8): four dark patches, and a glow on the
         // second black patch (bottom right) is where the glare is strongest.
-        let cc24 = spdcam_core::builtin::COLORCHECKER24.load().unwrap();
+        let cc24 = spdcam_core::chart::registry::COLORCHECKER24_TABLE
+            .load()
+            .unwrap();
         let double = spdcam_core::spectral::SpectralSet::new(
             cc24.wavelengths().to_vec(),
             (0..48).map(|i| format!("p{i}")).collect(),
