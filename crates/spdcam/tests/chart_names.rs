@@ -90,7 +90,11 @@ fn no_chart_name_is_spelled_outside_the_registry() {
     let mut spelled = Vec::new();
     for file in &files {
         let relative = file.strip_prefix(&root).unwrap().to_string_lossy();
-        if REGISTRY.iter().any(|r| relative == *r) {
+        // The registry, and modules that are tests on their own (`mod tests;` in a file).
+        let test_module = file
+            .file_name()
+            .is_some_and(|n| n == "tests.rs" || n == "test_support.rs");
+        if test_module || REGISTRY.iter().any(|r| relative == *r) {
             continue;
         }
         let text = std::fs::read_to_string(file).unwrap();
