@@ -106,7 +106,7 @@ table.grid-table th:first-child{text-align:left;width:22%}table.metrics th{white
 @page{margin:9mm}\
 @media print{body{margin:0;max-width:none;padding:0;font-size:7.5pt}h1{font-size:13pt}h3{font-size:8.5pt;margin:4px 0 2px}\
 .summary{font-size:9pt}.verdict{padding:3px 8px;margin:3px 0}.verdict strong{font-size:9pt}\
-img.photo{max-height:36mm;width:auto}svg.spd-plot{max-height:36mm}svg.uv-diagram{max-height:37mm}svg.r-bars{max-height:19mm}.meter .reading .value{font-size:10pt}.meter .reading .label{font-size:6.5pt}svg.tm30-cvg{max-width:44mm}\
+img.photo{max-height:32mm;width:auto}svg.spd-plot{max-height:32mm}svg.uv-diagram{max-height:33mm}svg.r-bars{max-height:19mm}.meter .reading .value{font-size:10pt}.meter .reading .label{font-size:6.5pt}svg.tm30-cvg{max-width:44mm}\
 figcaption,.small,table.metrics td.explain{font-size:6.5pt}tr.metric:not(.not-meaningful) td.explain{display:none}.film-tv td,.film-tv th{padding:0 4px 0 0}table.grid-table{font-size:6.5pt}\
 section{break-after:page;margin:0}section:last-of-type{break-after:auto}\
 .row{gap:8px;margin-top:3px}}";
