@@ -8,7 +8,7 @@
 
 use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::rounding::{
-    round_sig, shown, shown_with_unit, undetermined_words, NOT_DETERMINABLE, UNCALIBRATED,
+    marked_uncalibrated, round_sig, shown, shown_with_unit, undetermined_words, NOT_DETERMINABLE,
 };
 use serde::Serialize;
 use spdcam_core::quality::dominant::{dominant_wavelength, peak_wavelength_nm, ILLUMINANT_E_XY};
@@ -202,12 +202,10 @@ fn film_tv(
                 // Its reference is a light of the estimate's own CCT, which the photo does not
                 // determine.
                 format!("{NOT_DETERMINABLE} (its reference needs the CCT)")
-            } else if calibrated {
-                // SSI has no calibrated interval (`registry::Metric::calibrated`): say so
-                // rather than print a bare number beside numbers that carry theirs.
-                format!("{v:.0} ({UNCALIBRATED})")
             } else {
-                format!("{v:.0}")
+                // SSI has no calibrated interval (`registry::Metric::calibrated`): said so
+                // rather than a bare number beside numbers that carry theirs.
+                marked_uncalibrated(format!("{v:.0}"), None, calibrated)
             };
             out.push(Reading { key, label, value });
         }
@@ -344,6 +342,7 @@ fn spectral_hue(nm: f64) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rounding::UNCALIBRATED;
     use crate::test_support::{estimate_of, estimate_of_d65};
     use spdcam_core::spectral::{Grid, Spd};
 

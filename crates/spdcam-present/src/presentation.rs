@@ -14,8 +14,8 @@
 
 use crate::meaningful::{cct_meaningful, cri_meaningful};
 use crate::meter::Meter;
+use crate::rounding::{marked_uncalibrated, shown, undetermined_words};
 pub use crate::rounding::{round_sig, round_with_uncertainty};
-use crate::rounding::{shown, undetermined_words, UNCALIBRATED};
 use serde::Serialize;
 use spdcam_core::light_families::LightKind;
 use spdcam_core::quality::registry::{self, Group, MeaningfulFor};
@@ -119,11 +119,10 @@ impl Presentation {
                             .map(|i| i.half95);
                         let (value, not_meaningful) = match meaningful_value(estimate, key) {
                             Ok(v) => match shown(key, v, half95) {
-                                // A calibrated estimate without this metric's interval.
-                                Ok(text) if half95.is_none() && uncertainty.is_some() => {
-                                    (Some(format!("{text} ({UNCALIBRATED})")), None)
-                                }
-                                Ok(text) => (Some(text), None),
+                                Ok(text) => (
+                                    Some(marked_uncalibrated(text, half95, uncertainty.is_some())),
+                                    None,
+                                ),
                                 Err(_) => (None, Some(undetermined_words(key, v, half95))),
                             },
                             Err(why) => (None, Some(why)),

@@ -31,6 +31,16 @@ use spdcam_core::quality::registry::{self, Determined, Metric, Precision};
 /// calibration gives it none ([`registry::Metric::calibrated`]), or none for this model.
 pub const UNCALIBRATED: &str = "uncalibrated: no interval";
 
+/// `text`, a number as shown, followed by [`UNCALIBRATED`] where the estimate's other
+/// numbers carry intervals (`calibrated`) and this one has none (`half95` is `None`).
+pub fn marked_uncalibrated(text: String, half95: Option<f64>, calibrated: bool) -> String {
+    if calibrated && half95.is_none() {
+        format!("{text} ({UNCALIBRATED})")
+    } else {
+        text
+    }
+}
+
 /// The words that stand in place of a number its photo does not determine.
 pub const NOT_DETERMINABLE: &str = "not determinable from this photo";
 

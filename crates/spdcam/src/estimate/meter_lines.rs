@@ -7,7 +7,7 @@ use spdcam_core::quality::registry::{self, Group};
 use spdcam_infer::Estimate;
 use spdcam_present::meter::Meter;
 use spdcam_present::presentation::meaningful_value;
-use spdcam_present::rounding::{shown_with_unit, UNCALIBRATED};
+use spdcam_present::rounding::{marked_uncalibrated, shown_with_unit};
 
 /// `xy (0.3127, 0.3290); CCT 6500 ± 300 K, Δuv +0.0031 ± 0.0012`, or for coloured light
 /// the dominant wavelength, purity and peak; and the illuminance when known.
@@ -47,12 +47,11 @@ pub(super) fn metrics_line(e: &Estimate) -> String {
                 Err(_) => "—".to_string(),
                 Ok(v) => {
                     let half95 = intervals.and_then(|i| i.get(m.key)).map(|i| i.half95);
-                    let text = shown_with_unit(m.key, v, half95);
-                    if intervals.is_some() && half95.is_none() {
-                        format!("{text} ({UNCALIBRATED})")
-                    } else {
-                        text
-                    }
+                    marked_uncalibrated(
+                        shown_with_unit(m.key, v, half95),
+                        half95,
+                        intervals.is_some(),
+                    )
                 }
             };
             format!("{} {value}", m.symbol)
