@@ -3,7 +3,7 @@
 //! ([`KnownChart::name`]), the one name people read ([`KnownChart::shown_name`]), its
 //! patches' layout and names, where its reflectances come from ([`Reflectances`]), the
 //! physical chart a photo of it shows and how that chart is found in photos
-//! ([`KnownChart::template`]), and which chart's shipped model reads it
+//! ([`KnownChart::physical`], [`KnownChart::patch_fraction`]), and which chart's shipped model reads it
 //! ([`KnownChart::model_chart`]; the models themselves are `spdcam_infer`'s, looked up by
 //! this enum). Other code names a chart by its variant, never by a string; any other chart
 //! is a reflectance CSV.
