@@ -47,31 +47,46 @@ fn planck_uv(t: f64) -> [f64; 2] {
     [4.0 * xyz[0] / d, 6.0 * xyz[1] / d]
 }
 
-/// The Planckian table rows (T, u, v), T geometric from [`CCT_MIN_K`] to [`CCT_MAX_K`].
-fn planck_table() -> &'static [[f64; 3]] {
-    static TABLE: OnceLock<Vec<[f64; 3]>> = OnceLock::new();
-    TABLE.get_or_init(|| {
-        let ratio = (CCT_MAX_K / CCT_MIN_K).ln() / TABLE_STEPS as f64;
-        (0..=TABLE_STEPS)
-            .map(|i| {
-                let t = if i == TABLE_STEPS {
-                    CCT_MAX_K
-                } else {
-                    CCT_MIN_K * (ratio * i as f64).exp()
-                };
-                let [u, v] = planck_uv(t);
-                [t, u, v]
-            })
-            .collect()
-    })
+/// The Planckian table: rows (T, u, v) at T geometric from [`CCT_MIN_K`] to [`CCT_MAX_K`],
+/// each computed the first time it is read. A search touches a few dozen of the 4,609 rows
+/// (the bisection's steps and their neighbours), so a process that asks for a handful of CCTs
+/// does not pay for the whole table (2.2 million Planck evaluations).
+struct PlanckTable;
+
+/// The rows' (u, v), filled on first use.
+static TABLE_UV: [OnceLock<[f64; 2]>; TABLE_STEPS + 1] =
+    [const { OnceLock::new() }; TABLE_STEPS + 1];
+
+impl PlanckTable {
+    /// The number of rows.
+    const fn len(&self) -> usize {
+        TABLE_STEPS + 1
+    }
+
+    /// The temperature of row `i`.
+    fn temperature(i: usize) -> f64 {
+        if i == TABLE_STEPS {
+            CCT_MAX_K
+        } else {
+            let ratio = (CCT_MAX_K / CCT_MIN_K).ln() / TABLE_STEPS as f64;
+            CCT_MIN_K * (ratio * i as f64).exp()
+        }
+    }
+
+    /// Row `i`: (T, u, v).
+    fn row(&self, i: usize) -> [f64; 3] {
+        let t = Self::temperature(i);
+        let [u, v] = *TABLE_UV[i].get_or_init(|| planck_uv(t));
+        [t, u, v]
+    }
 }
 
 /// The index of the `table` row nearest `uv`, by bisection on the sign of the distance's
 /// slope along the locus: row `i` lies before the nearest point while `uv` is ahead of the
 /// locus's normal there, `(uv − row i) · (row i+1 − row i−1) > 0`.
-fn nearest_row(table: &[[f64; 3]], [u, v]: [f64; 2]) -> usize {
+fn nearest_row(table: &PlanckTable, [u, v]: [f64; 2]) -> usize {
     let ahead = |i: usize| {
-        let (p, c, n) = (table[i - 1], table[i], table[i + 1]);
+        let (p, c, n) = (table.row(i - 1), table.row(i), table.row(i + 1));
         (u - c[1]) * (n[1] - p[1]) + (v - c[2]) * (n[2] - p[2]) > 0.0
     };
     // The first interior row `k` that `uv` is not ahead of: rows 1..k are behind it.
@@ -85,7 +100,10 @@ fn nearest_row(table: &[[f64; 3]], [u, v]: [f64; 2]) -> usize {
         }
     }
     let k = lo;
-    let dist2 = |i: usize| (table[i][1] - u).powi(2) + (table[i][2] - v).powi(2);
+    let dist2 = |i: usize| {
+        let r = table.row(i);
+        (r[1] - u).powi(2) + (r[2] - v).powi(2)
+    };
     (k.saturating_sub(1)..(k + 2).min(table.len()))
         .min_by(|&a, &b| dist2(a).total_cmp(&dist2(b)))
         .unwrap_or(0)
@@ -136,15 +154,15 @@ pub fn uv_to_cct_duv(uv: [f64; 2]) -> Result<(f64, f64)> {
             "chromaticity ({u}, {v}) is not finite"
         )));
     }
-    let table = planck_table();
+    let table = PlanckTable;
     let dist = |row: &[f64; 3]| (row[1] - u).hypot(row[2] - v);
-    let m = nearest_row(table, [u, v]);
+    let m = nearest_row(&table, [u, v]);
     if m == 0 || m == table.len() - 1 {
         return Err(Error::invalid(format!(
             "chromaticity u = {u}, v = {v} has a CCT outside {CCT_MIN_K}–{CCT_MAX_K} K"
         )));
     }
-    let (p, c, n) = (table[m - 1], table[m], table[m + 1]);
+    let (p, c, n) = (table.row(m - 1), table.row(m), table.row(m + 1));
     let (dp, dc, dn) = (dist(&p), dist(&c), dist(&n));
 
     // Triangular solution (Ohno 2014): project onto the chord between the neighbours.
@@ -175,11 +193,11 @@ mod tests {
 
     #[test]
     fn table_spans_the_range_at_ratio_1_001() {
-        let t = planck_table();
+        let t = PlanckTable;
         assert_eq!(t.len(), TABLE_STEPS + 1);
-        assert_eq!(t[0][0], CCT_MIN_K);
-        assert_eq!(t[TABLE_STEPS][0], CCT_MAX_K);
-        let ratio = t[1][0] / t[0][0];
+        assert_eq!(t.row(0)[0], CCT_MIN_K);
+        assert_eq!(t.row(TABLE_STEPS)[0], CCT_MAX_K);
+        let ratio = t.row(1)[0] / t.row(0)[0];
         assert!((ratio - 1.001).abs() < 1e-5, "{ratio}");
     }
 
@@ -196,16 +214,25 @@ mod tests {
     }
 
     /// The table row nearest `uv` by a full scan, the method the bisection replaces.
-    fn nearest_row_by_scan(table: &[[f64; 3]], [u, v]: [f64; 2]) -> usize {
-        let dist = |row: &[f64; 3]| (row[1] - u).hypot(row[2] - v);
+    fn nearest_row_by_scan(table: &PlanckTable, [u, v]: [f64; 2]) -> usize {
+        let dist = |row: [f64; 3]| (row[1] - u).hypot(row[2] - v);
         (0..table.len())
-            .min_by(|&a, &b| dist(&table[a]).total_cmp(&dist(&table[b])))
+            .min_by(|&a, &b| dist(table.row(a)).total_cmp(&dist(table.row(b))))
             .unwrap()
     }
 
     #[test]
+    fn a_row_read_lazily_is_planck_at_its_temperature() {
+        let t = PlanckTable;
+        for i in [0, 1, 2303, TABLE_STEPS - 1, TABLE_STEPS] {
+            let [temperature, u, v] = t.row(i);
+            assert_eq!([u, v], planck_uv(temperature), "row {i}");
+        }
+    }
+
+    #[test]
     fn bisection_finds_the_row_a_full_scan_finds() {
-        let table = planck_table();
+        let table = &PlanckTable;
         let mut cases = 0;
         for k in 0..=400 {
             let t = 1005.0 * (99_000.0f64 / 1005.0).powf(k as f64 / 400.0);
@@ -229,7 +256,7 @@ mod tests {
             serde_json::from_str(include_str!("../../tests/reference/colorimetry.json")).unwrap();
         let cases = reference["cct_duv"]["cases"].as_array().unwrap();
         assert!(cases.len() >= 10);
-        let table = planck_table();
+        let table = &PlanckTable;
         for case in cases {
             let uv = [
                 case["uv"][0].as_f64().unwrap(),
@@ -240,7 +267,7 @@ mod tests {
             // colour-science's Ohno 2013 CCT lies between the neighbours of the row found.
             let cct = case["CCT"].as_f64().unwrap();
             assert!(
-                table[m - 1][0] <= cct && cct <= table[m + 1][0],
+                table.row(m - 1)[0] <= cct && cct <= table.row(m + 1)[0],
                 "{}",
                 case["source"]
             );
