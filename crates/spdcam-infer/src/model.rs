@@ -85,15 +85,36 @@ pub struct ModelHeader {
 pub struct Model {
     header: ModelHeader,
     network: Network,
+    /// FNV-1a 64 of the network's parameter values, the fixed part of
+    /// [`Model::fingerprint`], hashed once when the model is made (the weights never change
+    /// after).
+    parameters_hash: u64,
 }
 
+/// FNV-1a 64's offset basis (Fowler, Noll, Vo; IETF draft-eastlake-fnv).
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
 fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    fnv1a_on(FNV_OFFSET, bytes)
+}
+
+/// FNV-1a 64 of `bytes` continued from the state `hash` (FNV hashes byte by byte, so hashing
+/// two pieces in turn is hashing them joined).
+fn fnv1a_on(mut hash: u64, bytes: &[u8]) -> u64 {
     for &b in bytes {
         hash ^= u64::from(b);
         hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
     }
     hash
+}
+
+/// FNV-1a 64 of `network`'s parameter values as f32 little-endian bytes, in forward order.
+fn parameters_hash(network: &Network) -> u64 {
+    network
+        .parameters()
+        .iter()
+        .flat_map(|p| &p.data)
+        .fold(FNV_OFFSET, |hash, v| fnv1a_on(hash, &v.to_le_bytes()))
 }
 
 /// Reads little-endian numbers from a byte slice, with errors instead of panics.
@@ -162,7 +183,11 @@ impl Model {
                 })
                 .collect(),
         };
-        let model = Model { header, network };
+        let model = Model {
+            parameters_hash: parameters_hash(&network),
+            header,
+            network,
+        };
         model.validate()?;
         Ok(model)
     }
@@ -305,12 +330,7 @@ impl Model {
     /// estimates from another's, so a calibration is used only for the model it was
     /// measured on.
     pub fn fingerprint(&self) -> String {
-        let mut bytes: Vec<u8> = self
-            .network
-            .parameters()
-            .iter()
-            .flat_map(|p| p.data.iter().flat_map(|v| v.to_le_bytes()))
-            .collect();
+        let mut hash = self.parameters_hash;
         if let Some(map) = &self.header.colour_map {
             let numbers = [
                 map.mired.slope,
@@ -318,9 +338,11 @@ impl Model {
                 map.duv.slope,
                 map.duv.offset,
             ];
-            bytes.extend(numbers.iter().flat_map(|v| v.to_le_bytes()));
+            for v in numbers {
+                hash = fnv1a_on(hash, &v.to_le_bytes());
+            }
         }
-        format!("{:016x}", fnv1a(&bytes))
+        format!("{hash:016x}")
     }
 
     /// The network.
@@ -545,11 +567,25 @@ impl Model {
                 .try_into()
                 .map_err(|_| truncated())?,
         );
-        if fnv1a(body) != stored {
+        // The checksum is summed beside the reading (both are passes over megabytes); a
+        // mismatch wins over whatever the reading found.
+        let (intact, model) = rayon::join(|| fnv1a(body) == stored, || Self::from_body(body));
+        if !intact {
             return Err(bad(
                 "the file is damaged (checksum mismatch): it was cut short or changed".into(),
             ));
         }
+        model
+    }
+
+    /// The model in `body`, the bytes of a `.spdm` file up to its checksum, whose magic and
+    /// version have been checked.
+    fn from_body(body: &[u8]) -> Result<Model> {
+        let bad = |message: String| InferError::ModelFile {
+            path: "<bytes>".into(),
+            message,
+        };
+        let truncated = || bad("the file is truncated".into());
         let mut c = Cursor {
             bytes: body,
             at: 12,
@@ -579,26 +615,35 @@ impl Model {
                 "the weights hold {blob_len} bytes, the header lists {expected} values"
             )));
         }
-        let mut values = blob
-            .chunks_exact(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
-        let parameters: Vec<Parameter> = header
-            .tensors
-            .iter()
-            .map(|t| {
-                let n = t.shape.iter().product();
-                Parameter {
-                    name: t.name.clone(),
-                    shape: t.shape.clone(),
-                    data: values.by_ref().take(n).collect(),
-                }
-            })
-            .collect();
-        let inputs = header.feature_names.len();
-        let outputs = header.target.len();
-        let network = Network::new(header.architecture.clone(), inputs, outputs, parameters)
-            .map_err(|e| bad(format!("the weights do not fit the architecture: {e}")))?;
-        let model = Model { header, network };
+        let read_network = || {
+            let mut values = blob
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+            let parameters: Vec<Parameter> = header
+                .tensors
+                .iter()
+                .map(|t| {
+                    let n = t.shape.iter().product();
+                    Parameter {
+                        name: t.name.clone(),
+                        shape: t.shape.clone(),
+                        data: values.by_ref().take(n).collect(),
+                    }
+                })
+                .collect();
+            let inputs = header.feature_names.len();
+            let outputs = header.target.len();
+            Network::new(header.architecture.clone(), inputs, outputs, parameters)
+                .map_err(|e| bad(format!("the weights do not fit the architecture: {e}")))
+        };
+        // The weights' bytes are the parameters' values as `parameters_hash` hashes them
+        // (f32 LE in forward order, as `to_bytes` writes them): hashed beside the reading.
+        let (parameters_hash, network) = rayon::join(|| fnv1a(blob), read_network);
+        let model = Model {
+            parameters_hash,
+            header,
+            network: network?,
+        };
         model
             .validate()
             .map_err(|e| bad(format!("the model is inconsistent: {e}")))?;

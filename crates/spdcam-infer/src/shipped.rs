@@ -5,6 +5,7 @@
 
 use crate::error::{InferError, Result};
 use crate::model::Model;
+use rayon::prelude::*;
 use spdcam_core::chart::{shown_chart_name, KnownChart};
 
 /// A model shipped inside the program and what was measured on it: `models/<chart>.spdm`
@@ -78,8 +79,9 @@ impl ModelSet {
     /// # Ok::<(), spdcam_infer::InferError>(())
     /// ```
     pub fn shipped() -> Result<ModelSet> {
+        // Read in parallel: each read checks the file's checksum and hashes the weights.
         let models = SHIPPED
-            .iter()
+            .par_iter()
             .map(|shipped| {
                 let name = shipped.name();
                 let model = Model::from_bytes(shipped.model)
