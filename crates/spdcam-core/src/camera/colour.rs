@@ -101,6 +101,27 @@ fn encode_from_table(table: &[f32], linear: f32) -> f32 {
     table[i] + f * (table[i + 1] - table[i])
 }
 
+/// Steps of the sRGB decoding table over encoded values 0…1: linear interpolation in it is
+/// within 1e-5 of the curve, and a power per pixel and channel made the 24 MP photo bench
+/// about 0.1 s slower.
+const DECODE_TABLE_STEPS: usize = 4096;
+
+/// The sRGB decoding (IEC 61966-2-1) of `encoded`, clipped to 0…1, interpolated in a table
+/// made once (within 1e-5 of [`colorimetry::srgb_decode`]): for loops over pixels or
+/// feature rows.
+#[inline]
+pub fn srgb_decode_fast(encoded: f32) -> f32 {
+    static TABLE: OnceLock<Vec<f32>> = OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        (0..=DECODE_TABLE_STEPS)
+            .map(|k| colorimetry::srgb_decode_f32(k as f32 / DECODE_TABLE_STEPS as f32))
+            .collect()
+    });
+    let x = encoded.clamp(0.0, 1.0) * DECODE_TABLE_STEPS as f32;
+    let i = (x as usize).min(DECODE_TABLE_STEPS - 1);
+    table[i] + (x - i as f32) * (table[i + 1] - table[i])
+}
+
 /// Camera RGB → encoded, quantised sRGB, as one matrix, a table and a number of levels.
 #[derive(Debug, Clone)]
 pub struct ColourTransform {

@@ -10,6 +10,7 @@
 //! noisy ones both segment; duplicates are merged.
 
 use super::pyramid::Level;
+use rayon::prelude::*;
 
 /// A candidate patch, in level pixel coordinates.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,48 +72,11 @@ pub fn find_blobs(level: &Level) -> Vec<Blob> {
     }
     let gradient = gradient(level);
     let max_area = (w * h / 12).max(MIN_AREA + 1);
-    let mut scored: Vec<(f64, Blob)> = Vec::new();
-    let mut visited = vec![false; w * h];
-    let mut stack = Vec::new();
-    let mut pixels = Vec::new();
-    for &t in &THRESHOLDS {
-        visited.fill(false);
-        for start in 0..w * h {
-            if visited[start] || gradient[start] >= t {
-                continue;
-            }
-            pixels.clear();
-            stack.push(start);
-            visited[start] = true;
-            while let Some(i) = stack.pop() {
-                pixels.push(i);
-                let (x, y) = (i % w, i / w);
-                let mut visit = |j: usize| {
-                    if !visited[j] && gradient[j] < t {
-                        visited[j] = true;
-                        stack.push(j);
-                    }
-                };
-                if x > 0 {
-                    visit(i - 1);
-                }
-                if x + 1 < w {
-                    visit(i + 1);
-                }
-                if y > 0 {
-                    visit(i - w);
-                }
-                if y + 1 < h {
-                    visit(i + w);
-                }
-            }
-            if (MIN_AREA..=max_area).contains(&pixels.len()) {
-                if let Some(b) = measure(level, &pixels) {
-                    scored.push(b);
-                }
-            }
-        }
-    }
+    // Each threshold's regions on their own, in parallel, joined in the thresholds' order.
+    let mut scored: Vec<(f64, Blob)> = THRESHOLDS
+        .par_iter()
+        .flat_map_iter(|&t| regions_below(level, &gradient, t, max_area))
+        .collect();
     // Merge the same patch found at several thresholds: keep the largest region.
     scored.sort_by(|a, b| b.1.area.total_cmp(&a.1.area));
     let mut kept: Vec<(f64, Blob)> = Vec::new();
@@ -130,6 +94,53 @@ pub fn find_blobs(level: &Level) -> Vec<Blob> {
         kept.truncate(MAX_BLOBS);
     }
     kept.into_iter().map(|(_, b)| b).collect()
+}
+
+/// The plausible patches, each with its shape error, among the 4-connected regions of
+/// `level` where `gradient` stays below `t`, of [`MIN_AREA`] to `max_area` pixels, in scan
+/// order.
+fn regions_below(level: &Level, gradient: &[f32], t: f32, max_area: usize) -> Vec<(f64, Blob)> {
+    let (w, h) = (level.width, level.height);
+    let mut scored: Vec<(f64, Blob)> = Vec::new();
+    let mut visited = vec![false; w * h];
+    let mut stack = Vec::new();
+    let mut pixels = Vec::new();
+    for start in 0..w * h {
+        if visited[start] || gradient[start] >= t {
+            continue;
+        }
+        pixels.clear();
+        stack.push(start);
+        visited[start] = true;
+        while let Some(i) = stack.pop() {
+            pixels.push(i);
+            let (x, y) = (i % w, i / w);
+            let mut visit = |j: usize| {
+                if !visited[j] && gradient[j] < t {
+                    visited[j] = true;
+                    stack.push(j);
+                }
+            };
+            if x > 0 {
+                visit(i - 1);
+            }
+            if x + 1 < w {
+                visit(i + 1);
+            }
+            if y > 0 {
+                visit(i - w);
+            }
+            if y + 1 < h {
+                visit(i + w);
+            }
+        }
+        if (MIN_AREA..=max_area).contains(&pixels.len()) {
+            if let Some(b) = measure(level, &pixels) {
+                scored.push(b);
+            }
+        }
+    }
+    scored
 }
 
 /// Largest central difference over the channels of the 3 × 3 box-smoothed level, scaled so
