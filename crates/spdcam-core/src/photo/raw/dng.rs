@@ -226,10 +226,29 @@ fn exif_rational(v: f64) -> Option<Rational> {
         d /= 10;
     }
     let n = (v * f64::from(d)).round();
-    (n >= 1.0 && n <= f64::from(u32::MAX)).then(|| Rational { n: n as u32, d })
+    (n >= 1.0 && n <= f64::from(u32::MAX)).then_some(Rational { n: n as u32, d })
 }
 
 /// The `CFAPattern` bytes (0 red, 1 green, 2 blue) of a 2×2 layout, row-major.
 fn cfa_pattern(pattern: CfaPattern) -> [u8; 4] {
     [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(x, y)| pattern.channel_at(x, y) as u8)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::exif_rational;
+
+    #[test]
+    fn exposure_times_keep_nine_digits_as_exif_rationals() {
+        let r = exif_rational(0.003_401_5).unwrap();
+        assert_eq!((r.n, r.d), (3_401_500, 1_000_000_000));
+        // 5000 s: the denominator steps down until the numerator fits 32 bits.
+        let r = exif_rational(5000.0).unwrap();
+        assert_eq!((r.n, r.d), (500_000_000, 100_000));
+        let r = exif_rational(1e-9).unwrap();
+        assert_eq!((r.n, r.d), (1, 1_000_000_000));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-11, 1e10] {
+            assert!(exif_rational(bad).is_none(), "{bad}");
+        }
+    }
 }
