@@ -53,3 +53,19 @@ def test_a_truncated_dng_is_refused_with_its_name(dng):
     data = dng.read_bytes()
     with pytest.raises(spdcam.SpdcamError, match="cut.dng"):
         spdcam.estimate(data[: len(data) // 3], source="cut.dng")
+
+
+def test_a_dng_told_its_illuminance_gives_absolute_levels(cli, tmp_path):
+    """`render --illuminance` writes the DNG's EXIF exposure (ISO 12232 saturation-based
+    speed); Python reads the absolute levels of the raw photo back as it does a JPEG's."""
+    path = tmp_path / "lit.dng"
+    done = cli(
+        "render", "--spd", "A", "--scene", "1200x900", "--chart-centre", "0.5,0.5",
+        "--chart-width", "0.4", "--seed", "30", "--illuminance", "250", "-o", str(path),
+    )
+    assert done.returncode == 0, done.stderr
+    e = spdcam.estimate(str(path))
+    assert e.absolute is not None, e.json.get("absolute_reason")
+    # Read back within 3 % (crates/spdcam/tests/cli_raw.rs says why).
+    assert abs(e.absolute["illuminance_lux"] / 250.0 - 1.0) < 0.03, e.absolute
+    assert "saturation-based speed" in e.absolute["note"]

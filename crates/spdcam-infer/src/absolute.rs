@@ -13,6 +13,18 @@
 //! one illuminance; the median is the answer. The result rests on the camera's ISO rating,
 //! its tone curve and the lens's vignetting, so it is approximate (tens of per cent): every
 //! output says so.
+//!
+//! A raw photo is read on its sensor values instead, by ISO 12232's saturation-based speed
+//! ([`Exposure::luminance_from_raw`]): a neutral patch's green raw value v (a share of the
+//! white level above black, read on the mosaic) had the luminance
+//! L = v · (78 / S) · N² / (q · t), every neutral patch neither clipped nor nearly black
+//! counting. The green photosites stand for the luminance: a neutral patch's green is its
+//! luminance when the camera's green sensitivity, weighted by the light, is shaped as the
+//! CIE V(λ) in the proportion it has under the light the ISO was rated for. The EXIF ISO is
+//! taken as the saturation speed, which a camera rated by SOS or by noise, or with
+//! headroom above its white level, does not give exactly; under a light unlike the
+//! rating's, the green's share of luminance changes (the built-in Nikon D5100's by −21 %
+//! under CIE A against daylight at 5500 K): see [`APPROXIMATE_RAW`].
 
 use crate::error::Result;
 use serde::Serialize;
@@ -34,6 +46,14 @@ pub const APPROXIMATE: &str = "approximate (tens of per cent): from the EXIF exp
      ISO 12232 standard output sensitivity, assuming the camera's ISO rating, a linear tone \
      curve near mid-grey and a lens factor of 0.65; vignetting, exposure correction in the \
      camera and a chart that is not square to the light change it";
+
+/// What every absolute number read from a raw file carries.
+pub const APPROXIMATE_RAW: &str = "approximate (tens of per cent): from the EXIF exposure \
+     by the ISO 12232 saturation-based speed (the white level reached at 78/ISO lux·s), \
+     assuming the EXIF ISO is the sensor's saturation speed, the green photosites stand \
+     for luminance as under the light the ISO was rated for, and a lens factor of 0.65; \
+     a light unlike the rating's (tungsten against daylight: tens of per cent on some \
+     sensors), vignetting and a chart that is not square to the light change it";
 
 /// The absolute levels of a photo's estimate, or why there are none.
 pub type Absolute = std::result::Result<AbsoluteLevel, String>;
@@ -72,17 +92,6 @@ pub fn absolute_level(
     metrics: &LightingMetrics,
     unusable: &[bool],
 ) -> Result<Absolute> {
-    if analysis.raw.is_some() {
-        // A raw value relates to exposure by the sensor's saturation (ISO 12232's
-        // saturation-based speed), not by the JPEG rendering's SOS this module assumes; the
-        // developed features are scaled to the chart's white besides.
-        return Ok(Err(
-            "absolute levels are not read from raw files yet (their relation to the EXIF \
-             exposure is the sensor's saturation, which spdcam does not calibrate yet); \
-             the JPEG of the same shot gives them"
-                .into(),
-        ));
-    }
     let Some(exposure) = analysis.exposure else {
         return Ok(Err(
             "the photo's EXIF gives no aperture, exposure time and ISO".into(),
@@ -98,8 +107,17 @@ pub fn absolute_level(
         Err(reason) => return Ok(Err(reason)),
     };
     // The luminance is linear in the linear value: each patch's illuminance and the median
-    // are the level's, scaled.
-    let lux = |ratio: f64| std::f64::consts::PI * exposure.luminance(ratio);
+    // are the level's, scaled. A raw value (the green photosites, linear on the sensor)
+    // relates to exposure by the saturation-based speed, a rendered one by the SOS.
+    let raw = analysis.raw.is_some();
+    let lux = |ratio: f64| {
+        std::f64::consts::PI
+            * if raw {
+                exposure.luminance_from_raw(ratio)
+            } else {
+                exposure.luminance(ratio)
+            }
+    };
     let illuminance_lux = lux(level.level);
     let found: Vec<(usize, f64)> = level.patches.iter().map(|&(k, r)| (k, lux(r))).collect();
     let grid = spd.grid();
@@ -120,7 +138,7 @@ pub fn absolute_level(
         spectral_irradiance_w_m2_nm: spd.iter().map(|s| s * scale).collect(),
         exposure,
         patches: found,
-        note: APPROXIMATE,
+        note: if raw { APPROXIMATE_RAW } else { APPROXIMATE },
     }))
 }
 

@@ -142,6 +142,9 @@ pub struct Camera {
     camera_name: String,
     chart: Chart,
     response: SpectralResponse,
+    /// The raw response of a perfect white diffuser per unit of light in each band:
+    /// `white[channel·bands + band] = S_channel(λ)·Δλ`.
+    white: Vec<f32>,
     region_map: Vec<u16>,
     /// Each region's centre across the chart, for the lighting gradient.
     region_centres: Vec<[f32; 2]>,
@@ -231,6 +234,10 @@ impl Camera {
             return Err(Error::invalid("a chart may have at most 65534 patches"));
         }
         let response = SpectralResponse::new(sensitivities, &chart, grid)?;
+        let white: Vec<f32> = (0..3)
+            .flat_map(|c| sensitivities.curves.item(c).iter())
+            .map(|&s| (s * grid.step_nm) as f32)
+            .collect();
         let region_map = chart.layout.region_map();
         let region_centres = chart.layout.region_centres();
         let geometry =
@@ -241,6 +248,7 @@ impl Camera {
             camera_name: sensitivities.name.clone(),
             chart,
             response,
+            white,
             region_map,
             region_centres,
             geometry,
@@ -320,7 +328,7 @@ impl Camera {
             + self.geometry.boundaries.len() * std::mem::size_of::<(usize, usize, f64)>()
             + patches * (bands * std::mem::size_of::<f64>() + std::mem::size_of::<String>())
             + self.chart.feature_patches.len() * std::mem::size_of::<usize>()
-            + regions * 3 * bands * std::mem::size_of::<f32>();
+            + (regions + 1) * 3 * bands * std::mem::size_of::<f32>();
         bytes as u64
     }
 
@@ -448,6 +456,26 @@ impl Camera {
         out.iter_mut()
             .for_each(|raw| expose(raw, scale, shot.full_scale));
         Ok((out, scale))
+    }
+
+    /// The raw camera RGB (1 = full scale, unclipped) a perfect white diffuser square to
+    /// `spd` reads at the exposure `scale` ([`Camera::exposed_chart_at`] gives a photo's):
+    /// the light as the sensor sees it at that exposure, before the shot's uneven lighting
+    /// and glare. The virtual camera's absolute exposure rests on it
+    /// ([`crate::photo::raw::dng::virtual_exposure`]).
+    pub fn exposed_white(&self, spd: &Spd, scale: f32) -> Result<[f64; 3]> {
+        let light = self.light(spd)?;
+        let bands = light.len();
+        let mut rgb = [0.0f64; 3];
+        for (c, row) in self.white.chunks_exact(bands).enumerate() {
+            rgb[c] = f64::from(scale)
+                * row
+                    .iter()
+                    .zip(&light)
+                    .map(|(&s, &l)| f64::from(s) * f64::from(l))
+                    .sum::<f64>();
+        }
+        Ok(rgb)
     }
 
     /// Photographs a scene given as linear raw camera RGB at the sensor (exposed, 1 = full

@@ -13,6 +13,17 @@
 //! Cameras' tone curves are not linear, their ISO ratings are within about a third of a
 //! stop of SOS, and lenses vignette: the result is approximate (tens of per cent), which
 //! every output saying it repeats.
+//!
+//! A raw file's values are the sensor's, before any tone curve: for them the chain is ISO
+//! 12232:2019's saturation-based speed instead. A sensor of saturation speed S_sat reaches
+//! its white level (the maximum unclipped value) at the focal-plane exposure
+//! H_sat = 78 / S_sat lux·s; the 78 puts an 18 % grey metered by a reflected-light meter at
+//! 18 %/√2 ≈ 12.7 % of saturation, half a stop of headroom above a 100 % white diffuser. A
+//! raw value is linear in exposure, so an area read at v of the white level (black
+//! subtracted) had H = v · 78 / S and L = v · (78 / S) · N² / (q · t)
+//! ([`Exposure::luminance_from_raw`]). The EXIF ISO is taken as S_sat: a camera rated by
+//! SOS, by noise or with extra headroom, or a raw channel that is not the luminance, moves
+//! the result.
 
 use exif::{In, Reader, Tag, Value};
 use serde::Serialize;
@@ -21,6 +32,9 @@ use serde::Serialize;
 pub const SOS_LINEAR_VALUE: f64 = 0.18;
 /// The focal-plane exposure (lux·s) that ISO S renders at [`SOS_LINEAR_VALUE`] is this / S.
 pub const SOS_EXPOSURE_CONSTANT: f64 = 10.0;
+/// ISO 12232:2019 saturation-based speed: a sensor of speed S saturates (reaches its white
+/// level) at the focal-plane exposure H_sat = this / S lux·s.
+pub const SATURATION_EXPOSURE_CONSTANT: f64 = 78.0;
 /// The lens factor q of H = q · L · t / N² (ISO 12232, ISO 2720: π/4 · transmission 0.9 ·
 /// vignetting 0.98 · cos⁴ 10° ≈ 0.65).
 pub const LENS_FACTOR: f64 = 0.65;
@@ -88,6 +102,28 @@ impl Exposure {
     pub fn luminance(&self, y: f64) -> f64 {
         (y / SOS_LINEAR_VALUE) * (SOS_EXPOSURE_CONSTANT / self.iso) * self.f_number.powi(2)
             / (LENS_FACTOR * self.exposure_time_s)
+    }
+
+    /// The luminance (cd/m²) of a scene area a raw file reads at `v` of the sensor's white
+    /// level (black subtracted; linear, before any development), with the EXIF ISO taken
+    /// as the sensor's ISO 12232 saturation-based speed: L = v · (78 / S) · N² / (q · t)
+    /// (module documentation).
+    pub fn luminance_from_raw(&self, v: f64) -> f64 {
+        v * (SATURATION_EXPOSURE_CONSTANT / self.iso) * self.f_number.powi(2)
+            / (LENS_FACTOR * self.exposure_time_s)
+    }
+
+    /// The exposure at aperture `f_number` on a sensor of saturation speed `iso` that reads
+    /// a scene area of `luminance` (cd/m²) at `v` of the white level: its time is
+    /// t = v · (78 / S) · N² / (q · L), so that [`Exposure::luminance_from_raw`] of `v`
+    /// gives `luminance` back. `None` unless every input is finite and positive.
+    pub fn for_raw_value(f_number: f64, iso: f64, luminance: f64, v: f64) -> Option<Exposure> {
+        if !(luminance.is_finite() && luminance > 0.0 && v.is_finite() && v > 0.0) {
+            return None;
+        }
+        let time =
+            v * (SATURATION_EXPOSURE_CONSTANT / iso) * f_number.powi(2) / (LENS_FACTOR * luminance);
+        Exposure::new(f_number, time, iso)
     }
 
     /// `f/4, 1/60 s, ISO 400`.
@@ -196,5 +232,24 @@ mod tests {
         };
         assert!((e.luminance(0.18) - 0.1 * 16.0 / 0.0065).abs() < 1e-9);
         assert!((e.luminance(0.36) - 2.0 * e.luminance(0.18)).abs() < 1e-9);
+        // A raw file: at the white level (v = 1) ISO 100 saturated at H = 78/100 lux·s, so
+        // L = 0.78 · 16 / (0.65 · 0.01) = 1920 cd/m²; half the raw value, half the light.
+        assert!((e.luminance_from_raw(1.0) - 0.78 * 16.0 / 0.0065).abs() < 1e-9);
+        assert!((e.luminance_from_raw(0.25) - 480.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_raw_exposure_for_a_luminance_reads_it_back() {
+        let e = Exposure::for_raw_value(4.0, 100.0, 318.31, 0.4).unwrap();
+        assert_eq!((e.f_number, e.iso), (4.0, 100.0));
+        // t = 0.4 · 0.78 · 16 / (0.65 · 318.31) = 24.1 ms.
+        assert!((e.exposure_time_s - 0.4 * 0.78 * 16.0 / (0.65 * 318.31)).abs() < 1e-12);
+        assert!((e.luminance_from_raw(0.4) / 318.31 - 1.0).abs() < 1e-12);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(Exposure::for_raw_value(4.0, 100.0, bad, 0.4).is_none());
+            assert!(Exposure::for_raw_value(4.0, 100.0, 318.31, bad).is_none());
+            assert!(Exposure::for_raw_value(bad, 100.0, 318.31, 0.4).is_none());
+            assert!(Exposure::for_raw_value(4.0, bad, 318.31, 0.4).is_none());
+        }
     }
 }

@@ -14,11 +14,13 @@ use parse::parse_pair;
 use places_photo::render_places;
 use scene_photo::render_scene;
 use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::Camera;
 use spdcam_core::imageio;
 use spdcam_core::light_families::Lighting;
-use spdcam_core::photo::raw::dng::virtual_camera_dng;
+use spdcam_core::photo::raw::dng::{virtual_camera_dng, virtual_exposure};
 use spdcam_core::photo::scene;
-use spdcam_core::spectral::{Grid, SpectralSet};
+use spdcam_core::photo::Exposure;
+use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_core::{fsio, limits, named_light};
 use std::path::{Path, PathBuf};
 
@@ -44,6 +46,12 @@ pub struct RenderArgs {
     /// under A and D65, the light's neutral as shot); `-` writes it to standard output.
     #[arg(short, long)]
     output: PathBuf,
+    /// With FILE.dng: the light's illuminance on the chart, lux; the DNG then carries the
+    /// EXIF exposure (f/4, ISO 100 as the sensor's ISO 12232 saturation-based speed, and
+    /// the time that puts the chart's raw values at that illuminance), from which
+    /// `estimate` reads absolute levels. Not with --place or --right-light.
+    #[arg(long, value_name = "LUX", conflicts_with_all = ["places", "right_light"])]
+    illuminance: Option<f64>,
     /// Also write the feature row (mean sRGB 0–255 of each patch) as CSV; `-` for standard
     /// output.
     #[arg(long, value_name = "FILE.csv")]
@@ -196,6 +204,12 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
             "the chart is written as PNG or as a raw DNG: name the output FILE.png or FILE.dng"
         ),
     }
+    if args.illuminance.is_some() && !dng {
+        bail!(
+            "--illuminance sets the EXIF exposure of a raw DNG: name the output FILE.dng \
+             (a JPEG or PNG has no exposure written)"
+        );
+    }
     let spd = match (&args.spd, &args.lighting, args.draw) {
         (Some(spec), _, _) => named_light::resolve_spd(spec, data_dir, &grid)?,
         (None, Some(recipe), Some(index)) => {
@@ -255,9 +269,13 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         let mosaic = rendering.stages.cfa.as_ref().ok_or_else(|| {
             anyhow::anyhow!("a three-sensor camera has no mosaic to write as a DNG")
         })?;
+        let exposure = args
+            .illuminance
+            .map(|lux| dng_exposure(&camera, &spd.spd, lux))
+            .transpose()?;
         fsio::write_output(
             &args.output,
-            &virtual_camera_dng(&camera, &spd.spd, mosaic, None)?,
+            &virtual_camera_dng(&camera, &spd.spd, mosaic, exposure)?,
         )?;
     } else {
         fsio::write_output(&args.output, &imageio::encode_png(&rendering.image, depth)?)?;
@@ -281,6 +299,14 @@ pub fn run(args: RenderArgs, data_dir: &DataDir) -> Result<()> {
         args.output.display()
     ))?;
     Ok(())
+}
+
+/// The EXIF exposure of a DNG `camera` took under `spd` lighting its chart at `lux`
+/// (`--illuminance`): at the exposure the camera metered
+/// ([`spdcam_core::photo::raw::dng::virtual_exposure`]).
+fn dng_exposure(camera: &Camera, spd: &Spd, lux: f64) -> Result<Exposure> {
+    let scale = camera.exposed_chart_at(&[spd], None)?.1;
+    Ok(virtual_exposure(camera, spd, scale, lux)?)
 }
 
 fn write_stages(dir: &Path, stages: &spdcam_core::camera::Stages) -> Result<()> {

@@ -121,7 +121,8 @@ pub(super) fn scene_camera(args: &RenderArgs, chart: Chart, data_dir: &DataDir) 
 }
 
 /// Writes a scene photo to `--output`: its JPEG, or for FILE.dng the sensor's `mosaic` as
-/// `camera` under `light` would write it (`no_mosaic` says why a scene has none).
+/// `camera` under `light` would write it, with the EXIF exposure of `--illuminance` when
+/// given (`no_mosaic` says why a scene has none).
 pub(super) fn write_scene(
     args: &RenderArgs,
     (camera, light): (&Camera, &Spd),
@@ -139,8 +140,12 @@ pub(super) fn write_scene(
     let mosaic = mosaic.ok_or_else(|| {
         anyhow::anyhow!("this scene has no single mosaic to write as a DNG ({no_mosaic})")
     })?;
+    let exposure = args
+        .illuminance
+        .map(|lux| super::dng_exposure(camera, light, lux))
+        .transpose()?;
     Ok(fsio::write_output(
         &args.output,
-        &virtual_camera_dng(camera, light, mosaic, None)?,
+        &virtual_camera_dng(camera, light, mosaic, exposure)?,
     )?)
 }

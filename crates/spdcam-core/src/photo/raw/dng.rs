@@ -4,6 +4,19 @@
 //! calibration illuminants, `AsShotNeutral` and the EXIF exposure (TIFF/EP puts it in
 //! IFD 0). The virtual camera writes its photos this way (`spdcam render -o photo.dng`), so
 //! that tests have raw photos of a known light; any DNG reader opens them.
+//!
+//! The virtual camera's exposure is relative: it meters the chart and scales its raw
+//! values to that, whatever the light's level. Told the light's illuminance on the chart,
+//! [`virtual_exposure`] writes the EXIF exposure that ISO 12232:2019's saturation-based
+//! speed gives those raw values: the sensor is rated ISO [`VIRTUAL_ISO`] by saturation
+//! under the light photographed, the lens is at [`VIRTUAL_F_NUMBER`], and the exposure
+//! time is what puts a perfect white diffuser at the green raw value the photo has
+//! ([`Exposure::for_raw_value`]). A reader that takes the EXIF ISO as the saturation speed
+//! and the green photosites as luminance ([`Exposure::luminance_from_raw`]) reads the
+//! light's level back. A real camera's ISO is rated under one daylight illuminant, so
+//! under another light its green's share of luminance moves what such a reader finds
+//! (docs/raw.md); the virtual camera's rating follows the light, so that its files test
+//! the reading itself.
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -20,6 +33,11 @@ use tiff::tags::Tag;
 pub const DNG_BLACK: u16 = 256;
 /// The white level written (a 14-bit sensor).
 pub const DNG_WHITE: u16 = 16383;
+/// The aperture the virtual camera's DNGs are exposed at (f-number).
+pub const VIRTUAL_F_NUMBER: f64 = 4.0;
+/// The virtual sensor's ISO 12232:2019 saturation-based speed: its white level is reached at
+/// the focal-plane exposure 78 / 100 = 0.78 lux·s of the light photographed.
+pub const VIRTUAL_ISO: f64 = 100.0;
 /// Denominator of the matrices' signed rationals.
 const MATRIX_DENOMINATOR: i32 = 10_000;
 
@@ -124,10 +142,12 @@ pub fn encode_dng(mosaic: &Mosaic, meta: &DngMetadata) -> Result<Vec<u8>> {
     dir.write_tag(Tag::Unknown(50728), &neutral[..])
         .map_err(fail)?; // AsShotNeutral
     if let Some(e) = &meta.exposure {
-        let time = Rational {
-            n: (e.exposure_time_s * 1_000_000.0).round().max(1.0) as u32,
-            d: 1_000_000,
-        };
+        let time = exif_rational(e.exposure_time_s).ok_or_else(|| {
+            Error::invalid(format!(
+                "the exposure time {} s cannot be written as an EXIF rational",
+                e.exposure_time_s
+            ))
+        })?;
         let f_number = Rational {
             n: (e.f_number * 100.0).round() as u32,
             d: 100,
@@ -162,7 +182,73 @@ pub fn virtual_camera_dng(
     encode_dng(mosaic, &meta)
 }
 
+/// The EXIF exposure of a photo `camera` took of its chart under `spd` lighting the chart
+/// at `illuminance_lux`, with its raw values scaled by `scale` ([`Camera::exposed_chart_at`]
+/// gives a photo's): f/[`VIRTUAL_F_NUMBER`], ISO [`VIRTUAL_ISO`] as the sensor's
+/// saturation-based speed under `spd`, and the time at which a perfect white diffuser
+/// (luminance E/π) reads its green raw value at `scale`
+/// ([`Exposure::for_raw_value`]; the module documentation says why). An error for an
+/// illuminance that is not finite and positive, or a light the camera's green does not see.
+pub fn virtual_exposure(
+    camera: &Camera,
+    spd: &Spd,
+    scale: f32,
+    illuminance_lux: f64,
+) -> Result<Exposure> {
+    if !(illuminance_lux.is_finite() && illuminance_lux > 0.0) {
+        return Err(Error::invalid(format!(
+            "the illuminance {illuminance_lux} lx must be finite and above zero"
+        )));
+    }
+    let green = camera.exposed_white(spd, scale)?[1];
+    let luminance = illuminance_lux / std::f64::consts::PI;
+    let exposure = Exposure::for_raw_value(VIRTUAL_F_NUMBER, VIRTUAL_ISO, luminance, green)
+        .ok_or_else(|| Error::invalid("the light gives this camera no green signal"))?;
+    match exif_rational(exposure.exposure_time_s) {
+        Some(_) => Ok(exposure),
+        None => Err(Error::invalid(format!(
+            "{illuminance_lux} lx at this photo's raw level (ISO {VIRTUAL_ISO}, \
+             f/{VIRTUAL_F_NUMBER}) needs an exposure time of {} s, which EXIF cannot hold",
+            exposure.exposure_time_s
+        ))),
+    }
+}
+
+/// A positive value as an EXIF rational of at least 9 significant digits where it fits
+/// (the largest power-of-ten denominator up to 10⁹ that keeps the numerator in 32 bits);
+/// `None` when it is not finite and positive or lies outside 10⁻⁹…4·10⁹.
+fn exif_rational(v: f64) -> Option<Rational> {
+    if !(v.is_finite() && v > 0.0) {
+        return None;
+    }
+    let mut d: u32 = 1_000_000_000;
+    while d > 1 && v * f64::from(d) > f64::from(u32::MAX) {
+        d /= 10;
+    }
+    let n = (v * f64::from(d)).round();
+    (n >= 1.0 && n <= f64::from(u32::MAX)).then_some(Rational { n: n as u32, d })
+}
+
 /// The `CFAPattern` bytes (0 red, 1 green, 2 blue) of a 2×2 layout, row-major.
 fn cfa_pattern(pattern: CfaPattern) -> [u8; 4] {
     [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(x, y)| pattern.channel_at(x, y) as u8)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::exif_rational;
+
+    #[test]
+    fn exposure_times_keep_nine_digits_as_exif_rationals() {
+        let r = exif_rational(0.003_401_5).unwrap();
+        assert_eq!((r.n, r.d), (3_401_500, 1_000_000_000));
+        // 5000 s: the denominator steps down until the numerator fits 32 bits.
+        let r = exif_rational(5000.0).unwrap();
+        assert_eq!((r.n, r.d), (500_000_000, 100_000));
+        let r = exif_rational(1e-9).unwrap();
+        assert_eq!((r.n, r.d), (1, 1_000_000_000));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-11, 1e10] {
+            assert!(exif_rational(bad).is_none(), "{bad}");
+        }
+    }
 }

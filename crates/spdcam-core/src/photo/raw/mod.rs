@@ -435,6 +435,73 @@ mod tests {
     }
 
     #[test]
+    fn a_dng_told_its_illuminance_reads_it_back_on_each_grey_patch() {
+        // The chart in the middle of the scene (vignetting under 1 % there) under two
+        // lights at two levels: each grey patch's green raw value, by the EXIF exposure
+        // as ISO 12232 saturation speed, gives the illuminance it was told.
+        let camera = scene_camera();
+        let grid = *camera.grid();
+        let observer = Observer::cie1931(&grid).unwrap();
+        let chart = Chart::colorchecker24(&grid).unwrap();
+        let template = ChartTemplate::from_chart(&chart).unwrap();
+        let options = AnalyseOptions {
+            templates: vec![template],
+            ..AnalyseOptions::default()
+        };
+        let scene = SceneOptions {
+            width: 1200,
+            height: 900,
+            width_share: (0.3, 0.3),
+            centre: Some([0.5, 0.5]),
+            vignetting: (0.0, 0.0),
+            ..SceneOptions::default()
+        };
+        for (k, (spd, lux)) in [
+            (StandardIlluminant::A.spd(&grid).unwrap(), 250.0),
+            (StandardIlluminant::D65.spd(&grid).unwrap(), 20_000.0),
+        ]
+        .iter()
+        .enumerate()
+        {
+            let shot =
+                scene::photograph(&camera, SceneLight::single(spd), 20 + k as u64, &scene).unwrap();
+            let scale = camera.exposed_chart_at(&[spd], None).unwrap().1;
+            let exposure = super::dng::virtual_exposure(&camera, spd, scale, *lux).unwrap();
+            let bytes =
+                virtual_camera_dng(&camera, spd, shot.mosaic.as_ref().unwrap(), Some(exposure))
+                    .unwrap();
+            let photo = decode_photo(&bytes, "lux.dng").unwrap();
+            let read = photo.raw().unwrap().exposure.unwrap();
+            assert_eq!((read.f_number, read.iso), (4.0, 100.0));
+            assert!(
+                (read.exposure_time_s / exposure.exposure_time_s - 1.0).abs() < 1e-6,
+                "{read:?} vs {exposure:?}"
+            );
+            let analysis = analyse(&photo, &options).unwrap();
+            let mut greys = 0;
+            for (f, _) in chart.neutral_features() {
+                let patch = &analysis.patches[chart.feature_patches[f]];
+                if patch.clipped || patch.dark {
+                    continue;
+                }
+                let green = f64::from(patch.camera_rgb.unwrap()[1]);
+                let factor = observer
+                    .reflectance_to_xyz(chart.reflectances.item(chart.feature_patches[f]), spd)[1];
+                let found = std::f64::consts::PI * read.luminance_from_raw(green) / factor;
+                // The grey's green share of its luminance factor under the light, the noise
+                // and the DNG's 14-bit steps: within 3 %.
+                assert!(
+                    (found / lux - 1.0).abs() < 0.03,
+                    "light {k}, grey {}: {found} lx, not {lux}",
+                    f + 1
+                );
+                greys += 1;
+            }
+            assert!(greys >= 4, "{greys} greys read");
+        }
+    }
+
+    #[test]
     fn a_damaged_or_truncated_raw_file_is_an_error_naming_it_never_a_crash() {
         let camera = scene_camera();
         let spd = StandardIlluminant::D65.spd(camera.grid()).unwrap();
