@@ -142,7 +142,7 @@ pub(super) fn write_scene(
     })?;
     let exposure = args
         .illuminance
-        .map(|lux| super::dng_exposure(camera, light, lux))
+        .map(|lux| super::chart_photo::dng_exposure(camera, light, lux))
         .transpose()?;
     Ok(fsio::write_output(
         &args.output,
