@@ -97,42 +97,53 @@ impl RawMosaic {
         (self.width / cw, self.height / ch)
     }
 
-    /// Linear camera RGB of cell (`cx`, `cy`): each channel's photosites averaged, black
-    /// subtracted, as a share of full scale (white − black); and whether any photosite of
-    /// it is clipped.
-    #[inline]
-    pub fn cell(&self, cx: usize, cy: usize) -> ([f32; 3], bool) {
+    /// The reader of this mosaic's cells ([`CellReader::cell`]).
+    pub fn cell_reader(&self) -> CellReader<'_> {
         let (cw, ch) = self.cell_size();
-        let mut sum = [0f32; 3];
-        let mut count = [0u32; 3];
-        let mut clipped = false;
-        for dy in 0..ch {
-            let y = cy * ch + dy;
-            for dx in 0..cw {
-                let x = cx * cw + dx;
-                let base = (y * self.width + x) * self.channels;
-                for k in 0..self.channels {
-                    let colour = match &self.cfa {
-                        Some(t) => t.colours[dy * t.width + dx] as usize,
-                        None => k,
-                    };
-                    let stored = self.values[base + k] as f32;
-                    let black = self.black_at(x, y, k);
-                    let white = self.white[colour];
-                    clipped |= stored >= black + CLIP_SHARE * (white - black);
-                    sum[colour] += (stored - black) / (white - black);
-                    count[colour] += 1;
+        let (bw, bh) = self.black_tile;
+        let repeats = bw > 0 && bh > 0 && cw % bw == 0 && ch % bh == 0;
+        let levels = if repeats {
+            let mut levels = Vec::with_capacity(cw * ch * self.channels);
+            for dy in 0..ch {
+                for dx in 0..cw {
+                    for k in 0..self.channels {
+                        let black = self.black_at(dx, dy, k);
+                        let colour = self.colour_at(dx, dy, k);
+                        let white = self.white[colour];
+                        levels.push(Levels {
+                            colour,
+                            black,
+                            range: white - black,
+                            clip: black + CLIP_SHARE * (white - black),
+                        });
+                    }
                 }
             }
+            levels
+        } else {
+            Vec::new()
+        };
+        CellReader {
+            mosaic: self,
+            cell_size: (cw, ch),
+            levels,
         }
-        (
-            std::array::from_fn(|c| sum[c] / count[c].max(1) as f32),
-            clipped,
-        )
+    }
+
+    /// The colour (0 red, 1 green, 2 blue) of channel `k` of the photosite at (`dx`, `dy`)
+    /// within its cell.
+    #[inline]
+    fn colour_at(&self, dx: usize, dy: usize, k: usize) -> usize {
+        match &self.cfa {
+            Some(t) => t.colours[dy * t.width + dx] as usize,
+            None => k,
+        }
     }
 
     #[inline]
     fn black_at(&self, x: usize, y: usize, channel: usize) -> f32 {
+        // Called per photosite only where the black-level tile does not repeat within the
+        // cell (see `CellReader`).
         let (bw, bh) = self.black_tile;
         let per = self.black.len() / (bw * bh).max(1);
         let i = ((y % bh) * bw + x % bw) * per + channel.min(per.saturating_sub(1));
@@ -155,6 +166,7 @@ impl RawMosaic {
         let (cells_x, cells_y) = self.cells();
         let (w, h) = (cells_x / bin, cells_y / bin);
         let mut linear = vec![[0f32; 3]; w * h];
+        let reader = self.cell_reader();
         linear
             .par_chunks_mut(w.max(1))
             .enumerate()
@@ -163,7 +175,7 @@ impl RawMosaic {
                     let mut s = [0f32; 3];
                     for by in 0..bin {
                         for bx in 0..bin {
-                            let (v, _) = self.cell(px * bin + bx, py * bin + by);
+                            let (v, _) = reader.cell(px * bin + bx, py * bin + by);
                             (0..3).for_each(|c| s[c] += v[c]);
                         }
                     }
@@ -306,6 +318,72 @@ impl RawMosaic {
             }
         }
         Ok(())
+    }
+}
+
+/// A photosite's black level, its range to white (white − black) and the value from which
+/// it counts as clipped, for one position and channel of the cell.
+#[derive(Debug, Clone, Copy)]
+struct Levels {
+    colour: usize,
+    black: f32,
+    range: f32,
+    clip: f32,
+}
+
+/// Reads a [`RawMosaic`]'s cells with the levels of each position in the cell worked out
+/// once (where the black-level tile repeats within the cell, as in every raw file seen),
+/// not per photosite: the preview reads every cell of the photo.
+pub struct CellReader<'a> {
+    mosaic: &'a RawMosaic,
+    cell_size: (usize, usize),
+    /// Per position in the cell and channel, row by row; empty where the black-level tile
+    /// does not repeat within the cell.
+    levels: Vec<Levels>,
+}
+
+impl CellReader<'_> {
+    /// Linear camera RGB of cell (`cx`, `cy`): each channel's photosites averaged, black
+    /// subtracted, as a share of full scale (white − black); and whether any photosite of
+    /// it is clipped.
+    #[inline]
+    pub fn cell(&self, cx: usize, cy: usize) -> ([f32; 3], bool) {
+        let m = self.mosaic;
+        let (cw, ch) = self.cell_size;
+        let mut sum = [0f32; 3];
+        let mut count = [0u32; 3];
+        let mut clipped = false;
+        for dy in 0..ch {
+            let y = cy * ch + dy;
+            for dx in 0..cw {
+                let x = cx * cw + dx;
+                let base = (y * m.width + x) * m.channels;
+                for k in 0..m.channels {
+                    let stored = m.values[base + k] as f32;
+                    let levels = match self.levels.get((dy * cw + dx) * m.channels + k) {
+                        Some(&levels) => levels,
+                        None => {
+                            let black = m.black_at(x, y, k);
+                            let colour = m.colour_at(dx, dy, k);
+                            let white = m.white[colour];
+                            Levels {
+                                colour,
+                                black,
+                                range: white - black,
+                                clip: black + CLIP_SHARE * (white - black),
+                            }
+                        }
+                    };
+                    clipped |= stored >= levels.clip;
+                    sum[levels.colour] += (stored - levels.black) / levels.range;
+                    count[levels.colour] += 1;
+                }
+            }
+        }
+        (
+            std::array::from_fn(|c| sum[c] / count[c].max(1) as f32),
+            clipped,
+        )
     }
 }
 

@@ -225,13 +225,14 @@ fn patch_cells(
     let [[sx0, sy0], _, [sx1, sy1], _] = square;
     let mut cells = Vec::new();
     let mut clipped = Vec::new();
+    let reader = raw.cell_reader();
     for cy in (y0..y1).step_by(stride) {
         for cx in (x0..x1).step_by(stride) {
             let q = inverse.apply([(cx as f64 + 0.5) * cw as f64, (cy as f64 + 0.5) * ch as f64]);
             if q[0] < sx0 || q[0] > sx1 || q[1] < sy0 || q[1] > sy1 {
                 continue;
             }
-            let (v, c) = raw.cell(cx, cy);
+            let (v, c) = reader.cell(cx, cy);
             cells.push(v);
             clipped.push(c);
         }
