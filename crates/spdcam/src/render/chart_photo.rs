@@ -24,7 +24,7 @@ pub(super) fn render_chart(
     messages: Messages,
     dng: bool,
 ) -> Result<()> {
-    let camera = args.camera.camera(data_dir, &grid)?;
+    let camera = args.camera.camera(data_dir, grid)?;
     let rendering = camera.render(spd, args.seed, args.stages.is_some() || dng)?;
     let depth = camera.config().colour.bit_depth;
     if let Some(dir) = &args.stages {
