@@ -107,15 +107,7 @@ impl RawMosaic {
             for dy in 0..ch {
                 for dx in 0..cw {
                     for k in 0..self.channels {
-                        let black = self.black_at(dx, dy, k);
-                        let colour = self.colour_at(dx, dy, k);
-                        let white = self.white[colour];
-                        levels.push(Levels {
-                            colour,
-                            black,
-                            range: white - black,
-                            clip: black + CLIP_SHARE * (white - black),
-                        });
+                        levels.push(self.levels_at(dx, dy, dx, dy, k));
                     }
                 }
             }
@@ -127,6 +119,21 @@ impl RawMosaic {
             mosaic: self,
             cell_size: (cw, ch),
             levels,
+        }
+    }
+
+    /// The levels of channel `k` of the photosite at (`x`, `y`), which lies at (`dx`, `dy`)
+    /// within its cell.
+    #[inline]
+    fn levels_at(&self, x: usize, y: usize, dx: usize, dy: usize, k: usize) -> Levels {
+        let black = self.black_at(x, y, k);
+        let colour = self.colour_at(dx, dy, k);
+        let white = self.white[colour];
+        Levels {
+            colour,
+            black,
+            range: white - black,
+            clip: black + CLIP_SHARE * (white - black),
         }
     }
 
@@ -362,17 +369,7 @@ impl CellReader<'_> {
                     let stored = m.values[base + k] as f32;
                     let levels = match self.levels.get((dy * cw + dx) * m.channels + k) {
                         Some(&levels) => levels,
-                        None => {
-                            let black = m.black_at(x, y, k);
-                            let colour = m.colour_at(dx, dy, k);
-                            let white = m.white[colour];
-                            Levels {
-                                colour,
-                                black,
-                                range: white - black,
-                                clip: black + CLIP_SHARE * (white - black),
-                            }
-                        }
+                        None => m.levels_at(x, y, dx, dy, k),
                     };
                     clipped |= stored >= levels.clip;
                     sum[levels.colour] += (stored - levels.black) / levels.range;
