@@ -194,6 +194,8 @@ mod tests {
             band95: band(0.1),
             expected_gfc: 0.99,
             gfc_at_least95: 0.97,
+            gfc_margin_factor: 2.0,
+            gfc_margin_local: true,
             difficulty: 0.01,
             widening: 1.0,
             metrics: BTreeMap::new(),

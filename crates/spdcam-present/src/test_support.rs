@@ -29,6 +29,8 @@ pub(crate) fn estimate_of(spd: Spd, halves: &[(&str, f64)]) -> Estimate {
                 band95: band,
                 expected_gfc: 0.995,
                 gfc_at_least95: 0.98,
+                gfc_margin_factor: 2.0,
+                gfc_margin_local: true,
                 difficulty: 0.01,
                 widening: 1.0,
                 metrics: halves

@@ -10,16 +10,20 @@ use crate::trust::judged::{
     Judged,
 };
 use crate::trust::real::{balanced, real_split};
+use crate::trust::records::CalibrationRecord;
 use crate::trust::scenes::scene_rows;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::Chart;
 use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::quality::registry;
+use spdcam_core::spectral::Grid;
 use spdcam_infer::pca::{Components, Pca};
 use spdcam_infer::ridge::{Gram, Ridge};
+use spdcam_infer::trust::calibration::estimate_cct;
+use spdcam_infer::trust::local_margin::{photo_coordinates, LocalMargin, COORDINATES};
 use spdcam_infer::trust::{
-    self, ChartCheck, GfcModel, MetricCalibration, SelfCheck, TrustCalibration, JITTER_COPIES,
-    JITTER_SIGMA,
+    self, ChartCheck, GfcModel, MetricCalibration, SelfCheck, TrustCalibration, DOUBTFUL_GFC,
+    JITTER_COPIES, JITTER_SIGMA, POOR_GFC,
 };
 use spdcam_infer::Model;
 use std::collections::BTreeMap;
@@ -45,6 +49,9 @@ pub struct CalibrationPhotos {
     /// The cross-validation group of each photo: a lamp's photos (patch level and scene)
     /// together, so that a lamp never informs its own prediction; each real photo alone.
     groups: Vec<usize>,
+    /// Each photo's source (`virtual`, `scene` or the real set's name) and light's type,
+    /// for its record.
+    sources: Vec<(String, String)>,
 }
 
 /// The kinds of calibration photo, each of which the metric intervals and the expected
@@ -96,13 +103,14 @@ impl CalibrationPhotos {
 }
 
 /// Fits `model`'s calibration: the self-check's levels on the virtual photos alone (clean
-/// by construction, so that they tell bad photos), everything else on all of `photos`.
+/// by construction, so that they tell bad photos), everything else on all of `photos`;
+/// beside it, each photo's record.
 pub fn fit_calibration(
     model: &Model,
     chart: &str,
     photos: &CalibrationPhotos,
     method: String,
-) -> Result<TrustCalibration> {
+) -> Result<(TrustCalibration, Vec<CalibrationRecord>)> {
     let (judged, features) = (&photos.judged, &photos.features);
     let d = model.grid().count;
     let err = |j: &Judged, k: usize| (j.spd[k] - j.truth.as_ref().map_or(0.0, |t| t[k])).abs();
@@ -146,7 +154,7 @@ pub fn fit_calibration(
     let mut glares = checks_of(|s| Some(s.glare));
     let mut two_lights = checks_of(|s| Some(s.two_lights));
     let kinds = photos.kinds();
-    let gfc_model = fit_gfc_model(judged, &photos.groups, &kinds)?;
+    let (gfc_model, held_out) = fit_gfc_model(judged, &photos.groups, &kinds)?;
     let expected_gaps: Vec<f64> = judged
         .iter()
         .map(|j| 1.0 - gfc_model.expected(&j.spd, difficulty(j)))
@@ -176,7 +184,29 @@ pub fn fit_calibration(
         .iter()
         .map(|row| trust::clipped_patches(row) as f64)
         .collect();
-    Ok(TrustCalibration {
+    let local_margin = fit_local_margin(
+        &model.grid(),
+        judged,
+        &expected_gaps,
+        &held_out,
+        (&photos.groups, &kinds),
+        gfc_model.gap_margin95,
+    )?;
+    let records = (0..judged.len())
+        .map(|i| {
+            let (source, light) = &photos.sources[i];
+            CalibrationRecord::of(
+                &judged[i],
+                source,
+                light,
+                photos.groups[i],
+                1.0 - expected_gaps[i],
+                held_out[i],
+                clipped[i] as usize,
+            )
+        })
+        .collect();
+    let calibration = TrustCalibration {
         model: model.fingerprint(),
         chart: chart.to_string(),
         method,
@@ -201,7 +231,100 @@ pub fn fit_calibration(
         metrics: metric_calibrations,
         real_photos: photos.judged.len() - photos.virtual_count - photos.scene_count,
         scenes_per_lamp: photos.scenes_per_lamp,
-    })
+        local_margin,
+    };
+    Ok((calibration, records))
+}
+
+/// Calibration photos among which a photo's expected-GFC margin is taken
+/// ([`LocalMargin`]). Chosen on the SG's calibration photos of `docs/trust.md`
+/// (`tools/local_margin_choice.py`) among 30, 50 and 100 and four sets of coordinates by
+/// the rule of [`local_margin_wins`].
+pub const LOCAL_NEIGHBOURS: usize = 100;
+
+/// The local margin of the calibration photos `judged` (estimates on `grid`; 1 − their
+/// expected GFC `expected_gaps`, their held-out residuals of ln(1 − GFC) `held_out`, their
+/// cross-validation groups and kinds), where it wins over the pooled margin `pooled` by
+/// [`local_margin_wins`]: built on the photos that can be placed ([`photo_coordinates`]: a
+/// CCT and a self-check); `None` with fewer than [`LOCAL_NEIGHBOURS`] of them or where it
+/// does not win.
+fn fit_local_margin(
+    grid: &Grid,
+    judged: &[Judged],
+    expected_gaps: &[f64],
+    held_out: &[f64],
+    (groups, kinds): (&[usize], &[PhotoKind]),
+    pooled: f64,
+) -> Result<Option<LocalMargin>> {
+    let mut placed: Vec<([f64; COORDINATES], f64)> = Vec::with_capacity(judged.len());
+    let mut photos = Vec::with_capacity(judged.len());
+    for (i, j) in judged.iter().enumerate() {
+        let check = j.self_check.as_ref();
+        if let Some(x) = photo_coordinates(
+            1.0 - expected_gaps[i],
+            estimate_cct(grid, &j.spd)?,
+            check.map(|c| c.mean),
+            check.and_then(|c| c.veil.as_ref()).map(|v| v.share),
+        ) {
+            placed.push((x, held_out[i]));
+            photos.push(PlacedPhoto {
+                group: groups[i],
+                kind: kinds[i],
+                expected_gfc: 1.0 - expected_gaps[i],
+                gfc: gfc(j),
+            });
+        }
+    }
+    let Some(local) = LocalMargin::fit(&placed, LOCAL_NEIGHBOURS) else {
+        return Ok(None);
+    };
+    Ok(local_margin_wins(&local, &photos, pooled).then_some(local))
+}
+
+/// A calibration photo placed among the others, for [`local_margin_wins`].
+struct PlacedPhoto {
+    /// Its cross-validation group (a lamp's photos share one).
+    group: usize,
+    /// Its kind.
+    kind: PhotoKind,
+    /// Its expected GFC.
+    expected_gfc: f64,
+    /// Its GFC.
+    gfc: f64,
+}
+
+/// Whether the local margin `local` serves the verdict better than the pooled margin
+/// `pooled` on the calibration photos `photos` (in `local`'s order), each judged by the
+/// neighbours of other groups only (cross-validated over lamps): no kind of photo may have
+/// more `ok` photos (as far as the margin decides: expected GFC ≥ [`DOUBTFUL_GFC`] and its 95 %
+/// floor ≥ [`POOR_GFC`]) below GFC [`POOR_GFC`] than under the pooled margin, and more photos
+/// of GFC ≥ [`DOUBTFUL_GFC`] must be `ok`. Fixed with the candidates of
+/// [`LOCAL_NEIGHBOURS`], before any test photo was judged.
+fn local_margin_wins(local: &LocalMargin, photos: &[PlacedPhoto], pooled: f64) -> bool {
+    let ok = |p: &PlacedPhoto, margin: f64| {
+        p.expected_gfc >= DOUBTFUL_GFC
+            && 1.0 - (1.0 - p.expected_gfc) * margin.max(0.0).exp() >= POOR_GFC
+    };
+    // Per kind: poor photos called ok, pooled and local; good photos called ok, the same.
+    let mut counts: BTreeMap<&str, [usize; 4]> = BTreeMap::new();
+    for (i, p) in photos.iter().enumerate() {
+        let others: Vec<usize> = (0..photos.len())
+            .filter(|&o| photos[o].group != p.group)
+            .collect();
+        let margin = local.margin95_among(&local.photos[i], &others);
+        let c = counts.entry(p.kind.label()).or_default();
+        let poor = p.gfc < POOR_GFC;
+        let good = p.gfc >= DOUBTFUL_GFC;
+        c[0] += usize::from(poor && ok(p, pooled));
+        c[1] += usize::from(poor && ok(p, margin));
+        c[2] += usize::from(good && ok(p, pooled));
+        c[3] += usize::from(good && ok(p, margin));
+    }
+    let no_more_poor = counts.values().all(|c| c[1] <= c[0]);
+    let (good_pooled, good_local) = counts
+        .values()
+        .fold((0, 0), |(a, b), c| (a + c[2], b + c[3]));
+    no_more_poor && good_local > good_pooled
 }
 
 /// Powers of the expected 1 − GFC in a metric's floor that the calibration chooses among
@@ -338,8 +461,13 @@ const GFC_GAP_FLOOR: f64 = 1e-5;
 /// of principal components and the penalty with the least squared error of ln(1 − GFC) in
 /// cross-validation over whole groups (`groups[i]` is photo i's: a lamp's photos share one,
 /// so a lamp never informs its own prediction; ties go to fewer components and the stronger
-/// penalty), then refitted on every photo. The constant is not penalised.
-pub fn fit_gfc_model(judged: &[Judged], groups: &[usize], kinds: &[PhotoKind]) -> Result<GfcModel> {
+/// penalty), then refitted on every photo. The constant is not penalised. Beside the model,
+/// each photo's residual ln(1 − GFC) minus its prediction without its own group, in order.
+pub fn fit_gfc_model(
+    judged: &[Judged],
+    groups: &[usize],
+    kinds: &[PhotoKind],
+) -> Result<(GfcModel, Vec<f64>)> {
     let n = judged.len();
     if groups.len() != n || kinds.len() != n {
         return Err(EvalError::invalid(format!(
@@ -434,14 +562,18 @@ pub fn fit_gfc_model(judged: &[Judged], groups: &[usize], kinds: &[PhotoKind]) -
     let mut model = with(k);
     let x = inputs(&model);
     // Each photo's residual predicted without its own group, with the chosen settings.
-    let mut residuals = Vec::with_capacity(n);
+    let mut held_out = vec![0.0; n];
     for (test, train) in &folds {
         let ridge = solve(&gram(&x, train)?, penalty)?;
-        residuals.extend(
-            test.iter()
-                .map(|&i| (target[i][0] - ridge.predict(&x[i])[0], kinds[i])),
-        );
+        for &i in test {
+            held_out[i] = target[i][0] - ridge.predict(&x[i])[0];
+        }
     }
+    let residuals: Vec<(f64, PhotoKind)> = held_out
+        .iter()
+        .copied()
+        .zip(kinds.iter().copied())
+        .collect();
     model.gap_quantiles95 = group_quantiles(&residuals, 0.95, MIN_METRIC_PHOTOS);
     model.gap_margin95 = model.gap_quantiles95.values().copied().fold(0.0, f64::max);
     let ridge = solve(&gram(&x, &(0..n).collect::<Vec<_>>())?, penalty)?;
@@ -457,7 +589,7 @@ pub fn fit_gfc_model(judged: &[Judged], groups: &[usize], kinds: &[PhotoKind]) -
     model.low = input_ranges.iter().map(|r| r[0]).collect();
     model.high = input_ranges.iter().map(|r| r[1]).collect();
     model.gap_range = range(&mut target.iter().map(|t| t[0]));
-    Ok(model)
+    Ok((model, held_out))
 }
 
 /// One model's fitted calibration.
@@ -468,6 +600,8 @@ pub struct Calibrated {
     pub chart: String,
     /// The calibration.
     pub calibration: TrustCalibration,
+    /// The photos it was fitted on, one record each.
+    pub records: Vec<CalibrationRecord>,
 }
 
 /// The calibrations [`calibrate`] fitted, and the held-out cameras it left out.
@@ -508,6 +642,17 @@ pub fn calibrate(
         let virtual_count = judged.len();
         let per_lamp = photos.shots as usize;
         let mut groups: Vec<usize> = (0..virtual_count).map(|i| i / per_lamp.max(1)).collect();
+        let light_of = |lamp: usize| -> String {
+            lamps
+                .get(lamp)
+                .and_then(|&l| setup.library.types.get(l))
+                .map_or("other", |t| t.label())
+                .to_string()
+        };
+        let mut sources: Vec<(String, String)> = groups
+            .iter()
+            .map(|&g| ("virtual".to_string(), light_of(g)))
+            .collect();
         let mut features = shots.clean.features;
         let mut method = format!(
             "the split's {} validation lamps, {} photos each by its held-out cameras with the \
@@ -531,6 +676,7 @@ pub fn calibrate(
             let (lamp_of, rows): (Vec<usize>, Vec<Vec<f64>>) = found.rows.into_iter().unzip();
             let truths: Vec<Vec<f64>> = lamp_of.iter().map(|&l| truth[lamps[l]].clone()).collect();
             judged.extend(judge_rows(&model, check.as_ref(), &rows, Some(&truths))?);
+            sources.extend(lamp_of.iter().map(|&l| ("scene".to_string(), light_of(l))));
             groups.extend(lamp_of);
             features.extend(rows);
             method += &format!(
@@ -556,6 +702,10 @@ pub fn calibrate(
                 Some(&set.val.truths),
             )?);
             features.extend(set.val.features.iter().cloned());
+            sources.extend(
+                (0..set.val.features.len())
+                    .map(|_| (set.label.to_string(), "measured".to_string())),
+            );
         }
         let real_count = judged.len() - virtual_count - scene_count;
         groups.extend((0..real_count).map(|i| lamps.len() + i));
@@ -572,12 +722,15 @@ pub fn calibrate(
             scene_count,
             scenes_per_lamp: scenes,
             groups,
+            sources,
         };
-        let calibration = fit_calibration(&model, &chart_name, &calibration_photos, method)?;
+        let (calibration, records) =
+            fit_calibration(&model, &chart_name, &calibration_photos, method)?;
         out.push(Calibrated {
             model: path,
             chart: chart_name,
             calibration,
+            records,
         });
     }
     Ok(Calibrations {
@@ -681,7 +834,7 @@ mod tests {
             assert!((gfc(r) - want).abs() < 1e-9, "{} {want}", gfc(r));
         }
         let groups: Vec<usize> = (0..rows.len()).map(|i| i / 4).collect();
-        let model = fit_gfc_model(&rows, &groups, &[PhotoKind::Virtual; 80]).unwrap();
+        let (model, _) = fit_gfc_model(&rows, &groups, &[PhotoKind::Virtual; 80]).unwrap();
         // An exact law leaves no residual: the 95 % floor is the median.
         assert!(model.gap_margin95.abs() < 0.05, "{}", model.gap_margin95);
         for r in &rows {

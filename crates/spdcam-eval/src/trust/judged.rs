@@ -88,14 +88,7 @@ pub fn judge_rows(
         .collect()
 }
 
-/// The `q` quantile of `values` with the split-conformal finite-sample correction: the
-/// ⌈(n+1)q⌉-th smallest (Lei et al. 2018, JASA 113: 1094–1111, section 2.2).
-pub fn conformal_quantile(values: &mut [f64], q: f64) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    let k = (((n + 1) as f64 * q).ceil() as usize).clamp(1, n);
-    values[k - 1]
-}
+pub use spdcam_infer::trust::conformal_quantile;
 
 /// The median of `values`.
 pub fn median(values: &mut [f64]) -> f64 {

@@ -91,9 +91,32 @@ when the detection confidence is below 0.8, more feature patches are clipped tha
 the calibration photos, any is nearly black, the self-check's mean or split \
 residual, colour gradient, glare or two-lights ratio exceeds its 99th percentile on the calibration photos, the difficulty exceeds its \
 99th percentile (many lights give nearly this photo, or it is unlike the training lights), \
-or the expected GFC is below 0.95; `unusable` when more than half the patches are clipped, \
+or the expected GFC is below 0.95, or 95 % of estimates like it need not reach GFC 0.90 \
+(`may_be_poor`, below); `unusable` when more than half the patches are clipped, \
 the self-check cannot be made (too few usable patches) or a self-check residual exceeds \
 three times its level. An unusable estimate's numbers are not printed.\n\
+- **The photos most like it.** The expected GFC's 95 % margin is taken among the 100 \
+calibration photos nearest to the photo in four \
+standardised coordinates: ln(1 − expected GFC), ln CCT of the estimate, ln self-check \
+residual and the veil of glare read on the dark patches (`spdcam_infer::trust::local_margin`; \
+localised conformal prediction, Guan 2023, Biometrika 110: 33–50, with nearest neighbours as \
+in Papadopoulos, Vovk & Gammerman 2011, JAIR 40: 815–840). A real photo whose light explains \
+it as real photos are explained, without glare, is judged by the real photos like it; a \
+virtual photo of a lamp the chart cannot tell from another, by those. A photo without a CCT \
+or a self-check (an SG photo read without the data directory) keeps the pooled margin. \
+Chosen on the calibration photos, each judged by neighbours of other lamps (`python3 \
+tools/local_margin_choice.py` on `spdcam trust calibrate --records`), among four sets of \
+coordinates and 30, 50 or 100 neighbours, by a rule fixed with them: no kind of photo may \
+have more `ok` photos below GFC 0.90 than under the pooled margin, and of those the most \
+photos of GFC ≥ 0.95 `ok`. SG: 436 of 539 such photos `ok` against 348 pooled (real 132 vs \
+0, scene 123 vs 135, virtual 213 vs 244; `ok` below 0.90: 0, 1, 5 as pooled). Without the \
+self-check and the veil (difficulty, expected 1 − GFC, CCT) the real photos were not told \
+from virtual ones (12–35 real `ok`) and more poor virtual photos were `ok` (9). Tried for \
+the metric intervals too, not kept: their conformal scales taken among the 100 (or 200) \
+nearest calibration photos narrowed the CCT's 95 % interval (SG held-out virtual ± 37 → \
+24 %, scene ± 29 → 19 %, Hue test photos ± 76 → 22 %, ColorChecker 24 held-out virtual \
+± 28 → 19 %) but let several intervals hold less than 90 % (Telelumen/Canon Duv 93 → 85 %, \
+ColorChecker 24 scene R9 91 → 86 %, SG scene Duv 91 → 89 %; with 200: 84 %, 85 %, 88 %).\n\
 - **Calibration set**, fixed before any result: the split's 54 validation lamps \
 (docs/validation-split.json), 8 photos each by the split's held-out cameras with the \
 randomised in-camera stage. The clipping rule was first fixed a priori at a quarter of the \
@@ -174,6 +197,9 @@ struct Measured {
     reliability: SetReliability,
     /// The set's verdict reasons, counted.
     reasons: ReasonCounts,
+    /// Its row of the table of margins used: the share of photos whose margin was local
+    /// and the median factor used.
+    margin_used: String,
 }
 
 /// How many of a set's photos carry each kind of reason in their verdict
@@ -260,8 +286,11 @@ fn measure_row(
         counts: BTreeMap::new(),
     };
     let mut coverage: BTreeMap<String, MetricCoverage> = BTreeMap::new();
+    let (mut local, mut factors) = (0usize, Vec::with_capacity(judged.len()));
     for (j, row) in judged.iter().zip(features) {
-        let u = cal.uncertainty(&j.spd, &j.spread, &j.metric_spread, residual(j))?;
+        let u = cal.uncertainty(&j.spd, &j.spread, &j.metric_spread, j.self_check.as_ref())?;
+        local += usize::from(u.gfc_margin_local);
+        factors.push(u.gfc_margin_factor);
         for (key, &err) in &j.metric_error {
             if let Some(interval) = u.metrics.get(key) {
                 let c = coverage.entry(key.clone()).or_default();
@@ -322,7 +351,13 @@ fn measure_row(
         mean_gfc(Verdict::Doubtful),
     );
     let pairs: Vec<(f64, f64)> = expected.into_iter().zip(actual).collect();
+    let margin_used = format!(
+        "| {label} | {:.0} % | × {:.1} |\n",
+        100.0 * local as f64 / n,
+        median(&mut factors)
+    );
     Ok(Measured {
+        margin_used,
         reasons,
         row,
         metrics: coverage,
@@ -567,11 +602,20 @@ impl TrustReport {
              calibration's estimates like it reach GFC 0.90, i.e. where its expected 1 − GFC \
              times the calibration's 95 % margin stays below 0.10. The margin is each kind of \
              calibration photo's 95 % quantile of how far its 1 − GFC lay above the expected \
-             one (predicted without its own lamp), the largest of the kinds and of all of them \
-             pooled, so that it holds on each kind. Per model: each kind's factor, the one \
-             used, and the expected GFC an `ok` needs.\n\n\
+             one (predicted without its own lamp), taken among the 100 calibration photos most \
+             like the photo at hand (`spdcam_infer::trust::local_margin`: nearest in ln(1 − \
+             expected GFC), ln CCT of the estimate, ln self-check residual and the veil of glare \
+             on the dark patches, each standardised; localised conformal prediction, Guan 2023). \
+             A photo without a self-check or a CCT gets the pooled margin instead: the largest \
+             of each kind's quantile and of all of them pooled, so that it holds on each kind. \
+             Per model: each kind's factor, the pooled margin, and the expected GFC an `ok` \
+             needs under it; then per set, the share of photos given a local margin and the \
+             median factor they were given.\n\n\
              | model | patch-level virtual | scene photos | real photos | pooled | used | expected GFC needed |\n\
              |---|---:|---:|---:|---:|---:|---:|\n",
+        );
+        let mut margins_used = String::from(
+            "\n| model · photos | local margin | median factor used |\n|---|---:|---:|\n",
         );
         let mut diagram = Vec::new();
         let mut scenes_per_lamp = 0;
@@ -643,6 +687,7 @@ impl TrustReport {
                 &shots.clean.truths,
             )?;
             md += &measured.row;
+            margins_used += &measured.margin_used;
             reason_rows.push(measured.reasons);
             metric_sets.push(("held-out virtual".to_string(), measured.metrics));
             diagram.push(measured.reliability);
@@ -674,6 +719,7 @@ impl TrustReport {
                 &scene_truths,
             )?;
             md += &measured.row;
+            margins_used += &measured.margin_used;
             reason_rows.push(measured.reasons);
             metric_sets.push(("scene photos".to_string(), measured.metrics));
             diagram.push(measured.reliability);
@@ -698,6 +744,7 @@ impl TrustReport {
                     &rows.truths,
                 )?;
                 md += &measured.row;
+                margins_used += &measured.margin_used;
                 reason_rows.push(measured.reasons);
                 metric_sets.push((format!("real: {label} (test)"), measured.metrics));
                 diagram.push(measured.reliability);
@@ -798,6 +845,7 @@ impl TrustReport {
         );
         sections += &reasons_table(&reason_rows);
         sections += &margins_md;
+        sections += &margins_used;
         sections.push('\n');
         sections += &metrics_md;
         sections += &corrections_md;

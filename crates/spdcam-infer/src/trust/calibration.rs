@@ -2,12 +2,15 @@
 //! spread, the GFC to expect of it, and the levels above which a self-check is doubtful; the
 //! calibrations shipped with the models.
 
+use super::local_margin::{photo_coordinates, LocalMargin};
 use super::self_check::SelfCheck;
 use crate::error::{InferError, Result};
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
+use spdcam_core::colorimetry::{uv_to_cct_duv, xy_to_uv1960, Observer};
 use spdcam_core::spectral::{Grid, Spd};
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
 
 /// A band around the SPD on its wavelengths (written to JSON as the edges' values).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -34,9 +37,17 @@ pub struct Uncertainty {
     pub band95: Band,
     /// The GFC such estimates reach, in the median: the calibration's [`GfcModel`].
     pub expected_gfc: f64,
-    /// The GFC 95 % of such estimates reach at least ([`GfcModel::at_least95`]): an
-    /// estimate is called `ok` only where this is not poor.
+    /// The GFC 95 % of such estimates reach at least: the expected GFC moved by the 95 %
+    /// margin of the calibration photos most like this one ([`LocalMargin`]), or by the
+    /// pooled margin ([`GfcModel::at_least95`]) where the photo cannot be placed among them.
+    /// An estimate is called `ok` only where this is not poor.
     pub gfc_at_least95: f64,
+    /// The margin used: how many times 1 − GFC may exceed its expected value for 95 % of
+    /// such estimates (e to the margin of ln(1 − GFC)).
+    pub gfc_margin_factor: f64,
+    /// Whether that margin was taken among the calibration photos most like this one
+    /// (`true`) or pooled over them all.
+    pub gfc_margin_local: bool,
     /// The mean spread of the perturbed estimates (see [`Perturbed::spread`](super::spread::Perturbed::spread)).
     pub difficulty: f64,
     /// How many times the bands and intervals are widened because the estimated light
@@ -193,6 +204,11 @@ pub struct TrustCalibration {
     /// sampled as a user's photo is; they join what the real photos join. 0: none.
     #[serde(default)]
     pub scenes_per_lamp: usize,
+    /// The expected GFC's margin among the calibration photos most like a photo (absent from
+    /// older files, and where the calibration photos had no self-check: then the pooled
+    /// [`GfcModel::gap_margin95`] serves every photo).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_margin: Option<LocalMargin>,
 }
 
 /// The GFC to expect of an estimate, from the estimate itself: a ridge regression (Hoerl &
@@ -269,9 +285,14 @@ impl GfcModel {
     }
 
     /// The GFC that 95 % of estimates like `spd` reach at least: the prediction moved by
-    /// the calibration's 95 % residual margin ([`GfcModel::gap_margin95`]).
+    /// the calibration's pooled 95 % residual margin ([`GfcModel::gap_margin95`]).
     pub fn at_least95(&self, spd: &[f64], difficulty: f64) -> f64 {
-        let gap = self.predicted_gap(spd, difficulty) + self.gap_margin95.max(0.0);
+        self.at_least(spd, difficulty, self.gap_margin95)
+    }
+
+    /// The prediction of ln(1 − GFC) moved by `margin` (at least 0), as a GFC.
+    pub fn at_least(&self, spd: &[f64], difficulty: f64, margin: f64) -> f64 {
+        let gap = self.predicted_gap(spd, difficulty) + margin.max(0.0);
         (1.0 - gap.exp()).clamp(0.0, 1.0)
     }
 
@@ -324,6 +345,7 @@ impl TrustCalibration {
             || c.scale68.len() != d
             || c.scale95.len() != d
             || !c.gfc_model.fits(d)
+            || c.local_margin.as_ref().is_some_and(|l| !l.fits())
         {
             return Err(InferError::invalid(format!(
                 "{shown}: the calibration's arrays do not agree in length"
@@ -362,15 +384,16 @@ impl TrustCalibration {
 
     /// The bands, expected GFC and metric intervals of `spd` (the model's peak-normalised
     /// estimate) whose perturbed estimates spread by `spread` per wavelength and by
-    /// `metric_spread` per metric ([`Perturbed`](super::spread::Perturbed)), and whose self-check residual is
-    /// `residual` ([`SelfCheck::mean`]; `None` without a self-check).
+    /// `metric_spread` per metric ([`Perturbed`](super::spread::Perturbed)), and whose
+    /// self-check is `check` (`None` without one).
     pub fn uncertainty(
         &self,
         spd: &[f64],
         spread: &[f64],
         metric_spread: &BTreeMap<String, f64>,
-        residual: Option<f64>,
+        check: Option<&SelfCheck>,
     ) -> Result<Uncertainty> {
+        let residual = check.map(|c| c.mean);
         let d = self.floor.len();
         if spd.len() != d || spread.len() != d {
             return Err(InferError::invalid(format!(
@@ -392,11 +415,24 @@ impl TrustCalibration {
         };
         let difficulty = spread.iter().sum::<f64>() / d as f64;
         let expected_gfc = self.gfc_model.expected(spd, difficulty);
+        let local = match &self.local_margin {
+            Some(local) => photo_coordinates(
+                expected_gfc,
+                estimate_cct(&grid, spd)?,
+                residual,
+                check.and_then(|c| c.veil.as_ref()).map(|v| v.share),
+            )
+            .map(|x| local.margin95(&x)),
+            None => None,
+        };
+        let margin = local.unwrap_or(self.gfc_model.gap_margin95).max(0.0);
         Ok(Uncertainty {
             band68: band(&self.scale68)?,
             band95: band(&self.scale95)?,
             expected_gfc,
-            gfc_at_least95: self.gfc_model.at_least95(spd, difficulty),
+            gfc_at_least95: self.gfc_model.at_least(spd, difficulty, margin),
+            gfc_margin_factor: margin.exp(),
+            gfc_margin_local: local.is_some(),
             difficulty,
             widening,
             metrics: self
@@ -416,6 +452,29 @@ impl TrustCalibration {
                 .collect(),
         })
     }
+}
+
+/// The CCT (K) of `spd` on `grid` (CIE 1931 2°; Ohno 2014 through
+/// [`uv_to_cct_duv`]), `None` where it has none (too far from the Planckian locus or black).
+pub fn estimate_cct(grid: &Grid, spd: &[f64]) -> Result<Option<f64>> {
+    // The estimation grid's observer is resampled once: every estimate asks for it.
+    static ESTIMATION: OnceLock<Observer> = OnceLock::new();
+    let xy = if *grid == Grid::ESTIMATION {
+        let observer = match ESTIMATION.get() {
+            Some(o) => o,
+            None => {
+                let o = Observer::cie1931(grid)?;
+                ESTIMATION.get_or_init(|| o)
+            }
+        };
+        observer.spd_to_xy(spd)
+    } else {
+        Observer::cie1931(grid)?.spd_to_xy(spd)
+    };
+    if !xy.iter().all(|v| v.is_finite()) {
+        return Ok(None);
+    }
+    Ok(uv_to_cct_duv(xy_to_uv1960(xy)).ok().map(|(cct, _)| cct))
 }
 
 /// The shipped calibration measured on `model` (`models/<chart>.trust.json`, made by
@@ -531,7 +590,58 @@ mod tests {
             clipped_doubtful: 0,
             real_photos: 0,
             scenes_per_lamp: 0,
+            local_margin: None,
         }
+    }
+
+    /// A self-check of mean residual `mean`, nothing else found.
+    fn check_of(mean: f64) -> SelfCheck {
+        SelfCheck {
+            mean,
+            split: 0.0,
+            worst: 0.0,
+            worst_patches: Vec::new(),
+            colour_gradient: None,
+            glare: 0.0,
+            two_lights: 0.0,
+            veil: None,
+        }
+    }
+
+    #[test]
+    fn the_gfc_margin_is_the_local_one_where_the_photo_can_be_placed_else_the_pooled_one() {
+        // On 300–800 nm so that the estimate has a CCT.
+        let wavelengths: Vec<f64> = (0..51).map(|k| 300.0 + 10.0 * f64::from(k)).collect();
+        let mut cal = test_calibration(wavelengths.clone(), Vec::new());
+        cal.gfc_model.gap_margin95 = 5.0f64.ln();
+        let d = wavelengths.len();
+        let (spd, spread) = (vec![1.0; d], vec![0.0; d]);
+        let expected_gap = (-3.0f64).exp();
+        let at_least = |factor: f64| 1.0 - expected_gap * factor;
+        let pooled = cal
+            .uncertainty(&spd, &spread, &BTreeMap::new(), Some(&check_of(0.04)))
+            .unwrap();
+        assert!(!pooled.gfc_margin_local);
+        assert!((pooled.gfc_at_least95 - at_least(5.0)).abs() < 1e-12);
+        // Calibration photos all alike, their residuals ln 2 at most: the margin is ln 2.
+        let cct = estimate_cct(&cal.grid().unwrap(), &spd).unwrap();
+        let x = photo_coordinates(1.0 - expected_gap, cct, Some(0.04), None).unwrap();
+        let photos: Vec<_> = (0..20)
+            .map(|k| (x, 2.0f64.ln() * f64::from(k) / 19.0))
+            .collect();
+        cal.local_margin = LocalMargin::fit(&photos, 20);
+        let local = cal
+            .uncertainty(&spd, &spread, &BTreeMap::new(), Some(&check_of(0.04)))
+            .unwrap();
+        assert!(local.gfc_margin_local);
+        assert!((local.gfc_margin_factor - 2.0).abs() < 1e-12);
+        assert!((local.gfc_at_least95 - at_least(2.0)).abs() < 1e-12);
+        // Without a self-check the photo cannot be placed: the pooled margin.
+        let unplaced = cal
+            .uncertainty(&spd, &spread, &BTreeMap::new(), None)
+            .unwrap();
+        assert!(!unplaced.gfc_margin_local);
+        assert!((unplaced.gfc_at_least95 - at_least(5.0)).abs() < 1e-12);
     }
 
     #[test]
@@ -539,10 +649,10 @@ mod tests {
         let cal = test_calibration(vec![400.0, 410.0], Vec::new());
         let (spd, spread) = ([1.0, 0.5], [0.05, 0.05]);
         let plain = cal
-            .uncertainty(&spd, &spread, &BTreeMap::new(), Some(0.04))
+            .uncertainty(&spd, &spread, &BTreeMap::new(), Some(&check_of(0.04)))
             .unwrap();
         let wide = cal
-            .uncertainty(&spd, &spread, &BTreeMap::new(), Some(0.1))
+            .uncertainty(&spd, &spread, &BTreeMap::new(), Some(&check_of(0.1)))
             .unwrap();
         assert_eq!((plain.widening, wide.widening), (1.0, 2.0));
         // Half-width 2 × (0.1 + 0.05) = 0.3, doubled by the widening.
@@ -577,7 +687,7 @@ mod tests {
             .collect();
         // Widening 2 (residual 0.1 over 0.05).
         let u = cal
-            .uncertainty(&[1.0, 0.5], &[0.0; 2], &spreads, Some(0.1))
+            .uncertainty(&[1.0, 0.5], &[0.0; 2], &spreads, Some(&check_of(0.1)))
             .unwrap();
         // Ra: its floor scaled by (gap / reference)¹.
         let want = 2.0 * (0.02 * gap / 0.01 + 0.5) * 2.0;

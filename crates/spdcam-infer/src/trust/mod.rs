@@ -13,12 +13,14 @@
 //! refuses them when not. Then one module per job, in that order: [`self_check`] (the chart
 //! re-rendered under the estimate), [`spread`] (the estimates of perturbed copies of the
 //! features), [`calibration`]
-//! (bands, expected GFC and the doubtful levels, from a calibration file per model measured
+//! (bands, expected GFC — its margin among the calibration photos most like the photo,
+//! [`local_margin`] — and the doubtful levels, from a calibration file per model measured
 //! on held-out virtual photos of held-out lamps: `spdcam trust calibrate`, docs/trust.md) and
 //! [`verdict`] (every check weighed into ok / doubtful / unusable).
 
 pub mod calibration;
 pub mod chart_identity;
+pub mod local_margin;
 pub mod self_check;
 pub mod spread;
 pub mod verdict;
@@ -28,6 +30,7 @@ pub use calibration::{
     Uncertainty,
 };
 pub use chart_identity::{ChartIdentity, Identity};
+pub use local_margin::{conformal_quantile, photo_coordinates, LocalMargin};
 pub use self_check::{ChartCheck, SelfCheck, Veil};
 pub use spread::{clipped_patch, feature_scale, Perturbed, JITTER_COPIES, JITTER_SIGMA};
 pub use verdict::{

@@ -238,7 +238,7 @@ pub fn weigh(
                 spd,
                 &perturbed.spread(),
                 &perturbed.metric_spread(&model.grid().wavelengths()),
-                self_check.as_ref().map(|s| s.mean),
+                self_check.as_ref(),
             )?)
         }
         None => {

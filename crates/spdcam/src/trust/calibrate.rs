@@ -8,6 +8,7 @@ use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
 use spdcam_eval::trust::fit::calibrate as fit;
+use spdcam_eval::trust::records::write_records;
 use std::path::PathBuf;
 
 /// Options of `spdcam trust calibrate`.
@@ -30,6 +31,11 @@ pub(super) struct CalibrateArgs {
     /// The thesis's data (holding measured/…); default: the data directory's thesis/.
     #[arg(long)]
     thesis_data: Option<PathBuf>,
+    /// Also write each model's calibration photos one by one (source, light, GFC, expected
+    /// GFC, held-out residual, self-check, veil, clipping, CCT) as
+    /// `<chart>.calibration-photos.csv` into this directory.
+    #[arg(long)]
+    records: Option<PathBuf>,
     /// Directory to write `<chart>.trust.json` into.
     #[arg(short, long)]
     output: PathBuf,
@@ -53,11 +59,26 @@ pub(super) fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
         let out = args.output.join(format!("{}.trust.json", c.chart));
         let json = serde_json::to_string_pretty(&c.calibration)?;
         write_atomic(&out, format!("{json}\n").as_bytes())?;
+        if let Some(dir) = &args.records {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+            let file = dir.join(format!("{}.calibration-photos.csv", c.chart));
+            write_records(&file, &c.records)?;
+            eprintln!(
+                "{}: {} calibration photos → {}",
+                c.model.display(),
+                c.records.len(),
+                file.display()
+            );
+        }
         eprintln!(
-            "{}: calibration → {} (expected GFC from ln(difficulty) and {} principal components; {} scene photos per lamp; {} real photos)",
+            "{}: calibration → {} (expected GFC from ln(difficulty) and {} principal components, its margin {}; {} scene photos per lamp; {} real photos)",
             c.model.display(),
             out.display(),
             c.calibration.gfc_model.components.len(),
+            c.calibration.local_margin.as_ref().map_or("pooled".to_string(), |l| format!(
+                "among the {} calibration photos most like each photo",
+                l.neighbours
+            )),
             c.calibration.scenes_per_lamp,
             c.calibration.real_photos
         );
