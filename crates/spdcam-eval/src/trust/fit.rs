@@ -239,7 +239,8 @@ pub fn fit_calibration(
 /// Calibration photos among which a photo's expected-GFC margin is taken
 /// ([`LocalMargin`]). Chosen on the SG's calibration photos of `docs/trust.md`
 /// (`tools/local_margin_choice.py`) among 30, 50 and 100 and four sets of coordinates by
-/// the rule of [`local_margin_wins`].
+/// the rule the calibration applies before it keeps a local margin at all: no kind of photo
+/// with more poor estimates `ok`, and more good ones `ok`.
 pub const LOCAL_NEIGHBOURS: usize = 100;
 
 /// The local margin of the calibration photos `judged` (estimates on `grid`; 1 − their
