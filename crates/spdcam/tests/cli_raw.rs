@@ -42,6 +42,10 @@ fn a_rendered_dng_is_estimated_from_its_mosaic_with_the_lights_colour() {
         serde_json::json!(["A", "D65"]),
         "{raw}"
     );
+    // The virtual camera's DNG has neither forward matrices nor lens-shading opcodes.
+    assert_eq!(raw["colour"]["forward_matrix"], false, "{raw}");
+    assert_eq!(raw["gain_maps_applied"], 0, "{raw}");
+    assert_eq!(raw["opcodes_skipped"], serde_json::json!([]), "{raw}");
     // Planckian 3000 K: CIE 1931 xy (0.4369, 0.4041) (CIE 015:2018, Planck's law).
     let xy = [
         raw["light_xy"][0].as_f64().unwrap(),

@@ -2,10 +2,14 @@
 //! Specification* 1.6, chapter 6, "Mapping Camera Color Space to CIE XYZ Space"): one or two
 //! `ColorMatrix` tags, each mapping CIE XYZ to the camera's raw RGB under its calibration
 //! illuminant, interpolated linearly in inverse colour temperature (mired) at the colour
-//! temperature of the photo's own neutral, found by iteration.
+//! temperature of the photo's own neutral, found by iteration; with the camera's own
+//! `CameraCalibration` and `AnalogBalance` where the file gives them
+//! (XYZ → camera = AnalogBalance · CameraCalibration · ColorMatrix), and its
+//! `ForwardMatrix` for developing white-balanced colours where it gives one.
 //!
 //! spdcam uses it twice: the light's chromaticity is the camera's reading of a spectrally
-//! flat patch taken back to XYZ ([`RawColour::light_xy`]), and the patches are developed to
+//! flat patch taken back to XYZ ([`RawColour::light_xy`]; the DNG way finds the white from
+//! the colour matrices, forward matrices or not), and the patches are developed to
 //! white-balanced sRGB as a raw converter does ([`RawColour::development`]).
 
 use crate::colorimetry;
@@ -13,23 +17,46 @@ use crate::error::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
-/// One `ColorMatrix` of a raw file: XYZ → camera raw RGB under its calibration illuminant.
+/// One calibration illuminant's matrices of a raw file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibratedMatrix {
     /// The calibration illuminant as the file names it (`A`, `D65`, …).
     pub illuminant: String,
     /// Its correlated colour temperature, kelvin.
     pub cct_k: f64,
-    /// XYZ → camera RGB.
+    /// `ColorMatrix`: XYZ → the reference camera's RGB.
     pub xyz_to_camera: Matrix3<f64>,
+    /// `CameraCalibration`: the reference camera's RGB → this camera's (identity when the
+    /// file gives none).
+    pub camera_calibration: Matrix3<f64>,
+    /// `ForwardMatrix`: white-balanced reference camera RGB → XYZ adapted to D50, when the
+    /// file gives one.
+    pub forward: Option<Matrix3<f64>>,
+}
+
+impl CalibratedMatrix {
+    /// A `ColorMatrix` alone (no camera calibration, no forward matrix).
+    pub fn new(illuminant: &str, cct_k: f64, xyz_to_camera: Matrix3<f64>) -> CalibratedMatrix {
+        CalibratedMatrix {
+            illuminant: illuminant.to_string(),
+            cct_k,
+            xyz_to_camera,
+            camera_calibration: Matrix3::identity(),
+            forward: None,
+        }
+    }
 }
 
 /// The colour calibration a raw file carries: its matrices (one or two, by calibration
-/// illuminant) and the camera's neutral as shot, when the file gives one.
+/// illuminant), its analog balance and the camera's neutral as shot, when the file gives
+/// them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RawColour {
     /// The matrices, ordered by colour temperature (warmest first).
     pub matrices: Vec<CalibratedMatrix>,
+    /// `AnalogBalance`: the gains applied to each channel before the values were stored
+    /// (1, 1, 1 when the file gives none).
+    pub analog_balance: [f64; 3],
     /// The camera's own estimate of a neutral's raw RGB (`AsShotNeutral`), G = 1.
     pub as_shot_neutral: Option<[f64; 3]>,
 }
@@ -43,6 +70,8 @@ pub struct RawColourUse {
     pub warm_weight: f64,
     /// The neutral's colour temperature the matrices were interpolated at, kelvin.
     pub neutral_cct_k: f64,
+    /// Whether the patches were developed through the file's forward matrices.
+    pub forward_matrix: bool,
 }
 
 /// Iterations of the neutral ↔ matrix fixed point (the DNG SDK stops within a few).
@@ -80,30 +109,70 @@ impl RawColour {
                 m.illuminant
             )));
         }
+        if let Some(m) = matrices.iter().find(|m| {
+            m.camera_calibration.try_inverse().is_none()
+                || m.forward.is_some_and(|f| f.try_inverse().is_none())
+        }) {
+            return Err(Error::invalid(format!(
+                "the raw file's camera calibration or forward matrix for illuminant {} \
+                 cannot be inverted",
+                m.illuminant
+            )));
+        }
+        // The DNG specification asks for forward matrices with every colour matrix or none.
+        if !matrices.iter().all(|m| m.forward.is_some()) {
+            matrices.iter_mut().for_each(|m| m.forward = None);
+        }
         matrices.sort_by(|a, b| a.cct_k.total_cmp(&b.cct_k));
         let as_shot_neutral =
             as_shot_neutral.filter(|n| n.iter().all(|v| v.is_finite() && *v > 0.0));
         Ok(RawColour {
             matrices,
+            analog_balance: [1.0; 3],
             as_shot_neutral,
         })
     }
 
-    /// The XYZ → camera matrix at colour temperature `cct_k` (DNG 1.6 ch. 6: linear in
-    /// mired between the two calibration illuminants, the nearer one beyond them) and the
-    /// warmest matrix's weight.
-    fn xyz_to_camera_at(&self, cct_k: f64) -> (Matrix3<f64>, f64) {
+    /// The same calibration with the file's `AnalogBalance` (ignored unless every gain is
+    /// finite and positive).
+    pub fn with_analog_balance(mut self, gains: [f64; 3]) -> RawColour {
+        if gains.iter().all(|g| g.is_finite() && *g > 0.0) {
+            self.analog_balance = gains;
+        }
+        self
+    }
+
+    /// Linear interpolation in mired at `cct_k` of one matrix of each illuminant (DNG 1.6
+    /// ch. 6: the nearer one beyond them), with the warmest one's weight.
+    fn interpolate(
+        &self,
+        cct_k: f64,
+        pick: impl Fn(&CalibratedMatrix) -> Matrix3<f64>,
+    ) -> (Matrix3<f64>, f64) {
         let first = &self.matrices[0];
         let Some(second) = self.matrices.last().filter(|m| m.cct_k > first.cct_k) else {
-            return (first.xyz_to_camera, 1.0);
+            return (pick(first), 1.0);
         };
         let mired = 1e6 / cct_k.clamp(CCT_RANGE_K.0, CCT_RANGE_K.1);
         let (m1, m2) = (1e6 / first.cct_k, 1e6 / second.cct_k);
         let g = ((mired - m2) / (m1 - m2)).clamp(0.0, 1.0);
-        (
-            first.xyz_to_camera * g + second.xyz_to_camera * (1.0 - g),
-            g,
-        )
+        (pick(first) * g + pick(second) * (1.0 - g), g)
+    }
+
+    /// AnalogBalance · CameraCalibration at `cct_k`: the reference camera's RGB → the
+    /// values as stored.
+    fn reference_to_stored(&self, cct_k: f64) -> Matrix3<f64> {
+        let balance = Matrix3::from_diagonal(&Vector3::from(self.analog_balance));
+        balance * self.interpolate(cct_k, |m| m.camera_calibration).0
+    }
+
+    /// The XYZ → stored camera RGB matrix at colour temperature `cct_k` (DNG 1.6 ch. 6:
+    /// AnalogBalance · CameraCalibration · ColorMatrix, each interpolated linearly in mired
+    /// between the two calibration illuminants, the nearer one beyond them) and the warmest
+    /// matrix's weight.
+    fn xyz_to_camera_at(&self, cct_k: f64) -> (Matrix3<f64>, f64) {
+        let (colour, g) = self.interpolate(cct_k, |m| m.xyz_to_camera);
+        (self.reference_to_stored(cct_k) * colour, g)
     }
 
     /// The camera → XYZ matrix for a photo whose neutral (a spectrally flat surface's raw
@@ -147,6 +216,7 @@ impl RawColour {
                 matrices: self.matrices.iter().map(|m| m.illuminant.clone()).collect(),
                 warm_weight: used.1,
                 neutral_cct_k: cct_k,
+                forward_matrix: false,
             },
         ))
     }
@@ -165,34 +235,63 @@ impl RawColour {
     }
 
     /// Camera raw RGB → linear sRGB (D65) white-balanced for the light whose neutral is
-    /// `neutral`: the file's matrix to XYZ, Bradford adaptation from the neutral's white to
-    /// D65, then IEC 61966-2-1's XYZ → linear sRGB. Scaled so that the neutral itself maps
-    /// to equal channels of its own green value: what a raw converter's "as shot" rendering
-    /// does before its tone curve.
+    /// `neutral`, then IEC 61966-2-1's XYZ → linear sRGB. With forward matrices, the DNG
+    /// way (1.6 ch. 6): the stored values → the reference camera's, divided by the
+    /// neutral's reference RGB, the interpolated `ForwardMatrix` to XYZ at D50, Bradford to
+    /// D65. Without them: the colour matrix to XYZ, Bradford from the neutral's white to
+    /// D65. Scaled so that the neutral itself maps to equal channels of its own green
+    /// value: what a raw converter's "as shot" rendering does before its tone curve.
     pub fn development(&self, neutral: [f64; 3]) -> Result<(Matrix3<f64>, RawColourUse)> {
-        let (to_xyz, used) = self.camera_to_xyz(neutral)?;
-        let white = to_xyz * Vector3::from(neutral);
-        let d65 = colorimetry::xy_to_xyz(D65_XY, 1.0);
+        let (to_xyz, mut used) = self.camera_to_xyz(neutral)?;
         let bradford = Matrix3::from_row_slice(&BRADFORD.concat());
         let inverse_bradford = bradford
             .try_inverse()
             .expect("the Bradford matrix is invertible");
-        let source = bradford * white;
-        let target = bradford * Vector3::from(d65);
-        if !source.iter().all(|v| v.is_finite() && *v > 0.0) {
-            return Err(Error::invalid(
-                "the photo's neutral lies outside the colours a light can have",
-            ));
-        }
-        let scale = Matrix3::from_diagonal(&target.component_div(&source));
+        let adapt = |from: Vector3<f64>, to: Vector3<f64>| -> Result<Matrix3<f64>> {
+            let (source, target) = (bradford * from, bradford * to);
+            if !source.iter().all(|v| v.is_finite() && *v > 0.0) {
+                return Err(Error::invalid(
+                    "the photo's neutral lies outside the colours a light can have",
+                ));
+            }
+            let scale = Matrix3::from_diagonal(&target.component_div(&source));
+            Ok(inverse_bradford * scale * bradford)
+        };
+        let d65 = Vector3::from(colorimetry::xy_to_xyz(D65_XY, 1.0));
+        let to_adapted_xyz = if self.matrices[0].forward.is_some() {
+            let cct_k = used.neutral_cct_k;
+            let stored_to_reference = self
+                .reference_to_stored(cct_k)
+                .try_inverse()
+                .ok_or_else(|| Error::invalid("the camera calibration cannot be inverted"))?;
+            let reference = stored_to_reference * Vector3::from(neutral);
+            if !reference.iter().all(|v| v.is_finite() && *v > 0.0) {
+                return Err(Error::invalid(
+                    "the photo's neutral has a channel at or below zero in the reference \
+                     camera's values",
+                ));
+            }
+            let balance = Matrix3::from_diagonal(&reference.map(|v| 1.0 / v));
+            let (forward, _) = self.interpolate(cct_k, |m| m.forward.expect("all or none"));
+            let d50 = Vector3::from(colorimetry::xy_to_xyz(D50_XY, 1.0));
+            used.forward_matrix = true;
+            adapt(d50, d65)? * forward * balance * stored_to_reference
+        } else {
+            let white = to_xyz * Vector3::from(neutral);
+            adapt(white, d65)? * to_xyz
+        };
         let to_srgb = crate::camera::colour::xyz_to_srgb_matrix();
-        let m = to_srgb * inverse_bradford * scale * bradford * to_xyz;
+        let m = to_srgb * to_adapted_xyz;
         // The neutral keeps its green level, so exposure reads the same before and after.
         let grey = m * Vector3::from(neutral);
         let norm = neutral[1] / grey[1];
         Ok((m * norm, used))
     }
 }
+
+/// CIE D50's chromaticity, the profile connection space's white that forward matrices map
+/// a neutral to (ICC.1:2010 D50 XYZ 0.9642, 1, 0.8249).
+const D50_XY: [f64; 2] = [0.34570, 0.35854];
 
 /// CIE D65's chromaticity (CIE 15:2018, table 11.3, 2° observer).
 const D65_XY: [f64; 2] = [0.31272, 0.32903];
@@ -235,16 +334,8 @@ mod tests {
         let other = Matrix3::new(1.1, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.9) * xyz_to_srgb;
         RawColour::new(
             vec![
-                CalibratedMatrix {
-                    illuminant: "D65".into(),
-                    cct_k: 6504.0,
-                    xyz_to_camera: other,
-                },
-                CalibratedMatrix {
-                    illuminant: "A".into(),
-                    cct_k: 2856.0,
-                    xyz_to_camera: xyz_to_srgb,
-                },
+                CalibratedMatrix::new("D65", 6504.0, other),
+                CalibratedMatrix::new("A", 2856.0, xyz_to_srgb),
             ],
             None,
         )
@@ -292,11 +383,7 @@ mod tests {
             e.contains("no colour matrix") && e.contains("raw converter"),
             "{e}"
         );
-        let singular = CalibratedMatrix {
-            illuminant: "D65".into(),
-            cct_k: 6504.0,
-            xyz_to_camera: Matrix3::zeros(),
-        };
+        let singular = CalibratedMatrix::new("D65", 6504.0, Matrix3::zeros());
         let e = RawColour::new(vec![singular], None)
             .unwrap_err()
             .to_string();
@@ -314,5 +401,105 @@ mod tests {
         assert_eq!(illuminant_cct(21), Some(("D65", 6504.0)));
         assert_eq!(illuminant_cct(0), None);
         assert_eq!(illuminant_cct(255), None);
+    }
+
+    /// CIE A's chromaticity (CIE 15:2018, table 11.3).
+    const A_XY: [f64; 2] = [0.44757, 0.40745];
+
+    /// A camera whose raw RGB is linear sRGB (a single D65 matrix), with `forward` as its
+    /// forward matrix.
+    fn srgb_camera(forward: Option<Matrix3<f64>>) -> RawColour {
+        let xyz_to_srgb = crate::camera::colour::xyz_to_srgb_matrix();
+        let mut matrix = CalibratedMatrix::new("D65", 6504.0, xyz_to_srgb);
+        matrix.forward = forward;
+        RawColour::new(vec![matrix], None).unwrap()
+    }
+
+    /// The Bradford adaptation from white `from` to white `to` (xy).
+    fn bradford(from: [f64; 2], to: [f64; 2]) -> Matrix3<f64> {
+        let b = Matrix3::from_row_slice(&BRADFORD.concat());
+        let (s, t) = (
+            b * Vector3::from(colorimetry::xy_to_xyz(from, 1.0)),
+            b * Vector3::from(colorimetry::xy_to_xyz(to, 1.0)),
+        );
+        b.try_inverse().unwrap() * Matrix3::from_diagonal(&t.component_div(&s)) * b
+    }
+
+    #[test]
+    fn an_analog_balance_is_undone_before_the_matrices() {
+        // The same sensor with its red amplified 2× before storing: its values and its
+        // AnalogBalance tag say so, and the light and the development read the same.
+        let plain = two_matrices();
+        let amplified = two_matrices().with_analog_balance([2.0, 1.0, 1.0]);
+        let a = colorimetry::xyz_to_linear_srgb(colorimetry::xy_to_xyz(A_XY, 1.0));
+        let stored = [2.0 * a[0], a[1], a[2]];
+        let (x, y) = (
+            plain.light_xy(a).unwrap(),
+            amplified.light_xy(stored).unwrap(),
+        );
+        assert!(
+            (x[0] - y[0]).abs() < 1e-9 && (x[1] - y[1]).abs() < 1e-9,
+            "{x:?} {y:?}"
+        );
+        let (m, _) = plain.development(a).unwrap();
+        let (n, _) = amplified.development(stored).unwrap();
+        let gain = Matrix3::from_diagonal(&Vector3::new(2.0, 1.0, 1.0));
+        assert!((m - n * gain).abs().max() < 1e-9, "{m} {n}");
+        // Gains that are not positive are ignored.
+        assert_eq!(
+            two_matrices()
+                .with_analog_balance([0.0, 1.0, 1.0])
+                .analog_balance,
+            [1.0; 3]
+        );
+    }
+
+    #[test]
+    fn a_forward_matrix_develops_white_balanced_colours_and_leaves_the_light_alone() {
+        let srgb_to_xyz = crate::camera::colour::xyz_to_srgb_matrix()
+            .try_inverse()
+            .unwrap();
+        // The sRGB camera's forward matrix: white-balanced RGB under D65 is its own RGB;
+        // to XYZ, then adapted D65 → D50.
+        let forward = bradford(D65_XY, D50_XY) * srgb_to_xyz;
+        let (with, without) = (srgb_camera(Some(forward)), srgb_camera(None));
+        // Under D65 both ways develop alike.
+        let d65 = colorimetry::xyz_to_linear_srgb(colorimetry::xy_to_xyz(D65_XY, 1.0));
+        let (m, used) = with.development(d65).unwrap();
+        let (n, plain) = without.development(d65).unwrap();
+        assert!(used.forward_matrix && !plain.forward_matrix);
+        assert!((m - n).abs().max() < 2e-3, "{m} {n}");
+        // Under A the forward matrix white-balances in the camera's RGB (here sRGB, a von
+        // Kries scaling of its channels) where the colour matrix adapts by Bradford: the
+        // development is diag(1 / neutral), scaled to keep the green.
+        let a = colorimetry::xyz_to_linear_srgb(colorimetry::xy_to_xyz(A_XY, 1.0));
+        let (m, _) = with.development(a).unwrap();
+        let expected = Matrix3::from_diagonal(&Vector3::from(a.map(|v| a[1] / v)));
+        assert!((m - expected).abs().max() < 1e-4, "{m} {expected}");
+        let (n, _) = without.development(a).unwrap();
+        assert!((m - n).abs().max() > 1e-2, "Bradford and von Kries differ");
+        // The light's colour comes from the colour matrices either way.
+        let (x, y) = (with.light_xy(a).unwrap(), without.light_xy(a).unwrap());
+        assert!((x[0] - y[0]).abs() < 1e-12 && (x[1] - y[1]).abs() < 1e-12);
+        assert!(
+            (x[0] - A_XY[0]).abs() < 5e-4 && (x[1] - A_XY[1]).abs() < 5e-4,
+            "{x:?}"
+        );
+    }
+
+    #[test]
+    fn forward_matrices_are_used_only_when_every_illuminant_has_one() {
+        let xyz_to_srgb = crate::camera::colour::xyz_to_srgb_matrix();
+        let mut first = CalibratedMatrix::new("A", 2856.0, xyz_to_srgb);
+        first.forward = Some(Matrix3::identity());
+        let second = CalibratedMatrix::new("D65", 6504.0, xyz_to_srgb);
+        let colour = RawColour::new(vec![first, second], None).unwrap();
+        assert!(colour.matrices.iter().all(|m| m.forward.is_none()));
+        let mut singular = CalibratedMatrix::new("D65", 6504.0, xyz_to_srgb);
+        singular.forward = Some(Matrix3::zeros());
+        let e = RawColour::new(vec![singular], None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("forward matrix"), "{e}");
     }
 }

@@ -4,15 +4,19 @@
 //! an error naming the file.
 
 use super::colour::{illuminant_cct, CalibratedMatrix, RawColour};
+use super::opcodes::OpcodeList;
 use super::{CfaTile, RawMosaic};
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::photo::Exposure;
 use nalgebra::Matrix3;
-use rawler::decoders::{Orientation, RawDecodeParams};
+use rawler::decoders::{Orientation, RawDecodeParams, WellKnownIFD};
+use rawler::formats::tiff::IFD;
 use rawler::rawimage::{RawImageData, RawPhotometricInterpretation};
 use rawler::rawsource::RawSource;
+use rawler::tags::DngTag;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::rc::Rc;
 
 /// Whether the file's first bytes (at least 12) are those of a raw format whose container
 /// is not TIFF (CR3, RAF, ORF, RW2); TIFF-based raw files (DNG, CR2, NEF, ARW, PEF, …)
@@ -55,9 +59,12 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
         let decoder = rawler::get_decoder(&file)?;
         let image = decoder.raw_image(&file, &params, false)?;
         let exif = decoder.raw_metadata(&file, &params).ok().map(|m| m.exif);
-        Ok::<_, rawler::RawlerError>((image, exif))
+        // A DNG's own tags beyond what rawler reads (none for other formats).
+        let root = decoder.ifd(WellKnownIFD::Root).ok().flatten();
+        let raw_ifd = decoder.ifd(WellKnownIFD::Raw).ok().flatten();
+        Ok::<_, rawler::RawlerError>((image, exif, DngTags { root, raw_ifd }))
     }));
-    let (image, exif) = match decoded {
+    let (image, exif, dng) = match decoded {
         Ok(Ok(decoded)) => decoded,
         Ok(Err(e)) => {
             return Err(fail(format!(
@@ -164,16 +171,29 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
             continue;
         }
         let m: Vec<f64> = flat[..9].iter().map(|&v| v as f64).collect();
-        matrices.push(CalibratedMatrix {
-            illuminant: name.to_string(),
-            cct_k,
-            xyz_to_camera: Matrix3::from_row_slice(&m),
-        });
+        let mut matrix = CalibratedMatrix::new(name, cct_k, Matrix3::from_row_slice(&m));
+        // The DNG's CameraCalibration and ForwardMatrix of the same calibration illuminant.
+        if let Some(k) = dng.calibration_index(*illuminant as u16) {
+            if let Some(cc) =
+                dng.matrix(&[DngTag::CameraCalibration1, DngTag::CameraCalibration2][k])
+            {
+                matrix.camera_calibration = cc;
+            }
+            matrix.forward = dng.matrix(&[DngTag::ForwardMatrix1, DngTag::ForwardMatrix2][k]);
+        }
+        matrices.push(matrix);
     }
     let wb = image.wb_coeffs;
     let as_shot_neutral = (wb[..3].iter().all(|v| v.is_finite() && *v > 0.0))
         .then(|| [wb[1] / wb[0], 1.0, wb[1] / wb[2]].map(|v| v as f64));
-    let colour = RawColour::new(matrices, as_shot_neutral).map_err(|e| fail(e.to_string()))?;
+    let mut colour = RawColour::new(matrices, as_shot_neutral).map_err(|e| fail(e.to_string()))?;
+    if let Some(balance) = dng.values(DngTag::AnalogBalance, 3) {
+        colour = colour.with_analog_balance([balance[0], balance[1], balance[2]]);
+    }
+    let opcodes = match dng.bytes(DngTag::OpcodeList2) {
+        Some(bytes) => OpcodeList::parse(bytes).map_err(|e| fail(e.to_string()))?,
+        None => OpcodeList::default(),
+    };
     let exposure = exif.and_then(|exif| {
         let number = |r: Option<rawler::formats::tiff::Rational>| {
             r.filter(|r| r.d != 0).map(|r| r.n as f64 / r.d as f64)
@@ -186,7 +206,7 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
             .or(exif.iso_speed.map(f64::from))?;
         Exposure::new(f_number, exposure_time_s, iso)
     });
-    let mosaic = RawMosaic {
+    let mut mosaic = RawMosaic {
         camera: format!("{} {}", image.clean_make, image.clean_model)
             .trim()
             .to_string(),
@@ -200,10 +220,71 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
         colour,
         orientation: orientation_code(image.orientation),
         exposure,
+        gain_maps_applied: 0,
+        opcodes_skipped: opcodes.skipped,
         values,
     };
     mosaic.validate().map_err(|e| fail(e.to_string()))?;
+    for map in &opcodes.gain_maps {
+        map.apply(&mut mosaic);
+    }
+    mosaic.gain_maps_applied = opcodes.gain_maps.len();
     Ok(mosaic)
+}
+
+/// A DNG's image file directories as rawler read them: IFD 0 (the camera profile's tags)
+/// and the raw image's (its opcode lists); both `None` for other formats.
+struct DngTags {
+    root: Option<Rc<IFD>>,
+    raw_ifd: Option<Rc<IFD>>,
+}
+
+impl DngTags {
+    /// The tag's entry: in IFD 0, else in the raw image's IFD.
+    fn entry(&self, tag: DngTag) -> Option<&rawler::formats::tiff::Entry> {
+        [&self.root, &self.raw_ifd]
+            .into_iter()
+            .flatten()
+            .find_map(|ifd| ifd.get_entry(tag))
+    }
+
+    /// The tag's first `n` values as numbers, when it holds at least `n` finite ones.
+    fn values(&self, tag: DngTag, n: usize) -> Option<Vec<f64>> {
+        let entry = self.entry(tag)?;
+        let v: Vec<f64> = (0..n)
+            .map(|i| entry.value.get_f32(i).ok().flatten().map(f64::from))
+            .collect::<Option<_>>()?;
+        v.iter().all(|x| x.is_finite()).then_some(v)
+    }
+
+    /// A 3 × 3 matrix tag (row-major), when the file gives one.
+    fn matrix(&self, tag: &DngTag) -> Option<Matrix3<f64>> {
+        self.values(*tag, 9).map(|v| Matrix3::from_row_slice(&v))
+    }
+
+    /// The bytes of an UNDEFINED (or BYTE) tag.
+    fn bytes(&self, tag: DngTag) -> Option<&[u8]> {
+        match &self.entry(tag)?.value {
+            rawler::formats::tiff::Value::Undefined(b) | rawler::formats::tiff::Value::Byte(b) => {
+                Some(b)
+            }
+            _ => None,
+        }
+    }
+
+    /// Which calibration illuminant (0 or 1) has EXIF light-source code `code`.
+    fn calibration_index(&self, code: u16) -> Option<usize> {
+        [
+            DngTag::CalibrationIlluminant1,
+            DngTag::CalibrationIlluminant2,
+        ]
+        .into_iter()
+        .position(|tag| {
+            self.entry(tag)
+                .and_then(|e| e.value.get_u16(0).ok().flatten())
+                == Some(code)
+        })
+    }
 }
 
 /// The EXIF orientation code of rawler's orientation.

@@ -2,7 +2,8 @@
 //! colour-filter mosaic in IFD 0 (`NewSubFileType` 0, `PhotometricInterpretation` CFA
 //! 32803), with its black and white levels, CFA pattern, two `ColorMatrix` tags with their
 //! calibration illuminants, `AsShotNeutral` and the EXIF exposure (TIFF/EP puts it in
-//! IFD 0). The virtual camera writes its photos this way (`spdcam render -o photo.dng`), so
+//! IFD 0); where given, `ForwardMatrix1/2`, `AnalogBalance` and lens-shading gain maps
+//! (`OpcodeList2`), as cameras and raw converters write them. The virtual camera writes its photos this way (`spdcam render -o photo.dng`), so
 //! that tests have raw photos of a known light; any DNG reader opens them.
 //!
 //! The virtual camera's exposure is relative: it meters the chart and scales its raw
@@ -18,6 +19,7 @@
 //! (docs/raw.md); the virtual camera's rating follows the light, so that its files test
 //! the reading itself.
 
+use super::opcodes::{gain_map_list, GainMap};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::photo::Exposure;
@@ -53,6 +55,40 @@ pub struct DngMetadata {
     pub as_shot_neutral: [f64; 3],
     /// The exposure, when known.
     pub exposure: Option<Exposure>,
+    /// `ForwardMatrix1` and `ForwardMatrix2` (white-balanced camera RGB → XYZ at D50), for
+    /// the same illuminants as `matrices`.
+    pub forward_matrices: Option<[Matrix3<f64>; 2]>,
+    /// `AnalogBalance`: gains applied to each channel before the values were stored.
+    pub analog_balance: Option<[f64; 3]>,
+    /// Lens-shading gain maps, written as `OpcodeList2`.
+    pub gain_maps: Vec<GainMap>,
+}
+
+/// An UNDEFINED (type 7) TIFF value: bytes whose meaning the tag defines, as `OpcodeList2`.
+struct Undefined<'a>(&'a [u8]);
+
+impl tiff::encoder::TiffValue for Undefined<'_> {
+    const BYTE_LEN: u8 = 1;
+    const FIELD_TYPE: tiff::tags::Type = tiff::tags::Type::UNDEFINED;
+    fn count(&self) -> usize {
+        self.0.len()
+    }
+    fn data(&self) -> std::borrow::Cow<'_, [u8]> {
+        std::borrow::Cow::Borrowed(self.0)
+    }
+}
+
+/// A 3 × 3 matrix as a DNG's nine signed rationals, row by row.
+fn matrix_rationals(matrix: &Matrix3<f64>) -> Vec<SRational> {
+    // nalgebra iterates column by column: the transpose's order is the rows'.
+    matrix
+        .transpose()
+        .iter()
+        .map(|&v| SRational {
+            n: (v * MATRIX_DENOMINATOR as f64).round() as i32,
+            d: MATRIX_DENOMINATOR,
+        })
+        .collect()
 }
 
 /// The DNG file of `mosaic` (normalised raw, 1 = full scale; quantised to
@@ -116,20 +152,38 @@ pub fn encode_dng(mosaic: &Mosaic, meta: &DngMetadata) -> Result<Vec<u8>> {
     dir.write_tag(Tag::Unknown(50717), u32::from(DNG_WHITE))
         .map_err(fail)?; // WhiteLevel
     for (k, (illuminant, matrix)) in meta.matrices.iter().enumerate() {
-        let rationals: Vec<SRational> = matrix
-            .transpose()
-            .iter()
-            .map(|&v| SRational {
-                n: (v * MATRIX_DENOMINATOR as f64).round() as i32,
-                d: MATRIX_DENOMINATOR,
-            })
-            .collect();
-        // ColorMatrix1/2 (row-major: the transpose of nalgebra's column order) and
-        // CalibrationIlluminant1/2.
-        dir.write_tag(Tag::Unknown(50721 + k as u16), &rationals[..])
-            .map_err(fail)?;
+        // ColorMatrix1/2 and CalibrationIlluminant1/2.
+        dir.write_tag(
+            Tag::Unknown(50721 + k as u16),
+            &matrix_rationals(matrix)[..],
+        )
+        .map_err(fail)?;
         dir.write_tag(Tag::Unknown(50778 + k as u16), *illuminant)
             .map_err(fail)?;
+    }
+    for (k, matrix) in meta.forward_matrices.iter().flatten().enumerate() {
+        // ForwardMatrix1/2.
+        dir.write_tag(
+            Tag::Unknown(50964 + k as u16),
+            &matrix_rationals(matrix)[..],
+        )
+        .map_err(fail)?;
+    }
+    if let Some(balance) = meta.analog_balance {
+        let gains: Vec<Rational> = balance
+            .iter()
+            .map(|&v| Rational {
+                n: (v * 1_000_000.0).round().clamp(1.0, f64::from(u32::MAX)) as u32,
+                d: 1_000_000,
+            })
+            .collect();
+        dir.write_tag(Tag::Unknown(50727), &gains[..])
+            .map_err(fail)?; // AnalogBalance
+    }
+    if !meta.gain_maps.is_empty() {
+        let list = gain_map_list(&meta.gain_maps);
+        dir.write_tag(Tag::Unknown(51009), Undefined(&list))
+            .map_err(fail)?; // OpcodeList2
     }
     let neutral: Vec<Rational> = meta
         .as_shot_neutral
@@ -178,6 +232,9 @@ pub fn virtual_camera_dng(
         matrices: camera.dng_colour_matrices()?,
         as_shot_neutral: camera.neutral_under(spd)?,
         exposure,
+        forward_matrices: None,
+        analog_balance: None,
+        gain_maps: Vec::new(),
     };
     encode_dng(mosaic, &meta)
 }

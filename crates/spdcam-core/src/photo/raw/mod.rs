@@ -15,12 +15,14 @@
 //! white levels, colour filter layout and orientation. [`RawMosaic::preview`] renders the
 //! upright photo the chart is looked for in (one pixel per colour-filter tile, so no
 //! demosaicing), and [`RawMosaic::preview_to_sensor`] takes its coordinates back to the
-//! mosaic, where [`sample`] reads each patch.
+//! mosaic, where [`sample`] reads each patch. A DNG's lens-shading gain maps
+//! ([`opcodes`]) are applied to the stored values as the file is read.
 
 pub mod colour;
 mod decode;
 pub mod dng;
 mod header;
+pub mod opcodes;
 mod sample;
 
 pub use colour::{CalibratedMatrix, RawColour, RawColourUse};
@@ -80,6 +82,10 @@ pub struct RawMosaic {
     pub orientation: u16,
     /// The exposure from the file's EXIF, when it gives aperture, time and ISO.
     pub exposure: Option<Exposure>,
+    /// The DNG's lens-shading gain maps applied to `values` (`OpcodeList2`).
+    pub gain_maps_applied: usize,
+    /// The opcodes of the DNG's `OpcodeList2` not applied, by name.
+    pub opcodes_skipped: Vec<String>,
     /// The stored values of the active area, row-major, `channels` per photosite.
     pub(crate) values: Vec<u16>,
 }
@@ -507,6 +513,151 @@ mod tests {
             );
             assert!((white[0] - white[2]).abs() < 12.0, "{white:?}");
         }
+    }
+
+    /// The light's chromaticity a DNG's chart reads, and its Δu′v′ from `truth` (xy).
+    fn light_read(bytes: &[u8], truth: [f64; 2]) -> (super::RawReading, f64) {
+        let grid = Grid::SIMULATION;
+        let template = ChartTemplate::from_chart(&Chart::colorchecker24(&grid).unwrap()).unwrap();
+        let options = AnalyseOptions {
+            templates: vec![template],
+            ..AnalyseOptions::default()
+        };
+        let photo = decode_photo(bytes, "shading.dng").unwrap();
+        let reading = analyse(&photo, &options).unwrap().raw.unwrap();
+        let uv = |xy: [f64; 2]| {
+            crate::quality::uv::xyz_to_uv1976(crate::colorimetry::xy_to_xyz(xy, 1.0))
+        };
+        let (a, b) = (uv(reading.light_xy), uv(truth));
+        let duv = (a[0] - b[0]).hypot(a[1] - b[1]);
+        (reading, duv)
+    }
+
+    #[test]
+    fn a_dngs_lens_shading_gain_maps_are_applied_before_the_light_is_read() {
+        use super::dng::{encode_dng, DngMetadata};
+        use super::opcodes::GainMap;
+        // A phone-like lens: each colour falls off with the squared distance from the
+        // middle (as a share of the half-diagonal), red most, and the DNG carries the gains
+        // that undo it, one map per position of the RGGB tile on a 13 × 17 grid.
+        let camera = scene_camera();
+        let grid = *camera.grid();
+        let spd = StandardIlluminant::D65.spd(&grid).unwrap();
+        let truth = Observer::cie1931(&grid).unwrap().spd_to_xy(spd.values());
+        let scene = SceneOptions {
+            width: 1200,
+            height: 900,
+            width_share: (0.35, 0.35),
+            centre: Some([0.3, 0.32]),
+            vignetting: (0.0, 0.0),
+            ..SceneOptions::default()
+        };
+        let shot = scene::photograph(&camera, SceneLight::single(&spd), 30, &scene).unwrap();
+        let plain = shot.mosaic.unwrap();
+        let falloff = [0.45f64, 0.25, 0.35];
+        let shading = |x: f64, y: f64, c: usize| {
+            // x, y as shares of the width and height.
+            let r2 = ((x - 0.5) * 1200.0).powi(2) + ((y - 0.5) * 900.0).powi(2);
+            1.0 - falloff[c] * r2 / (600.0f64.powi(2) + 450.0f64.powi(2))
+        };
+        let mut shaded = plain.clone();
+        for y in 0..shaded.height {
+            for x in 0..shaded.width {
+                let c = shaded.pattern.channel_at(x, y);
+                shaded.data[y * 1200 + x] *=
+                    shading((x as f64 + 0.5) / 1200.0, (y as f64 + 0.5) / 900.0, c) as f32;
+            }
+        }
+        let (points_v, points_h) = (13u32, 17u32);
+        let maps: Vec<GainMap> = [(0, 0), (0, 1), (1, 0), (1, 1)]
+            .iter()
+            .map(|&(top, left)| {
+                let c = shaded.pattern.channel_at(left, top);
+                let gains = (0..points_v)
+                    .flat_map(|i| (0..points_h).map(move |j| (i, j)))
+                    .map(|(i, j)| {
+                        let (y, x) = (i as f64 / 12.0, j as f64 / 16.0);
+                        (1.0 / shading(x, y, c)) as f32
+                    })
+                    .collect();
+                GainMap {
+                    area: [top as u32, left as u32, 900, 1200],
+                    planes: (0, 1),
+                    pitch: (2, 2),
+                    points: (points_v, points_h),
+                    spacing: (1.0 / 12.0, 1.0 / 16.0),
+                    origin: (0.0, 0.0),
+                    map_planes: 1,
+                    gains,
+                }
+            })
+            .collect();
+        let meta = |gain_maps: Vec<GainMap>| DngMetadata {
+            camera: camera.camera_name().to_string(),
+            matrices: camera.dng_colour_matrices().unwrap(),
+            as_shot_neutral: camera.neutral_under(&spd).unwrap(),
+            exposure: None,
+            forward_matrices: None,
+            analog_balance: None,
+            gain_maps,
+        };
+        let (_, unshaded) = light_read(&encode_dng(&plain, &meta(Vec::new())).unwrap(), truth);
+        let (reading, corrected) = light_read(&encode_dng(&shaded, &meta(maps)).unwrap(), truth);
+        let (_, uncorrected) = light_read(&encode_dng(&shaded, &meta(Vec::new())).unwrap(), truth);
+        assert_eq!(reading.gain_maps_applied, 4);
+        assert!(reading
+            .describe()
+            .contains("4 lens-shading gain maps applied"));
+        assert!(
+            corrected < unshaded + 0.0005 && uncorrected > 4.0 * corrected.max(0.001),
+            "Δu′v′ unshaded {unshaded}, shaded and corrected {corrected}, shaded {uncorrected}"
+        );
+    }
+
+    #[test]
+    fn forward_matrices_and_analog_balance_read_back_from_a_written_dng() {
+        use super::dng::{encode_dng, DngMetadata};
+        let camera = scene_camera();
+        let spd = StandardIlluminant::A.spd(camera.grid()).unwrap();
+        let shot = scene::photograph(
+            &camera,
+            SceneLight::single(&spd),
+            31,
+            &SceneOptions {
+                width: 600,
+                height: 450,
+                ..SceneOptions::default()
+            },
+        )
+        .unwrap();
+        let forward = [
+            nalgebra::Matrix3::new(0.6, 0.2, 0.15, 0.25, 0.7, 0.05, 0.02, 0.1, 0.7),
+            nalgebra::Matrix3::new(0.65, 0.18, 0.12, 0.28, 0.68, 0.04, 0.01, 0.12, 0.69),
+        ];
+        let meta = DngMetadata {
+            camera: camera.camera_name().to_string(),
+            matrices: camera.dng_colour_matrices().unwrap(),
+            as_shot_neutral: camera.neutral_under(&spd).unwrap(),
+            exposure: None,
+            forward_matrices: Some(forward),
+            analog_balance: Some([1.25, 1.0, 0.8]),
+            gain_maps: Vec::new(),
+        };
+        let raw = super::decode(
+            &encode_dng(shot.mosaic.as_ref().unwrap(), &meta).unwrap(),
+            "f.dng",
+        )
+        .unwrap();
+        let balance = raw.colour.analog_balance;
+        assert!(
+            (0..3).all(|c| (balance[c] - [1.25, 1.0, 0.8][c]).abs() < 1e-6),
+            "{balance:?}"
+        );
+        // Matrix 1 is A (warmest first), as written.
+        for (read, written) in raw.colour.matrices.iter().zip(&forward) {
+            assert!((read.forward.unwrap() - written).abs().max() < 1e-4);
+        }
+        assert_eq!(raw.gain_maps_applied, 0);
     }
 
     #[test]

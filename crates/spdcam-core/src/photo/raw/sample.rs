@@ -40,13 +40,17 @@ pub struct RawReading {
     pub neutral_patches: Vec<usize>,
     /// How the file's matrices were used.
     pub colour: RawColourUse,
+    /// The DNG's lens-shading gain maps applied before the patches were read.
+    pub gain_maps_applied: usize,
+    /// The opcodes of the DNG's `OpcodeList2` not applied, by name.
+    pub opcodes_skipped: Vec<String>,
 }
 
 impl RawReading {
     /// One line for a person: "raw file (camera …): patches read on the sensor's mosaic,
     /// the light's colour from N grey patches through the file's A and D65 matrices".
     pub fn describe(&self) -> String {
-        format!(
+        let mut line = format!(
             "raw file ({}): patches read on the sensor's mosaic, the light's colour from {} \
              grey patches through the file's {} colour matri{}",
             self.camera,
@@ -57,7 +61,24 @@ impl RawReading {
             } else {
                 "ces"
             }
-        )
+        );
+        if self.colour.forward_matrix {
+            line.push_str(", developed through its forward matrices");
+        }
+        if self.gain_maps_applied > 0 {
+            line.push_str(&format!(
+                "; its {} lens-shading gain map{} applied",
+                self.gain_maps_applied,
+                if self.gain_maps_applied == 1 { "" } else { "s" }
+            ));
+        }
+        if !self.opcodes_skipped.is_empty() {
+            line.push_str(&format!(
+                "; not applied: {}",
+                self.opcodes_skipped.join(", ")
+            ));
+        }
+        line
     }
 }
 
@@ -160,6 +181,8 @@ pub fn sample(
             light_xy,
             neutral_patches: usable.iter().map(|u| u.0).collect(),
             colour,
+            gain_maps_applied: raw.gain_maps_applied,
+            opcodes_skipped: raw.opcodes_skipped.clone(),
         },
     ))
 }
