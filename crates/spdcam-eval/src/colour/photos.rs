@@ -59,6 +59,8 @@ pub struct Scored {
     /// The estimate's CCT (K) and the half-width (K) of its calibrated 95 % interval, where
     /// the model has a calibration and the estimate a CCT.
     pub cct_interval: Option<(f64, f64)>,
+    /// The estimate's own colour fidelity index (ANSI/IES TM-30 Rf), where it has one.
+    pub rf: Option<f64>,
 }
 
 impl Scored {
@@ -72,6 +74,7 @@ impl Scored {
         Ok(Scored {
             ok: trust.is_some_and(|t| t.verdict == Verdict::Ok),
             cct_interval: estimate.metrics.cct_k.zip(half95),
+            rf: estimate.metrics.tm30_rf,
             ..Scored::spd(&estimate.spd, light)?
         })
     }
@@ -84,6 +87,7 @@ impl Scored {
             colour: ColourScore::of(&light.spd, spd)?,
             ok: false,
             cct_interval: None,
+            rf: None,
         })
     }
 }

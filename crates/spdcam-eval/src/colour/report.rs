@@ -88,7 +88,7 @@ impl ModelColour {
 }
 
 /// The columns of [`ColourReport::photos_csv`].
-const PHOTO_COLUMNS: [&str; 17] = [
+const PHOTO_COLUMNS: [&str; 19] = [
     "model",
     "light_named",
     "photo",
@@ -105,12 +105,14 @@ const PHOTO_COLUMNS: [&str; 17] = [
     "delta_uv_prime",
     "true_cct_k",
     "estimate_cct_k",
+    "cct_half95_k",
+    "estimate_rf",
     "ok",
 ];
 
 impl ColourReport {
     /// Every photo of every model as CSV, a row each (model, light, camera, GFC, the true and
-    /// estimated u′v′ and CCT, verdict): what the tables summarise, for a study of its own
+    /// estimated u′v′ and CCT, the CCT's 95 % half-width, the estimate's TM-30 Rf, verdict): what the tables summarise, for a study of its own
     /// (empty cells where a photo was refused or a CCT is not scored).
     pub fn photos_csv(&self) -> crate::error::Result<String> {
         let mut w = csv::Writer::from_writer(Vec::new());
@@ -143,6 +145,8 @@ impl ColourReport {
                         number(c.map(|c| c.delta_uv_prime)),
                         number(c.and_then(|c| c.true_cct)),
                         number(c.and_then(|c| c.estimate_cct)),
+                        number(e.and_then(|e| e.cct_interval).map(|(_, half)| half)),
+                        number(e.and_then(|e| e.rf)),
                         e.is_some_and(|e| e.ok).to_string(),
                     ];
                     w.write_record(&record).map_err(fail)?;
@@ -389,6 +393,7 @@ mod tests {
             },
             ok: true,
             cct_interval: None,
+            rf: None,
         };
         let report = ColourReport {
             models: vec![cc24(
@@ -424,12 +429,12 @@ mod tests {
             lines[1],
             format!(
                 "cc24.spdm,false,scene,test lamps,\"Lamp, \"\"warm\"\"\",{kind},cam_b,false,\
-                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,true"
+                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,,true"
             )
         );
         assert_eq!(
             lines[2],
-            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,false")
+            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,false")
         );
     }
 }

@@ -144,6 +144,7 @@ mod tests {
             },
             ok: true,
             cct_interval: half.map(|h| (estimate, h)),
+            rf: None,
         }
     }
 
