@@ -249,10 +249,13 @@ fn describe_head(head: &[u8]) -> String {
 pub fn decode_photo(bytes: &[u8], source: &str) -> Result<Photo> {
     // DNG and most raw formats are TIFF files: the raw decoder is asked whether it knows
     // the file; an ordinary TIFF image goes to the image decoder.
-    if raw::looks_like_raw(bytes)
-        || (fsio::image_format(bytes) == Some("TIFF") && raw::is_raw_file(bytes))
-    {
+    if raw::looks_like_raw(bytes) {
         return Photo::from_raw(source, raw::decode(bytes, source)?);
+    }
+    if fsio::image_format(bytes) == Some("TIFF") {
+        if let Some(mosaic) = raw::decode_if_raw(bytes, source)? {
+            return Photo::from_raw(source, mosaic);
+        }
     }
     decode_encoded(bytes, source)
 }

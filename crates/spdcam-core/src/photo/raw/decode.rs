@@ -30,20 +30,42 @@ pub fn looks_like_raw(head: &[u8]) -> bool {
         || head.starts_with(b"IIU\0")
 }
 
-/// Whether rawler knows `bytes` as a raw file (a DNG, or a camera's TIFF-based format); an
-/// ordinary TIFF image is not one.
-pub fn is_raw_file(bytes: &[u8]) -> bool {
-    catch_unwind(|| rawler::get_decoder(&RawSource::new_from_slice(bytes)).is_ok()).unwrap_or(false)
-}
-
 /// Decodes the raw file `bytes` (named `source` in messages). The largest image a
 /// TIFF-structured file claims is checked against [`limits::IMAGE_PIXELS`] before the
 /// decoder allocates it, the decoded photosite count again after; any panic inside the
 /// decoder becomes an error.
 pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
+    match decode_known(bytes, source)? {
+        Ok(mosaic) => Ok(mosaic),
+        Err(unknown) => Err(Error::Image {
+            context: source.to_string(),
+            message: format!(
+                "cannot decode this raw file ({unknown}); is it damaged or truncated? A raw \
+                 file must be copied whole from the camera; or develop it to JPEG or TIFF in \
+                 a raw converter and give spdcam that"
+            ),
+        }),
+    }
+}
+
+/// [`decode`] for a file that may be an ordinary TIFF image: `None` when rawler knows no
+/// raw format in it (the file is read once, not once to ask and again to decode).
+pub fn decode_if_raw(bytes: &[u8], source: &str) -> Result<Option<RawMosaic>> {
+    Ok(decode_known(bytes, source)?.ok())
+}
+
+/// The mosaic of a file rawler knows as raw; `Ok(Err(why))` when it knows no raw format in
+/// it; an error for a raw file it cannot decode or that is beyond the limits.
+fn decode_known(bytes: &[u8], source: &str) -> Result<std::result::Result<RawMosaic, String>> {
     let fail = |message: String| Error::Image {
         context: source.to_string(),
         message,
+    };
+    let file = RawSource::new_from_slice(bytes);
+    let decoder = match catch_unwind(AssertUnwindSafe(|| rawler::get_decoder(&file))) {
+        Ok(Ok(decoder)) => decoder,
+        Ok(Err(e)) => return Ok(Err(e.to_string())),
+        Err(_) => return Ok(Err("the decoder failed reading its header".into())),
     };
     let max_pixels = limits::IMAGE_PIXELS.value()?;
     if let Some(claimed) = super::header::largest_claimed_pixels(bytes) {
@@ -54,9 +76,7 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
         )?;
     }
     let decoded = catch_unwind(AssertUnwindSafe(|| {
-        let file = RawSource::new_from_slice(bytes);
         let params = RawDecodeParams::default();
-        let decoder = rawler::get_decoder(&file)?;
         let image = decoder.raw_image(&file, &params, false)?;
         let exif = decoder.raw_metadata(&file, &params).ok().map(|m| m.exif);
         // A DNG's own tags beyond what rawler reads (none for other formats).
@@ -64,7 +84,7 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
         let raw_ifd = decoder.ifd(WellKnownIFD::Raw).ok().flatten();
         Ok::<_, rawler::RawlerError>((image, exif, DngTags { root, raw_ifd }))
     }));
-    let (image, exif, dng) = match decoded {
+    let (mut image, exif, dng) = match decoded {
         Ok(Ok(decoded)) => decoded,
         Ok(Err(e)) => {
             return Err(fail(format!(
@@ -136,8 +156,13 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
             .collect()
     };
     let mut white = image.whitelevel.as_vec();
-    let (values, scale) = match &image.data {
-        RawImageData::Integer(all) if all.len() == stride * image.height => (crop(all), 1.0),
+    // The decoded values are kept as they are when the active area is the whole image.
+    let whole = (x0, y0, width, height) == (0, 0, image.width, image.height);
+    let data = std::mem::replace(&mut image.data, RawImageData::Integer(Vec::new()));
+    let (values, scale) = match data {
+        RawImageData::Integer(all) if all.len() == stride * image.height => {
+            (if whole { all } else { crop(&all) }, 1.0)
+        }
         RawImageData::Float(all) if all.len() == stride * image.height => {
             // Floating-point DNGs store 0…white; kept as 16-bit steps of the white level.
             let top = white.iter().cloned().fold(1.0f32, f32::max);
@@ -229,7 +254,7 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
         map.apply(&mut mosaic);
     }
     mosaic.gain_maps_applied = opcodes.gain_maps.len();
-    Ok(mosaic)
+    Ok(Ok(mosaic))
 }
 
 /// A DNG's image file directories as rawler read them: IFD 0 (the camera profile's tags)

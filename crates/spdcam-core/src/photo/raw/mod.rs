@@ -26,7 +26,7 @@ pub mod opcodes;
 mod sample;
 
 pub use colour::{CalibratedMatrix, RawColour, RawColourUse};
-pub use decode::{decode, is_raw_file, looks_like_raw};
+pub use decode::{decode, decode_if_raw, looks_like_raw};
 pub use sample::{sample, RawReading};
 
 use crate::camera::colour::srgb_encode_fast;
@@ -121,10 +121,21 @@ impl RawMosaic {
         } else {
             Vec::new()
         };
+        // A 2 × 2 mosaic (Bayer) reads its four photosites with their weights worked out:
+        // 1 / (range · photosites of that colour in the cell).
+        let quad = (self.channels == 1 && (cw, ch) == (2, 2) && levels.len() == 4).then(|| {
+            let mut per_colour = [0u32; 3];
+            levels.iter().for_each(|l| per_colour[l.colour] += 1);
+            std::array::from_fn(|k| {
+                let l = levels[k];
+                (l, 1.0 / (l.range * per_colour[l.colour] as f32))
+            })
+        });
         CellReader {
             mosaic: self,
             cell_size: (cw, ch),
             levels,
+            quad,
         }
     }
 
@@ -353,6 +364,8 @@ pub struct CellReader<'a> {
     /// Per position in the cell and channel, row by row; empty where the black-level tile
     /// does not repeat within the cell.
     levels: Vec<Levels>,
+    /// For a 2 × 2 mosaic with `levels`: each photosite's levels and weight.
+    quad: Option<[(Levels, f32); 4]>,
 }
 
 impl CellReader<'_> {
@@ -362,6 +375,18 @@ impl CellReader<'_> {
     #[inline]
     pub fn cell(&self, cx: usize, cy: usize) -> ([f32; 3], bool) {
         let m = self.mosaic;
+        if let Some(quad) = &self.quad {
+            let top = 2 * cy * m.width + 2 * cx;
+            let stored = [top, top + 1, top + m.width, top + m.width + 1].map(|i| m.values[i]);
+            let mut rgb = [0f32; 3];
+            let mut clipped = false;
+            for (&value, (levels, weight)) in stored.iter().zip(quad) {
+                let value = f32::from(value);
+                clipped |= value >= levels.clip;
+                rgb[levels.colour] += (value - levels.black) * weight;
+            }
+            return (rgb, clipped);
+        }
         let (cw, ch) = self.cell_size;
         let mut sum = [0f32; 3];
         let mut count = [0u32; 3];
