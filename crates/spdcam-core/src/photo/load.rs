@@ -427,6 +427,24 @@ mod tests {
         assert!(p.rgb8().is_none());
     }
 
+    #[test]
+    fn an_ordinary_tiff_is_read_as_an_image_not_a_raw_file() {
+        // A TIFF goes through the raw decoder first (DNG and most raw formats are TIFFs),
+        // which knows no camera in it: it is decoded as the image it is.
+        let img = image::ImageBuffer::<image::Rgb<u8>, _>::from_fn(40, 30, |x, y| {
+            image::Rgb([(x * 6) as u8, (y * 8) as u8, 200])
+        });
+        let mut bytes = Vec::new();
+        DynamicImage::ImageRgb8(img)
+            .write_to(&mut Cursor::new(&mut bytes), ImageFormat::Tiff)
+            .unwrap();
+        assert!(raw::decode_if_raw(&bytes, "t.tif").unwrap().is_none());
+        let p = decode_photo(&bytes, "t.tif").unwrap();
+        assert_eq!((p.width, p.height, p.bit_depth()), (40, 30, 8));
+        assert!(p.raw().is_none());
+        assert_eq!(&p.rgb8().unwrap()[3 * (2 * 40 + 3)..][..3], &[18, 16, 200]);
+    }
+
     fn jpeg_of(width: u32, height: u32) -> Vec<u8> {
         let img = image::ImageBuffer::<image::Rgb<u8>, _>::from_fn(width, height, |x, y| {
             image::Rgb([(x * 7) as u8, (y * 5) as u8, ((x + y) * 3) as u8])
