@@ -112,7 +112,16 @@ for path in sorted(committed.glob("*.spdm")):
     if not same:
         print(f"{path.name}: DIFFERS from the committed model")
         sys.exit(1)
+# The raw colour correction is a ridge fit: the same numbers but for the last digits.
+a = json.loads((committed / "raw-colour.json").read_text())
+b = json.loads((rebuilt / "raw-colour.json").read_text())
+numbers = lambda c: c["intercept"] + c["weights"][0] + c["weights"][1]
+worst = max(abs(x - y) for x, y in zip(numbers(a), numbers(b)))
+if a["fitted_on"] != b["fitted_on"] or worst > 1e-9:
+    print(f"raw-colour.json: DIFFERS from the committed one (largest difference {worst:.2e})")
+    sys.exit(1)
+print(f"raw-colour.json: rebuilt (largest difference {worst:.2e})")
 PY
 # The steps after this script (the Python package, the web app) test the shipped models:
 # the copy gets the committed ones back (their trust calibrations name them).
-cp "$repo"/models/*.spdm "$work/spdcam/models/"
+cp "$repo"/models/*.spdm "$repo"/models/raw-colour.json "$work/spdcam/models/"

@@ -60,3 +60,32 @@ fn a_map_is_fitted_from_the_model_without_one_and_reads_its_photos_better() {
     assert_eq!(again.median_delta_uv, fit.median_delta_uv);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_raw_correction_fitted_on_the_fit_lamps_reads_unseen_lamps_closer_and_is_the_shipped_one() {
+    use spdcam_eval::colour::raw_fit::{RawFit, RawFitOptions};
+    use spdcam_infer::measured_colour::RawColourCorrection;
+    let data = DataDir::new(Some(data_dir()));
+    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let options = RawFitOptions {
+        split: repo.join("docs/validation-split.json"),
+        library: LampFiles::default(),
+        cameras: None,
+    };
+    let fit = RawFit::fit(&options, &data, &mut |_| {}).unwrap();
+    let [[fit_before, fit_after], [val_before, val_after]] = fit.median_delta_uv;
+    // The matrices' bias on lamps is most of their error: unseen lamps through the same
+    // cameras come at least 40 % closer.
+    assert!(fit_after < 0.6 * fit_before, "{fit_before} → {fit_after}");
+    assert!(val_after < 0.6 * val_before, "{val_before} → {val_after}");
+    // The committed models/raw-colour.json is what the fit gives (up to the last digits
+    // another CPU's arithmetic may change).
+    let shipped = RawColourCorrection::shipped().unwrap();
+    assert_eq!(shipped.fitted_on, fit.correction.fitted_on);
+    for t in 0..2 {
+        assert!((shipped.intercept[t] - fit.correction.intercept[t]).abs() < 1e-9);
+        for (a, b) in shipped.weights[t].iter().zip(&fit.correction.weights[t]) {
+            assert!((a - b).abs() < 1e-9 * (1.0 + a.abs()), "{a} vs {b}");
+        }
+    }
+}

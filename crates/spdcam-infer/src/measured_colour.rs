@@ -10,13 +10,146 @@
 //! ([`ColourHead::conform`]), so its shape changes as little as the colour needs; its CCT
 //! and Duv intervals are those of the measured chromaticity's own calibrated error
 //! ([`cct_duv_intervals`]), not the model's.
+//!
+//! A 3×3 calibration reads a smooth light (incandescent, daylight) nearly exactly, and a
+//! spiky one (LEDs, fluorescents) with a bias that every camera shares: through the held-out
+//! cameras of the validation split, phosphor white LEDs read greener by v′ 0.007 on average,
+//! each camera between 0.003 and 0.010. [`RawColourCorrection`] takes that bias off, as
+//! a linear function of the estimated spectrum's shape fitted on the split's fit lamps
+//! through its training cameras (`spdcam colour-map raw`).
 
 use crate::colour_head::ColourHead;
+use crate::error::{InferError, Result};
 use crate::model::Model;
+use crate::ridge::Ridge;
 use crate::trust::MetricInterval;
-use spdcam_core::colorimetry::xy_to_xyz;
-use spdcam_core::quality::uv::xyz_to_uv1976;
+use serde::{Deserialize, Serialize};
+use spdcam_core::colorimetry::{uv1960_to_xy, xy_to_xyz};
+use spdcam_core::quality::uv::{uv1976_to_uv1960, xyz_to_uv1976};
+use spdcam_core::spectral::{Grid, Spd};
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
+
+/// The shipped correction (`models/raw-colour.json`, made by the README's recipe).
+const SHIPPED_CORRECTION: &str = include_str!("../../../models/raw-colour.json");
+
+/// The wavelengths the correction reads a spectrum's shape on: 400–700 nm every 10 nm.
+pub const CORRECTION_GRID: Grid = Grid {
+    start_nm: 400.0,
+    step_nm: 10.0,
+    count: 31,
+};
+
+/// The bias of a raw file's 3×3 colour matrices in CIE 1976 u′v′ as a linear function of the
+/// light's spectrum: bias = intercept + Σ weightᵢ·sᵢ, with s the spectrum on
+/// [`CORRECTION_GRID`] scaled to sum 1 (its shape only). Fitted by ridge regression (Hoerl &
+/// Kennard 1970; [`Ridge`]) on the matrix readings of virtual cameras' DNGs
+/// ([`spdcam_core::photo::raw::dng::virtual_raw_colour`]) against the true light.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RawColourCorrection {
+    /// The bias where the shape is all zero, (u′, v′).
+    pub intercept: [f64; 2],
+    /// Weights of the shape's values on [`CORRECTION_GRID`], for u′ and for v′.
+    pub weights: [Vec<f64>; 2],
+    /// The ridge penalty, relative to the mean diagonal of XᵀX.
+    pub penalty: f64,
+    /// What it was fitted on, in words.
+    pub fitted_on: String,
+}
+
+impl RawColourCorrection {
+    /// The shape the correction reads: `spd` on [`CORRECTION_GRID`], negatives 0, sum 1; an
+    /// error for a spectrum without light there.
+    pub fn shape(spd: &Spd) -> Result<Vec<f64>> {
+        let on_grid = spd
+            .resampled(&CORRECTION_GRID)
+            .map_err(|e| InferError::invalid(format!("the raw colour correction: {e}")))?;
+        let values: Vec<f64> = on_grid.values().iter().map(|v| v.max(0.0)).collect();
+        let sum: f64 = values.iter().sum();
+        if !(sum > 0.0 && sum.is_finite()) {
+            return Err(InferError::invalid(
+                "the raw colour correction needs a spectrum with light in 400–700 nm",
+            ));
+        }
+        Ok(values.iter().map(|v| v / sum).collect())
+    }
+
+    /// Fits the correction to `samples`, each a shape ([`RawColourCorrection::shape`]) and
+    /// the matrices' bias (read − true u′v′) for that light, with the relative ridge
+    /// `penalty` (the intercept as a constant input, penalised alike).
+    pub fn fit(samples: &[(Vec<f64>, [f64; 2])], penalty: f64, fitted_on: String) -> Result<Self> {
+        let n = CORRECTION_GRID.count;
+        if samples.iter().any(|(s, _)| s.len() != n) {
+            return Err(InferError::invalid(format!(
+                "the raw colour correction reads shapes of {n} values"
+            )));
+        }
+        let x: Vec<Vec<f64>> = samples
+            .iter()
+            .map(|(s, _)| std::iter::once(1.0).chain(s.iter().copied()).collect())
+            .collect();
+        let y: Vec<Vec<f64>> = samples.iter().map(|(_, b)| b.to_vec()).collect();
+        let ridge = Ridge::fit(&x, &y, penalty, None)?;
+        Ok(RawColourCorrection {
+            intercept: [ridge.weight(0, 0), ridge.weight(1, 0)],
+            weights: [0, 1].map(|t| (1..=n).map(|j| ridge.weight(t, j)).collect()),
+            penalty,
+            fitted_on,
+        })
+    }
+
+    /// The matrices' bias (u′, v′) the correction expects for a light of shape `shape`.
+    pub fn bias(&self, shape: &[f64]) -> [f64; 2] {
+        [0, 1].map(|t| {
+            self.intercept[t]
+                + self.weights[t]
+                    .iter()
+                    .zip(shape)
+                    .map(|(w, s)| w * s)
+                    .sum::<f64>()
+        })
+    }
+
+    /// The chromaticity (CIE 1931 xy) the matrices read as `xy`, less the bias the
+    /// correction expects for a light estimated as `spd`.
+    pub fn correct(&self, xy: [f64; 2], spd: &Spd) -> Result<[f64; 2]> {
+        let bias = self.bias(&Self::shape(spd)?);
+        let read = xyz_to_uv1976(xy_to_xyz(xy, 1.0));
+        let corrected = [read[0] - bias[0], read[1] - bias[1]];
+        Ok(uv1960_to_xy(uv1976_to_uv1960(corrected)))
+    }
+
+    /// Checks the numbers (for a correction read from a file).
+    pub fn validate(&self) -> Result<()> {
+        let n = CORRECTION_GRID.count;
+        let finite = self
+            .intercept
+            .iter()
+            .chain(self.weights.iter().flatten())
+            .all(|v| v.is_finite());
+        if self.weights.iter().any(|w| w.len() != n) || !finite {
+            return Err(InferError::invalid(format!(
+                "a raw colour correction holds {n} finite weights for u′ and for v′"
+            )));
+        }
+        Ok(())
+    }
+
+    /// The correction shipped with the program (`models/raw-colour.json`).
+    pub fn shipped() -> Result<&'static RawColourCorrection> {
+        static SHIPPED: OnceLock<std::result::Result<RawColourCorrection, String>> =
+            OnceLock::new();
+        SHIPPED
+            .get_or_init(|| {
+                let c: RawColourCorrection =
+                    serde_json::from_str(SHIPPED_CORRECTION).map_err(|e| e.to_string())?;
+                c.validate().map_err(|e| e.to_string())?;
+                Ok(c)
+            })
+            .as_ref()
+            .map_err(|e| InferError::invalid(format!("models/raw-colour.json: {e}")))
+    }
+}
 
 /// `spds` (the model's SPDs on its grid, peak 1, row-major) each moved to chromaticity `xy`
 /// (CIE 1931); `false` and unchanged where the model has no PCA basis to move them in.
@@ -73,5 +206,62 @@ pub fn set_intervals(metrics: &mut BTreeMap<String, MetricInterval>, cct_k: f64)
         if let Some(slot) = metrics.get_mut(key) {
             *slot = interval;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use spdcam_core::cie_illuminant::planck;
+
+    /// A made-up bias: 0.002 in u′ and −0.01 in v′ per unit of the shape's share at
+    /// 450 nm (index 5), and a constant 0.001 in v′.
+    fn made_up_bias(shape: &[f64]) -> [f64; 2] {
+        [0.002 * shape[5], 0.001 - 0.01 * shape[5]]
+    }
+
+    #[test]
+    fn a_linear_bias_is_fitted_back_and_taken_off() {
+        // Planckian lights of 2000–9800 K with a spike at 450 nm of varying height.
+        let samples: Vec<(Vec<f64>, [f64; 2])> = (0..40)
+            .map(|k| {
+                let mut spd = planck(2000.0 + 200.0 * k as f64, &CORRECTION_GRID).unwrap();
+                let mut values = spd.values().to_vec();
+                values[5] += 0.05 * (k % 7) as f64;
+                spd = Spd::new(CORRECTION_GRID, values).unwrap();
+                let shape = RawColourCorrection::shape(&spd).unwrap();
+                let bias = made_up_bias(&shape);
+                (shape, bias)
+            })
+            .collect();
+        let c = RawColourCorrection::fit(&samples, 1e-9, "made up".into()).unwrap();
+        c.validate().unwrap();
+        for (shape, bias) in &samples {
+            let b = c.bias(shape);
+            assert!((b[0] - bias[0]).abs() < 1e-6 && (b[1] - bias[1]).abs() < 1e-6);
+        }
+        // Correcting a reading moves it by the bias in u′v′.
+        let spd = Spd::new(CORRECTION_GRID, samples[3].0.clone()).unwrap();
+        let read = [0.40, 0.39];
+        let corrected = c.correct(read, &spd).unwrap();
+        let (a, b) = (
+            xyz_to_uv1976(xy_to_xyz(read, 1.0)),
+            xyz_to_uv1976(xy_to_xyz(corrected, 1.0)),
+        );
+        let expected = made_up_bias(&samples[3].0);
+        assert!((a[0] - b[0] - expected[0]).abs() < 1e-6, "{a:?} {b:?}");
+        assert!((a[1] - b[1] - expected[1]).abs() < 1e-6, "{a:?} {b:?}");
+    }
+
+    #[test]
+    fn a_black_spectrum_or_a_damaged_correction_is_an_error() {
+        let black = Spd::new(CORRECTION_GRID, vec![0.0; 31]).unwrap();
+        assert!(RawColourCorrection::shape(&black).is_err());
+        let mut c = RawColourCorrection::shipped().unwrap().clone();
+        c.validate().unwrap();
+        c.weights[1].pop();
+        assert!(c.validate().is_err());
+        c.weights[1].push(f64::NAN);
+        assert!(c.validate().is_err());
     }
 }

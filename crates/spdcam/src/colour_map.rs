@@ -1,6 +1,8 @@
 //! `spdcam colour-map fit`: a correction of the light's colour for a model, fitted on the
 //! split's validation lamps through its training cameras (the protocol is
 //! `spdcam_eval::colour::map_fit`'s; this parses its options and writes the model).
+//! `spdcam colour-map raw`: the correction of raw files' colour matrices, fitted on the
+//! split's fit lamps through its training cameras (`spdcam_eval::colour::raw_fit`).
 
 use crate::args::held_out::LibraryArgs;
 use anyhow::Result;
@@ -8,6 +10,7 @@ use clap::{Args, Subcommand};
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio;
 use spdcam_eval::colour::map_fit::{MapFit, MapFitOptions};
+use spdcam_eval::colour::raw_fit::{RawFit, RawFitOptions};
 use std::path::PathBuf;
 
 /// Options of `spdcam colour-map`.
@@ -23,6 +26,26 @@ enum ColourMapCommand {
     /// true light's on the split's validation lamps photographed by its training cameras,
     /// and write the model with it (needs the data directory).
     Fit(FitArgs),
+    /// Fit the correction of the light's colour that raw files' 3×3 colour matrices read, as
+    /// a function of the light's shape, on the split's fit lamps seen by its training
+    /// cameras, and write it (`models/raw-colour.json`; needs the data directory).
+    Raw(RawArgs),
+}
+
+#[derive(Debug, Args)]
+struct RawArgs {
+    /// The validation split (`spdcam lamps split`): its fit lamps and training cameras.
+    #[arg(long, value_name = "SPLIT.json")]
+    split: PathBuf,
+    #[command(flatten)]
+    library: LibraryArgs,
+    /// Directory of camera sensitivity CSVs holding the split's training cameras; default:
+    /// the data directory's cameras/.
+    #[arg(long, value_name = "DIR")]
+    cameras: Option<PathBuf>,
+    /// The correction (JSON).
+    #[arg(short, long, value_name = "FILE.json")]
+    output: PathBuf,
 }
 
 #[derive(Debug, Args)]
@@ -59,7 +82,33 @@ struct FitArgs {
 pub fn run(args: ColourMapArgs, data_dir: &DataDir) -> Result<()> {
     match args.command {
         ColourMapCommand::Fit(a) => fit(a, data_dir),
+        ColourMapCommand::Raw(a) => raw(a, data_dir),
     }
+}
+
+fn raw(args: RawArgs, data_dir: &DataDir) -> Result<()> {
+    fsio::check_parent_dir(&args.output)?;
+    let options = RawFitOptions {
+        split: args.split,
+        library: args.library.files(),
+        cameras: args.cameras,
+    };
+    let fit = RawFit::fit(&options, data_dir, &mut |what| eprintln!("{what}"))?;
+    for s in &fit.skipped {
+        eprintln!("left out training camera {}: {}", s.name, s.reason);
+    }
+    let mut text = serde_json::to_string_pretty(&fit.correction)?;
+    text.push('\n');
+    fsio::write_atomic(&args.output, text.as_bytes())?;
+    let [[fit_before, fit_after], [val_before, val_after]] = fit.median_delta_uv;
+    println!(
+        "fitted on {}\nmedian Δu′v′ of the matrices' reading: fit lights {fit_before:.4} → \
+         {fit_after:.4}; validation lamps (unseen), the same cameras {val_before:.4} → \
+         {val_after:.4}\nwrote {}",
+        fit.correction.fitted_on,
+        args.output.display()
+    );
+    Ok(())
 }
 
 fn fit(args: FitArgs, data_dir: &DataDir) -> Result<()> {

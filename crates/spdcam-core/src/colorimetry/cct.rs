@@ -166,7 +166,7 @@ pub fn cct_duv_to_uv(cct: f64, duv: f64) -> Result<[f64; 2]> {
     let [u1, v1] = locus_uv(cct + 0.01)?;
     let (du, dv) = (u0 - u1, v0 - v1);
     let h = du.hypot(dv);
-    if !(h > 0.0) {
+    if h.is_nan() || h <= 0.0 {
         return Err(Error::invalid(format!(
             "colour temperature {cct} K has no Planckian direction to compute"
         )));

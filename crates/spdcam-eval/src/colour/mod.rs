@@ -19,6 +19,7 @@
 pub mod lights;
 pub mod map_fit;
 pub mod photos;
+pub mod raw_fit;
 mod report;
 pub mod score;
 pub mod summary;

@@ -34,7 +34,7 @@ use crate::error::{InferError, Result};
 use crate::estimate::{Colorimetry, Estimate};
 use crate::feature_rows::FeatureRows;
 use crate::kind_prior::{self, KindPriors};
-use crate::measured_colour;
+use crate::measured_colour::{self, RawColourCorrection};
 use crate::photo_options::chart_templates;
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, GridMap};
@@ -473,6 +473,10 @@ impl Estimator {
         )?;
         let mut spds = model.estimate_rows(&features.values)?;
         if let Some(xy) = measured {
+            // The matrices' bias for a light of the shape the model reads, taken off.
+            let d = model.grid().count;
+            let own = Spd::new(model.grid(), spds[..d.min(spds.len())].to_vec())?;
+            let xy = RawColourCorrection::shipped()?.correct(xy, &own)?;
             measured_colour::conform(model, &mut spds, xy);
         }
         self.told_of_light(index, spds)

@@ -19,6 +19,7 @@
 //! (docs/raw.md); the virtual camera's rating follows the light, so that its files test
 //! the reading itself.
 
+use super::colour::{illuminant_cct, CalibratedMatrix, RawColour};
 use super::opcodes::{gain_map_list, GainMap};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -237,6 +238,23 @@ pub fn virtual_camera_dng(
         gain_maps: Vec::new(),
     };
     encode_dng(mosaic, &meta)
+}
+
+/// The colour calibration the virtual camera's DNGs carry ([`virtual_camera_dng`]): its
+/// matrices fitted under A and D65, as a raw reader takes them
+/// ([`RawColour::light_xy`] gives the light a neutral shows through them).
+pub fn virtual_raw_colour(camera: &Camera) -> Result<RawColour> {
+    let matrices = camera
+        .dng_colour_matrices()?
+        .iter()
+        .map(|&(code, matrix)| {
+            let (name, cct_k) = illuminant_cct(code).ok_or_else(|| {
+                Error::invalid(format!("calibration illuminant code {code} has no CCT"))
+            })?;
+            Ok(CalibratedMatrix::new(name, cct_k, matrix))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    RawColour::new(matrices, None)
 }
 
 /// The EXIF exposure of a photo `camera` took of its chart under `spd` lighting the chart

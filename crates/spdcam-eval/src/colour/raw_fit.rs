@@ -1,0 +1,172 @@
+//! Fitting the correction of raw files' colour matrices (`spdcam colour-map raw`,
+//! [`RawColourCorrection`]): each of the split's *fit* lamps, and the smooth lights the
+//! training recipes also draw (Planckian radiators and CIE daylight, [`smooth_lights`]),
+//! seen by each of its *training* cameras as that camera's DNG gives it to a reader — the
+//! neutral under the light through the camera's matrices fitted under A and D65 — against
+//! the light's true chromaticity, and the bias fitted as a linear function of the light's
+//! shape. Its validation and test lamps and
+//! its held-out cameras stay unseen: the fit is scored on the validation lamps through the
+//! training cameras here, and `spdcam experiment colour --raw` measures it on the held-out
+//! cameras.
+
+use crate::error::Result;
+use crate::held_out::{training_cameras, LampFiles, SkippedCamera, GRID};
+use rayon::prelude::*;
+use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::{Camera, CameraConfig};
+use spdcam_core::chart::Chart;
+use spdcam_core::cie_illuminant::{daylight, planck};
+use spdcam_core::colorimetry::Observer;
+use spdcam_core::light_families::validation_split::LampPart;
+use spdcam_core::light_families::ValidationSplit;
+use spdcam_core::photo::raw::dng::virtual_raw_colour;
+use spdcam_core::quality::uv::xy_to_uv1976;
+use spdcam_core::spectral::Spd;
+use spdcam_infer::measured_colour::RawColourCorrection;
+use std::path::PathBuf;
+
+/// The relative ridge penalty the correction is fitted with (fixed before fitting).
+pub const PENALTY: f64 = 1e-3;
+
+/// What the correction is fitted on.
+#[derive(Debug, Clone)]
+pub struct RawFitOptions {
+    /// The validation split: its fit and validation lamps and training cameras.
+    pub split: PathBuf,
+    /// The lamp library.
+    pub library: LampFiles,
+    /// Directory of camera sensitivity CSVs holding the split's training cameras; `None`:
+    /// the data directory's cameras/.
+    pub cameras: Option<PathBuf>,
+}
+
+/// A fitted correction and what it does.
+#[derive(Debug, Clone)]
+pub struct RawFit {
+    /// The correction.
+    pub correction: RawColourCorrection,
+    /// Median Δu′v′ of the matrices' reading before and after the correction, on the fit
+    /// lights (what it was fitted on) and on the validation lamps (unseen lamps, the same
+    /// cameras): `[[fit before, fit after], [validation before, validation after]]`.
+    pub median_delta_uv: [[f64; 2]; 2],
+    /// Training cameras left out (unreadable curves), for the caller to report.
+    pub skipped: Vec<SkippedCamera>,
+}
+
+/// The smooth lights beside the fit lamps: Planckian radiators at 2,000–7,000 K every
+/// 250 K and CIE daylight at 4,000–10,000 K every 500 K, where a 3×3 calibration is nearly
+/// exact, so that the correction learns to leave them alone.
+pub fn smooth_lights() -> Result<Vec<Spd>> {
+    let planckian = (0..=20).map(|k| planck(2000.0 + 250.0 * k as f64, &GRID));
+    let daylights = (0..=12).map(|k| daylight(4000.0 + 500.0 * k as f64, &GRID));
+    Ok(planckian
+        .chain(daylights)
+        .collect::<std::result::Result<Vec<_>, _>>()?)
+}
+
+/// One lamp through one camera: the lamp's shape, and the matrices' read and the true u′v′.
+struct Reading {
+    shape: Vec<f64>,
+    read: [f64; 2],
+    truth: [f64; 2],
+}
+
+/// Every lamp of `lamps` through every camera of `cameras`.
+fn readings(cameras: &[Camera], lamps: &[Spd], observer: &Observer) -> Result<Vec<Reading>> {
+    let per_camera: Vec<Vec<Reading>> = cameras
+        .par_iter()
+        .map(|camera| {
+            let colour = virtual_raw_colour(camera)?;
+            lamps
+                .iter()
+                .map(|spd| {
+                    let xy = colour.light_xy(camera.neutral_under(spd)?)?;
+                    Ok(Reading {
+                        shape: RawColourCorrection::shape(spd)?,
+                        read: xy_to_uv1976(xy),
+                        truth: xy_to_uv1976(observer.spd_to_xy(spd.values())),
+                    })
+                })
+                .collect::<Result<Vec<_>>>()
+        })
+        .collect::<Result<_>>()?;
+    Ok(per_camera.into_iter().flatten().collect())
+}
+
+/// The median Δu′v′ of `readings` as read and as `correction` corrects them.
+fn medians(readings: &[Reading], correction: &RawColourCorrection) -> [f64; 2] {
+    let distance = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let before = readings.iter().map(|r| distance(r.read, r.truth)).collect();
+    let after = readings
+        .iter()
+        .map(|r| {
+            let bias = correction.bias(&r.shape);
+            distance([r.read[0] - bias[0], r.read[1] - bias[1]], r.truth)
+        })
+        .collect();
+    [super::median(before), super::median(after)]
+}
+
+impl RawFit {
+    /// Fits the correction of `options` (see the module's documentation); `progress` hears
+    /// what is being done.
+    pub fn fit(
+        options: &RawFitOptions,
+        data_dir: &DataDir,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<RawFit> {
+        let split = ValidationSplit::read(&options.split)?;
+        let library = options.library.read(data_dir, &GRID)?;
+        let held = training_cameras(&split, options.cameras.as_deref(), data_dir)?;
+        let chart = Chart::colorchecker24(&GRID)?;
+        let cameras: Vec<Camera> = held
+            .cameras
+            .iter()
+            .map(|s| Camera::new(s, chart.clone(), CameraConfig::default(), &GRID))
+            .collect::<std::result::Result<_, _>>()?;
+        let lamps = |part: LampPart, what: &str| -> Result<Vec<Spd>> {
+            let ids = library.positions(split.lamps(part), what)?;
+            Ok(ids.into_iter().map(|i| library.spds[i].clone()).collect())
+        };
+        let (fit_lamps, validation_lamps) = (
+            lamps(LampPart::Fit, "the split's fit lamps")?,
+            lamps(LampPart::Validation, "the split's validation lamps")?,
+        );
+        let smooth = smooth_lights()?;
+        let fit_lights: Vec<Spd> = fit_lamps.iter().chain(&smooth).cloned().collect();
+        let observer = Observer::cie1931(&GRID)?;
+        progress("the fit lights through the training cameras");
+        let fit_readings = readings(&cameras, &fit_lights, &observer)?;
+        let samples: Vec<(Vec<f64>, [f64; 2])> = fit_readings
+            .iter()
+            .map(|r| {
+                let bias = [r.read[0] - r.truth[0], r.read[1] - r.truth[1]];
+                (r.shape.clone(), bias)
+            })
+            .collect();
+        let fitted_on = format!(
+            "{} readings: the {} fit lamps of {} and {} Planckian and daylight lights through \
+             its {} training cameras' DNG matrices (fitted under A and D65 on the \
+             ColorChecker 24)",
+            samples.len(),
+            fit_lamps.len(),
+            options
+                .split
+                .file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+            smooth.len(),
+            cameras.len()
+        );
+        let correction = RawColourCorrection::fit(&samples, PENALTY, fitted_on)?;
+        progress("the validation lamps through the training cameras");
+        let validation_readings = readings(&cameras, &validation_lamps, &observer)?;
+        Ok(RawFit {
+            median_delta_uv: [
+                medians(&fit_readings, &correction),
+                medians(&validation_readings, &correction),
+            ],
+            correction,
+            skipped: held.skipped,
+        })
+    }
+}
