@@ -152,8 +152,10 @@ class Detection:
     size: tuple[int, int]
     #: For a camera raw file (DNG, CR2, CR3, NEF, ARW, RAF, …): what its mosaic said
     #: (``camera``; ``light_xy``, the light's CIE 1931 xy from the chart's grey patches
-    #: through the file's own colour matrices; ``neutral_patches``; ``colour``, how the
-    #: matrices were used); ``None`` for a JPEG, PNG or TIFF.
+    #: through the file's own colour matrices, before their bias for the estimated shape is
+    #: taken off; ``neutral_patches``; ``colour``, how the matrices were used, with
+    #: ``forward_matrix``; ``gain_maps_applied``, the DNG's lens-shading gain maps applied;
+    #: ``opcodes_skipped``, its other opcodes, not applied); ``None`` for a JPEG, PNG or TIFF.
     raw: Optional[dict[str, Any]] = None
     #: For one of several charts in a photo (:func:`estimate_places`): its place,
     #: ``{"number": 1-based from left to right, "of": how many, "centre": [x, y] px}``;

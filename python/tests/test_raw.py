@@ -44,8 +44,9 @@ def test_python_estimates_a_dng_with_the_light_read_on_the_mosaic(dng):
     assert e.detection.raw is not None
     light = e.detection.raw["light_xy"]
     assert abs(light[0] - A_XY[0]) < 0.003 and abs(light[1] - A_XY[1]) < 0.003, light
-    # The estimate carries that colour.
-    assert np.allclose(e.xy, light, atol=0.002), (e.xy, light)
+    # The estimate carries that colour, less the matrices' bias for the shape it reads
+    # (models/raw-colour.json): still within 0.003 of A's.
+    assert np.allclose(e.xy, A_XY, atol=0.003), (e.xy, light)
     assert e.detection.raw["colour"]["matrices"] == ["A", "D65"]
 
 

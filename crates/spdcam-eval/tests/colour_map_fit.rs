@@ -71,6 +71,7 @@ fn the_raw_correction_fitted_on_the_fit_lamps_reads_unseen_lamps_closer_and_is_t
         split: repo.join("docs/validation-split.json"),
         library: LampFiles::default(),
         cameras: None,
+        penalty: RawColourCorrection::shipped().unwrap().penalty,
     };
     let fit = RawFit::fit(&options, &data, &mut |_| {}).unwrap();
     let [[fit_before, fit_after], [val_before, val_after]] = fit.median_delta_uv;

@@ -43,6 +43,9 @@ struct RawArgs {
     /// the data directory's cameras/.
     #[arg(long, value_name = "DIR")]
     cameras: Option<PathBuf>,
+    /// The ridge penalty, relative to the mean diagonal of XᵀX.
+    #[arg(long, default_value_t = spdcam_eval::colour::raw_fit::PENALTY)]
+    penalty: f64,
     /// The correction (JSON).
     #[arg(short, long, value_name = "FILE.json")]
     output: PathBuf,
@@ -92,6 +95,7 @@ fn raw(args: RawArgs, data_dir: &DataDir) -> Result<()> {
         split: args.split,
         library: args.library.files(),
         cameras: args.cameras,
+        penalty: args.penalty,
     };
     let fit = RawFit::fit(&options, data_dir, &mut |what| eprintln!("{what}"))?;
     for s in &fit.skipped {

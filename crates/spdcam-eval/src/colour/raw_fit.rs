@@ -25,7 +25,7 @@ use spdcam_core::spectral::Spd;
 use spdcam_infer::measured_colour::RawColourCorrection;
 use std::path::PathBuf;
 
-/// The relative ridge penalty the correction is fitted with (fixed before fitting).
+/// The relative ridge penalty the correction is fitted with by default.
 pub const PENALTY: f64 = 1e-3;
 
 /// What the correction is fitted on.
@@ -38,6 +38,8 @@ pub struct RawFitOptions {
     /// Directory of camera sensitivity CSVs holding the split's training cameras; `None`:
     /// the data directory's cameras/.
     pub cameras: Option<PathBuf>,
+    /// The ridge penalty, relative to the mean diagonal of XᵀX.
+    pub penalty: f64,
 }
 
 /// A fitted correction and what it does.
@@ -157,7 +159,7 @@ impl RawFit {
             smooth.len(),
             cameras.len()
         );
-        let correction = RawColourCorrection::fit(&samples, PENALTY, fitted_on)?;
+        let correction = RawColourCorrection::fit(&samples, options.penalty, fitted_on)?;
         progress("the validation lamps through the training cameras");
         let validation_readings = readings(&cameras, &validation_lamps, &observer)?;
         Ok(RawFit {
