@@ -67,6 +67,7 @@ const OUTPUTS: &[(&str, &str, Output)] = &[
     ("lamps fit", "output", Output::File),
     ("light-kinds fit", "output", Output::File),
     ("colour-map fit", "output", Output::File),
+    ("colour-map raw", "output", Output::File),
     ("lamps validate", "output", Output::File),
     ("trust calibrate", "output", Output::AddsFilesTo),
     ("trust report", "output", Output::File),
