@@ -73,20 +73,29 @@ struct Reading {
     truth: [f64; 2],
 }
 
-/// Every lamp of `lamps` through every camera of `cameras`.
+/// Every lamp of `lamps` through every camera of `cameras` (each lamp's shape and true
+/// colour worked out once, not once per camera).
 fn readings(cameras: &[Camera], lamps: &[Spd], observer: &Observer) -> Result<Vec<Reading>> {
+    let lights: Vec<(Vec<f64>, [f64; 2])> = lamps
+        .iter()
+        .map(|spd| {
+            let truth = xy_to_uv1976(observer.spd_to_xy(spd.values()));
+            Ok((RawColourCorrection::shape(spd)?, truth))
+        })
+        .collect::<Result<_>>()?;
     let per_camera: Vec<Vec<Reading>> = cameras
         .par_iter()
         .map(|camera| {
             let colour = virtual_raw_colour(camera)?;
             lamps
                 .iter()
-                .map(|spd| {
+                .zip(&lights)
+                .map(|(spd, (shape, truth))| {
                     let xy = colour.light_xy(camera.neutral_under(spd)?)?;
                     Ok(Reading {
-                        shape: RawColourCorrection::shape(spd)?,
+                        shape: shape.clone(),
                         read: xy_to_uv1976(xy),
-                        truth: xy_to_uv1976(observer.spd_to_xy(spd.values())),
+                        truth: *truth,
                     })
                 })
                 .collect::<Result<Vec<_>>>()
