@@ -545,7 +545,13 @@ fn place(
                 if slot.as_ref().is_some_and(|s| c.score() <= s.score()) {
                     continue;
                 }
-                let cells = rotated.iter().map(|p| (p[0] + tc, p[1] + tr));
+                // A blob cut by the photo's border is no evidence of a grid going on: the
+                // background beside a chart at the edge is cut into patch-sized pieces.
+                let cells = rotated
+                    .iter()
+                    .zip(&lattice.members)
+                    .filter(|(_, m)| !blobs[m.0].may_touch_border(level.width, level.height))
+                    .map(|(p, _)| (p[0] + tc, p[1] + tr));
                 if lattice_goes_on(cells, cols, rows) {
                     continue;
                 }
@@ -606,7 +612,8 @@ fn ring_share(blobs: &[Blob], t: &ChartTemplate, map: &Homography) -> f64 {
 /// chart's own lattice never does (its border lies there); a part of a larger grid does,
 /// such as six by four patches of the ColorChecker Passport's other page beside its
 /// ColorChecker 24, which otherwise reads as a second one. The members need not continue
-/// patches found along the side: a page's dark patches are often missed.
+/// patches found along the side: a page's dark patches are often missed. `cells` leaves out
+/// members cut by the photo's border.
 fn lattice_goes_on(cells: impl Iterator<Item = (i32, i32)>, cols: i32, rows: i32) -> bool {
     let cells: std::collections::HashSet<(i32, i32)> = cells.collect();
     let beyond = |line: &dyn Fn(i32) -> (i32, i32), n: i32| {
@@ -1003,6 +1010,28 @@ mod tests {
         // One stray member beside a side is no grid going on.
         let stray = grid(0..6, 0..4).into_iter().chain([(6, 1), (2, -1)]);
         assert!(!lattice_goes_on(stray, 6, 4));
+    }
+
+    #[test]
+    fn a_blob_cut_by_the_border_is_told_from_a_whole_one() {
+        // A ColorChecker 24 at the top of a scene photo (colour experiment, CC24 under a
+        // phosphor LED) was refused: two pieces of background cut by the top edge, in line
+        // one step beyond its side, read as its grid going on.
+        let rectangle = |centre: [f64; 2], w: f64, h: f64| Blob {
+            centre,
+            area: w * h,
+            colour: [0.5; 3],
+            moments: [w * w / 12.0, 0.0, h * h / 12.0],
+        };
+        let (width, height) = (1200, 900);
+        // The pieces as segmented: 32 px tall, from the top row down.
+        assert!(rectangle([700.5, 16.0], 74.0, 32.0).may_touch_border(width, height));
+        assert!(rectangle([1190.0, 450.0], 20.0, 80.0).may_touch_border(width, height));
+        assert!(rectangle([600.0, 880.0], 80.0, 40.0).may_touch_border(width, height));
+        // Whole patches, near the edges and in the middle.
+        assert!(!rectangle([60.0, 500.0], 80.0, 80.0).may_touch_border(width, height));
+        assert!(!rectangle([600.0, 850.0], 80.0, 80.0).may_touch_border(width, height));
+        assert!(!rectangle([600.0, 450.0], 80.0, 80.0).may_touch_border(width, height));
     }
 
     #[test]

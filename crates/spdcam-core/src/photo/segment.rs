@@ -32,6 +32,20 @@ impl Blob {
         self.area.sqrt()
     }
 
+    /// Whether the blob may reach the edge of a `width` × `height` image, so that it may be
+    /// a shape cut by the photo's border rather than a whole patch: its extent along each
+    /// axis is taken as two standard deviations either side of its centre (exact for an
+    /// ellipse, 15 % more than a square's half-side).
+    pub fn may_touch_border(&self, width: usize, height: usize) -> bool {
+        let [sxx, _, syy] = self.moments;
+        let (hx, hy) = (2.0 * sxx.max(0.0).sqrt(), 2.0 * syy.max(0.0).sqrt());
+        let [x, y] = self.centre;
+        x - hx <= 1.0
+            || y - hy <= 1.0
+            || x + hx >= width as f64 - 1.0
+            || y + hy >= height as f64 - 1.0
+    }
+
     /// The length of `v` (pixels) in the blob's own metric: √(vᵀ Σ⁻¹ v) with Σ its second
     /// moments (the Mahalanobis length). A square of side s has Σ = s²/12 · I, so a vector
     /// one side long measures √12 whatever the square's foreshortening or rotation.
