@@ -39,13 +39,51 @@ pub fn decode(bytes: &[u8], source: &str) -> Result<RawMosaic> {
         Ok(mosaic) => Ok(mosaic),
         Err(unknown) => Err(Error::Image {
             context: source.to_string(),
-            message: format!(
-                "cannot decode this raw file ({unknown}); is it damaged or truncated? A raw \
-                 file must be copied whole from the camera; or develop it to JPEG or TIFF in \
-                 a raw converter and give spdcam that"
-            ),
+            message: cannot_decode(&unknown),
         }),
     }
+}
+
+/// What to tell a person whose raw file the decoder refused with `why`: a format or
+/// compression it does not read (GoPro's VC-5 DNGs, a camera it names but does not know) is
+/// said as such; anything else, a file whose camera cannot even be read among them, is most
+/// likely a damaged or truncated copy.
+fn cannot_decode(why: &str) -> String {
+    let develop = "develop it to JPEG or TIFF in a raw converter and give spdcam that";
+    let unknown_camera = why.contains("No decoder found") && !why.contains("make: ''");
+    if why.contains("Unsupported") || unknown_camera {
+        format!(
+            "cannot decode this raw file: the raw decoder does not read its format or \
+             compression ({why}); {develop}"
+        )
+    } else {
+        format!(
+            "cannot decode this raw file ({why}); is it damaged or truncated? A raw file \
+             must be copied whole from the camera; or {develop}"
+        )
+    }
+}
+
+/// Whether a panic at `file` (its source path) happened inside the raw decoder's crate.
+fn in_raw_decoder(file: &str) -> bool {
+    file.split(['/', '\\'])
+        .any(|part| part.starts_with("rawler-") || part == "rawler")
+}
+
+/// Keeps the raw decoder's panics off standard error: they are caught and become an error
+/// naming the file ([`decode`]), and rawler panics once per worker on some damaged files,
+/// which printed thousands of lines before that one error. Other panics are reported as
+/// before. Installed once, the first time a raw file is decoded.
+fn quiet_raw_decoder_panics() {
+    static INSTALL: std::sync::Once = std::sync::Once::new();
+    INSTALL.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !info.location().is_some_and(|l| in_raw_decoder(l.file())) {
+                previous(info);
+            }
+        }));
+    });
 }
 
 /// [`decode`] for a file that may be an ordinary TIFF image: `None` when rawler knows no
@@ -61,6 +99,7 @@ fn decode_known(bytes: &[u8], source: &str) -> Result<std::result::Result<RawMos
         context: source.to_string(),
         message,
     };
+    quiet_raw_decoder_panics();
     let file = RawSource::new_from_slice(bytes);
     let decoder = match catch_unwind(AssertUnwindSafe(|| rawler::get_decoder(&file))) {
         Ok(Ok(decoder)) => decoder,
@@ -86,13 +125,7 @@ fn decode_known(bytes: &[u8], source: &str) -> Result<std::result::Result<RawMos
     }));
     let (mut image, exif, dng) = match decoded {
         Ok(Ok(decoded)) => decoded,
-        Ok(Err(e)) => {
-            return Err(fail(format!(
-                "cannot decode this raw file ({e}); is it damaged or truncated? A raw file \
-                 must be copied whole from the camera; or develop it to JPEG or TIFF in a \
-                 raw converter and give spdcam that"
-            )))
-        }
+        Ok(Err(e)) => return Err(fail(cannot_decode(&e.to_string()))),
         Err(_) => {
             return Err(fail(
                 "the raw decoder failed on this file (damaged or truncated?); copy it whole \
@@ -323,5 +356,55 @@ fn orientation_code(orientation: Orientation) -> u16 {
         Orientation::Transverse => 7,
         Orientation::Rotate270 => 8,
         Orientation::Normal | Orientation::Unknown => 1,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_decoders_panics_are_told_by_their_source_path() {
+        // Where rawler 0.8 panicked on damaged public test files (a 6 kB NEF, a 12 kB RW2).
+        let registry = "/home/u/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f";
+        assert!(in_raw_decoder(&format!(
+            "{registry}/rawler-0.8.0/src/pumps.rs"
+        )));
+        assert!(in_raw_decoder(&format!(
+            "{registry}/rawler-0.8.0/src/decoders/rw2/v4decompressor.rs"
+        )));
+        assert!(in_raw_decoder(r"C:\deps\rawler\src\bits.rs"));
+        assert!(!in_raw_decoder(
+            "crates/spdcam-core/src/photo/raw/decode.rs"
+        ));
+        assert!(!in_raw_decoder(&format!(
+            "{registry}/rawloader-0.37.1/src/lib.rs"
+        )));
+        assert!(!in_raw_decoder(&format!(
+            "{registry}/rayon-core-1.12.1/src/job.rs"
+        )));
+    }
+
+    #[test]
+    fn an_unsupported_format_is_not_called_damaged() {
+        // rawler's words for a GoPro VC-5 DNG and for a camera it does not know.
+        for why in [
+            "Failed to decode image, possibly corrupt image: TODO: Unsupported DNG compression",
+            "Error: No decoder found, model 'X1', make: 'Newmaker', mode: ''",
+        ] {
+            let message = cannot_decode(why);
+            assert!(message.contains("does not read its format"), "{message}");
+            assert!(!message.contains("damaged"), "{message}");
+            assert!(message.contains(why));
+        }
+        // A cut file and one whose camera cannot be read (a CR3 of 128 kB) are damaged.
+        for why in [
+            "I/O error: subview(): Offset 5575128+334859 is behind EOF",
+            "Error: No decoder found, model '', make: '', mode: ''",
+        ] {
+            let cut = cannot_decode(why);
+            assert!(cut.contains("damaged or truncated"), "{cut}");
+            assert!(cut.contains("raw converter"), "{cut}");
+        }
     }
 }
