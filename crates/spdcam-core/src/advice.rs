@@ -424,6 +424,23 @@ pub fn not_the_chart(chart: &str, sampled: Sampled, mismatches: &[Mismatch]) -> 
     }
 }
 
+/// The note on a photo's charts that a grid of patches found beside them (centred at
+/// `centre`, photo pixels) was left out because it is not a `chart` (`mismatches`: why).
+pub fn place_left_out(chart: &str, centre: Option<[f64; 2]>, mismatches: &[Mismatch]) -> String {
+    let at = centre.map_or(String::new(), |[x, y]| format!(" at {x:.0}, {y:.0} px"));
+    let why = mismatches
+        .iter()
+        .map(Mismatch::to_string)
+        .collect::<Vec<_>>()
+        .join("; ");
+    let why = if why.is_empty() {
+        String::new()
+    } else {
+        format!(" ({why})")
+    };
+    format!("a grid of patches{at} was left out: it is not a {chart}{why}")
+}
+
 /// `is` for one, `are` for more.
 fn are(count: usize) -> &'static str {
     if count == 1 {

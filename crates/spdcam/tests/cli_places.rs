@@ -257,3 +257,84 @@ fn corners_given_once_per_chart_place_each_chart() {
     ]);
     assert!(e.contains("--corners needs eight numbers"), "{e}");
 }
+
+/// The example ColorChecker 24 photo with, on a canvas as wide again to its right, a dark
+/// board of six by four squares: the chart's grey row in its place, the other eighteen
+/// six saturated colours in turn. Detection takes it for a second chart; its colours say
+/// it is not one (as the white-balance page of a ColorChecker Passport opened above its
+/// ColorChecker 24 was read in a public raw photo).
+fn chart_beside_a_grid_that_is_not_one(path: &std::path::Path) {
+    let photo = image::open("../../examples/cc24-led.jpg")
+        .unwrap()
+        .to_rgb8();
+    let (w, h) = photo.dimensions();
+    let mut canvas = image::RgbImage::from_pixel(2 * w, h, image::Rgb([128, 120, 110]));
+    image::imageops::replace(&mut canvas, &photo, 0, 0);
+    let board_w = f64::from(w) * 0.8;
+    let (x0, y0) = (
+        f64::from(w) * 1.1,
+        (f64::from(h) - board_w * 4.0 / 6.0) / 2.0,
+    );
+    let pitch = board_w / 6.4;
+    let fill = |canvas: &mut image::RgbImage, x: f64, y: f64, side_x: f64, side_y: f64, c| {
+        for py in y as u32..(y + side_y) as u32 {
+            for px in x as u32..(x + side_x) as u32 {
+                canvas.put_pixel(px, py, image::Rgb(c));
+            }
+        }
+    };
+    fill(
+        &mut canvas,
+        x0,
+        y0,
+        board_w,
+        board_w * 4.0 / 6.0,
+        [25, 25, 25],
+    );
+    let greys = [243, 200, 160, 122, 85, 52];
+    let colours = [
+        [200, 40, 40],
+        [40, 170, 60],
+        [50, 60, 190],
+        [40, 170, 180],
+        [180, 50, 170],
+        [220, 200, 40],
+    ];
+    for r in 0..4 {
+        for c in 0..6 {
+            let colour = if r == 3 {
+                [greys[c]; 3]
+            } else {
+                colours[(r * 6 + c) % 6]
+            };
+            let x = x0 + pitch * (0.3 + c as f64);
+            let y = y0 + pitch * (0.25 + r as f64);
+            fill(&mut canvas, x, y, pitch * 0.8, pitch * 0.8, colour);
+        }
+    }
+    canvas.save(path).unwrap();
+}
+
+#[test]
+fn a_grid_beside_the_chart_that_is_not_a_chart_is_left_out_with_a_note() {
+    let dir = scratch("places-not-a-chart");
+    let photo = dir.join("chart-and-grid.png");
+    chart_beside_a_grid_that_is_not_one(&photo);
+    let run = common::spdcam(&["estimate", &s(&photo)]);
+    let (out, said) = (
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr),
+    );
+    assert!(run.status.success(), "{out}\n{said}");
+    assert!(
+        said.contains("chart-and-grid.png: a grid of patches at")
+            && said.contains("was left out: it is not a ColorChecker 24 (the patches' colours"),
+        "{said}"
+    );
+    // One estimate, of the chart, not numbered as a place; the command succeeds.
+    assert!(out.contains("chart-and-grid.png: xy"), "{out}");
+    assert!(!out.contains(" place "), "{out}");
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", &s(&photo), "--json"])).unwrap();
+    assert_eq!(json.as_array().unwrap().len(), 1, "{json}");
+}

@@ -10,7 +10,7 @@ use crate::photo_options::PhotoOptions;
 use crate::places;
 use crate::trust::{self, feature_scale, Identity, PhotoFlags};
 use rayon::prelude::*;
-use spdcam_core::advice::Sampled;
+use spdcam_core::advice::{place_left_out, Sampled};
 use spdcam_core::chart::shown_chart_name;
 use spdcam_core::photo::{
     self, analysis_overlay_jpeg, debug_paths, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis,
@@ -238,20 +238,28 @@ impl Estimator {
                 return vec![unusable];
             }
         };
+        let checked: Vec<(PhotoAnalysis, Result<Option<Identified>>)> = analyses
+            .into_iter()
+            .map(|analysis| {
+                let found = self.refuse_not_the_chart(&analysis);
+                (analysis, found)
+            })
+            .collect();
+        let checked = self.leave_out_places_not_the_chart(checked);
         // One drawing of every place, numbered, shared by their reports.
         let overlay = match options.overlay_width {
             Some(width) => {
-                let all: Vec<&PhotoAnalysis> = analyses.iter().collect();
+                let all: Vec<&PhotoAnalysis> = checked.iter().map(|(a, _)| a).collect();
                 Some(overlay_of(photo, &analyse.templates, &all, width).map_err(|e| e.to_string()))
             }
             None => None,
         };
         let mut debug = debug;
-        analyses
+        checked
             .into_iter()
-            .map(|analysis| {
+            .map(|(analysis, found)| {
                 let mut identified = None;
-                let analysed = self.refuse_not_the_chart(&analysis).and_then(|found| {
+                let analysed = found.and_then(|found| {
                     identified = found.map(Carried);
                     let overlay = overlay.clone().transpose().map_err(InferError::invalid)?;
                     Ok(AnalysedPhoto { analysis, overlay })
@@ -263,6 +271,52 @@ impl Estimator {
                     identified,
                     photo: 0,
                 }
+            })
+            .collect()
+    }
+
+    /// The places of one photo with those whose patches are not the chart left out, where
+    /// another place is the chart: a grid detection found beside a chart (the white-balance
+    /// page of a ColorChecker Passport opened above its ColorChecker 24) is no failed photo.
+    /// What was left out, and why, is a warning on each place kept, and the kept places are
+    /// numbered again (none when one is left). Where no place is the chart, every refusal
+    /// stands.
+    fn leave_out_places_not_the_chart(
+        &self,
+        checked: Vec<(PhotoAnalysis, Result<Option<Identified>>)>,
+    ) -> Vec<(PhotoAnalysis, Result<Option<Identified>>)> {
+        let refused =
+            |found: &Result<Option<Identified>>| matches!(found, Err(InferError::NotTheChart(_)));
+        if checked.len() < 2 || checked.iter().all(|(_, found)| refused(found)) {
+            return checked;
+        }
+        let (kept, left_out): (Vec<_>, Vec<_>) =
+            checked.into_iter().partition(|(_, found)| !refused(found));
+        let notes: Vec<String> = left_out
+            .iter()
+            .map(|(analysis, _)| {
+                let mismatches = self
+                    .identify(analysis)
+                    .map(|found| found.identity.mismatches())
+                    .unwrap_or_default();
+                let centre = analysis.place.as_ref().map(|p| p.centre);
+                place_left_out(&shown_chart_name(&analysis.chart), centre, &mismatches)
+            })
+            .collect();
+        let of = kept.len();
+        kept.into_iter()
+            .enumerate()
+            .map(|(k, (mut analysis, found))| {
+                analysis.place = match analysis.place.take() {
+                    Some(place) if of > 1 => Some(photo::Place {
+                        number: k + 1,
+                        of,
+                        ..place
+                    }),
+                    _ => None,
+                };
+                analysis.warnings.extend(notes.iter().cloned());
+                (analysis, found)
             })
             .collect()
     }
