@@ -26,6 +26,12 @@ use support::median;
 #[path = "../../spdcam-core/benches/support/mod.rs"]
 mod support;
 
+/// The ColorChecker 24's template, as the estimator searches for it.
+fn template() -> ChartTemplate {
+    let chart = Chart::colorchecker24(&Grid::SIMULATION).expect("chart");
+    ChartTemplate::from_chart(&chart).expect("template")
+}
+
 /// The 24-megapixel DNG of the ColorChecker 24 in a scene under D65.
 fn dng() -> Vec<u8> {
     let grid = Grid::SIMULATION;
@@ -64,6 +70,14 @@ fn main() {
     let decoder = median(5, || {
         black_box(spdcam_core::photo::raw::decode(&bytes, "bench.dng").expect("decoded"));
     });
+    let photo = spdcam_core::photo::decode_photo(&bytes, "bench.dng").expect("decoded");
+    let decoded = median(5, || {
+        black_box(spdcam_core::photo::decode_photo(&bytes, "bench.dng").expect("decoded"));
+    });
+    let templates = vec![template()];
+    let detection = median(5, || {
+        black_box(spdcam_core::photo::detect_all(&photo, &templates).expect("search"));
+    });
     let whole = median(5, || {
         black_box(
             estimator
@@ -79,6 +93,14 @@ fn main() {
     println!(
         "  baseline: decoding the raw file     {:8.1} ms",
         ms(decoder)
+    );
+    println!(
+        "  the decoding and its preview        {:8.1} ms",
+        ms(decoded)
+    );
+    println!(
+        "  detection on the preview            {:8.1} ms",
+        ms(detection)
     );
     println!(
         "  whole estimate                      {:8.1} ms  ({:.2}× the baseline; target ≤ 2)",

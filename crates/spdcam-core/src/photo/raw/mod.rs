@@ -194,16 +194,19 @@ impl RawMosaic {
         linear
             .par_chunks_mut(w.max(1))
             .enumerate()
-            .for_each(|(py, row)| {
-                for (px, out) in row.iter_mut().enumerate() {
-                    let mut s = [0f32; 3];
-                    for by in 0..bin {
-                        for bx in 0..bin {
-                            let (v, _) = reader.cell(px * bin + bx, py * bin + by);
-                            (0..3).for_each(|c| s[c] += v[c]);
+            .for_each(|(py, row)| match &reader.quad {
+                Some(quad) => self.bayer_preview_row(quad, bin, py, row),
+                None => {
+                    for (px, out) in row.iter_mut().enumerate() {
+                        let mut s = [0f32; 3];
+                        for by in 0..bin {
+                            for bx in 0..bin {
+                                let (v, _) = reader.cell(px * bin + bx, py * bin + by);
+                                (0..3).for_each(|c| s[c] += v[c]);
+                            }
                         }
+                        *out = s.map(|v| v / (bin * bin) as f32);
                     }
-                    *out = s.map(|v| v / (bin * bin) as f32);
                 }
             });
         let neutral = match self.colour.as_shot_neutral {
@@ -221,15 +224,18 @@ impl RawMosaic {
         linear.par_iter_mut().for_each(|v| {
             *v = std::array::from_fn(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2]);
         });
-        let mut greens: Vec<f32> = linear.iter().map(|v| v[1]).collect();
+        // A non-negative f32's bits order as its value: integers select faster than floats
+        // compared (the level below zero is clamped, as the gain's is below).
+        let mut greens: Vec<u32> = linear.iter().map(|v| v[1].max(0.0).to_bits()).collect();
         let k = ((greens.len() as f64 * 0.99) as usize).min(greens.len().saturating_sub(1));
         let bright = if greens.is_empty() {
             1.0
         } else {
-            *greens.select_nth_unstable_by(k, |a, b| a.total_cmp(b)).1
+            f32::from_bits(*greens.select_nth_unstable(k).1)
         };
         let gain = (PREVIEW_WHITE / (bright as f64).max(1e-6)) as f32;
-        let encode = |v: f32| (srgb_encode_fast(v * gain) * 255.0).round() as u8;
+        // Rounding half up: the encoded value is never negative.
+        let encode = |v: f32| (srgb_encode_fast(v * gain) * 255.0 + 0.5) as u8;
         let (uw, uh) = self.upright_size(w, h);
         let mut data = vec![0u8; uw * uh * 3];
         data.par_chunks_mut(uw * 3)
@@ -246,6 +252,43 @@ impl RawMosaic {
         let mut photo = Photo::from_rgb8(source, uw, uh, data)?;
         photo.exposure = self.exposure;
         Ok(photo)
+    }
+
+    /// Preview row `py` of a 2 × 2 (Bayer) mosaic, `bin` cells a pixel each way: each
+    /// position's photosites summed as integers over the pixel's cells, then its black
+    /// level taken off and its weight applied once (`quad`: [`CellReader`]'s levels and
+    /// weights) — the mean of [`CellReader::cell`] over those cells, without reading each
+    /// cell's levels.
+    fn bayer_preview_row(
+        &self,
+        quad: &[(Levels, f32); 4],
+        bin: usize,
+        py: usize,
+        row: &mut [[f32; 3]],
+    ) {
+        let mut sums = vec![[0u32; 4]; row.len()];
+        for by in 0..bin {
+            let top = 2 * (py * bin + by) * self.width;
+            let upper = &self.values[top..top + self.width];
+            let lower = &self.values[top + self.width..top + 2 * self.width];
+            for (px, sum) in sums.iter_mut().enumerate() {
+                let x0 = 2 * px * bin;
+                for x in (x0..x0 + 2 * bin).step_by(2) {
+                    sum[0] += u32::from(upper[x]);
+                    sum[1] += u32::from(upper[x + 1]);
+                    sum[2] += u32::from(lower[x]);
+                    sum[3] += u32::from(lower[x + 1]);
+                }
+            }
+        }
+        let cells = (bin * bin) as f32;
+        for (out, sum) in row.iter_mut().zip(&sums) {
+            let mut rgb = [0f32; 3];
+            for (&total, (levels, weight)) in sum.iter().zip(quad) {
+                rgb[levels.colour] += (total as f32 - cells * levels.black) * weight;
+            }
+            *out = rgb.map(|v| v / cells);
+        }
     }
 
     /// The preview's size once upright, from its stored size.
