@@ -88,7 +88,7 @@ impl ModelColour {
 }
 
 /// The columns of [`ColourReport::photos_csv`].
-const PHOTO_COLUMNS: [&str; 19] = [
+const PHOTO_COLUMNS: [&str; 21] = [
     "model",
     "light_named",
     "photo",
@@ -106,13 +106,16 @@ const PHOTO_COLUMNS: [&str; 19] = [
     "true_cct_k",
     "estimate_cct_k",
     "cct_half95_k",
+    "true_duv",
+    "estimate_duv",
     "estimate_rf",
     "ok",
 ];
 
 impl ColourReport {
     /// Every photo of every model as CSV, a row each (model, light, camera, GFC, the true and
-    /// estimated u′v′ and CCT, the CCT's 95 % half-width, the estimate's TM-30 Rf, verdict): what the tables summarise, for a study of its own
+    /// estimated u′v′ and CCT, the CCT's 95 % half-width, the true and estimated Duv, the
+    /// estimate's TM-30 Rf, verdict): what the tables summarise, for a study of its own
     /// (empty cells where a photo was refused or a CCT is not scored).
     pub fn photos_csv(&self) -> crate::error::Result<String> {
         let mut w = csv::Writer::from_writer(Vec::new());
@@ -146,6 +149,8 @@ impl ColourReport {
                         number(c.and_then(|c| c.true_cct)),
                         number(c.and_then(|c| c.estimate_cct)),
                         number(e.and_then(|e| e.cct_interval).map(|(_, half)| half)),
+                        number(c.and_then(|c| c.true_duv)),
+                        number(c.and_then(|c| c.estimate_duv)),
                         number(e.and_then(|e| e.rf)),
                         e.is_some_and(|e| e.ok).to_string(),
                     ];
@@ -390,6 +395,8 @@ mod tests {
                 estimate_uv_prime: [0.245, 0.52],
                 true_cct: Some(3000.0),
                 estimate_cct: None,
+                true_duv: Some(0.0004),
+                estimate_duv: None,
             },
             ok: true,
             cct_interval: None,
@@ -429,12 +436,12 @@ mod tests {
             lines[1],
             format!(
                 "cc24.spdm,false,scene,test lamps,\"Lamp, \"\"warm\"\"\",{kind},cam_b,false,\
-                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,,true"
+                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,0.0004,,,true"
             )
         );
         assert_eq!(
             lines[2],
-            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,false")
+            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,,,false")
         );
     }
 }

@@ -51,6 +51,10 @@ pub struct ColourScore {
     pub true_cct: Option<f64>,
     /// The estimate's CCT (K), where the truth's is scored and the estimate has one.
     pub estimate_cct: Option<f64>,
+    /// The true light's Duv, where its CCT is scored.
+    pub true_duv: Option<f64>,
+    /// The estimate's Duv, where the truth's CCT is scored and the estimate has one.
+    pub estimate_duv: Option<f64>,
 }
 
 impl ColourScore {
@@ -81,16 +85,16 @@ impl ColourScore {
     pub fn between(truth: &LightColour, estimate: &LightColour) -> ColourScore {
         let [a, b] = truth.uv_prime;
         let [c, d] = estimate.uv_prime;
-        let true_cct = truth
-            .cct_duv
-            .filter(|(_, duv)| duv.abs() <= CCT_MAX_DUV)
-            .map(|(cct, _)| cct);
+        let scored = truth.cct_duv.filter(|(_, duv)| duv.abs() <= CCT_MAX_DUV);
+        let estimated = scored.and(estimate.cct_duv);
         ColourScore {
             delta_uv_prime: (a - c).hypot(b - d),
             true_uv_prime: truth.uv_prime,
             estimate_uv_prime: estimate.uv_prime,
-            true_cct,
-            estimate_cct: true_cct.and(estimate.cct_duv.map(|(cct, _)| cct)),
+            true_cct: scored.map(|(cct, _)| cct),
+            estimate_cct: estimated.map(|(cct, _)| cct),
+            true_duv: scored.map(|(_, duv)| duv),
+            estimate_duv: estimated.map(|(_, duv)| duv),
         }
     }
 

@@ -141,6 +141,8 @@ mod tests {
                 estimate_uv_prime: [0.21, 0.5],
                 true_cct: Some(truth),
                 estimate_cct: Some(estimate),
+                true_duv: Some(0.0),
+                estimate_duv: Some(0.001),
             },
             ok: true,
             cct_interval: half.map(|h| (estimate, h)),
