@@ -196,3 +196,37 @@ fn a_dng_told_its_illuminance_gives_the_absolute_levels_back() {
         assert!(e.contains("illuminance"), "{bad}: {e}");
     }
 }
+
+#[test]
+fn a_dng_of_several_charts_told_the_first_ones_illuminance_gives_each_its_own() {
+    // Two ColorChecker 24s under CIE A, the second in a shade at half the light: with the
+    // first chart's illuminance the DNG's exposure gives each its own level back. (Under
+    // different lights the sensor's green stands for luminance differently: docs/raw.md.)
+    let dir = scratch("raw-places-illuminance");
+    let photo = dir.join("two.dng");
+    ok(&[
+        "render",
+        "--spd",
+        "A",
+        "--scene",
+        "1600x1000",
+        "--seed",
+        "3",
+        "--place",
+        "centre=0.28,0.5 width=0.3",
+        "--place",
+        "centre=0.72,0.5 width=0.3 level=0.5",
+        "--illuminance",
+        "400",
+        "-o",
+        &s(&photo),
+    ]);
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["estimate", &s(&photo), "--json"])).unwrap();
+    let estimates = json.as_array().unwrap();
+    assert_eq!(estimates.len(), 2, "{json}");
+    for (e, lux) in estimates.iter().zip([400.0, 200.0]) {
+        let read = e["absolute"]["illuminance_lux"].as_f64().unwrap();
+        assert!((read / lux - 1.0).abs() < 0.03, "{read} lx for {lux}: {e}");
+    }
+}

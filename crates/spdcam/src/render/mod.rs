@@ -47,8 +47,10 @@ pub struct RenderArgs {
     /// With FILE.dng: the light's illuminance on the chart, lux; the DNG then carries the
     /// EXIF exposure (f/4, ISO 100 as the sensor's ISO 12232 saturation-based speed, and
     /// the time that puts the chart's raw values at that illuminance), from which
-    /// `estimate` reads absolute levels. Not with --place or --right-light.
-    #[arg(long, value_name = "LUX", conflicts_with_all = ["places", "right_light"])]
+    /// `estimate` reads absolute levels. With --place, the first chart's illuminance (each
+    /// other chart's is this times its light level relative to the first's, as printed).
+    /// Not with --right-light.
+    #[arg(long, value_name = "LUX", conflicts_with = "right_light")]
     illuminance: Option<f64>,
     /// Also write the feature row (mean sRGB 0–255 of each patch) as CSV; `-` for standard
     /// output.
