@@ -61,20 +61,23 @@ pub struct Scored {
     pub cct_interval: Option<(f64, f64)>,
     /// The estimate's own colour fidelity index (ANSI/IES TM-30 Rf), where it has one.
     pub rf: Option<f64>,
+    /// The GFC the trust calibration expects of the estimate, where the model has one.
+    pub expected_gfc: Option<f64>,
 }
 
 impl Scored {
     /// Scores `estimate` of `light`: its SPD, its verdict and its CCT interval.
     pub fn of(estimate: &Estimate, light: &Light) -> Result<Scored> {
         let trust = estimate.trust.as_ref();
-        let half95 = trust
-            .and_then(|t| t.uncertainty.as_ref())
+        let uncertainty = trust.and_then(|t| t.uncertainty.as_ref());
+        let half95 = uncertainty
             .and_then(|u| u.metrics.get("cct_k"))
             .map(|m| m.half95);
         Ok(Scored {
             ok: trust.is_some_and(|t| t.verdict == Verdict::Ok),
             cct_interval: estimate.metrics.cct_k.zip(half95),
             rf: estimate.metrics.tm30_rf,
+            expected_gfc: uncertainty.map(|u| u.expected_gfc),
             ..Scored::spd(&estimate.spd, light)?
         })
     }
@@ -88,6 +91,7 @@ impl Scored {
             ok: false,
             cct_interval: None,
             rf: None,
+            expected_gfc: None,
         })
     }
 }

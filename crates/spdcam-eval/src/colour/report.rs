@@ -88,7 +88,7 @@ impl ModelColour {
 }
 
 /// The columns of [`ColourReport::photos_csv`].
-const PHOTO_COLUMNS: [&str; 21] = [
+const PHOTO_COLUMNS: [&str; 22] = [
     "model",
     "light_named",
     "photo",
@@ -109,13 +109,14 @@ const PHOTO_COLUMNS: [&str; 21] = [
     "true_duv",
     "estimate_duv",
     "estimate_rf",
+    "expected_gfc",
     "ok",
 ];
 
 impl ColourReport {
     /// Every photo of every model as CSV, a row each (model, light, camera, GFC, the true and
     /// estimated u′v′ and CCT, the CCT's 95 % half-width, the true and estimated Duv, the
-    /// estimate's TM-30 Rf, verdict): what the tables summarise, for a study of its own
+    /// estimate's TM-30 Rf, its expected GFC, verdict): what the tables summarise, for a study of its own
     /// (empty cells where a photo was refused or a CCT is not scored).
     pub fn photos_csv(&self) -> crate::error::Result<String> {
         let mut w = csv::Writer::from_writer(Vec::new());
@@ -152,6 +153,7 @@ impl ColourReport {
                         number(c.and_then(|c| c.true_duv)),
                         number(c.and_then(|c| c.estimate_duv)),
                         number(e.and_then(|e| e.rf)),
+                        number(e.and_then(|e| e.expected_gfc)),
                         e.is_some_and(|e| e.ok).to_string(),
                     ];
                     w.write_record(&record).map_err(fail)?;
@@ -401,6 +403,7 @@ mod tests {
             ok: true,
             cct_interval: None,
             rf: None,
+            expected_gfc: Some(0.98),
         };
         let report = ColourReport {
             models: vec![cc24(
@@ -436,12 +439,12 @@ mod tests {
             lines[1],
             format!(
                 "cc24.spdm,false,scene,test lamps,\"Lamp, \"\"warm\"\"\",{kind},cam_b,false,\
-                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,0.0004,,,true"
+                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,0.0004,,,0.98,true"
             )
         );
         assert_eq!(
             lines[2],
-            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,,,false")
+            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,,,,false")
         );
     }
 }

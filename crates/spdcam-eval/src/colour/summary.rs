@@ -147,6 +147,7 @@ mod tests {
             ok: true,
             cct_interval: half.map(|h| (estimate, h)),
             rf: None,
+            expected_gfc: None,
         }
     }
 
