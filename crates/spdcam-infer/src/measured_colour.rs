@@ -172,38 +172,66 @@ pub fn conform(model: &Model, spds: &mut [f64], xy: [f64; 2]) -> bool {
     true
 }
 
-/// Relative CCT errors (|estimate − truth| / truth) a raw photo's light is read within with
-/// 68 % and 95 % probability, and the same for Duv (absolute): the 68th and 95th
-/// percentiles of those errors on raw scene photos of the validation split's validation
-/// lamps through its held-out cameras, both charts pooled, read as shipped (the matrices'
-/// shared bias taken off, [`RawColourCorrection`]); `tools/raw_intervals.py` on the photos
-/// CSV of `spdcam experiment colour --raw --photos-csv` (`docs/raw.md`); their coverage is
-/// reported on its test lamps. A split conformal interval (Vovk, Gammerman & Shafer,
-/// *Algorithmic Learning in a Random World*, 2005; Lei et al., JASA 2018): one calibration
-/// set, the empirical quantile as half-width.
-pub const RAW_CCT_RELATIVE: [f64; 2] = [0.0349, 0.0920];
-/// See [`RAW_CCT_RELATIVE`].
-pub const RAW_DUV: [f64; 2] = [0.0021, 0.0056];
+/// How closely a raw photo's light is read, for one group of photos: the relative CCT
+/// error (|estimate − truth| / truth) and the Duv error (absolute) at 68 % and 95 %.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RawIntervals {
+    /// Relative CCT error, 68 % and 95 %.
+    pub cct_relative: [f64; 2],
+    /// Duv error, 68 % and 95 %.
+    pub duv: [f64; 2],
+}
+
+/// The expected GFC (the trust calibration's) that splits raw photos into the two groups
+/// of [`RAW_INTERVALS`]: the median of the validation photos below.
+pub const RAW_SPLIT_EXPECTED_GFC: f64 = 0.990389;
+
+/// The intervals of raw photos whose expected GFC is below [`RAW_SPLIT_EXPECTED_GFC`] and of
+/// those at or above it: the 68th and 95th percentiles of their errors on raw scene photos
+/// of the validation split's validation lamps through its held-out cameras (108 photos
+/// each), both charts pooled, read as shipped (the matrices' shared bias taken off,
+/// [`RawColourCorrection`]); `tools/raw_intervals.py` on the photos CSV of
+/// `spdcam experiment colour --raw --photos-csv` (`docs/raw.md`, which gives the rule and
+/// the coverage on the test lamps). A lamp the chart reads poorly (a mixed-colour LED, a
+/// fluorescent) has a low expected GFC and its colour too is read less closely. Split
+/// conformal intervals (Vovk, Gammerman & Shafer, *Algorithmic Learning in a Random World*,
+/// 2005; Lei et al., JASA 2018) in groups, one quantile each (Vovk 2012, "Conditional
+/// validity of inductive conformal predictors", PMLR 25: 475–490).
+pub const RAW_INTERVALS: [RawIntervals; 2] = [
+    RawIntervals {
+        cct_relative: [0.0476, 0.1040],
+        duv: [0.0030, 0.0074],
+    },
+    RawIntervals {
+        cct_relative: [0.0312, 0.0507],
+        duv: [0.0020, 0.0043],
+    },
+];
 
 /// The CCT and Duv intervals (half-widths at 68 % and 95 %) of a light a raw photo read at
-/// CCT `cct_k`.
-pub fn cct_duv_intervals(cct_k: f64) -> [MetricInterval; 2] {
+/// CCT `cct_k`, the estimate's expected GFC `expected_gfc` choosing the group.
+pub fn cct_duv_intervals(cct_k: f64, expected_gfc: f64) -> [MetricInterval; 2] {
+    let group = &RAW_INTERVALS[usize::from(expected_gfc >= RAW_SPLIT_EXPECTED_GFC)];
     [
         MetricInterval {
-            half68: RAW_CCT_RELATIVE[0] * cct_k,
-            half95: RAW_CCT_RELATIVE[1] * cct_k,
+            half68: group.cct_relative[0] * cct_k,
+            half95: group.cct_relative[1] * cct_k,
         },
         MetricInterval {
-            half68: RAW_DUV[0],
-            half95: RAW_DUV[1],
+            half68: group.duv[0],
+            half95: group.duv[1],
         },
     ]
 }
 
 /// Sets the CCT and Duv intervals of `metrics` (where they are there) for an estimate of
-/// CCT `cct_k` from a raw photo ([`cct_duv_intervals`]).
-pub fn set_intervals(metrics: &mut BTreeMap<String, MetricInterval>, cct_k: f64) {
-    let [cct, duv] = cct_duv_intervals(cct_k);
+/// CCT `cct_k` and expected GFC `expected_gfc` from a raw photo ([`cct_duv_intervals`]).
+pub fn set_intervals(
+    metrics: &mut BTreeMap<String, MetricInterval>,
+    cct_k: f64,
+    expected_gfc: f64,
+) {
+    let [cct, duv] = cct_duv_intervals(cct_k, expected_gfc);
     for (key, interval) in [("cct_k", cct), ("duv", duv)] {
         if let Some(slot) = metrics.get_mut(key) {
             *slot = interval;
@@ -215,6 +243,34 @@ pub fn set_intervals(metrics: &mut BTreeMap<String, MetricInterval>, cct_k: f64)
 mod tests {
     use super::*;
     use spdcam_core::cie_illuminant::planck;
+
+    #[test]
+    fn a_raw_photos_intervals_follow_its_expected_gfc() {
+        let below = cct_duv_intervals(4000.0, 0.95);
+        let above = cct_duv_intervals(4000.0, RAW_SPLIT_EXPECTED_GFC);
+        assert!((below[0].half95 - 0.1040 * 4000.0).abs() < 1e-9);
+        assert!((below[1].half95 - 0.0074).abs() < 1e-12);
+        assert!((above[0].half68 - 0.0312 * 4000.0).abs() < 1e-9);
+        assert!((above[1].half95 - 0.0043).abs() < 1e-12);
+        // Each group's 68 % interval lies inside its 95 %, and the well-read group's inside
+        // the other's.
+        for g in &RAW_INTERVALS {
+            assert!(g.cct_relative[0] < g.cct_relative[1] && g.duv[0] < g.duv[1]);
+        }
+        assert!(above[0].half95 < below[0].half95 && above[1].half95 < below[1].half95);
+        // Set where the estimate has the metric, left out where it has none.
+        let mut metrics = BTreeMap::new();
+        metrics.insert(
+            "cct_k".to_string(),
+            MetricInterval {
+                half68: 1.0,
+                half95: 2.0,
+            },
+        );
+        set_intervals(&mut metrics, 4000.0, 0.999);
+        assert_eq!(metrics["cct_k"], above[0]);
+        assert!(!metrics.contains_key("duv"));
+    }
 
     /// A made-up bias: 0.002 in u′ and −0.01 in v′ per unit of the shape's share at
     /// 450 nm (index 5), and a constant 0.001 in v′.

@@ -519,7 +519,7 @@ impl Estimator {
         let colorimetry = Colorimetry::of_metrics(&metrics)?;
         if photo.as_ref().is_some_and(|a| a.raw.is_some()) {
             if let (Some(u), Some(cct)) = (&mut trust.uncertainty, colorimetry.cct) {
-                measured_colour::set_intervals(&mut u.metrics, cct);
+                measured_colour::set_intervals(&mut u.metrics, cct, u.expected_gfc);
             }
         }
         let unusable: Vec<bool> = (0..flags.clipped.len())
