@@ -21,16 +21,10 @@ so the high group is not the well-read one. docs/raw.md says so.
 """
 
 import csv
-import math
 import statistics
 import sys
 
-def quantile(values, q):
-    """Split-conformal quantile: the ⌈(n + 1) q⌉-th smallest of n values (the largest where
-    that exceeds n)."""
-    ordered = sorted(values)
-    k = min(len(ordered), math.ceil((len(ordered) + 1) * q))
-    return ordered[k - 1]
+from raw_intervals import quantile
 
 
 def main(path):
