@@ -403,11 +403,7 @@ pub enum Sampled {
 /// The refusal of patches that are not the chart `chart` (as people know it) and what to
 /// do: place the corners again, show where the chart is, give a real chart's patches.
 pub fn not_the_chart(chart: &str, sampled: Sampled, mismatches: &[Mismatch]) -> String {
-    let what = mismatches
-        .iter()
-        .map(Mismatch::to_string)
-        .collect::<Vec<_>>()
-        .join("; ");
+    let what = mismatch_list(mismatches);
     match sampled {
         Sampled::Corners => format!(
             "these corners do not hold a {chart}: place them on the chart's four outer \
@@ -428,17 +424,20 @@ pub fn not_the_chart(chart: &str, sampled: Sampled, mismatches: &[Mismatch]) -> 
 /// `centre`, photo pixels) was left out because it is not a `chart` (`mismatches`: why).
 pub fn place_left_out(chart: &str, centre: Option<[f64; 2]>, mismatches: &[Mismatch]) -> String {
     let at = centre.map_or(String::new(), |[x, y]| format!(" at {x:.0}, {y:.0} px"));
-    let why = mismatches
+    let why = match mismatch_list(mismatches) {
+        list if list.is_empty() => list,
+        list => format!(" ({list})"),
+    };
+    format!("a grid of patches{at} was left out: it is not a {chart}{why}")
+}
+
+/// What was found against a chart, in words, separated by semicolons.
+fn mismatch_list(mismatches: &[Mismatch]) -> String {
+    mismatches
         .iter()
         .map(Mismatch::to_string)
         .collect::<Vec<_>>()
-        .join("; ");
-    let why = if why.is_empty() {
-        String::new()
-    } else {
-        format!(" ({why})")
-    };
-    format!("a grid of patches{at} was left out: it is not a {chart}{why}")
+        .join("; ")
 }
 
 /// `is` for one, `are` for more.

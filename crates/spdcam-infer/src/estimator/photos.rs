@@ -10,7 +10,7 @@ use crate::photo_options::PhotoOptions;
 use crate::places;
 use crate::trust::{self, feature_scale, Identity, PhotoFlags};
 use rayon::prelude::*;
-use spdcam_core::advice::{place_left_out, Sampled};
+use spdcam_core::advice::{place_left_out, Mismatch, Sampled};
 use spdcam_core::chart::shown_chart_name;
 use spdcam_core::photo::{
     self, analysis_overlay_jpeg, debug_paths, AnalyseOptions, ChartTemplate, Photo, PhotoAnalysis,
@@ -238,14 +238,14 @@ impl Estimator {
                 return vec![unusable];
             }
         };
-        let checked: Vec<(PhotoAnalysis, Result<Option<Identified>>)> = analyses
+        let checked: Vec<Checked> = analyses
             .into_iter()
             .map(|analysis| {
-                let found = self.refuse_not_the_chart(&analysis);
-                (analysis, found)
+                let (found, mismatches) = self.check_chart(&analysis);
+                (analysis, found, mismatches)
             })
             .collect();
-        let checked = self.leave_out_places_not_the_chart(checked);
+        let checked = leave_out_places_not_the_chart(checked);
         // One drawing of every place, numbered, shared by their reports.
         let overlay = match options.overlay_width {
             Some(width) => {
@@ -271,52 +271,6 @@ impl Estimator {
                     identified,
                     photo: 0,
                 }
-            })
-            .collect()
-    }
-
-    /// The places of one photo with those whose patches are not the chart left out, where
-    /// another place is the chart: a grid detection found beside a chart (the white-balance
-    /// page of a ColorChecker Passport opened above its ColorChecker 24) is no failed photo.
-    /// What was left out, and why, is a warning on each place kept, and the kept places are
-    /// numbered again (none when one is left). Where no place is the chart, every refusal
-    /// stands.
-    fn leave_out_places_not_the_chart(
-        &self,
-        checked: Vec<(PhotoAnalysis, Result<Option<Identified>>)>,
-    ) -> Vec<(PhotoAnalysis, Result<Option<Identified>>)> {
-        let refused =
-            |found: &Result<Option<Identified>>| matches!(found, Err(InferError::NotTheChart(_)));
-        if checked.len() < 2 || checked.iter().all(|(_, found)| refused(found)) {
-            return checked;
-        }
-        let (kept, left_out): (Vec<_>, Vec<_>) =
-            checked.into_iter().partition(|(_, found)| !refused(found));
-        let notes: Vec<String> = left_out
-            .iter()
-            .map(|(analysis, _)| {
-                let mismatches = self
-                    .identify(analysis)
-                    .map(|found| found.identity.mismatches())
-                    .unwrap_or_default();
-                let centre = analysis.place.as_ref().map(|p| p.centre);
-                place_left_out(&shown_chart_name(&analysis.chart), centre, &mismatches)
-            })
-            .collect();
-        let of = kept.len();
-        kept.into_iter()
-            .enumerate()
-            .map(|(k, (mut analysis, found))| {
-                analysis.place = match analysis.place.take() {
-                    Some(place) if of > 1 => Some(photo::Place {
-                        number: k + 1,
-                        of,
-                        ..place
-                    }),
-                    _ => None,
-                };
-                analysis.warnings.extend(notes.iter().cloned());
-                (analysis, found)
             })
             .collect()
     }
@@ -409,16 +363,23 @@ impl Estimator {
     /// errors are left for the estimate to give. What was identified is kept for the
     /// estimate, so that the model runs once per photo.
     fn refuse_not_the_chart(&self, analysis: &PhotoAnalysis) -> Result<Option<Identified>> {
+        self.check_chart(analysis).0
+    }
+
+    /// [`Estimator::refuse_not_the_chart`], with what was found against the chart (empty
+    /// where nothing was, or the photo could not be identified).
+    fn check_chart(&self, analysis: &PhotoAnalysis) -> (Result<Option<Identified>>, Vec<Mismatch>) {
         match self.identify(analysis) {
             Ok(found) => {
-                self.prepared.trust[found.index].identity.require(
+                let mismatches = found.identity.mismatches();
+                let required = self.prepared.trust[found.index].identity.require(
                     &found.identity,
                     sampled(analysis),
                     &analysis.source,
-                )?;
-                Ok(Some(found))
+                );
+                (required.map(|()| Some(found)), mismatches)
             }
-            Err(_) => Ok(None),
+            Err(_) => (Ok(None), Vec::new()),
         }
     }
 
@@ -685,4 +646,53 @@ pub struct AnalysedPhoto {
     /// The photo with the chart found drawn on it (as `--debug` draws it), reduced to
     /// `PhotoOptions::overlay_width` and encoded as JPEG, when asked for.
     pub overlay: Option<Vec<u8>>,
+}
+
+/// An analysed place, whether it is the chart ([`Estimator::refuse_not_the_chart`]) and what
+/// was found against it.
+type Checked = (PhotoAnalysis, Result<Option<Identified>>, Vec<Mismatch>);
+
+/// The places of one photo with those whose patches are not the chart left out, where
+/// another place is the chart: a grid detection found beside a chart (the white-balance
+/// page of a ColorChecker Passport opened above its ColorChecker 24) is no failed photo.
+/// What was left out, and why, is a warning on each place kept, and the kept places are
+/// numbered again (none when one is left). Where no place is the chart, every refusal
+/// stands.
+fn leave_out_places_not_the_chart(
+    checked: Vec<Checked>,
+) -> Vec<(PhotoAnalysis, Result<Option<Identified>>)> {
+    let refused =
+        |found: &Result<Option<Identified>>| matches!(found, Err(InferError::NotTheChart(_)));
+    if checked.len() < 2 || checked.iter().all(|(_, found, _)| refused(found)) {
+        return checked
+            .into_iter()
+            .map(|(a, found, _)| (a, found))
+            .collect();
+    }
+    let (kept, left_out): (Vec<_>, Vec<_>) = checked
+        .into_iter()
+        .partition(|(_, found, _)| !refused(found));
+    let notes: Vec<String> = left_out
+        .iter()
+        .map(|(analysis, _, mismatches)| {
+            let centre = analysis.place.as_ref().map(|p| p.centre);
+            place_left_out(&shown_chart_name(&analysis.chart), centre, mismatches)
+        })
+        .collect();
+    let of = kept.len();
+    kept.into_iter()
+        .enumerate()
+        .map(|(k, (mut analysis, found, _))| {
+            analysis.place = match analysis.place.take() {
+                Some(place) if of > 1 => Some(photo::Place {
+                    number: k + 1,
+                    of,
+                    ..place
+                }),
+                _ => None,
+            };
+            analysis.warnings.extend(notes.iter().cloned());
+            (analysis, found)
+        })
+        .collect()
 }
