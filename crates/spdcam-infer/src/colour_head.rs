@@ -103,52 +103,23 @@ impl ColourHead {
     /// that the spectrum they stand for, its negatives set to 0, moves [`ColourHead::pull`]
     /// of the way from its own chromaticity to `predicted` (see the module's
     /// documentation). Leaves them as they are where no step can be made (a black spectrum,
-    /// a non-finite prediction).
+    /// a non-finite prediction). For many spectra of one PCA, [`ColourHead::conformer`].
     pub fn conform(&self, pca: &Pca, coefficients: &mut [f64], predicted: [f64; 2]) {
-        if !predicted.iter().all(|t| t.is_finite()) || self.pull == 0.0 {
-            return;
-        }
-        let mut own = pca.reconstruct(coefficients);
-        own.iter_mut().for_each(|v| *v = v.max(0.0));
-        let Some(own) = self.uv(&own) else { return };
-        let target = [0, 1].map(|i| own[i] + self.pull * (predicted[i] - own[i]));
-        let k = coefficients.len().min(pca.len());
-        let variance: Vec<f64> = pca.explained_ratio[..k]
-            .iter()
-            .map(|r| (r * pca.total_variance).max(f64::MIN_POSITIVE))
-            .collect();
-        let component_xyz: Vec<[f64; 3]> =
-            pca.components[..k].iter().map(|c| self.xyz(c)).collect();
-        for _ in 0..CONFORM_STEPS {
-            let mut spd = pca.reconstruct(coefficients);
-            spd.iter_mut().for_each(|v| *v = v.max(0.0));
-            let xyz = self.xyz(&spd);
-            let Some(uv) = uv_of(xyz) else { return };
-            let r = [target[0] - uv[0], target[1] - uv[1]];
-            if r[0].hypot(r[1]) < CONFORM_TOLERANCE {
-                return;
-            }
-            let jacobian: Vec<[f64; 2]> = component_xyz.iter().map(|b| uv_slope(xyz, *b)).collect();
-            // J Λ Jᵀ, 2 × 2.
-            let mut m = [[0.0; 2]; 2];
-            for (j, l) in jacobian.iter().zip(&variance) {
-                for a in 0..2 {
-                    for b in 0..2 {
-                        m[a][b] += j[a] * l * j[b];
-                    }
-                }
-            }
-            let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-            if !(det.is_finite() && det.abs() > 1e-300) {
-                return;
-            }
-            let y = [
-                (m[1][1] * r[0] - m[0][1] * r[1]) / det,
-                (m[0][0] * r[1] - m[1][0] * r[0]) / det,
-            ];
-            for ((c, j), l) in coefficients.iter_mut().zip(&jacobian).zip(&variance) {
-                *c += l * (j[0] * y[0] + j[1] * y[1]);
-            }
+        self.conformer(pca).conform(coefficients, predicted);
+    }
+
+    /// This head ready to conform spectra of `pca`: what does not depend on the spectrum
+    /// (the coefficients' variances, the components' XYZ) computed once.
+    pub fn conformer<'a>(&'a self, pca: &'a Pca) -> Conformer<'a> {
+        Conformer {
+            head: self,
+            pca,
+            variance: pca
+                .explained_ratio
+                .iter()
+                .map(|r| (r * pca.total_variance).max(f64::MIN_POSITIVE))
+                .collect(),
+            component_xyz: pca.components.iter().map(|c| self.xyz(c)).collect(),
         }
     }
 
@@ -168,6 +139,91 @@ impl ColourHead {
             ));
         }
         Ok(())
+    }
+}
+
+/// A [`ColourHead`] with one PCA's numbers computed once ([`ColourHead::conformer`]), for
+/// conforming many spectra of that PCA.
+pub struct Conformer<'a> {
+    head: &'a ColourHead,
+    pca: &'a Pca,
+    /// Each coefficient's variance over the training spectra (Λ).
+    variance: Vec<f64>,
+    /// Each component's XYZ.
+    component_xyz: Vec<[f64; 3]>,
+}
+
+impl<'a> Conformer<'a> {
+    /// The PCA whose spectra it conforms.
+    pub fn pca(&self) -> &'a Pca {
+        self.pca
+    }
+
+    /// [`ColourHead::conform`] with this conformer's head and PCA.
+    pub fn conform(&self, coefficients: &mut [f64], predicted: [f64; 2]) {
+        if !predicted.iter().all(|t| t.is_finite()) || self.head.pull == 0.0 {
+            return;
+        }
+        let mut spd = self.pca.reconstruct(coefficients);
+        spd.iter_mut().for_each(|v| *v = v.max(0.0));
+        let Some(own) = self.head.uv(&spd) else {
+            return;
+        };
+        self.conform_from(coefficients, spd, own, predicted);
+    }
+
+    /// [`Conformer::conform`] of coefficients whose spectrum, negatives set to 0, is `spd`
+    /// of chromaticity `own`: for a caller that has just computed them.
+    pub fn conform_from(
+        &self,
+        coefficients: &mut [f64],
+        mut spd: Vec<f64>,
+        own: [f64; 2],
+        predicted: [f64; 2],
+    ) {
+        if !predicted.iter().all(|t| t.is_finite()) || self.head.pull == 0.0 {
+            return;
+        }
+        let pull = self.head.pull;
+        let target = [0, 1].map(|i| own[i] + pull * (predicted[i] - own[i]));
+        let k = coefficients.len().min(self.pca.len());
+        let (variance, component_xyz) = (&self.variance[..k], &self.component_xyz[..k]);
+        let mut jacobian = vec![[0.0; 2]; k];
+        for step in 0..CONFORM_STEPS {
+            if step > 0 {
+                self.pca.reconstruct_into(coefficients, &mut spd);
+                spd.iter_mut().for_each(|v| *v = v.max(0.0));
+            }
+            let xyz = self.head.xyz(&spd);
+            let Some(uv) = uv_of(xyz) else { return };
+            let r = [target[0] - uv[0], target[1] - uv[1]];
+            if r[0].hypot(r[1]) < CONFORM_TOLERANCE {
+                return;
+            }
+            for (j, b) in jacobian.iter_mut().zip(component_xyz) {
+                *j = uv_slope(xyz, *b);
+            }
+            // J Λ Jᵀ, 2 × 2.
+            let mut m = [[0.0; 2]; 2];
+            for (j, l) in jacobian.iter().zip(variance) {
+                for a in 0..2 {
+                    for b in 0..2 {
+                        m[a][b] += j[a] * l * j[b];
+                    }
+                }
+            }
+            let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+            if !(det.is_finite() && det.abs() > 1e-300) {
+                return;
+            }
+            let y = [
+                (m[1][1] * r[0] - m[0][1] * r[1]) / det,
+                (m[0][0] * r[1] - m[1][0] * r[0]) / det,
+            ];
+            for ((c, j), l) in coefficients.iter_mut().zip(&jacobian).zip(variance) {
+                *c += l * (j[0] * y[0] + j[1] * y[1]);
+            }
+        }
     }
 }
 

@@ -20,7 +20,7 @@
 //! light (an RGB lamp set to green) is left as the model reads it and the estimate stays
 //! continuous in the features.
 
-use crate::colour_head::ColourHead;
+use crate::colour_head::{ColourHead, Conformer};
 use crate::error::{InferError, Result};
 use crate::pca::Pca;
 use serde::{Deserialize, Serialize};
@@ -149,12 +149,18 @@ impl ColourMap {
     /// Moves `coefficients` (of `pca`) so that their spectrum has the corrected colour of its
     /// own; leaves them where the spectrum has none (black) or the map does not apply.
     pub fn correct(&self, pca: &Pca, coefficients: &mut [f64]) {
-        let mut own = pca.reconstruct(coefficients);
+        self.correct_with(&self.head.conformer(pca), coefficients);
+    }
+
+    /// [`ColourMap::correct`] with this map's head made ready for the PCA once
+    /// ([`ColourHead::conformer`]), for many spectra.
+    pub fn correct_with(&self, conformer: &Conformer, coefficients: &mut [f64]) {
+        let mut own = conformer.pca().reconstruct(coefficients);
         own.iter_mut().for_each(|v| *v = v.max(0.0));
         if let Some(uv) = self.head.uv(&own) {
             let target = self.apply(uv);
             if target != uv {
-                self.head.conform(pca, coefficients, target);
+                conformer.conform_from(coefficients, own, uv, target);
             }
         }
     }

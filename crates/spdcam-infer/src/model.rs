@@ -460,12 +460,11 @@ impl Model {
         let d = self.header.grid.count;
         let rows = outputs.len() / k;
         let mut spds = vec![0.0; rows * d];
+        let decoder = self.header.target.decoder(self.header.colour_map.as_ref());
         let decode = |(out, spd): (&[f32], &mut [f64])| {
             let mut t = vec![0.0; k];
             self.header.target_scaler.unscale_into(out, &mut t);
-            self.header
-                .target
-                .decode_into(&t, spd, self.header.colour_map.as_ref());
+            decoder.decode_into(&t, spd);
         };
         if rows > 512 {
             outputs

@@ -152,13 +152,20 @@ impl Pca {
 
     /// The row of data that the coefficients stand for (the inverse transform).
     pub fn reconstruct(&self, coefficients: &[f64]) -> Vec<f64> {
-        let mut out = self.mean.clone();
+        let mut out = vec![0.0; self.mean.len()];
+        self.reconstruct_into(coefficients, &mut out);
+        out
+    }
+
+    /// [`Pca::reconstruct`] into `out` (of the data's dimension), for callers that
+    /// reconstruct many rows into one buffer.
+    pub fn reconstruct_into(&self, coefficients: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(&self.mean);
         for (c, &a) in self.components.iter().zip(coefficients) {
             for (o, ci) in out.iter_mut().zip(c) {
                 *o += a * ci;
             }
         }
-        out
     }
 
     /// Checks the fitted numbers are consistent (for a PCA read from a file).

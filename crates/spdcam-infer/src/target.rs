@@ -4,7 +4,7 @@
 //! weights`, the thesis's G/H experiments), whose channel spectra are fitted from the
 //! training data.
 
-use crate::colour_head::ColourHead;
+use crate::colour_head::{ColourHead, Conformer};
 use crate::colour_map::ColourMap;
 use crate::error::{InferError, Result};
 use crate::pca::{Components, Pca};
@@ -63,6 +63,53 @@ pub enum Target {
     Weights(Channels),
 }
 
+/// A [`Target`] ready to decode many rows ([`Target::decoder`]).
+pub struct Decoder<'a> {
+    target: &'a Target,
+    /// The colour head of a PCA-colour target.
+    colour: Option<Conformer<'a>>,
+    /// The colour map and its head, for a PCA target.
+    map: Option<(&'a ColourMap, Conformer<'a>)>,
+}
+
+impl Decoder<'_> {
+    /// The (relative, max-normalised, non-negative) SPD for one row of targets, as
+    /// [`Target::decode_into`] makes it.
+    pub fn decode_into(&self, targets: &[f64], spd: &mut [f64]) {
+        match self.target {
+            Target::Pca(p) => match &self.map {
+                Some((map, conformer)) => {
+                    let mut coefficients = targets.to_vec();
+                    map.correct_with(conformer, &mut coefficients);
+                    p.reconstruct_into(&coefficients, spd);
+                }
+                None => p.reconstruct_into(targets, spd),
+            },
+            Target::PcaColour(p) => {
+                let k = p.pca.len();
+                let mut coefficients = targets[..k].to_vec();
+                if let Some(colour) = &self.colour {
+                    colour.conform(&mut coefficients, [targets[k], targets[k + 1]]);
+                }
+                if let Some((map, conformer)) = &self.map {
+                    map.correct_with(conformer, &mut coefficients);
+                }
+                p.pca.reconstruct_into(&coefficients, spd);
+            }
+            Target::Weights(c) => {
+                spd.iter_mut().for_each(|v| *v = 0.0);
+                for (w, ch) in targets.iter().zip(&c.spectra) {
+                    for (v, x) in spd.iter_mut().zip(ch) {
+                        *v += w.max(0.0) * x;
+                    }
+                }
+            }
+        }
+        // An estimate is a relative SPD: peak 1, nothing below 0.
+        spdcam_core::spectral::clip_normalise(spd);
+    }
+}
+
 impl Target {
     /// The number of targets.
     pub fn len(&self) -> usize {
@@ -90,36 +137,21 @@ impl Target {
     /// The (relative, max-normalised, non-negative) SPD for one row of targets, its colour
     /// corrected by `map` where given (a PCA target only: [`ColourMap::correct`]).
     pub fn decode_into(&self, targets: &[f64], spd: &mut [f64], map: Option<&ColourMap>) {
-        match self {
-            Target::Pca(p) => match map {
-                Some(map) => {
-                    let mut coefficients = targets.to_vec();
-                    map.correct(p, &mut coefficients);
-                    spd.copy_from_slice(&p.reconstruct(&coefficients));
-                }
-                None => spd.copy_from_slice(&p.reconstruct(targets)),
+        self.decoder(map).decode_into(targets, spd);
+    }
+
+    /// A decoder of many rows of targets, its colour corrected by `map` where given: what
+    /// does not depend on the row computed once.
+    pub fn decoder<'a>(&'a self, map: Option<&'a ColourMap>) -> Decoder<'a> {
+        let pca = self.pca();
+        Decoder {
+            target: self,
+            colour: match self {
+                Target::PcaColour(p) => Some(p.colour.conformer(&p.pca)),
+                _ => None,
             },
-            Target::PcaColour(p) => {
-                let k = p.pca.len();
-                let mut coefficients = targets[..k].to_vec();
-                p.colour
-                    .conform(&p.pca, &mut coefficients, [targets[k], targets[k + 1]]);
-                if let Some(map) = map {
-                    map.correct(&p.pca, &mut coefficients);
-                }
-                spd.copy_from_slice(&p.pca.reconstruct(&coefficients));
-            }
-            Target::Weights(c) => {
-                spd.iter_mut().for_each(|v| *v = 0.0);
-                for (w, ch) in targets.iter().zip(&c.spectra) {
-                    for (v, x) in spd.iter_mut().zip(ch) {
-                        *v += w.max(0.0) * x;
-                    }
-                }
-            }
+            map: map.zip(pca).map(|(m, pca)| (m, m.head.conformer(pca))),
         }
-        // An estimate is a relative SPD: peak 1, nothing below 0.
-        spdcam_core::spectral::clip_normalise(spd);
     }
 
     /// The targets of one max-normalised SPD on the model's grid, or `None` for a target
