@@ -4,6 +4,7 @@
 //! reach it.
 
 use crate::error::{InferError, Result};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// What each feature row is divided by before the per-feature scaling, so that the photo's
@@ -152,9 +153,15 @@ impl FeatureScaler {
         let width = self.width();
         check_rows(data, width, "features")?;
         let mut out = vec![0.0f32; data.len()];
-        for (row, o) in data.chunks_exact(width).zip(out.chunks_exact_mut(width)) {
-            self.transform_into(row, o);
-        }
+        // Rows of a large block in parallel, a task's worth at a time.
+        let task = (width * 256).max(1);
+        out.par_chunks_mut(task)
+            .zip(data.par_chunks(task))
+            .for_each(|(o, rows)| {
+                for (row, o) in rows.chunks_exact(width).zip(o.chunks_exact_mut(width)) {
+                    self.transform_into(row, o);
+                }
+            });
         Ok(out)
     }
 
