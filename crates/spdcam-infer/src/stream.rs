@@ -427,15 +427,12 @@ pub fn long_rows(spds: &[f64], width: usize, first_row: usize) -> Vec<u8> {
         .enumerate()
         .map(|(task, chunk)| {
             let mut out = Vec::with_capacity(chunk.len() * 20);
+            let mut decimals = zmij::Buffer::new();
             for (k, spd) in chunk.chunks_exact(width).enumerate() {
                 let _ = write!(out, "{}", row_name(first_row + task * LINES_PER_TASK + k));
                 for &v in spd {
-                    // −0 as 0, as the wide layout writes it.
-                    let _ = if v == 0.0 {
-                        write!(out, ",0")
-                    } else {
-                        write!(out, ",{v}")
-                    };
+                    out.push(b',');
+                    push_decimal(&mut out, &mut decimals, v);
                 }
                 out.push(b'\n');
             }
@@ -443,6 +440,27 @@ pub fn long_rows(spds: &[f64], width: usize, first_row: usize) -> Vec<u8> {
         })
         .collect();
     chunks.concat()
+}
+
+/// Appends `v` as `format!("{v}")` writes it: the shortest decimals that read back as `v`,
+/// never an exponent, −0 as 0 as the wide layout writes it. The digits come from Schubfach
+/// (Giulietti 2020, "The Schubfach way to render doubles"), which picks the same shortest,
+/// nearest decimals as std at a fraction of the cost; where two are equally near (an exact
+/// tie, as for 1690060720831323.25) it takes the even one and std the upper, both reading
+/// back as `v`. A value whose Schubfach text has an exponent is written by std.
+fn push_decimal(out: &mut Vec<u8>, decimals: &mut zmij::Buffer, v: f64) {
+    if v == 0.0 {
+        out.push(b'0');
+        return;
+    }
+    if v.is_finite() {
+        let text = decimals.format_finite(v);
+        if !text.contains('e') {
+            out.extend_from_slice(text.strip_suffix(".0").unwrap_or(text).as_bytes());
+            return;
+        }
+    }
+    let _ = write!(out, "{v}");
 }
 
 #[cfg(test)]
@@ -634,6 +652,80 @@ mod tests {
             vec![1.0; 61]
         );
         assert!(GridMap::new(&from, &Grid::parse("380-700:5").unwrap()).is_err());
+    }
+
+    #[test]
+    fn decimals_are_written_as_std_writes_them() {
+        let mut decimals = zmij::Buffer::new();
+        let mut ties = 0;
+        let mut check = |v: f64| {
+            let mut out = Vec::new();
+            push_decimal(&mut out, &mut decimals, v);
+            let got = String::from_utf8(out).unwrap();
+            let want = if v == 0.0 {
+                "0".to_string()
+            } else {
+                format!("{v}")
+            };
+            if got != want {
+                // Only an exact tie between two shortest decimals may differ: same length,
+                // both read back as v.
+                assert_eq!(got.len(), want.len(), "{v:e}: {got} against {want}");
+                assert_eq!(got.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{got}");
+                ties += 1;
+            }
+        };
+        for v in [
+            1.0,
+            0.5,
+            0.1,
+            1.0 / 3.0,
+            2.0,
+            100.0,
+            1e15,
+            1e16,
+            1e17,
+            1.5e300,
+            1e-5,
+            1.2e-6,
+            1e-7,
+            5e-324,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            -0.0,
+            -1.25,
+            123456.789,
+            0.30000000000000004,
+        ] {
+            check(v);
+        }
+        // 1690060720831323.25, exactly representable (the spacing there is 0.25): a tie.
+        check(1_690_060_720_831_323.0 + 0.25);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut spd_range = Vec::new();
+        for i in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            // Any bit pattern, then values of an SPD's range.
+            let v = match i % 2 {
+                0 => f64::from_bits(state),
+                _ => (state >> 11) as f64 / (1u64 << 53) as f64,
+            };
+            if v.is_finite() {
+                check(v);
+            }
+            if i % 2 == 1 {
+                spd_range.push(v);
+            }
+        }
+        assert!(ties < 100, "{ties} ties");
+        // Values of an SPD's range (multiples of 2⁻⁵³ have no exact tie): std's text exactly.
+        for v in spd_range {
+            let mut out = Vec::new();
+            push_decimal(&mut out, &mut decimals, v);
+            assert_eq!(String::from_utf8(out).unwrap(), format!("{v}"));
+        }
     }
 
     #[test]
