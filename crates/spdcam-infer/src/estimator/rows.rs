@@ -5,7 +5,7 @@ use super::{Estimator, ModelSpds};
 use crate::error::{InferError, Result};
 use crate::estimate::Estimate;
 use crate::feature_rows::FeatureRows;
-use crate::stream::{check_feature_rows, row_name, FeatureStream};
+use crate::stream::{check_feature_rows, row_name, FeatureBlock, FeatureStream};
 use crate::trust::{feature_scale, Identity, PhotoFlags};
 use rayon::prelude::*;
 use spdcam_core::advice::Sampled;
@@ -180,6 +180,7 @@ impl Estimator {
             index,
             source: source.to_string(),
             rows: 0,
+            ahead: None,
         })
     }
 }
@@ -194,6 +195,9 @@ pub struct RowStream<'a> {
     index: usize,
     source: String,
     rows: usize,
+    /// The block after the one last handed out, read and parsed while that one was
+    /// estimated (`None` before the first block).
+    ahead: Option<Result<Option<FeatureBlock>>>,
 }
 
 /// One block of a [`RowStream`]: the rows' features and their SPDs.
@@ -214,6 +218,35 @@ pub struct EstimatedBlock {
     own_spds: Option<Vec<f64>>,
 }
 
+/// The SPDs of one block of feature rows (named `names`, from `source`) by model `index`,
+/// after refusing rows that say nothing about the light or are not the model's chart.
+fn estimate_block(
+    estimator: &Estimator,
+    index: usize,
+    names: &[String],
+    source: &str,
+    block: FeatureBlock,
+) -> Result<EstimatedBlock> {
+    check_feature_rows(&block.values, names, source, block.first_row, true)?;
+    let ModelSpds {
+        told: model_spds,
+        own,
+    } = estimator.told_of_light(
+        index,
+        estimator.named(index).model.estimate_rows(&block.values)?,
+    )?;
+    estimator.require_chart_rows(index, &block.values, &model_spds, source, block.first_row)?;
+    let spds = estimator.map(index)?.apply(model_spds.clone());
+    Ok(EstimatedBlock {
+        first_row: block.first_row,
+        rows: block.rows,
+        features: block.values,
+        spds,
+        model_spds,
+        own_spds: own,
+    })
+}
+
 impl RowStream<'_> {
     /// The name of the model estimating the rows.
     pub fn model_name(&self) -> &str {
@@ -224,38 +257,28 @@ impl RowStream<'_> {
     /// nothing about the light, or that are not the model's chart
     /// ([`crate::trust::chart_identity`]), are refused, naming the row (1-based in the file).
     pub fn next_block(&mut self) -> Result<Option<EstimatedBlock>> {
-        let Some(block) = self.stream.next_block(self.rows)? else {
+        let read = match self.ahead.take() {
+            Some(read) => read?,
+            None => self.stream.next_block(self.rows)?,
+        };
+        let Some(block) = read else {
             return Ok(None);
         };
-        let names = self.stream.names();
-        check_feature_rows(&block.values, names, &self.source, block.first_row, true)?;
-        let ModelSpds {
-            told: model_spds,
-            own,
-        } = self.estimator.told_of_light(
-            self.index,
-            self.estimator
-                .named(self.index)
-                .model
-                .estimate_rows(&block.values)?,
-        )?;
-        self.estimator.require_chart_rows(
-            self.index,
-            &block.values,
-            &model_spds,
-            &self.source,
-            block.first_row,
-        )?;
-        let spds = self.estimator.map(self.index)?.apply(model_spds.clone());
-        self.rows += block.rows;
-        Ok(Some(EstimatedBlock {
-            first_row: block.first_row,
-            rows: block.rows,
-            features: block.values,
-            spds,
-            model_spds,
-            own_spds: own,
-        }))
+        // The next block is read and parsed while this one is estimated: reading has parts
+        // that run on one core (the file, the line breaks) which would otherwise leave the
+        // other idle.
+        let next_first = block.first_row + block.rows;
+        let names = self.stream.names().to_vec();
+        let (estimator, index, source) = (self.estimator, self.index, self.source.as_str());
+        let stream = &mut self.stream;
+        let (estimated, ahead) = rayon::join(
+            || estimate_block(estimator, index, &names, source, block),
+            || stream.next_block(next_first),
+        );
+        let estimated = estimated?;
+        self.ahead = Some(ahead);
+        self.rows += estimated.rows;
+        Ok(Some(estimated))
     }
 
     /// The full judged estimate of row `k` of `block`, named `estimate_N` after its place
