@@ -145,22 +145,35 @@ pub fn measure(level: &Level) -> ChannelScales {
     }
     // In pixel order, so that the samples of each magnification walk the planes forwards.
     edges.sort_unstable_by_key(|e| e.1);
+    // Each edge's place (pixel centre, from the image centre) and green gradient, worked
+    // out once for the many magnifications scored.
     let centre = [w as f64 / 2.0, h as f64 / 2.0];
+    let edges: Vec<EdgeSample> = edges
+        .iter()
+        .map(|&(_, i)| EdgeSample {
+            from_centre: [
+                (i % w) as f64 + 0.5 - centre[0],
+                (i / w) as f64 + 0.5 - centre[1],
+            ],
+            green: [
+                f64::from(green[i + 1] - green[i - 1]),
+                f64::from(green[i + w] - green[i - w]),
+            ],
+        })
+        .collect();
     let score = |plane: &[f32], k: f64| -> f64 {
         let (dot, energy) = edges
             .iter()
-            .map(|&(_, i)| {
-                let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+            .map(|edge| {
                 let p = [
-                    centre[0] + (x - centre[0]) * (1.0 + k),
-                    centre[1] + (y - centre[1]) * (1.0 + k),
+                    centre[0] + edge.from_centre[0] * (1.0 + k),
+                    centre[1] + edge.from_centre[1] * (1.0 + k),
                 ];
                 let cx = sample(plane, w, h, [p[0] + 1.0, p[1]])
                     - sample(plane, w, h, [p[0] - 1.0, p[1]]);
                 let cy = sample(plane, w, h, [p[0], p[1] + 1.0])
                     - sample(plane, w, h, [p[0], p[1] - 1.0]);
-                let gx = f64::from(green[i + 1] - green[i - 1]);
-                let gy = f64::from(green[i + w] - green[i - w]);
+                let [gx, gy] = edge.green;
                 // Each edge counts by how well the gradients line up, whatever the sign of
                 // its colour contrast: an edge where red falls as green rises (red against
                 // green) lines up as much as a grey one, and summed with its sign it would
@@ -185,9 +198,13 @@ pub fn measure(level: &Level) -> ChannelScales {
             .unwrap_or(0)];
         let lo = around.saturating_sub(COARSE);
         let hi = (around + COARSE).min(STEPS - 1);
+        // The coarse scores within the range are not computed again.
         let scores: Vec<(usize, f64)> = (lo..=hi)
             .into_par_iter()
-            .map(|s| (s, score(plane, magnification(s))))
+            .map(|s| match coarse.iter().position(|&c| c == s) {
+                Some(j) => (s, coarse_scores[j]),
+                None => (s, score(plane, magnification(s))),
+            })
             .collect();
         let at = |s: usize| scores.iter().find(|v| v.0 == s).map_or(f64::MIN, |v| v.1);
         let s = scores
@@ -211,6 +228,14 @@ pub fn measure(level: &Level) -> ChannelScales {
         red: best(0),
         blue: best(2),
     }
+}
+
+/// One green edge that [`measure`] aligns the other channels on.
+struct EdgeSample {
+    /// The pixel's centre less the image's centre.
+    from_centre: [f64; 2],
+    /// Green's central-difference gradient there (x, y).
+    green: [f64; 2],
 }
 
 /// `level` with red and blue brought back onto green: each resampled at the point its
