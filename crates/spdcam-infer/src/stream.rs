@@ -103,23 +103,17 @@ impl FeatureStream {
         &self.names
     }
 
-    /// Reads up to [`BLOCK_BYTES`] more bytes into `pending`.
+    /// Reads up to [`BLOCK_BYTES`] more bytes into `pending` (into its spare capacity,
+    /// without first zeroing it).
     fn fill(&mut self) -> Result<()> {
-        let start = self.pending.len();
-        self.pending.resize(start + BLOCK_BYTES, 0);
-        let mut filled = start;
-        while filled < self.pending.len() {
-            match self.input.read(&mut self.pending[filled..]) {
-                Ok(0) => {
-                    self.finished = true;
-                    break;
-                }
-                Ok(n) => filled += n,
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                Err(e) => return Err(InferError::invalid(format!("reading {}: {e}", self.source))),
-            }
+        self.pending.reserve(BLOCK_BYTES);
+        let read = (&mut self.input)
+            .take(BLOCK_BYTES as u64)
+            .read_to_end(&mut self.pending)
+            .map_err(|e| InferError::invalid(format!("reading {}: {e}", self.source)))?;
+        if read < BLOCK_BYTES {
+            self.finished = true;
         }
-        self.pending.truncate(filled);
         Ok(())
     }
 
@@ -160,7 +154,9 @@ impl FeatureStream {
                     }
                 }
             };
-            let text: Vec<u8> = self.pending.drain(..cut).collect();
+            // The block's whole lines; the start of an unfinished one stays pending.
+            let rest = self.pending.split_off(cut);
+            let text = std::mem::replace(&mut self.pending, rest);
             let first_line = self.line;
             let lines: Vec<&[u8]> = text
                 .strip_suffix(b"\n")
