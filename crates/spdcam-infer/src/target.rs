@@ -66,7 +66,7 @@ pub enum Target {
 /// A [`Target`] ready to decode many rows ([`Target::decoder`]).
 pub struct Decoder<'a> {
     target: &'a Target,
-    /// The colour head of a PCA-colour target.
+    /// The colour head of a PCA-colour target that pulls the spectrum.
     colour: Option<Conformer<'a>>,
     /// The colour map and its head, for a PCA target.
     map: Option<(&'a ColourMap, Conformer<'a>)>,
@@ -135,7 +135,8 @@ impl Target {
     }
 
     /// The (relative, max-normalised, non-negative) SPD for one row of targets, its colour
-    /// corrected by `map` where given (a PCA target only: [`ColourMap::correct`]).
+    /// corrected by `map` where given (a PCA target only: [`ColourMap::correct`]). For many
+    /// rows, [`Target::decoder`] once.
     pub fn decode_into(&self, targets: &[f64], spd: &mut [f64], map: Option<&ColourMap>) {
         self.decoder(map).decode_into(targets, spd);
     }
@@ -146,8 +147,9 @@ impl Target {
         let pca = self.pca();
         Decoder {
             target: self,
+            // A head that does not pull (0) leaves the spectrum as it is.
             colour: match self {
-                Target::PcaColour(p) => Some(p.colour.conformer(&p.pca)),
+                Target::PcaColour(p) if p.colour.pull != 0.0 => Some(p.colour.conformer(&p.pca)),
                 _ => None,
             },
             map: map.zip(pca).map(|(m, pca)| (m, m.head.conformer(pca))),

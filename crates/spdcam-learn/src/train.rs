@@ -227,11 +227,12 @@ fn score(fitted: &Fitted, outputs: &[f32], y: &[f32], spds: &[f64]) -> Result<(f
     let mut t = vec![0.0; k];
     let mut spd = vec![0.0; d];
     let mut gfc = 0.0;
+    let decoder = fitted.target.decoder(None);
     for r in 0..rows {
         fitted
             .targets
             .unscale_into(&outputs[r * k..(r + 1) * k], &mut t);
-        fitted.target.decode_into(&t, &mut spd, None);
+        decoder.decode_into(&t, &mut spd);
         gfc += spectral_error::gfc(&spds[r * d..(r + 1) * d], &spd)?;
     }
     Ok((mse, gfc / rows.max(1) as f64))
