@@ -19,6 +19,7 @@ use spdcam_core::photo::ChartTemplate;
 use spdcam_core::seed;
 use spdcam_core::spectral::Spd;
 use spdcam_core::spectral_error;
+use spdcam_infer::measured_colour::RawColourCorrection;
 use spdcam_infer::photo_options::PhotoOptions;
 use spdcam_infer::trust::Verdict;
 use spdcam_infer::{Estimate, Estimator, FeatureRows};
@@ -63,6 +64,9 @@ pub struct Scored {
     pub rf: Option<f64>,
     /// The GFC the trust calibration expects of the estimate, where the model has one.
     pub expected_gfc: Option<f64>,
+    /// The size (Δu′v′) of the bias a raw file's matrices have for a light of the estimate's
+    /// shape ([`RawColourCorrection::bias`]): what the raw colour correction takes off.
+    pub raw_bias: Option<f64>,
 }
 
 impl Scored {
@@ -78,6 +82,13 @@ impl Scored {
             cct_interval: estimate.metrics.cct_k.zip(half95),
             rf: estimate.metrics.tm30_rf,
             expected_gfc: uncertainty.map(|u| u.expected_gfc),
+            raw_bias: RawColourCorrection::shape(&estimate.spd)
+                .ok()
+                .map(|shape| {
+                    let [u, v] = RawColourCorrection::shipped()?.bias(&shape);
+                    Ok::<_, spdcam_infer::InferError>(u.hypot(v))
+                })
+                .transpose()?,
             ..Scored::spd(&estimate.spd, light)?
         })
     }
@@ -92,6 +103,7 @@ impl Scored {
             cct_interval: None,
             rf: None,
             expected_gfc: None,
+            raw_bias: None,
         })
     }
 }

@@ -88,7 +88,7 @@ impl ModelColour {
 }
 
 /// The columns of [`ColourReport::photos_csv`].
-const PHOTO_COLUMNS: [&str; 22] = [
+const PHOTO_COLUMNS: [&str; 23] = [
     "model",
     "light_named",
     "photo",
@@ -110,6 +110,7 @@ const PHOTO_COLUMNS: [&str; 22] = [
     "estimate_duv",
     "estimate_rf",
     "expected_gfc",
+    "raw_bias_uv",
     "ok",
 ];
 
@@ -154,6 +155,7 @@ impl ColourReport {
                         number(c.and_then(|c| c.estimate_duv)),
                         number(e.and_then(|e| e.rf)),
                         number(e.and_then(|e| e.expected_gfc)),
+                        number(e.and_then(|e| e.raw_bias)),
                         e.is_some_and(|e| e.ok).to_string(),
                     ];
                     w.write_record(&record).map_err(fail)?;
@@ -404,6 +406,7 @@ mod tests {
             cct_interval: None,
             rf: None,
             expected_gfc: Some(0.98),
+            raw_bias: None,
         };
         let report = ColourReport {
             models: vec![cc24(

@@ -148,6 +148,7 @@ mod tests {
             cct_interval: half.map(|h| (estimate, h)),
             rf: None,
             expected_gfc: None,
+            raw_bias: None,
         }
     }
 
