@@ -117,7 +117,8 @@ const PHOTO_COLUMNS: [&str; 23] = [
 impl ColourReport {
     /// Every photo of every model as CSV, a row each (model, light, camera, GFC, the true and
     /// estimated u′v′ and CCT, the CCT's 95 % half-width, the true and estimated Duv, the
-    /// estimate's TM-30 Rf, its expected GFC, verdict): what the tables summarise, for a study of its own
+    /// estimate's TM-30 Rf, its expected GFC, the bias the raw colour correction
+    /// expects for its shape, verdict): what the tables summarise, for a study of its own
     /// (empty cells where a photo was refused or a CCT is not scored).
     pub fn photos_csv(&self) -> crate::error::Result<String> {
         let mut w = csv::Writer::from_writer(Vec::new());
@@ -406,7 +407,7 @@ mod tests {
             cct_interval: None,
             rf: None,
             expected_gfc: Some(0.98),
-            raw_bias: None,
+            raw_bias: Some(0.0042),
         };
         let report = ColourReport {
             models: vec![cc24(
@@ -442,12 +443,12 @@ mod tests {
             lines[1],
             format!(
                 "cc24.spdm,false,scene,test lamps,\"Lamp, \"\"warm\"\"\",{kind},cam_b,false,\
-                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,0.0004,,,0.98,true"
+                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,0.0004,,,0.98,0.0042,true"
             )
         );
         assert_eq!(
             lines[2],
-            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,,,,false")
+            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,,,,,false")
         );
     }
 }
