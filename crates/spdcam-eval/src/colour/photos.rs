@@ -73,6 +73,7 @@ impl Scored {
     /// Scores `estimate` of `light`: its SPD, its verdict and its CCT interval.
     pub fn of(estimate: &Estimate, light: &Light) -> Result<Scored> {
         let trust = estimate.trust.as_ref();
+        let correction = RawColourCorrection::shipped()?;
         let uncertainty = trust.and_then(|t| t.uncertainty.as_ref());
         let half95 = uncertainty
             .and_then(|u| u.metrics.get("cct_k"))
@@ -82,13 +83,10 @@ impl Scored {
             cct_interval: estimate.metrics.cct_k.zip(half95),
             rf: estimate.metrics.tm30_rf,
             expected_gfc: uncertainty.map(|u| u.expected_gfc),
-            raw_bias: RawColourCorrection::shape(&estimate.spd)
-                .ok()
-                .map(|shape| {
-                    let [u, v] = RawColourCorrection::shipped()?.bias(&shape);
-                    Ok::<_, spdcam_infer::InferError>(u.hypot(v))
-                })
-                .transpose()?,
+            raw_bias: RawColourCorrection::shape(&estimate.spd).ok().map(|shape| {
+                let [u, v] = correction.bias(&shape);
+                u.hypot(v)
+            }),
             ..Scored::spd(&estimate.spd, light)?
         })
     }
