@@ -95,32 +95,29 @@ def main(path):
 def by_expected_gfc(rows):
     """The two-group candidate by the expected GFC: its split, each group's quantiles, and
     whether it is kept (against the pooled intervals)."""
-    return two_groups(rows, "expected_gfc", "expected GFC", high_is_narrow=True)
+    return two_groups(rows, "expected_gfc", "expected GFC")
 
 
 def by_raw_bias(rows, against):
     """The two-group candidate by the bias the raw colour correction takes off (its size in
     u′v′, `raw_bias_uv`): kept if it narrows the validation photos' median 95 % CCT
     half-width by a tenth against `against` (the expected-GFC groups' median)."""
-    return two_groups(rows, "raw_bias_uv", "raw bias", high_is_narrow=False, against=against)
+    return two_groups(rows, "raw_bias_uv", "raw bias", against=against)
 
 
-def two_groups(rows, key, name, high_is_narrow, against=None):
+def two_groups(rows, key, name, against=None):
     """Photos in two groups split at the validation photos' median of `key`, each group's
     quantiles from its own validation photos; kept if the validation photos' median 95 %
     CCT half-width is at most 0.9 of `against` (the pooled 95 % quantile when None)."""
     scored = [r for r in rows if r.get(key)]
     validation = [r for r in scored if r["set"] == "validation lamps"]
     split = sorted(float(r[key]) for r in validation)[len(validation) // 2]
-    def group(r):
-        above = float(r[key]) >= split
-        return "narrow" if above == high_is_narrow else "wide"
+    group = lambda r: "high" if float(r[key]) >= split else "low"
     limits = {}
-    for g in ("wide", "narrow"):
+    for g in ("low", "high"):
         cct, duv = errors([r for r in validation if group(r) == g])
         limits[g] = ([quantile(cct, q) for q in (0.68, 0.95)], [quantile(duv, q) for q in (0.68, 0.95)])
-        side = "≥" if (g == "narrow") == high_is_narrow else "<"
-        print(f"  {name} {side} {split:.4f}: {len(cct)} validation photos, "
+        print(f"  {name} {'≥' if g == 'high' else '<'} {split:.4f}: {len(cct)} validation photos, "
               f"CCT {limits[g][0][0]:.4f} / {limits[g][0][1]:.4f}, Duv {limits[g][1][0]:.4f} / {limits[g][1][1]:.4f}")
     cct, _ = errors(validation)
     baseline = quantile(cct, 0.95) if against is None else against
@@ -143,8 +140,8 @@ def two_groups(rows, key, name, high_is_narrow, against=None):
             duv_held += abs(float(r["estimate_duv"]) - float(r["true_duv"])) <= d95
             widths.append(c95)
         n = len(subset)
-        wide = sum(w == limits["wide"][0][1] for w in widths)
-        print(f"  {label} ({wide} of {n} in the wide group): median 95 % CCT half-width "
+        low = sum(group(r) == "low" for r in subset)
+        print(f"  {label} ({low} of {n} in the low group): median 95 % CCT half-width "
               f"{100 * statistics.median(widths):.1f} %, holds "
               f"{100 * held / n:.0f} %; Duv holds {100 * duv_held / n:.0f} %")
     return split, limits, kept, median
