@@ -194,6 +194,7 @@ fn generated_samples_are_the_camera_renders_of_their_lights() {
                     cam.features_fast(&cam.light(&draw.spd).unwrap(), &mut raw, &mut out);
                     out.iter().map(|&v| v as f64).collect()
                 }
+                Pipeline::Raw => unreachable!("raw samples have a test of their own"),
             };
             assert_eq!(
                 batch.features_of(i),
@@ -774,4 +775,55 @@ fn the_real_photo_sets_load_and_join_their_folders() {
         missing.to_string().contains("telelumen_canon5d4_dev"),
         "{missing}"
     );
+}
+
+#[test]
+fn raw_samples_read_each_patch_as_xyz_under_the_light_itself() {
+    use spdcam_core::colorimetry::{xyz_to_xy, Observer};
+    let cam = camera(CameraConfig::default());
+    // White lights, which the raw reading reads (no light is drawn again).
+    let light = Lighting::parse("mix:planck=0.5,daylight=0.5", &DataDir::default(), &GRID).unwrap();
+    let seed = 5;
+    let generator = Generator::new(
+        &cam,
+        &light,
+        GenerateOptions {
+            pipeline: Pipeline::Raw,
+            ..options(8, seed)
+        },
+    )
+    .unwrap();
+    let batch = generator.samples(0..8, None, &|_| {}).unwrap();
+    let observer = Observer::cie1931(&GRID).unwrap();
+    let chart = cam.chart();
+    // The ColorChecker 24's white (feature 19) and its blue (feature 13).
+    let white = chart.feature_patches[18];
+    let mut whites = Vec::new();
+    for i in 0..8 {
+        let draw = light.draw(seed, i as u64).unwrap();
+        let row = batch.features_of(i);
+        assert_eq!(row.len(), 72);
+        let read = [row[54], row[55], row[56]];
+        // The white patch's colorimetry under the light, a perfect white at Y = 1.
+        let truth = observer.reflectance_to_xyz(chart.reflectances.item(white), draw.spd.values());
+        let (xy_read, xy_true) = (xyz_to_xy(read), xyz_to_xy(truth));
+        assert!(
+            (xy_read[0] - xy_true[0]).abs() < 0.006 && (xy_read[1] - xy_true[1]).abs() < 0.006,
+            "sample {i}: white read at {xy_read:?}, truly {xy_true:?}"
+        );
+        let y_true = 100.0 * truth[1];
+        assert!(
+            (read[1] / y_true - 1.0).abs() < 0.03,
+            "sample {i}: Y {} vs {y_true}",
+            read[1]
+        );
+        whites.push(xy_read);
+    }
+    // Not white-balanced: the white follows the light's colour from sample to sample.
+    let spread = whites
+        .iter()
+        .map(|w| w[0])
+        .fold(f64::NEG_INFINITY, f64::max)
+        - whites.iter().map(|w| w[0]).fold(f64::INFINITY, f64::min);
+    assert!(spread > 0.01, "{whites:?}");
 }

@@ -62,6 +62,7 @@ fn one_camera_a_few_photos() {
         light_named: true,
         light_priors: Vec::new(),
         raw: false,
+        raw_models: Vec::new(),
     };
     let report = ColourReport::measure(&options, &data, &mut |_| {}).unwrap();
     assert_eq!(report.cameras, 1);

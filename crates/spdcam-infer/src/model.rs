@@ -380,6 +380,20 @@ impl Model {
         &self.header.training
     }
 
+    /// Whether it reads a raw photo's patches as XYZ through the file's matrices
+    /// (trained on `spdcam generate --raw`, [`spdcam_core::dataset::Pipeline::Raw`]) rather
+    /// than encoded colours.
+    pub fn reads_raw_xyz(&self) -> bool {
+        /// The pipeline of a dataset's origin, or of the set it was split from.
+        fn pipeline(origin: &serde_json::Value) -> Option<&str> {
+            match origin.get("pipeline") {
+                Some(p) => p.as_str(),
+                None => pipeline(origin.get("source")?),
+            }
+        }
+        self.training().data.origin.as_ref().and_then(pipeline) == Some("raw")
+    }
+
     /// The training chart as photos show it, when known.
     pub fn photo_chart(&self) -> Option<&ChartTemplate> {
         self.header.photo_chart.as_ref()

@@ -41,6 +41,12 @@ pub struct GenerateArgs {
     /// Noise-free patch-level features without an image, for very large sets.
     #[arg(long)]
     fast: bool,
+    /// Noise-free patch-level features as a raw file is read, for a raw model: each patch's
+    /// exposed camera RGB (no white balance, tone or JPEG) taken to XYZ by the camera's DNG
+    /// colour matrices (fitted under A and D65) at the chart's neutral, a perfect white at
+    /// Y = 100.
+    #[arg(long, conflicts_with_all = ["fast", "images"])]
+    raw: bool,
     /// Wavelengths the SPDs are stored at, START-END[:STEP] in nm (inside 380-780).
     #[arg(long, default_value = "380-780:5", value_name = "START-END[:STEP]")]
     spd_grid: String,
@@ -154,7 +160,9 @@ pub fn run(args: GenerateArgs, data_dir: &DataDir) -> Result<()> {
         count: args.count,
         seed: args.seed,
         shard: args.shard,
-        pipeline: if args.fast {
+        pipeline: if args.raw {
+            Pipeline::Raw
+        } else if args.fast {
             Pipeline::Fast
         } else {
             Pipeline::Full

@@ -76,11 +76,39 @@ fn a_rendered_dng_is_estimated_from_its_mosaic_with_the_lights_colour() {
         e["absolute_reason"].as_str().unwrap().contains("EXIF"),
         "{e}"
     );
+    // The shipped ColorChecker 24 raw model made the spectrum, and both outputs say so.
+    assert_eq!(
+        raw["spectrum_model"], "the shipped ColorChecker 24 raw model",
+        "{raw}"
+    );
     let out = spdcam(&["estimate", &s(&photo)]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains("raw file (spdcam") && stdout.contains("sensor's mosaic"),
         "{stdout}"
+    );
+    assert!(
+        stdout.contains("raw photos' spectra from the shipped ColorChecker 24 raw model"),
+        "{stdout}"
+    );
+
+    // A raw model reads raw patches only: refused as a photo's model, and a photo's model
+    // refused as a raw model, each with what to do instead.
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let raw_model = s(&models.join("colorchecker24.raw.spdm"));
+    let jpeg_model = s(&models.join("colorchecker24.spdm"));
+    let err = fails(&["estimate", &s(&photo), "--model", &raw_model]);
+    assert!(
+        err.contains("reads raw files' patches") && err.contains("--raw-model"),
+        "{err}"
+    );
+    let err = fails(&["estimate", &s(&photo), "--raw-model", &jpeg_model]);
+    assert!(err.contains("does not read raw patches"), "{err}");
+    // Given explicitly, it reads the photo as the shipped one does.
+    let given = ok(&["estimate", &s(&photo), "--raw-model", &raw_model]);
+    assert!(
+        given.contains(&format!("raw photos' spectra from {raw_model}")),
+        "{given}"
     );
 
     let cut = dir.join("cut.dng");

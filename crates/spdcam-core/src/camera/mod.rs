@@ -817,6 +817,27 @@ impl Camera {
         self.features_fast_with(self.config.in_camera.as_ref(), light, raw, out);
     }
 
+    /// The exposed raw camera RGB of every region under `light` (patches, then the
+    /// background; 1 = full scale): what a raw file of the chart holds under the in-camera
+    /// stage `ic`'s uneven lighting, glare and exposure, before any white balance, colour
+    /// matrix or tone. Exposed as one who shoots raw for the light exposes: the stage's
+    /// exposure, but never above [`RAW_BRIGHTEST`] for the chart's brightest patch value, so
+    /// that no patch clips.
+    pub fn raw_regions_with(&self, ic: Option<&InCamera>, light: &[f32], raw: &mut Vec<[f32; 3]>) {
+        let shot = self.shot(ic);
+        self.lit_regions(&shot, light, raw);
+        let patches = self.chart.reflectances.len().min(raw.len());
+        let brightest = raw[..patches]
+            .iter()
+            .flatten()
+            .fold(0.0f32, |m, &v| m.max(v));
+        let mut scale = self.exposure_scale(&shot, raw);
+        if brightest > 0.0 {
+            scale = scale.min(RAW_BRIGHTEST / brightest);
+        }
+        expose(raw, scale, shot.full_scale);
+    }
+
     /// [`Camera::features_fast`] with the in-camera stage `ic` in place of the configured
     /// one (calibration and domain randomisation vary it per call).
     pub fn features_fast_with(
@@ -912,6 +933,10 @@ impl Shot {
         }
     }
 }
+
+/// The highest raw value (share of full scale) [`Camera::raw_regions_with`] exposes a
+/// chart's patch to: below clipping with room for the sensor's noise.
+pub const RAW_BRIGHTEST: f32 = 0.9;
 
 /// Scales raw values by the exposure's `scale` and clips them at `full_scale`.
 /// Why an exposure under [`MIN_EXPOSURE`] is refused, for a message that names the option

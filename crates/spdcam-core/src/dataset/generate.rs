@@ -17,11 +17,16 @@ use super::writer::{
 };
 use super::DEFAULT_CHUNK_SIZE;
 use crate::builtin::DataDir;
+use crate::camera::in_camera::InCamera;
 use crate::camera::sensor::Sensitivities;
 use crate::camera::{Camera, CameraConfig, RenderBuffers};
 use crate::chart::Chart;
+use crate::colorimetry::srgb_decode;
 use crate::error::{Error, Result};
 use crate::light_families::Lighting;
+use crate::photo::raw::colour::chart_neutral;
+use crate::photo::raw::dng::virtual_raw_colour;
+use crate::photo::raw::CLIP_SHARE;
 use crate::spectral::Grid;
 use crate::{fsio, imageio, limits, seed};
 use rayon::prelude::*;
@@ -34,6 +39,9 @@ use std::sync::{Arc, Mutex};
 
 /// Samples one worker renders between progress reports.
 const BLOCK: u64 = 64;
+/// How often [`Pipeline::Raw`] draws a sample's light again when a raw file's reading
+/// cannot read the one drawn.
+const RAW_REDRAWS: u64 = 16;
 
 /// What to generate.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,6 +125,48 @@ impl Plan {
     }
 }
 
+/// The features of [`Pipeline::Raw`]: `camera`'s exposed raw RGB of its chart under `light`
+/// (the in-camera stage `ic`'s lighting and glare, exposed below clipping), each feature patch taken to XYZ
+/// by the camera's DNG matrices at the neutral of the chart's grey patches, as a raw file of
+/// it is read ([`virtual_raw_colour`], [`chart_neutral`], [`RawColour::relative_xyz`]).
+///
+/// [`RawColour::relative_xyz`]: crate::photo::raw::RawColour::relative_xyz
+pub fn raw_features(
+    camera: &Camera,
+    ic: Option<&InCamera>,
+    light: &[f32],
+    raw: &mut Vec<[f32; 3]>,
+    out: &mut Vec<f32>,
+) -> Result<()> {
+    camera.raw_regions_with(ic, light, raw);
+    let chart = camera.chart();
+    // The greys a raw file's reading keeps: neither clipped nor nearly black; under a
+    // strongly coloured light, where every grey is nearly black in some channel (a photo
+    // the raw reading refuses), the unclipped ones, so that every sample has its row.
+    let dark_level = srgb_decode(f64::from(crate::photo::DARK_LEVEL)) as f32;
+    let greys_where = |keep: &dyn Fn(&[f32; 3]) -> bool| -> Vec<([f32; 3], f64)> {
+        chart
+            .neutral_features()
+            .into_iter()
+            .map(|(k, reflectance)| (raw[chart.feature_patches[k]], reflectance))
+            .filter(|(v, _)| v.iter().all(|&c| c < CLIP_SHARE) && keep(v))
+            .collect()
+    };
+    let mut greys = greys_where(&|v| v.iter().all(|&c| c > dark_level));
+    if greys.is_empty() {
+        greys = greys_where(&|_| true);
+    }
+    let neutral = chart_neutral(&greys)
+        .filter(|n| n.iter().all(|&c| c > 0.0))
+        .ok_or_else(|| {
+            Error::invalid("every grey patch is clipped or black; the light's colour is unread")
+        })?;
+    let patches: Vec<[f32; 3]> = chart.feature_patches.iter().map(|&p| raw[p]).collect();
+    let xyz = virtual_raw_colour(camera)?.relative_xyz(neutral, &patches)?;
+    out.extend(xyz.iter().flatten());
+    Ok(())
+}
+
 /// What identifies a run, kept in the directory while it is unfinished.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct RunRecord {
@@ -147,9 +197,9 @@ impl<'a> Generator<'a> {
         if options.chunk_size == 0 {
             return Err(Error::invalid("the chunk size must be at least 1 sample"));
         }
-        if options.images && options.pipeline == Pipeline::Fast {
+        if options.images && options.pipeline != Pipeline::Full {
             return Err(Error::invalid(
-                "images need the full pipeline; the fast path renders no image",
+                "images need the full pipeline; the fast and raw paths render no image",
             ));
         }
         let sim = camera.grid();
@@ -295,20 +345,43 @@ impl<'a> Generator<'a> {
         images: Option<&Path>,
     ) -> Result<()> {
         let seed = self.options.seed;
-        let draw = self.lighting.draw(seed, i)?;
         let (camera, drawn) = match self.randomisation {
             Some(r) => r.draw(seed, i),
             None => (self.camera, None),
         };
         let ic = drawn.as_ref().or(camera.config().in_camera.as_ref());
-        let light = camera.light(&draw.spd).map_err(|e| {
-            Error::invalid(format!(
-                "sample {i}: lighting '{}' drew a light the camera cannot render: {e}",
-                self.lighting.spec()
-            ))
-        })?;
+        let render = |draw: &crate::light_families::LightDraw| {
+            camera.light(&draw.spd).map_err(|e| {
+                Error::invalid(format!(
+                    "sample {i}: lighting '{}' drew a light the camera cannot render: {e}",
+                    self.lighting.spec()
+                ))
+            })
+        };
+        let mut draw = self.lighting.draw(seed, i)?;
+        let mut light = render(&draw)?;
         ws.features.clear();
         match ws.buffers.as_mut() {
+            None if self.options.pipeline == Pipeline::Raw => {
+                // A light the raw reading cannot read (every grey clipped or black, or a
+                // neutral the matrices give no luminance: a deep blue or red light) is
+                // drawn again, from seed::derive(seed, i) and the attempt.
+                let mut attempt = 0;
+                while let Err(e) = raw_features(camera, ic, &light, &mut ws.raw, &mut ws.features) {
+                    attempt += 1;
+                    if attempt > RAW_REDRAWS {
+                        return Err(Error::invalid(format!(
+                            "sample {i}: no light of {RAW_REDRAWS} draws could be read as a \
+                             raw file reads it: {e}"
+                        )));
+                    }
+                    ws.features.clear();
+                    draw = self
+                        .lighting
+                        .draw(seed::derive(seed::derive(seed, i), attempt), i)?;
+                    light = render(&draw)?;
+                }
+            }
             None => camera.features_fast_with(ic, &light, &mut ws.raw, &mut ws.features),
             Some(buffers) => {
                 let noise_seed = seed::derive(seed, i);

@@ -160,6 +160,11 @@ pub enum Pipeline {
     Full,
     /// Noise-free patch-level features without an image (`Camera::features_fast`).
     Fast,
+    /// Noise-free patch-level features as a raw file is read: each patch's exposed camera
+    /// RGB (no white balance, tone or JPEG) taken to XYZ by the camera's DNG colour matrices
+    /// at the chart's own neutral, a perfect white at Y = 100
+    /// (`spdcam_core::photo::raw::RawColour::relative_xyz`).
+    Raw,
 }
 
 /// Part `index` of `count` of a run: a contiguous range of its sample files.

@@ -39,7 +39,7 @@ use spdcam_core::light_families::LampType;
 use spdcam_core::seed;
 use spdcam_core::spectral::{Grid, Spd};
 use spdcam_infer::kind_prior::KindPriors;
-use spdcam_infer::{Estimator, ModelSet};
+use spdcam_infer::{Estimator, Model, ModelSet, NamedModel};
 use std::path::PathBuf;
 
 /// The options of the colour protocol.
@@ -59,6 +59,9 @@ pub struct ColourOptions {
     pub light_priors: Vec<KindPriors>,
     /// (a) is taken as raw DNGs of the same scenes instead of JPEGs.
     pub raw: bool,
+    /// Models that read raw patches, each for the model of its chart
+    /// ([`Estimator::with_raw_models`]).
+    pub raw_models: Vec<PathBuf>,
 }
 
 /// What a row of a table groups.
@@ -248,6 +251,16 @@ impl ColourReport {
             raw: false,
         };
 
+        let raw_models = options
+            .raw_models
+            .iter()
+            .map(|p| {
+                Ok(NamedModel {
+                    name: crate::held_out::file_name(p),
+                    model: Model::load(p)?,
+                })
+            })
+            .collect::<Result<Vec<NamedModel>>>()?;
         let mut models = Vec::new();
         for (path, model, chart_name) in held_out.models()? {
             let chart = Chart::resolve(&chart_name, None, data_dir, &GRID)?;
@@ -265,6 +278,13 @@ impl ColourReport {
                     .light_priors
                     .iter()
                     .filter(|p| p.model == fingerprint)
+                    .cloned()
+                    .collect(),
+            )?
+            .with_raw_models(
+                raw_models
+                    .iter()
+                    .filter(|r| r.model.header().chart.as_deref() == Some(chart_name.as_str()))
                     .cloned()
                     .collect(),
             )?;

@@ -44,6 +44,7 @@ use spdcam_core::advice::Advice;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::chart::{shown_chart_name, Chart};
 use spdcam_core::light_families::LightKind;
+use spdcam_core::photo::raw::RawReading;
 use spdcam_core::photo::{ChartTemplate, PhotoAnalysis};
 use spdcam_core::quality::LightingMetrics;
 use spdcam_core::spectral::{Grid, Spd};
@@ -120,6 +121,9 @@ pub struct Estimator {
     priors: Arc<OnceLock<Vec<Option<KindPriors>>>>,
     /// The kind of light the estimates are told of.
     light: LightKind,
+    /// Per model of the set, in order: the model that reads a raw photo's patches for the
+    /// same chart ([`Model::reads_raw_xyz`]), when one is given ([`Estimator::with_raw_models`]).
+    raw_models: Arc<Vec<Option<NamedModel>>>,
 }
 
 impl Estimator {
@@ -169,6 +173,14 @@ impl Estimator {
         data_dir: DataDir,
         grid: Grid,
     ) -> Result<Estimator> {
+        if let Some(raw) = models.models().iter().find(|m| m.model.reads_raw_xyz()) {
+            return Err(InferError::invalid(format!(
+                "{} reads raw files' patches through their colour matrices, not a photo's \
+                 colours: give it as a raw model (`estimate --raw-model`) beside a model of \
+                 its chart",
+                raw.name
+            )));
+        }
         let trust = models
             .models()
             .iter()
@@ -202,9 +214,11 @@ impl Estimator {
         Estimator::with(prepared, Arc::default(), LightKind::Unknown, grid)
     }
 
-    /// The estimator of the shipped models (see [`ModelSet::shipped`]).
+    /// The estimator of the shipped models (see [`ModelSet::shipped`]), raw photos of a
+    /// chart read by its shipped raw model where it has one ([`ModelSet::shipped_raw`]).
     pub fn shipped(data_dir: DataDir, grid: Grid) -> Result<Estimator> {
-        Estimator::new(ModelSet::shipped()?, data_dir, grid)
+        Estimator::new(ModelSet::shipped()?, data_dir, grid)?
+            .with_raw_models(ModelSet::shipped_raw()?)
     }
 
     /// The estimator of `prepared` on the output grid `grid`, which must span
@@ -256,6 +270,7 @@ impl Estimator {
             on_grid,
             priors,
             light,
+            raw_models: Arc::default(),
         })
     }
 
@@ -276,7 +291,10 @@ impl Estimator {
         if grid == self.grid {
             return Ok(self.clone());
         }
-        Estimator::with(self.prepared.clone(), self.priors.clone(), self.light, grid)
+        let mut out =
+            Estimator::with(self.prepared.clone(), self.priors.clone(), self.light, grid)?;
+        out.raw_models = self.raw_models.clone();
+        Ok(out)
     }
 
     /// The same models told that the light is of `kind` ([`crate::kind_prior`]): each
@@ -336,6 +354,53 @@ impl Estimator {
         }
         let mut out = self.clone();
         out.priors = Arc::new(OnceLock::from(priors));
+        Ok(out)
+    }
+
+    /// The same models, raw photos of a chart read by the model of `raw` for it: each must
+    /// read raw patches ([`Model::reads_raw_xyz`]) and estimate on the wavelengths of the
+    /// set's model for its chart, which keeps the trust calibration, the verdict and the
+    /// kind priors. Its spectrum replaces that model's for raw photos; the light's colour
+    /// still comes from the file's matrices ([`crate::measured_colour`]).
+    pub fn with_raw_models(&self, raw: Vec<NamedModel>) -> Result<Estimator> {
+        let mut per_model: Vec<Option<NamedModel>> = self.raw_models.to_vec();
+        per_model.resize(self.prepared.models.models().len(), None);
+        for named in raw {
+            if !named.model.reads_raw_xyz() {
+                return Err(InferError::invalid(format!(
+                    "{} does not read raw patches: a raw model is trained on `spdcam \
+                     generate --raw`",
+                    named.name
+                )));
+            }
+            let chart = named.model.header().chart.clone();
+            let index = self
+                .prepared
+                .models
+                .models()
+                .iter()
+                .position(|m| m.model.header().chart == chart && !m.model.reads_raw_xyz())
+                .ok_or_else(|| {
+                    InferError::invalid(format!(
+                        "the raw model {} is for chart {}, which no model of the set reads",
+                        named.name,
+                        chart.as_deref().unwrap_or("(unnamed)")
+                    ))
+                })?;
+            let set_grid = self.prepared.models.models()[index].model.grid();
+            if named.model.grid() != set_grid {
+                return Err(InferError::invalid(format!(
+                    "the raw model {} estimates on {}, the chart's model on {}: train it on \
+                     the same wavelengths",
+                    named.name,
+                    named.model.grid().label(),
+                    set_grid.label()
+                )));
+            }
+            per_model[index] = Some(named);
+        }
+        let mut out = self.clone();
+        out.raw_models = Arc::new(per_model);
         Ok(out)
     }
 
@@ -459,9 +524,9 @@ impl Estimator {
         index: usize,
         features: &FeatureRows,
         source: &str,
-        measured: Option<[f64; 2]>,
+        raw: Option<(&RawReading, Option<&[usize]>)>,
     ) -> Result<ModelSpds> {
-        let model = &self.named(index).model;
+        let mut model = &self.named(index).model;
         model.check_features(&features.names, source)?;
         self.map(index)?;
         check_feature_rows(
@@ -471,12 +536,41 @@ impl Estimator {
             0,
             features.rows > 1,
         )?;
-        let mut spds = model.estimate_rows(&features.values)?;
-        if let Some(xy) = measured {
+        let raw_model = self.raw_models.get(index).and_then(Option::as_ref);
+        let mut spds = match (raw, raw_model) {
+            (Some((_, None)), Some(raw_model)) => {
+                return Err(InferError::invalid(format!(
+                    "{source}: {} cannot find its patches on this photo's chart",
+                    raw_model.name
+                )))
+            }
+            (Some((reading, Some(feature_patches))), Some(raw_model)) => {
+                // The raw model reads the patches' XYZ through the file's matrices.
+                let row: Vec<f64> = feature_patches
+                    .iter()
+                    .map(|&p| {
+                        reading.patch_xyz.get(p).copied().ok_or_else(|| {
+                            InferError::invalid(format!(
+                                "{source}: the raw reading holds no patch {}",
+                                p + 1
+                            ))
+                        })
+                    })
+                    .collect::<Result<Vec<[f32; 3]>>>()?
+                    .iter()
+                    .flatten()
+                    .map(|&v| f64::from(v))
+                    .collect();
+                model = &raw_model.model;
+                model.estimate_rows(&row)?
+            }
+            _ => model.estimate_rows(&features.values)?,
+        };
+        if let Some((reading, _)) = raw {
             // The matrices' bias for a light of the shape the model reads, taken off.
             let d = model.grid().count;
             let own = Spd::new(model.grid(), spds[..d.min(spds.len())].to_vec())?;
-            let xy = RawColourCorrection::shipped()?.correct(xy, &own)?;
+            let xy = RawColourCorrection::shipped()?.correct(reading.light_xy, &own)?;
             measured_colour::conform(model, &mut spds, xy);
         }
         self.told_of_light(index, spds)
@@ -501,6 +595,13 @@ impl Estimator {
         let chosen = self.named(index);
         let map = self.map(index)?;
         let judge = &self.prepared.trust[index];
+        let mut photo = photo;
+        if let (Some(reading), Some(raw_model)) = (
+            photo.as_mut().and_then(|a| a.raw.as_mut()),
+            self.raw_models.get(index).and_then(Option::as_ref),
+        ) {
+            reading.spectrum_model = Some(raw_model.name.clone());
+        }
         let mut trust = trust::assess(
             &chosen.model,
             judge.calibration.as_ref(),

@@ -420,7 +420,7 @@ impl Estimator {
                 index,
                 &rows,
                 &analysis.source,
-                analysis.raw.as_ref().map(|r| r.light_xy),
+                analysis.raw.as_ref().map(|r| (r, feature_patches)),
             )
         } else {
             Err(InferError::invalid("the patches are not the chart"))

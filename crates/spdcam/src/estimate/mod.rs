@@ -26,7 +26,7 @@ use spdcam_core::fsio;
 use spdcam_core::light_families::LightKind;
 use spdcam_core::spectral::{Grid, Spd, SpectralSet};
 use spdcam_infer::trust::Uncertainty;
-use spdcam_infer::{Estimate, Estimator, Model, ModelSet};
+use spdcam_infer::{Estimate, Estimator, Model, ModelSet, NamedModel};
 use spdcam_present::plot::spds_band_svg;
 use std::path::{Path, PathBuf};
 use truth::truths;
@@ -47,6 +47,11 @@ pub struct EstimateArgs {
     /// (ColorChecker Digital SG, ColorChecker 24), chosen by the chart in the photo.
     #[arg(long)]
     model: Option<PathBuf>,
+    /// A model that reads raw files' patches as XYZ through the file's matrices (trained on
+    /// `spdcam generate --raw`), for the chart of a model above: on a raw photo its spectrum
+    /// replaces that model's, which still judges it (repeatable, one per chart).
+    #[arg(long, value_name = "MODEL.spdm", conflicts_with = "features")]
+    raw_model: Vec<PathBuf>,
     /// Estimate from a features CSV instead of photos: a header naming the columns (p01_r,
     /// p01_g, …), one row per estimate; values on any scale (0–255 or 0–1). Streamed: up to
     /// 20 rows are printed in full, more one line each (xy, CCT, Duv, verdict) as they are
@@ -107,13 +112,32 @@ enum LayoutArg {
     Long,
 }
 
-/// The estimator of the model `--model` names, or of the shipped ones, on `grid`.
-fn estimator(path: Option<&Path>, data_dir: &DataDir, grid: Grid) -> Result<Estimator> {
-    let models = match path {
-        Some(p) => ModelSet::single(Model::load(p)?, p.display().to_string()),
-        None => ModelSet::shipped()?,
+/// The estimator of the model `--model` names, or of the shipped ones (with their raw
+/// models), on `grid`, raw photos read by the `--raw-model`s `raw` names.
+fn estimator(
+    path: Option<&Path>,
+    raw: &[PathBuf],
+    data_dir: &DataDir,
+    grid: Grid,
+) -> Result<Estimator> {
+    let estimator = match path {
+        Some(p) => Estimator::new(
+            ModelSet::single(Model::load(p)?, p.display().to_string()),
+            data_dir.clone(),
+            grid,
+        )?,
+        None => Estimator::shipped(data_dir.clone(), grid)?,
     };
-    Ok(Estimator::new(models, data_dir.clone(), grid)?)
+    let raw_models = raw
+        .iter()
+        .map(|p| {
+            Ok(NamedModel {
+                name: p.display().to_string(),
+                model: Model::load(p)?,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(estimator.with_raw_models(raw_models)?)
 }
 
 /// Whether the terminal report is left out: with `--json`, or with the SPDs on stdout.
@@ -139,7 +163,8 @@ pub fn run(args: EstimateArgs, data_dir: &DataDir) -> Result<()> {
         plot_is_png(plot)?;
     }
     let grid = Grid::parse(&args.range)?;
-    let estimator = estimator(args.model.as_deref(), data_dir, grid)?.for_light(args.light)?;
+    let estimator =
+        estimator(args.model.as_deref(), &args.raw_model, data_dir, grid)?.for_light(args.light)?;
     if let Some(path) = &args.features {
         return run_features(&args, path, &estimator);
     }

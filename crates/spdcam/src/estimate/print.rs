@@ -33,8 +33,19 @@ pub(super) fn print_estimates(
         }
         _ => String::new(),
     };
+    let mut raw_models: Vec<&str> = estimates
+        .iter()
+        .filter_map(|e| e.photo.as_ref()?.raw.as_ref()?.spectrum_model.as_deref())
+        .collect();
+    raw_models.sort_unstable();
+    raw_models.dedup();
+    let raw = if raw_models.is_empty() {
+        String::new()
+    } else {
+        format!(" (raw photos' spectra from {})", raw_models.join(", "))
+    };
     outln!(
-        "{} estimate(s) with {}{told}",
+        "{} estimate(s) with {}{raw}{told}",
         estimates.len(),
         models.join(", ")
     )?;

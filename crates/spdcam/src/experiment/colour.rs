@@ -53,6 +53,10 @@ pub(super) struct ColourArgs {
     /// instead of JPEGs.
     #[arg(long)]
     raw: bool,
+    /// With --raw: a model that reads raw patches (`spdcam generate --raw`) for the chart of
+    /// a --model, whose spectrum replaces that model's on the raw photos (repeatable).
+    #[arg(long, value_name = "MODEL.spdm", requires = "raw")]
+    raw_model: Vec<PathBuf>,
     /// Also write every photo's scores as CSV (model, light, camera, GFC, the true and
     /// estimated u′v′ and CCT, verdict): a row each.
     #[arg(long, value_name = "FILE.csv")]
@@ -82,6 +86,9 @@ impl ColourArgs {
         if self.raw {
             out += " --raw";
         }
+        for p in &self.raw_model {
+            out += &format!(" --raw-model {}", p.display());
+        }
         for p in &self.light_priors {
             out += &format!(" --light-priors {}", p.display());
         }
@@ -106,6 +113,7 @@ pub(super) fn run(args: ColourArgs, data_dir: &DataDir) -> Result<()> {
         patch_photos: args.patch_photos,
         light_named: args.light_named,
         raw: args.raw,
+        raw_models: args.raw_model.clone(),
         light_priors: args
             .light_priors
             .iter()

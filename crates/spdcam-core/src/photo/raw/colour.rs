@@ -234,6 +234,30 @@ impl RawColour {
         Ok(colorimetry::xyz_to_xy([xyz[0], xyz[1], xyz[2]]))
     }
 
+    /// Each of `rgb` (camera raw RGB, on the scale of `neutral`) as CIE 1931 XYZ through the
+    /// file's matrices at `neutral` ([`RawColour::camera_to_xyz`]), scaled so that the
+    /// neutral itself (a perfect white's reading) has Y = 100: the patches' colours as a
+    /// colorimeter would read them under this light, relative to the white. The feature
+    /// row a raw model reads ([`crate::dataset::Pipeline::Raw`]): the light's colour stays
+    /// in it, where a white-balanced development takes it out.
+    pub fn relative_xyz(&self, neutral: [f64; 3], rgb: &[[f32; 3]]) -> Result<Vec<[f32; 3]>> {
+        let (to_xyz, _) = self.camera_to_xyz(neutral)?;
+        let white = (to_xyz * Vector3::from(neutral))[1];
+        if !(white.is_finite() && white > 0.0) {
+            return Err(Error::invalid(
+                "the file's colour matrix gives the photo's neutral no luminance",
+            ));
+        }
+        let m = to_xyz * (100.0 / white);
+        Ok(rgb
+            .iter()
+            .map(|v| {
+                let xyz = m * Vector3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2]));
+                [xyz[0] as f32, xyz[1] as f32, xyz[2] as f32]
+            })
+            .collect())
+    }
+
     /// Camera raw RGB → linear sRGB (D65) white-balanced for the light whose neutral is
     /// `neutral`, then IEC 61966-2-1's XYZ → linear sRGB. With forward matrices, the DNG
     /// way (1.6 ch. 6): the stored values → the reference camera's, divided by the
@@ -289,6 +313,16 @@ impl RawColour {
     }
 }
 
+/// A chart's neutral: the camera RGB per unit reflectance of its grey patches, each given
+/// as (its camera RGB, its mean reflectance), summed over all of them (brighter greys weigh
+/// more, as their values are less noisy); `None` without a grey of positive reflectance.
+pub fn chart_neutral(greys: &[([f32; 3], f64)]) -> Option<[f64; 3]> {
+    let reflectance: f64 = greys.iter().map(|g| g.1).sum();
+    (reflectance > 0.0).then(|| {
+        std::array::from_fn(|c| greys.iter().map(|g| f64::from(g.0[c])).sum::<f64>() / reflectance)
+    })
+}
+
 /// CIE D50's chromaticity, the profile connection space's white that forward matrices map
 /// a neutral to (ICC.1:2010 D50 XYZ 0.9642, 1, 0.8249).
 const D50_XY: [f64; 2] = [0.34570, 0.35854];
@@ -340,6 +374,50 @@ mod tests {
             None,
         )
         .unwrap()
+    }
+
+    #[test]
+    fn patches_read_as_xyz_relative_to_the_white_through_the_matrix_at_the_neutral() {
+        // One matrix: the camera's raw RGB is XYZ itself (identity), so the neutral of a
+        // D65 white at half scale reads D65's XYZ with Y = 100, and a 20 % grey Y = 20.
+        let colour = RawColour::new(
+            vec![CalibratedMatrix::new("D65", 6504.0, Matrix3::identity())],
+            None,
+        )
+        .unwrap();
+        let d65 = colorimetry::xy_to_xyz(D65_XY, 0.5);
+        let neutral = d65;
+        let grey = d65.map(|v| (0.2 * v) as f32);
+        let red = [0.3f32, 0.1, 0.05];
+        let xyz = colour.relative_xyz(neutral, &[grey, red]).unwrap();
+        let white = colorimetry::xy_to_xyz(D65_XY, 100.0);
+        for c in 0..3 {
+            assert!(
+                (f64::from(xyz[0][c]) - 0.2 * white[c]).abs() < 1e-4,
+                "{xyz:?}"
+            );
+            assert!((f64::from(xyz[1][c]) - 200.0 * f64::from(red[c])).abs() < 1e-4);
+        }
+        // The neutral's scale does not matter; a neutral the matrix gives no light is an
+        // error, not a row of infinities.
+        let doubled = colour.relative_xyz(d65.map(|v| 2.0 * v), &[grey]).unwrap();
+        assert!(
+            (f64::from(doubled[0][1]) - 10.0).abs() < 1e-4,
+            "{doubled:?}"
+        );
+        assert!(colour.relative_xyz([0.0, 1.0, 1.0], &[grey]).is_err());
+    }
+
+    #[test]
+    fn a_charts_neutral_is_its_greys_light_per_unit_reflectance() {
+        // Greys of reflectance 0.9 and 0.3 reading 0.45 and 0.15 in green: 0.5 per unit.
+        let greys = [([0.36f32, 0.45, 0.27], 0.9), ([0.12f32, 0.15, 0.09], 0.3)];
+        let n = chart_neutral(&greys).unwrap();
+        let expected = [0.4, 0.5, 0.3];
+        for c in 0..3 {
+            assert!((n[c] - expected[c]).abs() < 1e-6, "{n:?}");
+        }
+        assert_eq!(chart_neutral(&[]), None);
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //! converter's "as shot" rendering would (white-balanced to that neutral, the file's
 //! matrix, sRGB), so that the feature row has the meaning and scale of a JPEG's.
 
-use super::colour::RawColourUse;
+use super::colour::{chart_neutral, RawColourUse};
 use super::RawMosaic;
 use crate::colorimetry::{srgb_decode, srgb_encode};
 use crate::error::{Error, Result};
@@ -40,6 +40,14 @@ pub struct RawReading {
     pub neutral_patches: Vec<usize>,
     /// How the file's matrices were used.
     pub colour: RawColourUse,
+    /// Every patch's XYZ through the file's matrices at the chart's neutral, a perfect
+    /// white at Y = 100 ([`super::RawColour::relative_xyz`]): a raw model's features.
+    #[serde(skip)]
+    pub patch_xyz: Vec<[f32; 3]>,
+    /// The raw model whose spectrum the estimate is, when one read these patches
+    /// (`spdcam_infer::Estimator::with_raw_models`); `None`: the chart's model read the
+    /// developed patches.
+    pub spectrum_model: Option<String>,
     /// The DNG's lens-shading gain maps applied before the patches were read.
     pub gain_maps_applied: usize,
     /// The opcodes of the DNG's `OpcodeList2` not applied, by name.
@@ -64,6 +72,9 @@ impl RawReading {
         );
         if self.colour.forward_matrix {
             line.push_str(", developed through its forward matrices");
+        }
+        if let Some(model) = &self.spectrum_model {
+            line.push_str(&format!(", the spectrum from {model}"));
         }
         if self.gain_maps_applied > 0 {
             line.push_str(&format!(
@@ -142,15 +153,12 @@ pub fn sample(
              is below full scale and the dark greys above black"
         )));
     }
-    let reflectance: f64 = usable.iter().map(|u| u.1).sum();
-    let neutral: [f64; 3] = std::array::from_fn(|c| {
-        usable
-            .iter()
-            .map(|&(p, _)| means[p].0[c] as f64)
-            .sum::<f64>()
-            / reflectance
-    });
+    let greys: Vec<([f32; 3], f64)> = usable.iter().map(|&(p, r)| (means[p].0, r)).collect();
+    let neutral = chart_neutral(&greys)
+        .ok_or_else(|| Error::invalid(format!("{source}: the chart's greys reflect nothing")))?;
     let light_xy = raw.colour.light_xy(neutral)?;
+    let camera_means: Vec<[f32; 3]> = means.iter().map(|m| m.0).collect();
+    let patch_xyz = raw.colour.relative_xyz(neutral, &camera_means)?;
     let (development, colour) = raw.colour.development(neutral)?;
     let gain = WHITE_LEVEL / neutral[1];
     let develop = develop_with(&development, gain);
@@ -181,6 +189,8 @@ pub fn sample(
             light_xy,
             neutral_patches: usable.iter().map(|u| u.0).collect(),
             colour,
+            patch_xyz,
+            spectrum_model: None,
             gain_maps_applied: raw.gain_maps_applied,
             opcodes_skipped: raw.opcodes_skipped.clone(),
         },
