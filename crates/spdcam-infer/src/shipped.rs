@@ -41,6 +41,15 @@ pub(crate) const SHIPPED: [Shipped; 2] = [
     shipped!(KnownChart::ColorChecker24, "colorchecker24"),
 ];
 
+/// The raw models shipped inside the program (`models/<chart>.raw.spdm`, made by the
+/// README's recipe): for each chart that has one, the model that reads a raw photo's patches
+/// as XYZ through the file's matrices (`spdcam generate --raw`), whose spectrum replaces the
+/// chart's model's on raw photos ([`crate::Estimator::with_raw_models`]).
+pub(crate) const SHIPPED_RAW: [(KnownChart, &[u8]); 1] = [(
+    KnownChart::ColorChecker24,
+    include_bytes!("../../../models/colorchecker24.raw.spdm"),
+)];
+
 impl Shipped {
     /// The model as messages name it: `the shipped ColorChecker 24 model`.
     pub fn name(&self) -> String {
@@ -90,6 +99,20 @@ impl ModelSet {
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(ModelSet { models })
+    }
+
+    /// The raw models shipped inside spdcam ([`SHIPPED_RAW`]), named as messages name them:
+    /// `the shipped ColorChecker 24 raw model`.
+    pub fn shipped_raw() -> Result<Vec<NamedModel>> {
+        SHIPPED_RAW
+            .iter()
+            .map(|(chart, bytes)| {
+                let name = format!("the shipped {} raw model", chart.shown_name());
+                let model = Model::from_bytes(bytes)
+                    .map_err(|e| InferError::invalid(format!("{name} is damaged: {e}")))?;
+                Ok(NamedModel { name, model })
+            })
+            .collect()
     }
 
     /// One model, named `name` (e.g. its file's path).
@@ -188,6 +211,22 @@ impl ModelSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shipped_raw_models_read_raw_patches_of_a_shipped_models_chart() {
+        let set = ModelSet::shipped().unwrap();
+        let raw = ModelSet::shipped_raw().unwrap();
+        assert_eq!(raw.len(), SHIPPED_RAW.len());
+        for ((chart, _), named) in SHIPPED_RAW.iter().zip(&raw) {
+            assert!(named.model.reads_raw_xyz(), "{}", named.name);
+            assert!(!set.for_known(*chart).unwrap().model.reads_raw_xyz());
+            assert_eq!(named.model.header().chart.as_deref(), Some(chart.name()));
+            assert_eq!(
+                named.model.grid(),
+                set.for_known(*chart).unwrap().model.grid()
+            );
+        }
+    }
 
     #[test]
     fn shipped_models_load_and_each_names_its_chart() {
