@@ -45,10 +45,16 @@ pub(crate) const SHIPPED: [Shipped; 2] = [
 /// README's recipe): for each chart that has one, the model that reads a raw photo's patches
 /// as XYZ through the file's matrices (`spdcam generate --raw`), whose spectrum replaces the
 /// chart's model's on raw photos ([`crate::Estimator::with_raw_models`]).
-pub(crate) const SHIPPED_RAW: [(KnownChart, &[u8]); 1] = [(
-    KnownChart::ColorChecker24,
-    include_bytes!("../../../models/colorchecker24.raw.spdm"),
-)];
+pub(crate) const SHIPPED_RAW: [(KnownChart, &[u8]); 2] = [
+    (
+        KnownChart::Sg96,
+        include_bytes!("../../../models/colorchecker_sg96.raw.spdm"),
+    ),
+    (
+        KnownChart::ColorChecker24,
+        include_bytes!("../../../models/colorchecker24.raw.spdm"),
+    ),
+];
 
 impl Shipped {
     /// The model as messages name it: `the shipped ColorChecker 24 model`.
