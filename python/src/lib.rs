@@ -77,10 +77,13 @@ impl Models {
 
 #[pymethods]
 impl Models {
-    /// The models shipped inside spdcam, one per chart.
+    /// The models shipped inside spdcam, one per chart, with their raw models (raw photos
+    /// of a chart that has one get its spectrum, as on the command line).
     #[staticmethod]
     fn shipped() -> PyResult<Models> {
-        Models::of(ModelSet::shipped().map_err(py_err)?).map_err(py_err)
+        Ok(Models {
+            estimator: Estimator::shipped(DataDir::new(None), Grid::ESTIMATION).map_err(py_err)?,
+        })
     }
 
     /// One model from a `.spdm` file.

@@ -48,6 +48,8 @@ def test_python_estimates_a_dng_with_the_light_read_on_the_mosaic(dng):
     # (models/raw-colour.json): still within 0.003 of A's.
     assert np.allclose(e.xy, A_XY, atol=0.003), (e.xy, light)
     assert e.detection.raw["colour"]["matrices"] == ["A", "D65"]
+    # The spectrum is the shipped ColorChecker 24 raw model's, as on the command line.
+    assert e.detection.raw["spectrum_model"] == "the shipped ColorChecker 24 raw model"
 
 
 def test_a_truncated_dng_is_refused_with_its_name(dng):
