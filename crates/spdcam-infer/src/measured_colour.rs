@@ -189,8 +189,10 @@ pub const RAW_SPLIT_EXPECTED_GFC: f64 = 0.990389;
 /// The intervals of raw photos whose expected GFC is below [`RAW_SPLIT_EXPECTED_GFC`] and of
 /// those at or above it: the 68th and 95th percentiles of their errors on raw scene photos
 /// of the validation split's validation lamps through its held-out cameras (108 photos
-/// each), both charts pooled, read as shipped (the matrices' shared bias taken off,
-/// [`RawColourCorrection`]); `tools/raw_intervals.py` on the photos CSV of
+/// each), both charts pooled, read as shipped before the raw models (the matrices' shared
+/// bias taken off for the JPEG model's shape, [`RawColourCorrection`]; with the raw models
+/// they hold on 97–98 % of those photos and 91 % of the test lamps');
+/// `tools/raw_intervals.py` on the photos CSV of
 /// `spdcam experiment colour --raw --photos-csv` (`docs/raw.md`, which gives the rule and
 /// the coverage on the test lamps). A lamp the chart reads poorly (a mixed-colour LED, a
 /// fluorescent) has a low expected GFC and its colour too is read less closely. Split
