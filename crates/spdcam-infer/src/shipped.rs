@@ -107,7 +107,7 @@ impl ModelSet {
         Ok(ModelSet { models })
     }
 
-    /// The raw models shipped inside spdcam ([`SHIPPED_RAW`]), named as messages name them:
+    /// The raw models shipped inside spdcam (`models/<chart>.raw.spdm`), named as messages name them:
     /// `the shipped ColorChecker 24 raw model`.
     pub fn shipped_raw() -> Result<Vec<NamedModel>> {
         SHIPPED_RAW

@@ -122,7 +122,7 @@ pub struct Estimator {
     /// The kind of light the estimates are told of.
     light: LightKind,
     /// Per model of the set, in order: the model that reads a raw photo's patches for the
-    /// same chart ([`Model::reads_raw_xyz`]), when one is given ([`Estimator::with_raw_models`]).
+    /// same chart ([`crate::Model::reads_raw_xyz`]), when one is given ([`Estimator::with_raw_models`]).
     raw_models: Arc<Vec<Option<NamedModel>>>,
 }
 
@@ -358,7 +358,7 @@ impl Estimator {
     }
 
     /// The same models, raw photos of a chart read by the model of `raw` for it: each must
-    /// read raw patches ([`Model::reads_raw_xyz`]) and estimate on the wavelengths of the
+    /// read raw patches ([`crate::Model::reads_raw_xyz`]) and estimate on the wavelengths of the
     /// set's model for its chart, which keeps the trust calibration, the verdict and the
     /// kind priors. Its spectrum replaces that model's for raw photos; the light's colour
     /// still comes from the file's matrices ([`crate::measured_colour`]).
