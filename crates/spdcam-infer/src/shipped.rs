@@ -107,8 +107,8 @@ impl ModelSet {
         Ok(ModelSet { models })
     }
 
-    /// The raw models shipped inside spdcam (`models/<chart>.raw.spdm`), named as messages name them:
-    /// `the shipped ColorChecker 24 raw model`.
+    /// The raw models shipped inside spdcam (`models/<chart>.raw.spdm`), named as messages
+    /// name them: `the shipped ColorChecker 24 raw model`.
     pub fn shipped_raw() -> Result<Vec<NamedModel>> {
         SHIPPED_RAW
             .iter()
