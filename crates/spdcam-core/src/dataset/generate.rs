@@ -126,9 +126,10 @@ impl Plan {
 }
 
 /// The features of [`Pipeline::Raw`]: `camera`'s exposed raw RGB of its chart under `light`
-/// (the in-camera stage `ic`'s lighting and glare, exposed below clipping), each feature patch taken to XYZ
-/// by the camera's DNG matrices at the neutral of the chart's grey patches, as a raw file of
-/// it is read ([`virtual_raw_colour`], [`chart_neutral`], [`RawColour::relative_xyz`]).
+/// (the in-camera stage `ic`'s lighting and glare, exposed below clipping), each feature
+/// patch taken to XYZ by the camera's DNG matrices at the neutral of the chart's grey
+/// patches, as a raw file of it is read ([`virtual_raw_colour`], [`chart_neutral`],
+/// [`RawColour::relative_xyz`]).
 ///
 /// [`RawColour::relative_xyz`]: crate::photo::raw::RawColour::relative_xyz
 pub fn raw_features(

@@ -122,7 +122,8 @@ pub struct Estimator {
     /// The kind of light the estimates are told of.
     light: LightKind,
     /// Per model of the set, in order: the model that reads a raw photo's patches for the
-    /// same chart ([`crate::Model::reads_raw_xyz`]), when one is given ([`Estimator::with_raw_models`]).
+    /// same chart ([`crate::Model::reads_raw_xyz`]), when one is given
+    /// ([`Estimator::with_raw_models`]).
     raw_models: Arc<Vec<Option<NamedModel>>>,
 }
 
