@@ -26,7 +26,7 @@ use crate::error::{Error, Result};
 use crate::light_families::Lighting;
 use crate::photo::raw::colour::chart_neutral;
 use crate::photo::raw::dng::virtual_raw_colour;
-use crate::photo::raw::CLIP_SHARE;
+use crate::photo::raw::{RawColour, CLIP_SHARE};
 use crate::spectral::Grid;
 use crate::{fsio, imageio, limits, seed};
 use rayon::prelude::*;
@@ -87,6 +87,9 @@ pub struct Generator<'a> {
     columns: Columns,
     spd_map: SpdMap,
     randomisation: Option<&'a Randomisation>,
+    /// With [`Pipeline::Raw`]: each camera a sample may be taken with, with the colour
+    /// calibration its DNGs carry ([`virtual_raw_colour`]), fitted once per camera.
+    raw_colours: Vec<(&'a Camera, RawColour)>,
 }
 
 /// The work of one run in one directory: which files are already there. Holds the
@@ -127,13 +130,14 @@ impl Plan {
 
 /// The features of [`Pipeline::Raw`]: `camera`'s exposed raw RGB of its chart under `light`
 /// (the in-camera stage `ic`'s lighting and glare, exposed below clipping), each feature
-/// patch taken to XYZ by the camera's DNG matrices at the neutral of the chart's grey
-/// patches, as a raw file of it is read ([`virtual_raw_colour`], [`chart_neutral`],
+/// patch taken to XYZ by the camera's DNG matrices `colour` ([`virtual_raw_colour`]) at the
+/// neutral of the chart's grey patches, as a raw file of it is read ([`chart_neutral`],
 /// [`RawColour::relative_xyz`]).
 ///
 /// [`RawColour::relative_xyz`]: crate::photo::raw::RawColour::relative_xyz
 pub fn raw_features(
     camera: &Camera,
+    colour: &RawColour,
     ic: Option<&InCamera>,
     light: &[f32],
     raw: &mut Vec<[f32; 3]>,
@@ -163,7 +167,7 @@ pub fn raw_features(
             Error::invalid("every grey patch is clipped or black; the light's colour is unread")
         })?;
     let patches: Vec<[f32; 3]> = chart.feature_patches.iter().map(|&p| raw[p]).collect();
-    let xyz = virtual_raw_colour(camera)?.relative_xyz(neutral, &patches)?;
+    let xyz = colour.relative_xyz(neutral, &patches)?;
     out.extend(xyz.iter().flatten());
     Ok(())
 }
@@ -231,14 +235,17 @@ impl<'a> Generator<'a> {
             ),
         )?;
         let spd_map = SpdMap::new(&sim.wavelengths(), &g)?;
-        Ok(Generator {
+        let mut generator = Generator {
             camera,
             lighting,
             options,
             columns,
             spd_map,
             randomisation: None,
-        })
+            raw_colours: Vec::new(),
+        };
+        generator.raw_colours = generator.raw_colours_of(std::slice::from_ref(camera))?;
+        Ok(generator)
     }
 
     /// Draws each sample's camera from `randomisation`'s pool and its in-camera parameters
@@ -261,7 +268,19 @@ impl<'a> Generator<'a> {
             ));
         }
         self.randomisation = Some(randomisation);
+        self.raw_colours = self.raw_colours_of(pool)?;
         Ok(self)
+    }
+
+    /// With [`Pipeline::Raw`], `cameras` each with its DNGs' colour calibration; else none.
+    fn raw_colours_of(&self, cameras: &'a [Camera]) -> Result<Vec<(&'a Camera, RawColour)>> {
+        if self.options.pipeline != Pipeline::Raw {
+            return Ok(Vec::new());
+        }
+        cameras
+            .iter()
+            .map(|c| Ok((c, virtual_raw_colour(c)?)))
+            .collect()
     }
 
     /// The columns of the samples.
@@ -368,7 +387,17 @@ impl<'a> Generator<'a> {
                 // neutral the matrices give no luminance: a deep blue or red light) is
                 // drawn again, from seed::derive(seed, i) and the attempt.
                 let mut attempt = 0;
-                while let Err(e) = raw_features(camera, ic, &light, &mut ws.raw, &mut ws.features) {
+                let colour = self
+                    .raw_colours
+                    .iter()
+                    .find(|(c, _)| std::ptr::eq(*c, camera))
+                    .map(|(_, colour)| colour)
+                    .ok_or_else(|| {
+                        Error::invalid(format!("sample {i}: the camera has no raw calibration"))
+                    })?;
+                while let Err(e) =
+                    raw_features(camera, colour, ic, &light, &mut ws.raw, &mut ws.features)
+                {
                     attempt += 1;
                     if attempt > RAW_REDRAWS {
                         return Err(Error::invalid(format!(
