@@ -547,21 +547,16 @@ impl Estimator {
             }
             (Some((reading, Some(feature_patches))), Some(raw_model)) => {
                 // The raw model reads the patches' XYZ through the file's matrices.
-                let row: Vec<f64> = feature_patches
-                    .iter()
-                    .map(|&p| {
-                        reading.patch_xyz.get(p).copied().ok_or_else(|| {
-                            InferError::invalid(format!(
-                                "{source}: the raw reading holds no patch {}",
-                                p + 1
-                            ))
-                        })
-                    })
-                    .collect::<Result<Vec<[f32; 3]>>>()?
-                    .iter()
-                    .flatten()
-                    .map(|&v| f64::from(v))
-                    .collect();
+                let mut row = Vec::with_capacity(3 * feature_patches.len());
+                for &p in feature_patches {
+                    let xyz = reading.patch_xyz.get(p).ok_or_else(|| {
+                        InferError::invalid(format!(
+                            "{source}: the raw reading holds no patch {}",
+                            p + 1
+                        ))
+                    })?;
+                    row.extend(xyz.map(f64::from));
+                }
                 model = &raw_model.model;
                 model.estimate_rows(&row)?
             }
