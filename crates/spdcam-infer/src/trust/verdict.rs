@@ -31,10 +31,20 @@ pub const UNUSABLE_CLIPPED_SHARE: f64 = 0.5;
 
 /// The number of clipped patches of a feature row (see [`clipped_patch`]).
 pub fn clipped_patches(row: &[f64]) -> usize {
+    clipped_features(row, &PhotoFlags::default()).len()
+}
+
+/// The feature patches of `row` the verdict counts as clipped: those the photo analysis
+/// flags (`flags`; on a raw file, clipped photosites left out of the patch) and those with
+/// a channel at the top of the scale ([`clipped_patch`]).
+pub fn clipped_features(row: &[f64], flags: &PhotoFlags) -> Vec<usize> {
     let scale = feature_scale(row);
-    row.chunks_exact(3)
-        .filter(|p| clipped_patch(p, scale))
-        .count()
+    (0..row.len() / 3)
+        .filter(|&i| {
+            flags.clipped.get(i).copied().unwrap_or(false)
+                || clipped_patch(&row[3 * i..3 * i + 3], scale)
+        })
+        .collect()
 }
 
 /// Patches to leave out of the self-check when no photo analysis flags them: a channel at
@@ -168,12 +178,7 @@ pub fn weigh(
     let scale = feature_scale(row);
     let patches = row.len() / 3;
     let skip = skipped_patches(row, scale, flags);
-    let clipped: Vec<usize> = (0..patches)
-        .filter(|&i| {
-            flags.clipped.get(i).copied().unwrap_or(false)
-                || clipped_patch(&row[3 * i..3 * i + 3], scale)
-        })
-        .collect();
+    let clipped = clipped_features(row, flags);
     let clipped_doubtful = calibration.map_or(0, |c| c.clipped_doubtful);
     let clipped_advice = |most: Option<usize>| Advice::Clipped {
         count: clipped.len(),
