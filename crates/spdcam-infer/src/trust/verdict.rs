@@ -127,8 +127,34 @@ pub fn assess(
     spd: &[f64],
     flags: &PhotoFlags,
 ) -> Result<Trust> {
+    assess_read_by(ReadBy { model, row }, calibration, check, row, spd, flags)
+}
+
+/// The model an estimate's spectrum was read by and the feature row it read: its answers
+/// to perturbed copies of that row give the estimate's difficulty and spread. For a photo's
+/// colours that is the photo's own row; for a raw photo read by a raw model, the patches'
+/// XYZ through the file's matrices.
+#[derive(Debug, Clone, Copy)]
+pub struct ReadBy<'a> {
+    /// The model (its calibration is the one the estimate is judged by).
+    pub model: &'a Model,
+    /// The row it read.
+    pub row: &'a [f64],
+}
+
+/// [`assess`] of a spectrum read by `read_by`, the photo's own colours `row` checked
+/// (clipping, dark patches, the self-check): how a raw photo read by a raw model is judged,
+/// by that model's calibration.
+pub fn assess_read_by(
+    read_by: ReadBy<'_>,
+    calibration: Option<&TrustCalibration>,
+    check: Option<&ChartCheck>,
+    row: &[f64],
+    spd: &[f64],
+    flags: &PhotoFlags,
+) -> Result<Trust> {
     let (verdict, advice, self_check, uncertainty) =
-        weigh(model, calibration, check, row, spd, flags)?;
+        weigh_read_by(read_by, calibration, check, row, spd, flags)?;
     Ok(Trust {
         verdict,
         reasons: advice.iter().map(Advice::to_string).collect(),
@@ -150,6 +176,19 @@ pub fn weigh(
     spd: &[f64],
     flags: &PhotoFlags,
 ) -> Result<Weighed> {
+    weigh_read_by(ReadBy { model, row }, calibration, check, row, spd, flags)
+}
+
+/// [`weigh`] of a spectrum read by `read_by` ([`assess_read_by`]).
+pub fn weigh_read_by(
+    read_by: ReadBy<'_>,
+    calibration: Option<&TrustCalibration>,
+    check: Option<&ChartCheck>,
+    row: &[f64],
+    spd: &[f64],
+    flags: &PhotoFlags,
+) -> Result<Weighed> {
+    let model = read_by.model;
     let mut verdict = Verdict::Ok;
     let mut reasons = Vec::new();
     let mut lower = |v: Verdict, reason: Advice, reasons: &mut Vec<Advice>| {
@@ -238,7 +277,7 @@ pub fn weigh(
     };
     let uncertainty = match calibration {
         Some(cal) => {
-            let perturbed = Perturbed::of(model, row)?;
+            let perturbed = Perturbed::of(model, read_by.row)?;
             Some(cal.uncertainty(
                 spd,
                 &perturbed.spread(),
