@@ -268,3 +268,29 @@ fn a_dng_of_several_charts_told_the_first_ones_illuminance_gives_each_its_own() 
         assert!((read / lux - 1.0).abs() < 0.03, "{read} lx for {lux}: {e}");
     }
 }
+
+#[test]
+fn a_raw_model_is_not_calibrated_on_the_real_photo_sets_jpegs() {
+    let dir = scratch("raw-calibrate");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let models = root.join("models");
+    let err = fails(&[
+        "trust",
+        "calibrate",
+        "--model",
+        &s(&models.join("colorchecker24.spdm")),
+        "--raw-model",
+        &s(&models.join("colorchecker24.raw.spdm")),
+        "--split",
+        &s(&root.join("docs/validation-split.json")),
+        "--scenes",
+        "1",
+        "--real",
+        "-o",
+        &s(&dir),
+    ]);
+    assert!(
+        err.contains("calibrated on raw scene photos alone") && err.contains("leave out --real"),
+        "{err}"
+    );
+}

@@ -26,7 +26,7 @@ use spdcam_infer::{Estimate, Estimator, FeatureRows};
 
 /// The DNG of a scene photo `shot` by `camera` under `spd`, as `spdcam render --scene -o
 /// x.dng` writes it.
-fn raw_scene(camera: &Camera, spd: &Spd, shot: &scene::ScenePhoto) -> Result<Vec<u8>> {
+pub(crate) fn raw_scene(camera: &Camera, spd: &Spd, shot: &scene::ScenePhoto) -> Result<Vec<u8>> {
     let mosaic = shot
         .mosaic
         .as_ref()

@@ -36,14 +36,13 @@ const MIN_METRIC_PHOTOS: usize = 40;
 /// per lamp), with `--scenes` scene photos of the same lamps and with `--real` real photos
 /// of the real sets' validation split.
 pub struct CalibrationPhotos {
-    /// Every photo's features, the virtual patch-level ones first.
-    features: Vec<Vec<f64>>,
+    /// Every photo's clipped patches, as the verdict counts them
+    /// ([`trust::clipped_features`]).
+    clipped: Vec<usize>,
     /// Every photo judged, in the same order.
     judged: Vec<Judged>,
-    /// How many of them are virtual patch-level photos.
-    virtual_count: usize,
-    /// How many are scene photos (after the virtual ones).
-    scene_count: usize,
+    /// Every photo's kind, in the same order.
+    kinds: Vec<PhotoKind>,
     /// Scene photos asked for per lamp.
     scenes_per_lamp: usize,
     /// The cross-validation group of each photo: a lamp's photos (patch level and scene)
@@ -64,65 +63,102 @@ pub enum PhotoKind {
     Scene,
     /// The real sets' validation photos.
     Real,
+    /// Virtual scene photos of smooth lights (Planckian radiators and CIE daylight): a raw
+    /// model's calibration has them beside the lamps' scene photos.
+    Smooth,
 }
 
 impl PhotoKind {
     /// Every kind.
-    pub const ALL: [PhotoKind; 3] = [PhotoKind::Virtual, PhotoKind::Scene, PhotoKind::Real];
+    pub const ALL: [PhotoKind; 4] = [
+        PhotoKind::Virtual,
+        PhotoKind::Scene,
+        PhotoKind::Real,
+        PhotoKind::Smooth,
+    ];
 
-    /// The kind's name in a calibration file: `virtual`, `scene` or `real`.
+    /// The kind's name in a calibration file: `virtual`, `scene`, `real` or `smooth`.
     pub fn label(self) -> &'static str {
         match self {
             PhotoKind::Virtual => "virtual",
             PhotoKind::Scene => "scene",
             PhotoKind::Real => "real",
+            PhotoKind::Smooth => "smooth",
         }
     }
 }
 
 impl CalibrationPhotos {
-    /// The virtual patch-level photos judged.
-    fn virtual_judged(&self) -> &[Judged] {
-        &self.judged[..self.virtual_count]
+    /// Scene photos alone, as a raw model's calibration has them: per photo its clipped
+    /// patches as the verdict counts them, its judgement, its kind
+    /// ([`PhotoKind::Scene`] or [`PhotoKind::Smooth`]), its cross-validation group (a
+    /// light's photos share one) and its source and light's type, for its record; `per_lamp`
+    /// photos asked for per lamp.
+    pub(crate) fn scenes_only(
+        clipped: Vec<usize>,
+        judged: Vec<Judged>,
+        kinds: Vec<PhotoKind>,
+        groups: Vec<usize>,
+        sources: Vec<(String, String)>,
+        per_lamp: usize,
+    ) -> CalibrationPhotos {
+        CalibrationPhotos {
+            scenes_per_lamp: per_lamp,
+            clipped,
+            judged,
+            kinds,
+            groups,
+            sources,
+        }
     }
 
-    /// Each photo's kind, in order.
-    fn kinds(&self) -> Vec<PhotoKind> {
-        (0..self.judged.len())
-            .map(|i| {
-                if i < self.virtual_count {
-                    PhotoKind::Virtual
-                } else if i < self.virtual_count + self.scene_count {
-                    PhotoKind::Scene
-                } else {
-                    PhotoKind::Real
-                }
-            })
-            .collect()
+    /// The photos the self-check's levels are fitted on: the virtual patch-level photos
+    /// (clean by construction, so that the levels tell bad photos); with none, every scene
+    /// photo (clean too: one light, no glare).
+    fn check_judged(&self) -> Vec<&Judged> {
+        let of = |wanted: &[PhotoKind]| -> Vec<&Judged> {
+            self.judged
+                .iter()
+                .zip(&self.kinds)
+                .filter(|(_, k)| wanted.contains(k))
+                .map(|(j, _)| j)
+                .collect()
+        };
+        let virtual_photos = of(&[PhotoKind::Virtual]);
+        if virtual_photos.is_empty() {
+            of(&[PhotoKind::Scene, PhotoKind::Smooth])
+        } else {
+            virtual_photos
+        }
+    }
+
+    /// How many photos are of `kind`.
+    fn count(&self, kind: PhotoKind) -> usize {
+        self.kinds.iter().filter(|&&k| k == kind).count()
     }
 }
 
-/// Fits `model`'s calibration: the self-check's levels on the virtual photos alone (clean
-/// by construction, so that they tell bad photos), everything else on all of `photos`;
-/// beside it, each photo's record.
+/// Fits `model`'s calibration: the self-check's levels on the clean photos alone
+/// ([`CalibrationPhotos::check_judged`]), everything else on all of `photos`; beside it, each
+/// photo's record.
 pub fn fit_calibration(
     model: &Model,
     chart: &str,
     photos: &CalibrationPhotos,
     method: String,
 ) -> Result<(TrustCalibration, Vec<CalibrationRecord>)> {
-    let (judged, features) = (&photos.judged, &photos.features);
+    let judged = &photos.judged;
     let d = model.grid().count;
     let err = |j: &Judged, k: usize| (j.spd[k] - j.truth.as_ref().map_or(0.0, |t| t[k])).abs();
-    let virtual_judged = photos.virtual_judged();
+    let clean_judged = photos.check_judged();
     let checks_of = |value: fn(&SelfCheck) -> Option<f64>| -> Vec<f64> {
-        virtual_judged
+        clean_judged
             .iter()
             .filter_map(|j| j.self_check.as_ref().and_then(value))
             .collect()
     };
     let mut checks = checks_of(|s| Some(s.mean));
-    let all_checked = checks.len() == virtual_judged.len();
+    let all_checked = checks.len() == clean_judged.len();
     let residual_reference = all_checked.then(|| median(&mut checks.clone()));
     let widenings: Vec<f64> = judged
         .iter()
@@ -153,7 +189,7 @@ pub fn fit_calibration(
     let mut gradients = checks_of(|s| s.colour_gradient);
     let mut glares = checks_of(|s| Some(s.glare));
     let mut two_lights = checks_of(|s| Some(s.two_lights));
-    let kinds = photos.kinds();
+    let kinds = photos.kinds.clone();
     let (gfc_model, held_out) = fit_gfc_model(judged, &photos.groups, &kinds)?;
     let expected_gaps: Vec<f64> = judged
         .iter()
@@ -180,10 +216,7 @@ pub fn fit_calibration(
             fit_metric(key, &photos)
         })
         .collect();
-    let mut clipped: Vec<f64> = features
-        .iter()
-        .map(|row| trust::clipped_patches(row) as f64)
-        .collect();
+    let mut clipped: Vec<f64> = photos.clipped.iter().map(|&c| c as f64).collect();
     let local_margin = fit_local_margin(
         &model.grid(),
         judged,
@@ -218,18 +251,18 @@ pub fn fit_calibration(
         residual_reference,
         difficulty_doubtful: conformal_quantile(&mut difficulties, 0.99),
         self_check_doubtful: all_checked.then(|| conformal_quantile(&mut checks, 0.99)),
-        split_doubtful: (splits.len() == virtual_judged.len())
+        split_doubtful: (splits.len() == clean_judged.len())
             .then(|| conformal_quantile(&mut splits, 0.99)),
         // Measured where most photos had enough unclipped neutral patches.
-        colour_gradient_doubtful: (10 * gradients.len() >= 9 * virtual_judged.len())
+        colour_gradient_doubtful: (10 * gradients.len() >= 9 * clean_judged.len())
             .then(|| conformal_quantile(&mut gradients, 0.99)),
-        glare_doubtful: (glares.len() == virtual_judged.len())
+        glare_doubtful: (glares.len() == clean_judged.len())
             .then(|| conformal_quantile(&mut glares, 0.99)),
-        two_lights_doubtful: (two_lights.len() == virtual_judged.len())
+        two_lights_doubtful: (two_lights.len() == clean_judged.len())
             .then(|| conformal_quantile(&mut two_lights, 0.99)),
         clipped_doubtful: conformal_quantile(&mut clipped, 0.99) as usize,
         metrics: metric_calibrations,
-        real_photos: photos.judged.len() - photos.virtual_count - photos.scene_count,
+        real_photos: photos.count(PhotoKind::Real),
         scenes_per_lamp: photos.scenes_per_lamp,
         local_margin,
     };
@@ -716,11 +749,21 @@ pub fn calibrate(
                 real.iter().map(|s| s.label).collect::<Vec<_>>().join(", ")
             );
         }
+        let kinds = [
+            (PhotoKind::Virtual, virtual_count),
+            (PhotoKind::Scene, scene_count),
+            (PhotoKind::Real, real_count),
+        ]
+        .into_iter()
+        .flat_map(|(kind, n)| std::iter::repeat_n(kind, n))
+        .collect();
         let calibration_photos = CalibrationPhotos {
-            features,
+            clipped: features
+                .iter()
+                .map(|row| trust::clipped_patches(row))
+                .collect(),
             judged,
-            virtual_count,
-            scene_count,
+            kinds,
             scenes_per_lamp: scenes,
             groups,
             sources,

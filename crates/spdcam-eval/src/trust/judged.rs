@@ -52,40 +52,59 @@ pub fn judge_rows(
                 None => None,
             };
             let perturbed = Perturbed::of(model, row)?;
-            let wavelengths = model.grid().wavelengths();
             let truth = truths.map(|t| t[r].clone());
-            let (metric_error, metric_value) = match &truth {
-                Some(t) => {
-                    let (e, t) = (
-                        LightingMetrics::from_samples(&wavelengths, &spd),
-                        LightingMetrics::from_samples(&wavelengths, t),
-                    );
-                    registry::calibrated()
-                        .filter_map(|metric| {
-                            let (k, value) = (metric.key, metric.value(&e)?);
-                            let error = (value - metric.value(&t)?).abs();
-                            Some(((k.to_string(), error), (k.to_string(), value)))
-                        })
-                        .unzip()
-                }
-                None => (BTreeMap::new(), BTreeMap::new()),
-            };
-            Ok(Judged {
-                spread: perturbed.spread(),
-                // The metrics' spread serves the intervals, measured only against a truth.
-                metric_spread: if truth.is_some() {
-                    perturbed.metric_spread(&wavelengths)
-                } else {
-                    BTreeMap::new()
-                },
-                metric_error,
-                metric_value,
-                truth,
+            Judged::of(
                 spd,
+                truth,
+                &perturbed,
                 self_check,
-            })
+                &model.grid().wavelengths(),
+            )
         })
         .collect()
+}
+
+impl Judged {
+    /// The estimate `spd` (peak 1, on `wavelengths`) judged: beside its truth when known,
+    /// its perturbed copies `perturbed` and its self-check.
+    pub fn of(
+        spd: Vec<f64>,
+        truth: Option<Vec<f64>>,
+        perturbed: &Perturbed,
+        self_check: Option<SelfCheck>,
+        wavelengths: &[f64],
+    ) -> Result<Judged> {
+        let (metric_error, metric_value) = match &truth {
+            Some(t) => {
+                let (e, t) = (
+                    LightingMetrics::from_samples(wavelengths, &spd),
+                    LightingMetrics::from_samples(wavelengths, t),
+                );
+                registry::calibrated()
+                    .filter_map(|metric| {
+                        let (k, value) = (metric.key, metric.value(&e)?);
+                        let error = (value - metric.value(&t)?).abs();
+                        Some(((k.to_string(), error), (k.to_string(), value)))
+                    })
+                    .unzip()
+            }
+            None => (BTreeMap::new(), BTreeMap::new()),
+        };
+        Ok(Judged {
+            spread: perturbed.spread(),
+            // The metrics' spread serves the intervals, measured only against a truth.
+            metric_spread: if truth.is_some() {
+                perturbed.metric_spread(wavelengths)
+            } else {
+                BTreeMap::new()
+            },
+            metric_error,
+            metric_value,
+            truth,
+            spd,
+            self_check,
+        })
+    }
 }
 
 pub use spdcam_infer::trust::conformal_quantile;

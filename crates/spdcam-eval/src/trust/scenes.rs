@@ -67,7 +67,7 @@ fn user_estimator(
 
 /// The scenes of the trust protocols: 1200×900 pixels, everything else as `spdcam render
 /// --scene` draws it.
-fn scene_options() -> SceneOptions {
+pub(crate) fn scene_options() -> SceneOptions {
     SceneOptions {
         width: 1200,
         height: 900,

@@ -1,13 +1,15 @@
 //! `spdcam trust calibrate`: the uncertainty calibration of models on held-out virtual
 //! photos of the split's validation lamps (`spdcam_eval::trust::fit`), written as
-//! `<chart>.trust.json`.
+//! `<chart>.trust.json`; of raw models on raw scene photos of the same lamps
+//! (`spdcam_eval::trust::raw`), written as `<chart>.raw.trust.json`.
 
 use crate::args::held_out::HeldOutArgs;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use spdcam_core::builtin::DataDir;
 use spdcam_core::fsio::write_atomic;
 use spdcam_eval::trust::fit::calibrate as fit;
+use spdcam_eval::trust::raw::calibrate_raw;
 use spdcam_eval::trust::records::write_records;
 use std::path::PathBuf;
 
@@ -28,6 +30,12 @@ pub(super) struct CalibrateArgs {
     /// sampled as a user's photo is): they join what the real photos join. 0: none.
     #[arg(long, default_value_t = 0)]
     scenes: usize,
+    /// Calibrate this raw model (`spdcam generate --raw`; repeatable) instead of the
+    /// `--model`s: on `--scenes` raw scene photos (DNGs) of each validation lamp, each
+    /// estimated as a user's raw photo is, the `--model` of its chart finding and checking
+    /// the chart. Written as `<chart>.raw.trust.json`.
+    #[arg(long = "raw-model", value_name = "FILE")]
+    raw_models: Vec<PathBuf>,
     /// The thesis's data (holding measured/…); default: the data directory's thesis/.
     #[arg(long)]
     thesis_data: Option<PathBuf>,
@@ -45,23 +53,43 @@ pub(super) struct CalibrateArgs {
 pub(super) fn run(args: CalibrateArgs, data_dir: &DataDir) -> Result<()> {
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("creating {}", args.output.display()))?;
-    let fitted = fit(
-        &args.photos.protocol(),
-        args.scenes,
-        args.real,
-        args.thesis_data.as_deref(),
-        data_dir,
-    )?;
+    let raw = !args.raw_models.is_empty();
+    if raw && args.real {
+        bail!("--real calibrates a model on the real photo sets' JPEGs; a raw model (--raw-model) is calibrated on raw scene photos alone: leave out --real");
+    }
+    let fitted = if raw {
+        calibrate_raw(
+            &args.photos.protocol(),
+            &args.raw_models,
+            args.scenes,
+            data_dir,
+        )?
+    } else {
+        fit(
+            &args.photos.protocol(),
+            args.scenes,
+            args.real,
+            args.thesis_data.as_deref(),
+            data_dir,
+        )?
+    };
+    let stem = |chart: &str| {
+        if raw {
+            format!("{chart}.raw")
+        } else {
+            chart.to_string()
+        }
+    };
     for skipped in &fitted.skipped {
         eprintln!("warning: {skipped}");
     }
     for c in fitted.models {
-        let out = args.output.join(format!("{}.trust.json", c.chart));
+        let out = args.output.join(format!("{}.trust.json", stem(&c.chart)));
         let json = serde_json::to_string_pretty(&c.calibration)?;
         write_atomic(&out, format!("{json}\n").as_bytes())?;
         if let Some(dir) = &args.records {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-            let file = dir.join(format!("{}.calibration-photos.csv", c.chart));
+            let file = dir.join(format!("{}.calibration-photos.csv", stem(&c.chart)));
             write_records(&file, &c.records)?;
             eprintln!(
                 "{}: {} calibration photos → {}",
