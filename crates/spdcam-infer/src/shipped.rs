@@ -41,20 +41,45 @@ pub(crate) const SHIPPED: [Shipped; 2] = [
     shipped!(KnownChart::ColorChecker24, "colorchecker24"),
 ];
 
-/// The raw models shipped inside the program (`models/<chart>.raw.spdm`, made by the
-/// README's recipe): for each chart that has one, the model that reads a raw photo's patches
-/// as XYZ through the file's matrices (`spdcam generate --raw`), whose spectrum replaces the
-/// chart's model's on raw photos ([`crate::Estimator::with_raw_models`]).
-pub(crate) const SHIPPED_RAW: [(KnownChart, &[u8]); 2] = [
-    (
-        KnownChart::Sg96,
-        include_bytes!("../../../models/colorchecker_sg96.raw.spdm"),
-    ),
-    (
-        KnownChart::ColorChecker24,
-        include_bytes!("../../../models/colorchecker24.raw.spdm"),
-    ),
+/// A raw model shipped inside the program and its trust calibration:
+/// `models/<chart>.raw.spdm` (made by the README's recipe), the model that reads a raw
+/// photo's patches as XYZ through the file's matrices (`spdcam generate --raw`), whose
+/// spectrum replaces the chart's model's on raw photos ([`crate::Estimator::with_raw_models`]),
+/// and `<chart>.raw.trust.json` (`spdcam trust calibrate --raw-model`), fitted on raw scene
+/// photos.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ShippedRaw {
+    /// The chart the model reads.
+    pub chart: KnownChart,
+    /// The model's `.spdm` bytes.
+    pub model: &'static [u8],
+    /// Its trust calibration's JSON.
+    pub calibration: &'static str,
+}
+
+/// The shipped raw model of `$chart`, its files named by the chart's machine name `$file`.
+macro_rules! shipped_raw {
+    ($chart:expr, $file:literal) => {
+        ShippedRaw {
+            chart: $chart,
+            model: include_bytes!(concat!("../../../models/", $file, ".raw.spdm")),
+            calibration: include_str!(concat!("../../../models/", $file, ".raw.trust.json")),
+        }
+    };
+}
+
+/// The shipped raw models, one per chart that has one.
+pub(crate) const SHIPPED_RAW: [ShippedRaw; 2] = [
+    shipped_raw!(KnownChart::Sg96, "colorchecker_sg96"),
+    shipped_raw!(KnownChart::ColorChecker24, "colorchecker24"),
 ];
+
+impl ShippedRaw {
+    /// The model as messages name it: `the shipped ColorChecker 24 raw model`.
+    pub fn name(&self) -> String {
+        format!("the shipped {} raw model", self.chart.shown_name())
+    }
+}
 
 impl Shipped {
     /// The model as messages name it: `the shipped ColorChecker 24 model`.
@@ -112,9 +137,9 @@ impl ModelSet {
     pub fn shipped_raw() -> Result<Vec<NamedModel>> {
         SHIPPED_RAW
             .iter()
-            .map(|(chart, bytes)| {
-                let name = format!("the shipped {} raw model", chart.shown_name());
-                let model = Model::from_bytes(bytes)
+            .map(|shipped| {
+                let name = shipped.name();
+                let model = Model::from_bytes(shipped.model)
                     .map_err(|e| InferError::invalid(format!("{name} is damaged: {e}")))?;
                 Ok(NamedModel { name, model })
             })
@@ -223,7 +248,7 @@ mod tests {
         let set = ModelSet::shipped().unwrap();
         let raw = ModelSet::shipped_raw().unwrap();
         assert_eq!(raw.len(), SHIPPED_RAW.len());
-        for ((chart, _), named) in SHIPPED_RAW.iter().zip(&raw) {
+        for (ShippedRaw { chart, .. }, named) in SHIPPED_RAW.iter().zip(&raw) {
             assert!(named.model.reads_raw_xyz(), "{}", named.name);
             assert!(!set.for_known(*chart).unwrap().model.reads_raw_xyz());
             assert_eq!(named.model.header().chart.as_deref(), Some(chart.name()));
@@ -231,6 +256,16 @@ mod tests {
                 named.model.grid(),
                 set.for_known(*chart).unwrap().model.grid()
             );
+            // Its own calibration, fitted on raw scene photos, with CCT and Duv intervals
+            // of the light's colour as raw files read it.
+            let calibration = crate::trust::calibration_for(&named.model)
+                .unwrap()
+                .unwrap_or_else(|| panic!("{}: no calibration", named.name));
+            assert_eq!(calibration.chart, chart.name());
+            assert!(calibration.method.starts_with("raw scene photos"));
+            for key in ["cct_k", "duv"] {
+                assert!(calibration.metrics.iter().any(|m| m.key == key), "{key}");
+            }
         }
     }
 

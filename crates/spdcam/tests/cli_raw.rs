@@ -1,8 +1,8 @@
 //! Camera raw files on the command line: `render --scene … -o x.dng` writes one, `estimate`
 //! reads it on its mosaic, says so, reads the light's colour through the file's matrices and
-//! gives the raw intervals; a cut file is refused by name. Told the light's illuminance
-//! (`--illuminance`), the DNG carries the EXIF exposure by ISO 12232's saturation-based
-//! speed and `estimate` reads the absolute levels back.
+//! judges it by the raw model's calibration; a cut file is refused by name. Told the light's
+//! illuminance (`--illuminance`), the DNG carries the EXIF exposure by ISO 12232's
+//! saturation-based speed and `estimate` reads the absolute levels back.
 
 mod common;
 
@@ -57,18 +57,17 @@ fn a_rendered_dng_is_estimated_from_its_mosaic_with_the_lights_colour() {
     );
     let cct = e["colorimetry"]["cct"].as_f64().unwrap();
     assert!((cct / 3000.0 - 1.0).abs() < 0.03, "{cct}");
-    // The raw intervals: 5.1 % of the CCT at 95 % where the expected GFC is high, 10.4 %
-    // where it is low.
-    let half = e["metric_uncertainty"]["cct_k"]["half95"].as_f64().unwrap();
+    // Judged by the raw model's own calibration (fitted on raw scene photos, smooth lights
+    // among them): a Planckian light is expected to be read closely, `ok`, and its CCT's
+    // 95 % interval holds the truth within ±4 % (the JPEG model's calibration gave raw
+    // photos ±5.1 % at best).
+    assert_eq!(e["verdict"], "ok", "{}", e["reasons"]);
     let expected_gfc = e["expected_gfc"].as_f64().unwrap();
-    let share = if expected_gfc >= 0.990389 {
-        0.0507
-    } else {
-        0.1040
-    };
+    assert!(expected_gfc > 0.98, "{expected_gfc}");
+    let half = e["metric_uncertainty"]["cct_k"]["half95"].as_f64().unwrap();
     assert!(
-        (half / cct - share).abs() < 1e-6,
-        "{half} of {cct} ({expected_gfc})"
+        (cct - 3000.0).abs() <= half && half / cct < 0.04,
+        "{cct} ± {half}"
     );
     // Without --illuminance the DNG has no EXIF exposure: no absolute levels, and why.
     assert!(e["absolute"].is_null(), "{e}");

@@ -38,7 +38,9 @@ use crate::measured_colour::{self, RawColourCorrection};
 use crate::photo_options::chart_templates;
 use crate::shipped::{ModelSet, NamedModel};
 use crate::stream::{check_feature_rows, GridMap};
-use crate::trust::{self, ChartCheck, ChartIdentity, PhotoFlags, Trust, TrustCalibration, Verdict};
+use crate::trust::{
+    self, ChartCheck, ChartIdentity, PhotoFlags, ReadBy, Trust, TrustCalibration, Verdict,
+};
 use rayon::prelude::*;
 use spdcam_core::advice::Advice;
 use spdcam_core::builtin::DataDir;
@@ -124,7 +126,17 @@ pub struct Estimator {
     /// Per model of the set, in order: the model that reads a raw photo's patches for the
     /// same chart ([`crate::Model::reads_raw_xyz`]), when one is given
     /// ([`Estimator::with_raw_models`]).
-    raw_models: Arc<Vec<Option<NamedModel>>>,
+    raw_models: Arc<Vec<Option<RawReader>>>,
+}
+
+/// A model that reads raw photos' patches, and the calibration its estimates are judged by.
+#[derive(Clone)]
+struct RawReader {
+    /// The model.
+    named: NamedModel,
+    /// Its trust calibration (`spdcam trust calibrate --raw-model`), shipped with it; `None`
+    /// for a model without one, whose estimates have no bands and no expected GFC.
+    calibration: Option<TrustCalibration>,
 }
 
 impl Estimator {
@@ -360,11 +372,13 @@ impl Estimator {
 
     /// The same models, raw photos of a chart read by the model of `raw` for it: each must
     /// read raw patches ([`crate::Model::reads_raw_xyz`]) and estimate on the wavelengths of the
-    /// set's model for its chart, which keeps the trust calibration, the verdict and the
-    /// kind priors. Its spectrum replaces that model's for raw photos; the light's colour
-    /// still comes from the file's matrices ([`crate::measured_colour`]).
+    /// set's model for its chart, which keeps the chart's checks (the self-check on the
+    /// photo's developed colours) and the kind priors. Its spectrum replaces that model's
+    /// for raw photos, judged by the raw model's own shipped calibration where it has one
+    /// ([`trust::calibration_for`]); the light's colour still comes from the file's matrices
+    /// ([`crate::measured_colour`]).
     pub fn with_raw_models(&self, raw: Vec<NamedModel>) -> Result<Estimator> {
-        let mut per_model: Vec<Option<NamedModel>> = self.raw_models.to_vec();
+        let mut per_model: Vec<Option<RawReader>> = self.raw_models.to_vec();
         per_model.resize(self.prepared.models.models().len(), None);
         for named in raw {
             if !named.model.reads_raw_xyz() {
@@ -398,7 +412,10 @@ impl Estimator {
                     set_grid.label()
                 )));
             }
-            per_model[index] = Some(named);
+            per_model[index] = Some(RawReader {
+                calibration: trust::calibration_for(&named.model)?,
+                named,
+            });
         }
         let mut out = self.clone();
         out.raw_models = Arc::new(per_model);
@@ -542,22 +559,13 @@ impl Estimator {
             (Some((_, None)), Some(raw_model)) => {
                 return Err(InferError::invalid(format!(
                     "{source}: {} cannot find its patches on this photo's chart",
-                    raw_model.name
+                    raw_model.named.name
                 )))
             }
             (Some((reading, Some(feature_patches))), Some(raw_model)) => {
                 // The raw model reads the patches' XYZ through the file's matrices.
-                let mut row = Vec::with_capacity(3 * feature_patches.len());
-                for &p in feature_patches {
-                    let xyz = reading.patch_xyz.get(p).ok_or_else(|| {
-                        InferError::invalid(format!(
-                            "{source}: the raw reading holds no patch {}",
-                            p + 1
-                        ))
-                    })?;
-                    row.extend(xyz.map(f64::from));
-                }
-                model = &raw_model.model;
+                let row = raw_row(reading, feature_patches, source)?;
+                model = &raw_model.named.model;
                 model.estimate_rows(&row)?
             }
             _ => model.estimate_rows(&features.values)?,
@@ -592,20 +600,55 @@ impl Estimator {
         let map = self.map(index)?;
         let judge = &self.prepared.trust[index];
         let mut photo = photo;
-        if let (Some(reading), Some(raw_model)) = (
-            photo.as_mut().and_then(|a| a.raw.as_mut()),
-            self.raw_models.get(index).and_then(Option::as_ref),
-        ) {
-            reading.spectrum_model = Some(raw_model.name.clone());
+        let raw_reader = self.raw_models.get(index).and_then(Option::as_ref);
+        let raw_row = match (&photo, raw_reader) {
+            (Some(analysis), Some(reader)) => match &analysis.raw {
+                Some(reading) => {
+                    let feature_patches = chosen
+                        .model
+                        .photo_chart()
+                        .filter(|t| t.name == analysis.chart)
+                        .map(|t| t.feature_patches.as_slice())
+                        .ok_or_else(|| {
+                            InferError::invalid(format!(
+                                "{}: {} cannot find its patches on this photo's chart",
+                                analysis.source, reader.named.name
+                            ))
+                        })?;
+                    Some(raw_row(reading, feature_patches, &analysis.source)?)
+                }
+                None => None,
+            },
+            _ => None,
+        };
+        if let (Some(reading), Some(reader)) =
+            (photo.as_mut().and_then(|a| a.raw.as_mut()), raw_reader)
+        {
+            reading.spectrum_model = Some(reader.named.name.clone());
         }
-        let mut trust = trust::assess(
-            &chosen.model,
-            judge.calibration.as_ref(),
-            judge.check.as_ref(),
-            row,
-            &model_spd,
-            flags,
-        )?;
+        // A raw photo read by a raw model is judged by that model's calibration, its spread
+        // from the raw patches; the photo's developed colours keep the chart's checks.
+        let mut trust = match (raw_reader, &raw_row) {
+            (Some(reader), Some(raw_row)) => trust::assess_read_by(
+                ReadBy {
+                    model: &reader.named.model,
+                    row: raw_row,
+                },
+                reader.calibration.as_ref(),
+                judge.check.as_ref(),
+                row,
+                &model_spd,
+                flags,
+            )?,
+            _ => trust::assess(
+                &chosen.model,
+                judge.calibration.as_ref(),
+                judge.check.as_ref(),
+                row,
+                &model_spd,
+                flags,
+            )?,
+        };
         self.bands_on_grid(&mut trust, map)?;
         self.check_kind(index, own, &mut trust)?;
         // The colorimetry, the metrics and the absolute level are of the model's whole
@@ -614,7 +657,9 @@ impl Estimator {
         let spd = Spd::new(self.grid, map.apply(model_spd))?;
         let metrics = LightingMetrics::of_spd(&full);
         let colorimetry = Colorimetry::of_metrics(&metrics)?;
-        if photo.as_ref().is_some_and(|a| a.raw.is_some()) {
+        // A raw photo read by the chart's own model: the CCT and Duv intervals of raw photos
+        // ([`measured_colour::RAW_INTERVALS`]); a raw model's calibration has its own.
+        if raw_row.is_none() && photo.as_ref().is_some_and(|a| a.raw.is_some()) {
             if let (Some(u), Some(cct)) = (&mut trust.uncertainty, colorimetry.cct) {
                 measured_colour::set_intervals(&mut u.metrics, cct, u.expected_gfc);
             }
@@ -735,4 +780,21 @@ impl ModelSpds {
     fn own(&self) -> &[f64] {
         self.own.as_deref().unwrap_or(&self.told)
     }
+}
+
+/// A raw photo's feature row for a raw model: the XYZ of each of `feature_patches` (the
+/// chart's patches the model reads, in its order) through the file's matrices, white
+/// Y = 100 ([`RawReading::patch_xyz`]).
+fn raw_row(reading: &RawReading, feature_patches: &[usize], source: &str) -> Result<Vec<f64>> {
+    let mut row = Vec::with_capacity(3 * feature_patches.len());
+    for &p in feature_patches {
+        let xyz = reading.patch_xyz.get(p).ok_or_else(|| {
+            InferError::invalid(format!(
+                "{source}: the raw reading holds no patch {}",
+                p + 1
+            ))
+        })?;
+        row.extend(xyz.map(f64::from));
+    }
+    Ok(row)
 }

@@ -477,13 +477,21 @@ pub fn estimate_cct(grid: &Grid, spd: &[f64]) -> Result<Option<f64>> {
     Ok(uv_to_cct_duv(xy_to_uv1960(xy)).ok().map(|(cct, _)| cct))
 }
 
-/// The shipped calibration measured on `model` (`models/<chart>.trust.json`, made by
-/// `spdcam trust calibrate`), if any.
+/// The shipped calibration measured on `model` (`models/<chart>.trust.json` or, for a
+/// shipped raw model, `models/<chart>.raw.trust.json`, made by `spdcam trust calibrate`), if
+/// any.
 pub fn calibration_for(model: &Model) -> Result<Option<TrustCalibration>> {
     let fingerprint = model.fingerprint();
-    for shipped in &crate::shipped::SHIPPED {
-        let name = format!("{}'s calibration", shipped.name());
-        let c = TrustCalibration::from_json(shipped.calibration, &name)?;
+    let shipped = crate::shipped::SHIPPED
+        .iter()
+        .map(|s| (s.name(), s.calibration))
+        .chain(
+            crate::shipped::SHIPPED_RAW
+                .iter()
+                .map(|s| (s.name(), s.calibration)),
+        );
+    for (model_name, json) in shipped {
+        let c = TrustCalibration::from_json(json, &format!("{model_name}'s calibration"))?;
         if c.model == fingerprint {
             return Ok(Some(c));
         }
