@@ -67,6 +67,9 @@ pub struct Scored {
     /// The size (Δu′v′) of the bias a raw file's matrices have for a light of the estimate's
     /// shape ([`RawColourCorrection::bias`]): what the raw colour correction takes off.
     pub raw_bias: Option<f64>,
+    /// The share of the model's wavelengths where the true SPD (peak 1) lies inside the
+    /// estimate's calibrated 95 % band, where it has one.
+    pub band95_held: Option<f64>,
 }
 
 impl Scored {
@@ -75,6 +78,23 @@ impl Scored {
         let trust = estimate.trust.as_ref();
         let correction = RawColourCorrection::shipped()?;
         let uncertainty = trust.and_then(|t| t.uncertainty.as_ref());
+        let band95_held = match uncertainty {
+            Some(u) => {
+                let truth = light
+                    .spd
+                    .resampled(estimate.spd.grid())?
+                    .normalised_by_max();
+                let (lower, upper) = (u.band95.lower.values(), u.band95.upper.values());
+                let held = truth
+                    .values()
+                    .iter()
+                    .enumerate()
+                    .filter(|&(k, t)| lower[k] <= *t && *t <= upper[k])
+                    .count();
+                Some(held as f64 / truth.values().len().max(1) as f64)
+            }
+            None => None,
+        };
         let half95 = uncertainty
             .and_then(|u| u.metrics.get("cct_k"))
             .map(|m| m.half95);
@@ -87,6 +107,7 @@ impl Scored {
                 let [u, v] = correction.bias(&shape);
                 u.hypot(v)
             }),
+            band95_held,
             ..Scored::spd(&estimate.spd, light)?
         })
     }
@@ -102,6 +123,7 @@ impl Scored {
             rf: None,
             expected_gfc: None,
             raw_bias: None,
+            band95_held: None,
         })
     }
 }

@@ -88,7 +88,7 @@ impl ModelColour {
 }
 
 /// The columns of [`ColourReport::photos_csv`].
-const PHOTO_COLUMNS: [&str; 23] = [
+const PHOTO_COLUMNS: [&str; 24] = [
     "model",
     "light_named",
     "photo",
@@ -111,6 +111,7 @@ const PHOTO_COLUMNS: [&str; 23] = [
     "estimate_rf",
     "expected_gfc",
     "raw_bias_uv",
+    "band95_held",
     "ok",
 ];
 
@@ -118,8 +119,9 @@ impl ColourReport {
     /// Every photo of every model as CSV, a row each (model, light, camera, GFC, the true and
     /// estimated u′v′ and CCT, the CCT's 95 % half-width, the true and estimated Duv, the
     /// estimate's TM-30 Rf, its expected GFC, the bias the raw colour correction
-    /// expects for its shape, verdict): what the tables summarise, for a study of its own
-    /// (empty cells where a photo was refused or a CCT is not scored).
+    /// expects for its shape, the share of wavelengths its 95 % band holds, verdict): what
+    /// the tables summarise, for a study of its own (empty cells where a photo was refused
+    /// or a CCT is not scored).
     pub fn photos_csv(&self) -> crate::error::Result<String> {
         let mut w = csv::Writer::from_writer(Vec::new());
         let fail = |e: csv::Error| EvalError::invalid(format!("the photos' CSV: {e}"));
@@ -157,6 +159,7 @@ impl ColourReport {
                         number(e.and_then(|e| e.rf)),
                         number(e.and_then(|e| e.expected_gfc)),
                         number(e.and_then(|e| e.raw_bias)),
+                        number(e.and_then(|e| e.band95_held)),
                         e.is_some_and(|e| e.ok).to_string(),
                     ];
                     w.write_record(&record).map_err(fail)?;
@@ -408,6 +411,7 @@ mod tests {
             rf: None,
             expected_gfc: Some(0.98),
             raw_bias: Some(0.0042),
+            band95_held: Some(0.9),
         };
         let report = ColourReport {
             models: vec![cc24(
@@ -443,12 +447,12 @@ mod tests {
             lines[1],
             format!(
                 "cc24.spdm,false,scene,test lamps,\"Lamp, \"\"warm\"\"\",{kind},cam_b,false,\
-                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,0.0004,,,0.98,0.0042,true"
+                 0.97,0.25,0.52,0.245,0.52,0.005,3000,,,0.0004,,,0.98,0.0042,0.9,true"
             )
         );
         assert_eq!(
             lines[2],
-            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,,,,,false")
+            format!("cc24.spdm,false,patch,test lamps,\"Lamp, \"\"warm\"\"\",{kind},,true,,,,,,,,,,,,,,,,false")
         );
     }
 }

@@ -149,6 +149,7 @@ mod tests {
             rf: None,
             expected_gfc: None,
             raw_bias: None,
+            band95_held: None,
         }
     }
 
