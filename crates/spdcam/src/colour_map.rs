@@ -46,6 +46,11 @@ struct RawArgs {
     /// The ridge penalty, relative to the mean diagonal of XᵀX.
     #[arg(long, default_value_t = spdcam_eval::colour::raw_fit::PENALTY)]
     penalty: f64,
+    /// A raw model (`spdcam generate --raw`; repeatable): fit the bias on the shapes it
+    /// reads from each training camera's raw patches of its chart, rather than on the lights'
+    /// true shapes (every model's readings pooled).
+    #[arg(long = "raw-model", value_name = "FILE")]
+    raw_models: Vec<PathBuf>,
     /// The correction (JSON).
     #[arg(short, long, value_name = "FILE.json")]
     output: PathBuf,
@@ -96,6 +101,7 @@ fn raw(args: RawArgs, data_dir: &DataDir) -> Result<()> {
         library: args.library.files(),
         cameras: args.cameras,
         penalty: args.penalty,
+        raw_models: args.raw_models,
     };
     let fit = RawFit::fit(&options, data_dir, &mut |what| eprintln!("{what}"))?;
     for s in &fit.skipped {

@@ -42,7 +42,9 @@ pub use csv_io::{
     RealPhotoSet, REAL_PHOTO_SETS,
 };
 pub use file::{encode_parquet, encode_parquet_as, Compression, FileFormat, ZSTD_LEVEL};
-pub use generate::{GenerateEvent, GenerateOptions, GenerateRequest, Generator, Plan};
+pub use generate::{
+    raw_features, GenerateEvent, GenerateOptions, GenerateRequest, Generator, Plan,
+};
 pub use identity::{sample_hash, SeenSamples};
 pub use lock::{DirLock, LockOwner, LOCK_FILE};
 pub use manifest::{

@@ -4,25 +4,30 @@
 //! seen by each of its *training* cameras as that camera's DNG gives it to a reader — the
 //! neutral under the light through the camera's matrices fitted under A and D65 — against
 //! the light's true chromaticity, and the bias fitted as a linear function of the light's
-//! shape. Its validation and test lamps and
+//! shape — or, given the raw models, of the shape each raw model reads from that camera's
+//! raw patches, the shape the correction is handed when a photo is read. Its validation and
+//! test lamps and
 //! its held-out cameras stay unseen: the fit is scored on the validation lamps through the
 //! training cameras here, and `spdcam experiment colour --raw` measures it on the held-out
 //! cameras.
 
-use crate::error::Result;
+use crate::error::{EvalError, Result};
 use crate::held_out::{training_cameras, LampFiles, SkippedCamera, GRID};
 use rayon::prelude::*;
 use spdcam_core::builtin::DataDir;
+use spdcam_core::camera::sensor::Sensitivities;
 use spdcam_core::camera::{Camera, CameraConfig};
 use spdcam_core::chart::Chart;
 use spdcam_core::cie_illuminant::{daylight, planck};
 use spdcam_core::colorimetry::Observer;
+use spdcam_core::dataset::raw_features;
 use spdcam_core::light_families::validation_split::LampPart;
 use spdcam_core::light_families::ValidationSplit;
 use spdcam_core::photo::raw::dng::virtual_raw_colour;
 use spdcam_core::quality::uv::xy_to_uv1976;
 use spdcam_core::spectral::Spd;
 use spdcam_infer::measured_colour::RawColourCorrection;
+use spdcam_infer::Model;
 use std::path::PathBuf;
 
 /// The relative ridge penalty the correction is fitted with by default.
@@ -40,6 +45,10 @@ pub struct RawFitOptions {
     pub cameras: Option<PathBuf>,
     /// The ridge penalty, relative to the mean diagonal of XᵀX.
     pub penalty: f64,
+    /// Raw models (`spdcam generate --raw`): when given, each reading's shape is each raw
+    /// model's estimate from that camera's raw patches of its chart, every model's readings
+    /// pooled; none: the light's true shape.
+    pub raw_models: Vec<PathBuf>,
 }
 
 /// A fitted correction and what it does.
@@ -104,6 +113,79 @@ fn readings(cameras: &[Camera], lamps: &[Spd], observer: &Observer) -> Result<Ve
     Ok(per_camera.into_iter().flatten().collect())
 }
 
+/// Each of `lights` through each of `cameras` (camera-major, as [`readings`] orders them)
+/// read by the raw model `model`: the shape ([`RawColourCorrection::shape`]) of its
+/// estimate from the camera's raw patches of the model's chart, without lighting gradient
+/// or glare ([`raw_features`]).
+fn estimated_shapes(
+    model: &Model,
+    cameras: &[Sensitivities],
+    lights: &[Spd],
+    data_dir: &DataDir,
+) -> Result<Vec<Vec<f64>>> {
+    let name = model
+        .header()
+        .chart
+        .clone()
+        .ok_or_else(|| EvalError::invalid("a raw model that names no chart"))?;
+    let chart = Chart::resolve(&name, None, data_dir, &GRID)?;
+    let d = model.grid().count;
+    let per_camera: Vec<Vec<Vec<f64>>> = cameras
+        .par_iter()
+        .map(|s| {
+            let camera = Camera::new(s, chart.clone(), CameraConfig::default(), &GRID)?;
+            let colour = virtual_raw_colour(&camera)?;
+            let (mut raw, mut row) = (Vec::new(), Vec::new());
+            for spd in lights {
+                raw_features(
+                    &camera,
+                    &colour,
+                    None,
+                    &camera.light(spd)?,
+                    &mut raw,
+                    &mut row,
+                )?;
+            }
+            let rows: Vec<f64> = row.iter().map(|&v| f64::from(v)).collect();
+            model
+                .estimate_rows(&rows)?
+                .chunks_exact(d)
+                .map(|spd| {
+                    Ok(RawColourCorrection::shape(&Spd::new(
+                        model.grid(),
+                        spd.to_vec(),
+                    )?)?)
+                })
+                .collect()
+        })
+        .collect::<Result<_>>()?;
+    Ok(per_camera.into_iter().flatten().collect())
+}
+
+/// `readings` once per raw model of `models`, each reading's shape the model's estimate
+/// ([`estimated_shapes`]); `readings` as they are without models.
+fn as_estimated(
+    readings: Vec<Reading>,
+    models: &[Model],
+    cameras: &[Sensitivities],
+    lights: &[Spd],
+    data_dir: &DataDir,
+) -> Result<Vec<Reading>> {
+    if models.is_empty() {
+        return Ok(readings);
+    }
+    let mut out = Vec::with_capacity(readings.len() * models.len());
+    for model in models {
+        let shapes = estimated_shapes(model, cameras, lights, data_dir)?;
+        out.extend(readings.iter().zip(shapes).map(|(r, shape)| Reading {
+            shape,
+            read: r.read,
+            truth: r.truth,
+        }));
+    }
+    Ok(out)
+}
+
 /// The median Δu′v′ of `readings` as read and as `correction` corrects them.
 fn medians(readings: &[Reading], correction: &RawColourCorrection) -> [f64; 2] {
     let distance = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
@@ -146,8 +228,29 @@ impl RawFit {
         let smooth = smooth_lights()?;
         let fit_lights: Vec<Spd> = fit_lamps.iter().chain(&smooth).cloned().collect();
         let observer = Observer::cie1931(&GRID)?;
+        let models: Vec<Model> = options
+            .raw_models
+            .iter()
+            .map(|path| {
+                let model = Model::load(path)?;
+                if !model.reads_raw_xyz() {
+                    return Err(EvalError::invalid(format!(
+                        "{} does not read raw patches: give a model trained on `spdcam \
+                         generate --raw`",
+                        path.display()
+                    )));
+                }
+                Ok(model)
+            })
+            .collect::<Result<_>>()?;
         progress("the fit lights through the training cameras");
-        let fit_readings = readings(&cameras, &fit_lights, &observer)?;
+        let fit_readings = as_estimated(
+            readings(&cameras, &fit_lights, &observer)?,
+            &models,
+            &held.cameras,
+            &fit_lights,
+            data_dir,
+        )?;
         let samples: Vec<(Vec<f64>, [f64; 2])> = fit_readings
             .iter()
             .map(|r| {
@@ -155,10 +258,26 @@ impl RawFit {
                 (r.shape.clone(), bias)
             })
             .collect();
+        let shapes = if models.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; the shapes {} raw model(s) read from each camera's raw patches ({})",
+                models.len(),
+                options
+                    .raw_models
+                    .iter()
+                    .map(|p| p
+                        .file_name()
+                        .map_or(String::new(), |n| n.to_string_lossy().into_owned()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        };
         let fitted_on = format!(
             "{} readings: the {} fit lamps of {} and {} Planckian and daylight lights through \
              its {} training cameras' DNG matrices (fitted under A and D65 on the \
-             ColorChecker 24)",
+             ColorChecker 24){shapes}",
             samples.len(),
             fit_lamps.len(),
             options
@@ -170,7 +289,13 @@ impl RawFit {
         );
         let correction = RawColourCorrection::fit(&samples, options.penalty, fitted_on)?;
         progress("the validation lamps through the training cameras");
-        let validation_readings = readings(&cameras, &validation_lamps, &observer)?;
+        let validation_readings = as_estimated(
+            readings(&cameras, &validation_lamps, &observer)?,
+            &models,
+            &held.cameras,
+            &validation_lamps,
+            data_dir,
+        )?;
         Ok(RawFit {
             median_delta_uv: [
                 medians(&fit_readings, &correction),
