@@ -72,6 +72,11 @@ fn the_raw_correction_fitted_on_the_fit_lamps_reads_unseen_lamps_closer_and_is_t
         library: LampFiles::default(),
         cameras: None,
         penalty: RawColourCorrection::shipped().unwrap().penalty,
+        // The shipped correction is fitted on the shapes the shipped raw models read.
+        raw_models: vec![
+            repo.join("models/colorchecker_sg96.raw.spdm"),
+            repo.join("models/colorchecker24.raw.spdm"),
+        ],
     };
     let fit = RawFit::fit(&options, &data, &mut |_| {}).unwrap();
     let [[fit_before, fit_after], [val_before, val_after]] = fit.median_delta_uv;
