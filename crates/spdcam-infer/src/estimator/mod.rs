@@ -629,7 +629,7 @@ impl Estimator {
         // A raw photo read by a raw model is judged by that model's calibration, its spread
         // from the raw patches; the photo's developed colours keep the chart's checks.
         let mut trust = match (raw_reader, &raw_row) {
-            (Some(reader), Some(raw_row)) => trust::assess_read_by(
+            (Some(reader), Some(raw_row)) => trust::weigh_read_by(
                 ReadBy {
                     model: &reader.named.model,
                     row: raw_row,
@@ -639,7 +639,8 @@ impl Estimator {
                 row,
                 &model_spd,
                 flags,
-            )?,
+            )?
+            .into(),
             _ => trust::assess(
                 &chosen.model,
                 judge.calibration.as_ref(),

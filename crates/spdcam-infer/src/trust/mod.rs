@@ -34,7 +34,7 @@ pub use local_margin::{conformal_quantile, photo_coordinates, LocalMargin};
 pub use self_check::{ChartCheck, SelfCheck, Veil};
 pub use spread::{clipped_patch, feature_scale, Perturbed, JITTER_COPIES, JITTER_SIGMA};
 pub use verdict::{
-    assess, assess_read_by, clipped_features, clipped_patches, flag_patches, photo_flags,
-    skipped_patches, weigh, weigh_read_by, PhotoFlags, ReadBy, Trust, Verdict, Weighed,
-    DOUBTFUL_GFC, POOR_GFC, SURE_DETECTION, UNUSABLE_CLIPPED_SHARE, UNUSABLE_SELF_CHECK_FACTOR,
+    assess, clipped_features, clipped_patches, flag_patches, photo_flags, skipped_patches, weigh,
+    weigh_read_by, PhotoFlags, ReadBy, Trust, Verdict, Weighed, DOUBTFUL_GFC, POOR_GFC,
+    SURE_DETECTION, UNUSABLE_CLIPPED_SHARE, UNUSABLE_SELF_CHECK_FACTOR,
 };

@@ -127,7 +127,7 @@ pub fn assess(
     spd: &[f64],
     flags: &PhotoFlags,
 ) -> Result<Trust> {
-    assess_read_by(ReadBy { model, row }, calibration, check, row, spd, flags)
+    Ok(weigh(model, calibration, check, row, spd, flags)?.into())
 }
 
 /// The model an estimate's spectrum was read by and the feature row it read: its answers
@@ -142,25 +142,16 @@ pub struct ReadBy<'a> {
     pub row: &'a [f64],
 }
 
-/// [`assess`] of a spectrum read by `read_by`, the photo's own colours `row` checked
-/// (clipping, dark patches, the self-check): how a raw photo read by a raw model is judged,
-/// by that model's calibration.
-pub fn assess_read_by(
-    read_by: ReadBy<'_>,
-    calibration: Option<&TrustCalibration>,
-    check: Option<&ChartCheck>,
-    row: &[f64],
-    spd: &[f64],
-    flags: &PhotoFlags,
-) -> Result<Trust> {
-    let (verdict, advice, self_check, uncertainty) =
-        weigh_read_by(read_by, calibration, check, row, spd, flags)?;
-    Ok(Trust {
-        verdict,
-        reasons: advice.iter().map(Advice::to_string).collect(),
-        self_check,
-        uncertainty,
-    })
+impl From<Weighed> for Trust {
+    /// The trust of what [`weigh`] found, its reasons in words.
+    fn from((verdict, advice, self_check, uncertainty): Weighed) -> Trust {
+        Trust {
+            verdict,
+            reasons: advice.iter().map(Advice::to_string).collect(),
+            self_check,
+            uncertainty,
+        }
+    }
 }
 
 /// What [`weigh`] finds: the verdict, the advice behind it, the self-check and the bands.
@@ -179,7 +170,9 @@ pub fn weigh(
     weigh_read_by(ReadBy { model, row }, calibration, check, row, spd, flags)
 }
 
-/// [`weigh`] of a spectrum read by `read_by` ([`assess_read_by`]).
+/// [`weigh`] of a spectrum read by `read_by`, the photo's own colours `row` checked
+/// (clipping, dark patches, the self-check): how a raw photo read by a raw model is judged,
+/// by that model's calibration.
 pub fn weigh_read_by(
     read_by: ReadBy<'_>,
     calibration: Option<&TrustCalibration>,
