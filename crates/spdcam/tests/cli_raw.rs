@@ -293,3 +293,31 @@ fn a_raw_model_is_not_calibrated_on_the_real_photo_sets_jpegs() {
         "{err}"
     );
 }
+
+#[test]
+fn a_raw_photo_of_a_chart_lit_half_by_another_light_is_not_ok() {
+    // The chart's left half under a Planckian 3000 K, its right half under D65: no one light
+    // explains the patches, which the self-check on the developed colours tells, with the
+    // raw model's calibration's levels.
+    let dir = scratch("raw-half");
+    let photo = dir.join("half.dng");
+    ok(&[
+        "render",
+        "--spd",
+        "planck:3000",
+        "--right-light",
+        "D65",
+        "--scene",
+        "1200x900",
+        "--seed",
+        "2",
+        "-o",
+        &s(&photo),
+    ]);
+    let out = spdcam(&["estimate", &s(&photo), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let e = &json[0];
+    assert_eq!(e["verdict"], "unusable", "{}", e["reasons"]);
+    let reasons = e["reasons"].to_string();
+    assert!(reasons.contains("does not explain"), "{reasons}");
+}
