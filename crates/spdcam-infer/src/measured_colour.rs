@@ -186,8 +186,9 @@ pub struct RawIntervals {
 /// of [`RAW_INTERVALS`]: the median of the validation photos below.
 pub const RAW_SPLIT_EXPECTED_GFC: f64 = 0.990389;
 
-/// The intervals of raw photos whose expected GFC is below [`RAW_SPLIT_EXPECTED_GFC`] and of
-/// those at or above it: the 68th and 95th percentiles of their errors on raw scene photos
+/// The intervals of a raw photo read by a chart's model without a raw model (a raw model's
+/// calibration has intervals of its own), for photos whose expected GFC is below
+/// [`RAW_SPLIT_EXPECTED_GFC`] and for those at or above it: the 68th and 95th percentiles of their errors on raw scene photos
 /// of the validation split's validation lamps through its held-out cameras (108 photos
 /// each), both charts pooled, read as shipped before the raw models (the matrices' shared
 /// bias taken off for the JPEG model's shape, [`RawColourCorrection`]; with the raw models
