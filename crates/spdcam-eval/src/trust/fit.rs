@@ -138,9 +138,9 @@ impl CalibrationPhotos {
     }
 }
 
-/// Fits `model`'s calibration: the self-check's levels on the clean photos alone
-/// ([`CalibrationPhotos::check_judged`]), everything else on all of `photos`; beside it, each
-/// photo's record.
+/// Fits `model`'s calibration: the self-check's levels on the clean photos alone (the
+/// virtual patch-level ones; without them, every scene photo), everything else on all of
+/// `photos`; beside it, each photo's record.
 pub fn fit_calibration(
     model: &Model,
     chart: &str,
