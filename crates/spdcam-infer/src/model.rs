@@ -394,6 +394,19 @@ impl Model {
         self.training().data.origin.as_ref().and_then(pipeline) == Some("raw")
     }
 
+    /// Refuses, naming it `name` and saying how one is made, a model that does not read raw
+    /// patches ([`Model::reads_raw_xyz`]) where a raw model is asked for.
+    pub fn require_raw_xyz(&self, name: &str) -> Result<()> {
+        if self.reads_raw_xyz() {
+            Ok(())
+        } else {
+            Err(InferError::invalid(format!(
+                "{name} does not read raw patches: a raw model is trained on `spdcam generate \
+                 --raw`"
+            )))
+        }
+    }
+
     /// The training chart as photos show it, when known.
     pub fn photo_chart(&self) -> Option<&ChartTemplate> {
         self.header.photo_chart.as_ref()

@@ -233,13 +233,7 @@ impl RawFit {
             .iter()
             .map(|path| {
                 let model = Model::load(path)?;
-                if !model.reads_raw_xyz() {
-                    return Err(EvalError::invalid(format!(
-                        "{} does not read raw patches: give a model trained on `spdcam \
-                         generate --raw`",
-                        path.display()
-                    )));
-                }
+                model.require_raw_xyz(&path.display().to_string())?;
                 Ok(model)
             })
             .collect::<Result<_>>()?;

@@ -75,12 +75,7 @@ pub fn calibrate_raw(
     let mut out = Vec::new();
     for path in raw_models {
         let raw = Model::load(path)?;
-        if !raw.reads_raw_xyz() {
-            return Err(EvalError::invalid(format!(
-                "{} does not read raw patches: give a model trained on `spdcam generate --raw`",
-                path.display()
-            )));
-        }
+        raw.require_raw_xyz(&path.display().to_string())?;
         let chart_name = raw.header().chart.clone().ok_or_else(|| {
             EvalError::invalid(format!("{}: the model names no chart", path.display()))
         })?;

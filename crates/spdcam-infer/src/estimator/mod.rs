@@ -381,13 +381,7 @@ impl Estimator {
         let mut per_model: Vec<Option<RawReader>> = self.raw_models.to_vec();
         per_model.resize(self.prepared.models.models().len(), None);
         for named in raw {
-            if !named.model.reads_raw_xyz() {
-                return Err(InferError::invalid(format!(
-                    "{} does not read raw patches: a raw model is trained on `spdcam \
-                     generate --raw`",
-                    named.name
-                )));
-            }
+            named.model.require_raw_xyz(&named.name)?;
             let chart = named.model.header().chart.clone();
             let index = self
                 .prepared
