@@ -24,6 +24,7 @@ use spdcam_core::photo::scene::{self, SceneLight};
 use spdcam_core::photo::ChartTemplate;
 use spdcam_core::seed;
 use spdcam_core::spectral::Spd;
+use spdcam_infer::estimator::raw_row;
 use spdcam_infer::trust::{self, Perturbed};
 use spdcam_infer::{Estimate, Estimator, Model, ModelSet, NamedModel, PhotoOptions};
 use std::path::PathBuf;
@@ -220,14 +221,7 @@ fn judge_raw(
         .raw
         .as_ref()
         .ok_or_else(|| EvalError::invalid("a raw photo's estimate without its raw reading"))?;
-    let mut xyz = Vec::with_capacity(3 * feature_patches.len());
-    for &p in feature_patches {
-        let patch = reading
-            .patch_xyz
-            .get(p)
-            .ok_or_else(|| EvalError::invalid(format!("the raw reading holds no patch {p}")))?;
-        xyz.extend(patch.map(f64::from));
-    }
+    let xyz = raw_row(reading, feature_patches, &analysis.source)?;
     let perturbed = Perturbed::of(raw, &xyz)?;
     let spd = spdcam_core::spectral::normalise_by_max(estimate.spd.values());
     let self_check = estimate.trust.as_ref().and_then(|t| t.self_check.clone());

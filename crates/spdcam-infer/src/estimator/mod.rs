@@ -779,8 +779,8 @@ impl ModelSpds {
 
 /// A raw photo's feature row for a raw model: the XYZ of each of `feature_patches` (the
 /// chart's patches the model reads, in its order) through the file's matrices, white
-/// Y = 100 ([`RawReading::patch_xyz`]).
-fn raw_row(reading: &RawReading, feature_patches: &[usize], source: &str) -> Result<Vec<f64>> {
+/// Y = 100 ([`RawReading::patch_xyz`]); `source` names the photo in an error.
+pub fn raw_row(reading: &RawReading, feature_patches: &[usize], source: &str) -> Result<Vec<f64>> {
     let mut row = Vec::with_capacity(3 * feature_patches.len());
     for &p in feature_patches {
         let xyz = reading.patch_xyz.get(p).ok_or_else(|| {
