@@ -456,6 +456,7 @@ impl Estimator {
             return Ok(ModelSpds {
                 told: spds,
                 own: None,
+                raw_row: None,
             });
         }
         let priors = self.priors()?[index]
@@ -471,6 +472,7 @@ impl Estimator {
         Ok(ModelSpds {
             told: moved.concat(),
             own: Some(spds),
+            raw_row: None,
         })
     }
 
@@ -549,6 +551,7 @@ impl Estimator {
             features.rows > 1,
         )?;
         let raw_model = self.raw_models.get(index).and_then(Option::as_ref);
+        let mut raw_row_read = None;
         let mut spds = match (raw, raw_model) {
             (Some((_, None)), Some(raw_model)) => {
                 return Err(InferError::invalid(format!(
@@ -560,7 +563,9 @@ impl Estimator {
                 // The raw model reads the patches' XYZ through the file's matrices.
                 let row = raw_row(reading, feature_patches, source)?;
                 model = &raw_model.named.model;
-                model.estimate_rows(&row)?
+                let spds = model.estimate_rows(&row)?;
+                raw_row_read = Some(row);
+                spds
             }
             _ => model.estimate_rows(&features.values)?,
         };
@@ -571,14 +576,17 @@ impl Estimator {
             let xy = RawColourCorrection::shipped()?.correct(reading.light_xy, &own)?;
             measured_colour::conform(model, &mut spds, xy);
         }
-        self.told_of_light(index, spds)
+        let mut spds = self.told_of_light(index, spds)?;
+        spds.raw_row = raw_row_read;
+        Ok(spds)
     }
 
     /// THE constructor of every estimate: the model's SPD `model_spd` (on its grid, peak 1)
     /// for `row`, judged (the self-check, the perturbed spread, the calibration; `flags`
     /// what a photo analysis found), and everything read from it on the output grid.
     /// `own` is the model's output before a kind of light moved it (`model_spd` itself
-    /// when none was named), which the kind's check weighs.
+    /// when none was named), which the kind's check weighs. `raw_row`: the raw patches' XYZ
+    /// a raw model read the spectrum from ([`ModelSpds::raw_row`]), which it is judged by.
     #[allow(clippy::too_many_arguments)]
     fn judged(
         &self,
@@ -587,6 +595,7 @@ impl Estimator {
         model_spd: Vec<f64>,
         own: &[f64],
         row: &[f64],
+        raw_row: Option<&[f64]>,
         flags: &PhotoFlags,
         photo: Option<PhotoAnalysis>,
     ) -> Result<Estimate> {
@@ -595,26 +604,6 @@ impl Estimator {
         let judge = &self.prepared.trust[index];
         let mut photo = photo;
         let raw_reader = self.raw_models.get(index).and_then(Option::as_ref);
-        let raw_row = match (&photo, raw_reader) {
-            (Some(analysis), Some(reader)) => match &analysis.raw {
-                Some(reading) => {
-                    let feature_patches = chosen
-                        .model
-                        .photo_chart()
-                        .filter(|t| t.name == analysis.chart)
-                        .map(|t| t.feature_patches.as_slice())
-                        .ok_or_else(|| {
-                            InferError::invalid(format!(
-                                "{}: {} cannot find its patches on this photo's chart",
-                                analysis.source, reader.named.name
-                            ))
-                        })?;
-                    Some(raw_row(reading, feature_patches, &analysis.source)?)
-                }
-                None => None,
-            },
-            _ => None,
-        };
         if let (Some(reading), Some(reader)) =
             (photo.as_mut().and_then(|a| a.raw.as_mut()), raw_reader)
         {
@@ -622,7 +611,7 @@ impl Estimator {
         }
         // A raw photo read by a raw model is judged by that model's calibration, its spread
         // from the raw patches; the photo's developed colours keep the chart's checks.
-        let mut trust = match (raw_reader, &raw_row) {
+        let mut trust = match (raw_reader, raw_row) {
             (Some(reader), Some(raw_row)) => trust::weigh_read_by(
                 ReadBy {
                     model: &reader.named.model,
@@ -768,6 +757,8 @@ struct ModelSpds {
     told: Vec<f64>,
     /// The model's own output, when a kind of light moved it to `told`.
     own: Option<Vec<f64>>,
+    /// The raw patches' XYZ ([`raw_row`]), when a raw model read a raw photo's spectrum.
+    raw_row: Option<Vec<f64>>,
 }
 
 impl ModelSpds {

@@ -306,6 +306,7 @@ impl Estimator {
             model_spds.told,
             &own,
             &identified.rows.values,
+            model_spds.raw_row.as_deref(),
             &identified.flags,
             Some(analysis),
         )

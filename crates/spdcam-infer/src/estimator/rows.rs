@@ -124,6 +124,7 @@ impl Estimator {
                     spd.to_vec(),
                     own,
                     row,
+                    None,
                     &PhotoFlags::default(),
                     None,
                 )
@@ -231,6 +232,7 @@ fn estimate_block(
     let ModelSpds {
         told: model_spds,
         own,
+        ..
     } = estimator.told_of_light(
         index,
         estimator.named(index).model.estimate_rows(&block.values)?,
@@ -309,6 +311,7 @@ impl RowStream<'_> {
                     block.model_spds[k * d..(k + 1) * d].to_vec(),
                     &own[k * d..(k + 1) * d],
                     &block.features[k * width..(k + 1) * width],
+                    None,
                     &PhotoFlags::default(),
                     None,
                 )
